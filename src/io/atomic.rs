@@ -1,0 +1,49 @@
+//! Write-to-temporary-then-rename.
+
+use anyhow::{Context, Result};
+use std::fs::File;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A file being written under a temporary name beside its final path.
+pub struct Staged {
+    tmp: tempfile::NamedTempFile,
+    target: PathBuf,
+}
+
+impl Staged {
+    /// Starts a staged file for `target` (its folder must exist).
+    pub fn new(target: &Path) -> Result<Self> {
+        let dir = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let name = target.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let tmp = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".partial")
+            .tempfile_in(dir)
+            .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+        Ok(Self { tmp, target: target.to_path_buf() })
+    }
+    /// The temporary path (for writers that open files themselves).
+    pub fn path(&self) -> &Path {
+        self.tmp.path()
+    }
+    /// The open temporary file.
+    pub fn file(&mut self) -> &mut File {
+        self.tmp.as_file_mut()
+    }
+    /// Flushes to disk and renames to the final path.
+    pub fn commit(self) -> Result<PathBuf> {
+        self.tmp.as_file().sync_all().ok();
+        let target = self.target.clone();
+        self.tmp.persist(&target).with_context(|| format!("cannot rename into {}", target.display()))?;
+        Ok(target)
+    }
+}
+
+/// Writes `path` atomically with the bytes `write` produces.
+pub fn write_atomic(path: &Path, write: impl FnOnce(&mut File) -> Result<()>) -> Result<PathBuf> {
+    let mut staged = Staged::new(path)?;
+    write(staged.file())?;
+    staged.file().flush()?;
+    staged.commit()
+}

@@ -1,0 +1,12 @@
+//! Outputs: every file is written to a temporary name in its folder and renamed when complete, so a
+//! killed run never leaves an artifact that looks finished.
+
+mod atomic;
+mod particles;
+mod rrd;
+mod timeline;
+
+pub use atomic::{Staged, write_atomic};
+pub use particles::{read_particles, write_particles};
+pub use rrd::RerunRecorder;
+pub use timeline::TimelineRecorder;

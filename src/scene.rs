@@ -1,0 +1,342 @@
+//! Scenes as TOML: the cloth, its material, the boundary, gravity, the solver and what to record.
+//!
+//! A scene file is read once into a [`Scene`] (unknown keys refused), `--set KEY=VALUE` overrides
+//! are applied by dotted path before that, and [`Scene::validate`] checks every value's range.
+//! Every error is an [`InputError`] naming the file and the key.
+
+use crate::cloth::{Corner, Edge, Spacing};
+use crate::error::InputError;
+use crate::material::Material;
+use crate::solve::{DynamicOptions, Integrator, StaticOptions};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The sheet: size, resolution, spacing and areal density.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClothSpec {
+    /// Side along x in m.
+    pub size_x_m: f64,
+    /// Side along y in m.
+    pub size_y_m: f64,
+    /// Particles along x (≥ 2).
+    pub nx: usize,
+    /// Particles along y (≥ 2).
+    pub ny: usize,
+    /// "uniform" (default) or "graded" (finer towards the edges).
+    #[serde(default)]
+    pub spacing: Spacing,
+    /// For graded spacing: 0 = uniform .. <1 = strongly graded. Default 0.5.
+    #[serde(default = "default_grading")]
+    pub grading: f64,
+    /// Areal density (mass per area) in kg/m² (45 g/m² = 0.045).
+    pub areal_density_kg_per_m2: f64,
+    /// Amplitude of an out-of-plane initial perturbation z = a·sin(πx/Lx)·sin(πy/Ly)·(y/Ly) in m,
+    /// used to break the mirror symmetry of a hang. Default 0.
+    #[serde(default)]
+    pub initial_perturbation_m: f64,
+}
+
+fn default_grading() -> f64 {
+    0.5
+}
+
+/// Boundary conditions.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// Corners pinned where they lie: "xmin_ymin", "xmax_ymin", "xmin_ymax", "xmax_ymax".
+    #[serde(default)]
+    pub pin_corners: Vec<Corner>,
+    /// Particles pinned where they lie, by grid indices [i, j].
+    #[serde(default)]
+    pub pin_particles: Vec<[usize; 2]>,
+    /// Edges clamped (position and slope fixed): "xmin", "xmax", "ymin", "ymax".
+    #[serde(default)]
+    pub clamp_edges: Vec<Edge>,
+}
+
+/// Gravity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySpec {
+    /// Gravitational acceleration in m/s², acting along −z. Default 9.80665.
+    #[serde(default = "default_g")]
+    pub g_m_per_s2: f64,
+}
+
+fn default_g() -> f64 {
+    crate::STANDARD_GRAVITY_M_PER_S2
+}
+
+impl Default for GravitySpec {
+    fn default() -> Self {
+        Self { g_m_per_s2: default_g() }
+    }
+}
+
+/// Which solver runs the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolverKind {
+    /// Newton on the total potential energy with line search.
+    #[default]
+    Static,
+    /// Explicit Euler with Provot's correction (seed 000).
+    ExplicitEuler,
+    /// Symplectic Euler.
+    SymplecticEuler,
+    /// Implicit Euler (Baraff–Witkin).
+    ImplicitEuler,
+}
+
+impl SolverKind {
+    /// The dynamic integrator, if this is one.
+    pub fn integrator(self) -> Option<Integrator> {
+        match self {
+            SolverKind::Static => None,
+            SolverKind::ExplicitEuler => Some(Integrator::ExplicitEuler),
+            SolverKind::SymplecticEuler => Some(Integrator::SymplecticEuler),
+            SolverKind::ImplicitEuler => Some(Integrator::ImplicitEuler),
+        }
+    }
+}
+
+/// The solver and its tolerances.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// "static" (default), "explicit-euler", "symplectic-euler" or "implicit-euler".
+    #[serde(default)]
+    pub kind: SolverKind,
+    /// Options of the static solver.
+    #[serde(default, rename = "static")]
+    pub static_: StaticOptions,
+    /// Options of the dynamic solvers.
+    #[serde(default)]
+    pub dynamic: DynamicOptions,
+}
+
+/// What to record besides `particles.parquet` and `run.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordSpec {
+    /// Write `timeline.mcap` (Foxglove SceneUpdate in JSON). Default false.
+    #[serde(default)]
+    pub timeline: bool,
+    /// Write `drape.rrd` (rerun). Default false.
+    #[serde(default)]
+    pub rerun: bool,
+    /// Record every k-th Newton iteration or time step (the final state is always recorded). Default 1.
+    #[serde(default = "default_every")]
+    pub every: usize,
+}
+
+fn default_every() -> usize {
+    1
+}
+
+impl Default for RecordSpec {
+    fn default() -> Self {
+        Self { timeline: false, rerun: false, every: 1 }
+    }
+}
+
+/// A complete scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// A short name.
+    pub name: String,
+    /// What the scene is, in words.
+    #[serde(default)]
+    pub description: String,
+    /// The sheet.
+    pub cloth: ClothSpec,
+    /// The fabric model.
+    pub material: Material,
+    /// Pins and clamps.
+    #[serde(default)]
+    pub boundary: BoundarySpec,
+    /// Gravity.
+    #[serde(default)]
+    pub gravity: GravitySpec,
+    /// Solver.
+    #[serde(default)]
+    pub solver: SolverSpec,
+    /// Recording.
+    #[serde(default)]
+    pub record: RecordSpec,
+}
+
+/// A scene with the file it came from.
+#[derive(Debug, Clone)]
+pub struct LoadedScene {
+    /// The validated scene.
+    pub scene: Scene,
+    /// The file it was read from.
+    pub path: PathBuf,
+}
+
+/// Parses `KEY=VALUE`; VALUE is read as TOML (number, bool, array, quoted string), else as a bare string.
+pub fn parse_override(s: &str) -> Result<(String, toml::Value), InputError> {
+    let Some((k, v)) = s.split_once('=') else {
+        return Err(InputError::new("--set", s, "expected KEY=VALUE, e.g. --set cloth.nx=41"));
+    };
+    let k = k.trim().to_string();
+    let v = v.trim();
+    let value = match toml::from_str::<toml::Table>(&format!("v = {v}")) {
+        Ok(mut t) => t.remove("v").unwrap_or_else(|| toml::Value::String(v.into())),
+        Err(_) => toml::Value::String(v.into()),
+    };
+    Ok((k, value))
+}
+
+/// Sets `key` (dotted path) in `table`, creating tables on the way.
+pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    let parts: Vec<&str> = key.split('.').collect();
+    let mut t = table;
+    for part in &parts[..parts.len() - 1] {
+        let entry = t.entry(part.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        t = entry.as_table_mut().ok_or_else(|| format!("`{part}` is not a table"))?;
+    }
+    t.insert(parts[parts.len() - 1].to_string(), value);
+    Ok(())
+}
+
+/// Reads a TOML file into a table, with the file named in errors.
+pub fn read_toml_table(path: &Path) -> Result<toml::Table, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
+    text.parse::<toml::Table>().map_err(|e| {
+        let msg = e.message().to_string();
+        let line = e.span().map(|s| text[..s.start].lines().count().max(1));
+        let at = line.map(|l| format!(" (line {l})")).unwrap_or_default();
+        InputError::new(path, "", format!("malformed TOML{at}: {msg}"))
+    })
+}
+
+/// Deserializes a table into `T`, naming the dotted key of the first error.
+pub fn from_table<T: serde::de::DeserializeOwned>(path: &Path, prefix: &str, table: toml::Table) -> Result<T, InputError> {
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let key = e.path().to_string();
+        let key = if key == "." { prefix.trim_end_matches('.').to_string() } else { format!("{prefix}{key}") };
+        let inner = e.into_inner().to_string();
+        InputError::new(path, key, inner.lines().next().unwrap_or("invalid value").to_string())
+    })
+}
+
+impl Scene {
+    /// Reads, overrides and validates a scene file.
+    pub fn load(path: &Path, overrides: &[(String, toml::Value)]) -> Result<LoadedScene, InputError> {
+        let mut table = read_toml_table(path)?;
+        for (k, v) in overrides {
+            set_dotted(&mut table, k, v.clone()).map_err(|m| InputError::new(path, k, m))?;
+        }
+        let scene: Scene = from_table(path, "", table)?;
+        scene.validate(path)?;
+        Ok(LoadedScene { scene, path: path.to_path_buf() })
+    }
+
+    /// Checks every value's range; the error names the key.
+    pub fn validate(&self, path: &Path) -> Result<(), InputError> {
+        let err = |k: &str, m: String| Err(InputError::new(path, k, m));
+        let pos = |k: &str, v: f64| -> Result<(), InputError> {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(InputError::new(path, k, format!("must be a finite number > 0, got {v}")));
+            }
+            Ok(())
+        };
+        let nonneg = |k: &str, v: f64| -> Result<(), InputError> {
+            if !v.is_finite() || v < 0.0 {
+                return Err(InputError::new(path, k, format!("must be a finite number ≥ 0, got {v}")));
+            }
+            Ok(())
+        };
+        let c = &self.cloth;
+        pos("cloth.size_x_m", c.size_x_m)?;
+        pos("cloth.size_y_m", c.size_y_m)?;
+        pos("cloth.areal_density_kg_per_m2", c.areal_density_kg_per_m2)?;
+        if !c.initial_perturbation_m.is_finite() {
+            return err("cloth.initial_perturbation_m", "must be finite".into());
+        }
+        if c.nx < 2 || c.nx > 2049 {
+            return err("cloth.nx", format!("must be in 2..=2049, got {}", c.nx));
+        }
+        if c.ny < 2 || c.ny > 2049 {
+            return err("cloth.ny", format!("must be in 2..=2049, got {}", c.ny));
+        }
+        if !(0.0..1.0).contains(&c.grading) {
+            return err("cloth.grading", format!("must be in [0, 1), got {}", c.grading));
+        }
+        match (&self.material.mass_spring, &self.material.continuum) {
+            (Some(_), Some(_)) => return err("material", "give either [material.mass_spring] or [material.continuum], not both".into()),
+            (None, None) => return err("material", "missing: add [material.mass_spring] or [material.continuum]".into()),
+            (Some(ms), None) => {
+                pos("material.mass_spring.stiffness_N_per_m", ms.stiffness_N_per_m)?;
+                for (k, v) in [
+                    ("structural_stiffness_N_per_m", ms.structural_stiffness_N_per_m),
+                    ("shear_stiffness_N_per_m", ms.shear_stiffness_N_per_m),
+                    ("bend_stiffness_N_per_m", ms.bend_stiffness_N_per_m),
+                    ("natural_length_m", ms.natural_length_m),
+                ] {
+                    if let Some(v) = v {
+                        pos(&format!("material.mass_spring.{k}"), v)?;
+                    }
+                }
+                nonneg("material.mass_spring.damping_Ns_per_m", ms.damping_Ns_per_m)?;
+                pos("material.mass_spring.elongation_rate", ms.elongation_rate)?;
+                if ms.natural_length_m.is_some() && c.spacing != Spacing::Uniform {
+                    return err("material.mass_spring.natural_length_m", "needs cloth.spacing = \"uniform\"".into());
+                }
+            }
+            (None, Some(cont)) => {
+                let r = cont.rigidities().map_err(|(k, m)| InputError::new(path, format!("material.continuum.{k}"), m))?;
+                for (k, v) in [
+                    ("tensile_warp", r.tensile_warp_N_per_m),
+                    ("tensile_weft", r.tensile_weft_N_per_m),
+                    ("bending_warp", r.bending_warp_N_m),
+                    ("bending_weft", r.bending_weft_N_m),
+                ] {
+                    pos(&format!("material.continuum.{k}"), v)?;
+                }
+                nonneg("material.continuum.shear", r.shear_N_per_m)?;
+            }
+        }
+        for (n, p) in self.boundary.pin_particles.iter().enumerate() {
+            if p[0] >= c.nx || p[1] >= c.ny {
+                return err(
+                    &format!("boundary.pin_particles[{n}]"),
+                    format!("[{}, {}] lies outside the {}×{} grid (i < nx, j < ny)", p[0], p[1], c.nx, c.ny),
+                );
+            }
+        }
+        if !self.boundary.clamp_edges.is_empty() && (c.nx < 3 || c.ny < 3) {
+            return err("boundary.clamp_edges", "a clamp needs at least 3 particles along each side".into());
+        }
+        if self.boundary.pin_corners.is_empty() && self.boundary.pin_particles.is_empty() && self.boundary.clamp_edges.is_empty() {
+            return err("boundary", "nothing is pinned or clamped: the sheet would fall freely".into());
+        }
+        nonneg("gravity.g_m_per_s2", self.gravity.g_m_per_s2)?;
+        let s = &self.solver.static_;
+        pos("solver.static.residual_tol_rel", s.residual_tol_rel)?;
+        pos("solver.static.lm_damping_initial", s.lm_damping_initial)?;
+        pos("solver.static.strain_bound", s.strain_bound)?;
+        if s.max_iterations == 0 || s.load_steps == 0 {
+            return err("solver.static", "max_iterations and load_steps must be ≥ 1".into());
+        }
+        let d = &self.solver.dynamic;
+        pos("solver.dynamic.dt_s", d.dt_s)?;
+        pos("solver.dynamic.max_time_s", d.max_time_s)?;
+        pos("solver.dynamic.residual_tol_rel", d.residual_tol_rel)?;
+        pos("solver.dynamic.speed_tol_m_per_s", d.speed_tol_m_per_s)?;
+        pos("solver.dynamic.strain_bound", d.strain_bound)?;
+        pos("solver.dynamic.cg_tol_rel", d.cg_tol_rel)?;
+        if d.max_time_s / d.dt_s > 1e9 {
+            return err("solver.dynamic.max_time_s", "more than 1e9 steps: raise dt_s or lower max_time_s".into());
+        }
+        if self.record.every == 0 {
+            return err("record.every", "must be ≥ 1".into());
+        }
+        Ok(())
+    }
+}

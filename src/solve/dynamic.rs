@@ -1,0 +1,349 @@
+//! Dynamic integrators, all stopping at equilibrium (largest residual force and largest speed below
+//! tolerance) or at a maximum simulated time:
+//! - explicit (forward) Euler as in seed 000: x ← x + Δt v, v ← v + Δt F/m with the damping force
+//!   −c v (Eq. 4), then Provot's position correction of springs stretched beyond the elongation rate;
+//! - symplectic (semi-implicit) Euler: v ← v + Δt F/m, x ← x + Δt v;
+//! - implicit Euler after Baraff & Witkin (1998): (M + Δt c + Δt² K) Δv = Δt (f − Δt K v), solved by
+//!   conjugate gradients with a block-Jacobi preconditioner.
+
+use super::linear::DofMap;
+use super::{Divergence, Observer, SolveReport, StateEvent, Status};
+use crate::physics::{HessianBlocks, Model};
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// A time integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Hash)]
+#[serde(rename_all = "kebab-case")]
+pub enum Integrator {
+    /// Forward Euler with Provot's correction (seed 000).
+    ExplicitEuler,
+    /// Semi-implicit (symplectic) Euler.
+    SymplecticEuler,
+    /// Implicit Euler (Baraff–Witkin, conjugate gradients).
+    ImplicitEuler,
+}
+
+impl Integrator {
+    /// The name written into outputs.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Integrator::ExplicitEuler => "explicit-euler",
+            Integrator::SymplecticEuler => "symplectic-euler",
+            Integrator::ImplicitEuler => "implicit-euler",
+        }
+    }
+}
+
+/// Options of the dynamic solvers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicOptions {
+    /// Time step in s. Default 1e-4.
+    #[serde(default = "default_dt")]
+    pub dt_s: f64,
+    /// Simulated time after which the solve stops with status max-iterations, in s. Default 60.
+    #[serde(default = "default_max_time")]
+    pub max_time_s: f64,
+    /// Equilibrium when the largest residual force is below this fraction of the lightest particle's
+    /// weight ... Default 1e-6.
+    #[serde(default = "default_tol")]
+    pub residual_tol_rel: f64,
+    /// ... and the largest speed is below this, in m/s. Default 1e-6.
+    #[serde(default = "default_vtol")]
+    pub speed_tol_m_per_s: f64,
+    /// Steps between equilibrium and divergence checks. Default 10.
+    #[serde(default = "default_check")]
+    pub check_every: usize,
+    /// A strain beyond which the solve is reported as diverged. Default 10.
+    #[serde(default = "default_strain")]
+    pub strain_bound: f64,
+    /// Relative tolerance of the conjugate-gradient solves (implicit Euler). Default 1e-10.
+    #[serde(default = "default_cg")]
+    pub cg_tol_rel: f64,
+    /// Whether damping applies (false: conservative dynamics, e.g. for energy checks). Default true.
+    #[serde(default = "default_true")]
+    pub damping: bool,
+}
+
+fn default_dt() -> f64 {
+    1e-4
+}
+fn default_max_time() -> f64 {
+    60.0
+}
+fn default_tol() -> f64 {
+    1e-6
+}
+fn default_vtol() -> f64 {
+    1e-6
+}
+fn default_check() -> usize {
+    10
+}
+fn default_strain() -> f64 {
+    10.0
+}
+fn default_cg() -> f64 {
+    1e-10
+}
+fn default_true() -> bool {
+    true
+}
+
+impl Default for DynamicOptions {
+    fn default() -> Self {
+        Self {
+            dt_s: default_dt(),
+            max_time_s: default_max_time(),
+            residual_tol_rel: default_tol(),
+            speed_tol_m_per_s: default_vtol(),
+            check_every: default_check(),
+            strain_bound: default_strain(),
+            cg_tol_rel: default_cg(),
+            damping: true,
+        }
+    }
+}
+
+/// Kinetic energy in J.
+pub fn kinetic_energy(model: &Model, v: &[Vector3<f64>]) -> f64 {
+    model.masses.iter().zip(v).map(|(m, vi)| 0.5 * m * vi.norm_squared()).sum()
+}
+
+/// Integrates from rest at `x` (updated in place) until equilibrium, divergence or the time limit.
+/// `v` holds the velocities (in: initial, out: final).
+pub fn solve_dynamic(
+    model: &Model,
+    integrator: Integrator,
+    x: &mut [Vector3<f64>],
+    v: &mut [Vector3<f64>],
+    opts: &DynamicOptions,
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let start = Instant::now();
+    let n = model.len();
+    let dt = opts.dt_s;
+    let c = if opts.damping { model.damping_Ns_per_m } else { 0.0 };
+    let free: Vec<bool> = model.fixed.iter().map(|f| !f).collect();
+    let w_ref = model.reference_weight();
+    let mut report = SolveReport {
+        solver: integrator.as_str().into(),
+        status: Status::MaxIterations,
+        iterations: 0,
+        linear_solves: 0,
+        inner_iterations: 0,
+        max_residual_N: f64::NAN,
+        max_residual_rel: f64::NAN,
+        energy_J: f64::NAN,
+        sim_time_s: Some(0.0),
+        wall_time_s: 0.0,
+        divergence: None,
+        message: String::new(),
+    };
+    if !free.iter().any(|&f| f) || !w_ref.is_finite() || !(dt > 0.0) {
+        report.status = Status::Invalid;
+        report.message = "nothing free to integrate, or a non-positive time step".into();
+        return report;
+    }
+    let total_weight: f64 = model.masses.iter().sum::<f64>() * model.gravity_m_per_s2.max(1.0);
+    let extent = {
+        let (lo, hi) = x.iter().fold((Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.inf(p), hi.sup(p))
+        });
+        (hi - lo).norm().max(1e-3)
+    };
+    let e0 = model.energy(x, 1.0) + kinetic_energy(model, v);
+    let blowup = 100.0 * total_weight * extent + 100.0 * e0.abs();
+    let max_steps = (opts.max_time_s / dt).ceil() as usize;
+    let inv_m: Vec<f64> = model.masses.iter().zip(&free).map(|(m, f)| if *f && *m > 0.0 { 1.0 / m } else { 0.0 }).collect();
+    for (vi, f) in v.iter_mut().zip(&free) {
+        if !f {
+            *vi = Vector3::zeros();
+        }
+    }
+    let mut g = Vec::with_capacity(n);
+    let mut implicit = ImplicitState::new(model);
+    let check = opts.check_every.max(1);
+    let mut step = 0usize;
+    loop {
+        let want = observer.wants(step);
+        if step % check == 0 || want || step == max_steps {
+            model.gradient(x, 1.0, &mut g);
+            let r = model.max_residual(&g);
+            let vmax = v.iter().map(|vi| vi.norm()).fold(0.0, f64::max);
+            let epot = model.energy(x, 1.0);
+            let etot = epot + kinetic_energy(model, v);
+            let time = step as f64 * dt;
+            if want {
+                observer.observe(&StateEvent { index: step, time_s: Some(time), x, max_residual_N: r, energy_J: etot });
+            }
+            let reason = if !etot.is_finite() || !r.is_finite() {
+                Some("non-finite".to_string())
+            } else if etot - e0 > blowup {
+                Some(format!("energy blow-up: {etot:.3e} J from {e0:.3e} J"))
+            } else {
+                let s = model.max_strain(x);
+                (s > opts.strain_bound).then(|| format!("strain {s:.3e} beyond bound {}", opts.strain_bound))
+            };
+            if let Some(reason) = reason {
+                report.status = Status::Diverged;
+                report.divergence = Some(Divergence { step, dt_s: Some(dt), reason: reason.clone() });
+                report.message = format!("diverged at step {step} (dt = {dt:e} s): {reason}");
+                break;
+            }
+            if r <= opts.residual_tol_rel * w_ref && vmax <= opts.speed_tol_m_per_s {
+                report.status = Status::Converged;
+                report.message = format!("equilibrium at t = {time:.4} s after {step} steps");
+                break;
+            }
+            if step >= max_steps {
+                report.message = format!("no equilibrium within {} s (residual {r:.3e} N, speed {vmax:.3e} m/s)", opts.max_time_s);
+                break;
+            }
+        } else {
+            model.gradient(x, 1.0, &mut g);
+        }
+        match integrator {
+            Integrator::ExplicitEuler => {
+                for p in 0..n {
+                    if free[p] {
+                        let a = (-g[p] - v[p] * c) * inv_m[p];
+                        x[p] += v[p] * dt;
+                        v[p] += a * dt;
+                    }
+                }
+                if let Some(rate) = model.elongation_rate {
+                    for t in &model.terms {
+                        t.provot_correct(x, &free, rate);
+                    }
+                }
+            }
+            Integrator::SymplecticEuler => {
+                for p in 0..n {
+                    if free[p] {
+                        v[p] += (-g[p] - v[p] * c) * (inv_m[p] * dt);
+                        x[p] += v[p] * dt;
+                    }
+                }
+            }
+            Integrator::ImplicitEuler => {
+                let iters = implicit.step(model, x, v, &g, c, dt, opts.cg_tol_rel);
+                report.linear_solves += 1;
+                report.inner_iterations += iters;
+            }
+        }
+        step += 1;
+    }
+    model.gradient(x, 1.0, &mut g);
+    report.iterations = step;
+    report.sim_time_s = Some(step as f64 * dt);
+    report.max_residual_N = model.max_residual(&g);
+    report.max_residual_rel = report.max_residual_N / w_ref;
+    report.energy_J = model.energy(x, 1.0);
+    report.wall_time_s = start.elapsed().as_secs_f64();
+    report
+}
+
+/// Work arrays of implicit Euler.
+struct ImplicitState {
+    dofs: DofMap,
+    h: HessianBlocks,
+    r: Vec<Vector3<f64>>,
+    z: Vec<Vector3<f64>>,
+    p: Vec<Vector3<f64>>,
+    ap: Vec<Vector3<f64>>,
+    dv: Vec<Vector3<f64>>,
+    precond: Vec<Matrix3<f64>>,
+}
+
+impl ImplicitState {
+    fn new(model: &Model) -> Self {
+        let n = model.len();
+        let z = vec![Vector3::zeros(); n];
+        Self {
+            dofs: DofMap::new(&model.fixed),
+            h: HessianBlocks::default(),
+            r: z.clone(),
+            z: z.clone(),
+            p: z.clone(),
+            ap: z.clone(),
+            dv: z,
+            precond: Vec::new(),
+        }
+    }
+
+    /// A x for A = M + Δt c I + Δt² K on free particles (fixed rows and columns are zero).
+    fn apply(&self, model: &Model, c: f64, dt: f64, x: &[Vector3<f64>], out: &mut [Vector3<f64>]) {
+        out.iter_mut().for_each(|o| *o = Vector3::zeros());
+        self.h.mul_add(x, out);
+        for (p, o) in out.iter_mut().enumerate() {
+            if self.dofs.dof(p).is_some() {
+                *o = *o * (dt * dt) + x[p] * (model.masses[p] + dt * c);
+            } else {
+                *o = Vector3::zeros();
+            }
+        }
+    }
+
+    /// One Baraff–Witkin step; returns the CG iterations used.
+    #[allow(clippy::too_many_arguments)]
+    fn step(&mut self, model: &Model, x: &mut [Vector3<f64>], v: &mut [Vector3<f64>], g: &[Vector3<f64>], c: f64, dt: f64, tol: f64) -> usize {
+        let n = model.len();
+        model.hessian(x, &mut self.h);
+        // b = Δt (f − Δt K v), f = −∇E − c v
+        let mut kv = vec![Vector3::zeros(); n];
+        self.h.mul_add(v, &mut kv);
+        let masked = |p: usize, val: Vector3<f64>| if self.dofs.dof(p).is_some() { val } else { Vector3::zeros() };
+        let b: Vec<Vector3<f64>> = (0..n).map(|p| masked(p, (-g[p] - v[p] * c - kv[p] * dt) * dt)).collect();
+        let diag = self.h.diagonal(n);
+        self.precond = (0..n)
+            .map(|p| {
+                let a = diag[p] * (dt * dt) + Matrix3::identity() * (model.masses[p] + dt * c);
+                if self.dofs.dof(p).is_some() { a.try_inverse().unwrap_or_else(Matrix3::identity) } else { Matrix3::zeros() }
+            })
+            .collect();
+        // Preconditioned conjugate gradients from Δv = 0.
+        let dot = |a: &[Vector3<f64>], b: &[Vector3<f64>]| a.iter().zip(b).map(|(x, y)| x.dot(y)).sum::<f64>();
+        self.dv.iter_mut().for_each(|d| *d = Vector3::zeros());
+        self.r.copy_from_slice(&b);
+        for p in 0..n {
+            self.z[p] = self.precond[p] * self.r[p];
+        }
+        self.p.copy_from_slice(&self.z);
+        let b_norm = dot(&b, &b).sqrt();
+        let mut rz = dot(&self.r, &self.z);
+        let mut it = 0;
+        while it < 10 * n.max(10) && dot(&self.r, &self.r).sqrt() > tol * b_norm && b_norm > 0.0 {
+            let mut ap = std::mem::take(&mut self.ap);
+            self.apply(model, c, dt, &self.p, &mut ap);
+            let pap = dot(&self.p, &ap);
+            if !(pap > 0.0) {
+                self.ap = ap;
+                break;
+            }
+            let alpha = rz / pap;
+            for p in 0..n {
+                self.dv[p] += self.p[p] * alpha;
+                self.r[p] -= ap[p] * alpha;
+                self.z[p] = self.precond[p] * self.r[p];
+            }
+            self.ap = ap;
+            let rz_new = dot(&self.r, &self.z);
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for p in 0..n {
+                self.p[p] = self.z[p] + self.p[p] * beta;
+            }
+            it += 1;
+        }
+        for p in 0..n {
+            if self.dofs.dof(p).is_some() {
+                v[p] += self.dv[p];
+                x[p] += v[p] * dt;
+            }
+        }
+        it
+    }
+}

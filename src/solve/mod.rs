@@ -1,0 +1,64 @@
+//! Solvers on a [`Model`](crate::physics::Model): static Newton with line search, and the dynamic
+//! integrators (explicit Euler with Provot's correction, symplectic Euler, implicit Euler).
+//! Every solve returns a [`SolveReport`] with a [`Status`]; solvers never print and never panic on
+//! bad numerics. Observers ([`Observer`]) receive states and do the I/O.
+
+mod dynamic;
+mod linear;
+mod newton;
+mod report;
+
+pub use dynamic::{DynamicOptions, Integrator, solve_dynamic};
+pub use linear::{DofMap, SparseSpd};
+pub use newton::{StaticOptions, solve_static};
+pub use report::{Divergence, SolveReport, Status};
+
+use nalgebra::Vector3;
+
+/// A state handed to observers: an iteration of Newton or a time step of a dynamic solve.
+pub struct StateEvent<'a> {
+    /// Newton iteration or time-step index.
+    pub index: usize,
+    /// Simulated time in s (dynamic solves only).
+    pub time_s: Option<f64>,
+    /// Positions of all particles in m.
+    pub x: &'a [Vector3<f64>],
+    /// Largest residual force on a free particle in N.
+    pub max_residual_N: f64,
+    /// Total energy (potential, plus kinetic in dynamics) in J.
+    pub energy_J: f64,
+}
+
+/// Receives states during a solve (argmin's observer pattern): recorders, progress bars.
+pub trait Observer {
+    /// Whether the observer wants the state at this index (so solvers skip the work of building it).
+    fn wants(&self, index: usize) -> bool;
+    /// Called with a state the observer wanted.
+    fn observe(&mut self, event: &StateEvent<'_>);
+}
+
+/// An observer that wants nothing.
+pub struct NoObserver;
+
+impl Observer for NoObserver {
+    fn wants(&self, _index: usize) -> bool {
+        false
+    }
+    fn observe(&mut self, _event: &StateEvent<'_>) {}
+}
+
+/// Fans one state out to several observers.
+pub struct Observers<'a>(pub Vec<&'a mut dyn Observer>);
+
+impl Observer for Observers<'_> {
+    fn wants(&self, index: usize) -> bool {
+        self.0.iter().any(|o| o.wants(index))
+    }
+    fn observe(&mut self, event: &StateEvent<'_>) {
+        for o in self.0.iter_mut() {
+            if o.wants(event.index) {
+                o.observe(event);
+            }
+        }
+    }
+}

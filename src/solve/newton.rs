@@ -1,0 +1,222 @@
+//! Static equilibrium: Newton's method on the total potential energy with Levenberg–Marquardt
+//! damping and a backtracking (Armijo) line search, as seed 003 §10.2 recommends; optionally with
+//! incremental loading (the external loads raised in `load_steps` equal steps, §10.3.3).
+//!
+//! A flat net has no transverse stiffness at the start, so its Hessian is singular: the damping
+//! `μ` (added on the diagonal, scaled by the mean diagonal) keeps every system positive definite,
+//! grows when a factorization or line search fails and shrinks after each accepted step, so the
+//! last iterations are plain Newton with quadratic convergence.
+
+use super::linear::{DofMap, SparseSpd, solve_in_place};
+use super::{Divergence, Observer, SolveReport, StateEvent, Status};
+use crate::physics::{HessianBlocks, Model};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// Options of the static solver.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticOptions {
+    /// Convergence when the largest residual force on a free particle is below this fraction of the
+    /// lightest free particle's weight. Default 1e-9.
+    #[serde(default = "default_tol")]
+    pub residual_tol_rel: f64,
+    /// Newton iterations allowed over all load steps. Default 500.
+    #[serde(default = "default_max_iter")]
+    pub max_iterations: usize,
+    /// Number of equal load increments (1 = full load at once). Default 1.
+    #[serde(default = "default_steps")]
+    pub load_steps: usize,
+    /// Initial Levenberg–Marquardt damping relative to the mean Hessian diagonal. Default 1e-3.
+    #[serde(default = "default_lm")]
+    pub lm_damping_initial: f64,
+    /// A strain (relative elongation) beyond which the solve is reported as diverged. Default 10.
+    #[serde(default = "default_strain")]
+    pub strain_bound: f64,
+}
+
+fn default_tol() -> f64 {
+    1e-9
+}
+fn default_max_iter() -> usize {
+    500
+}
+fn default_steps() -> usize {
+    1
+}
+fn default_lm() -> f64 {
+    1e-3
+}
+fn default_strain() -> f64 {
+    10.0
+}
+
+impl Default for StaticOptions {
+    fn default() -> Self {
+        Self {
+            residual_tol_rel: default_tol(),
+            max_iterations: default_max_iter(),
+            load_steps: default_steps(),
+            lm_damping_initial: default_lm(),
+            strain_bound: default_strain(),
+        }
+    }
+}
+
+fn free_max_residual(model: &Model, g: &[Vector3<f64>]) -> f64 {
+    model.max_residual(g)
+}
+
+/// Solves for the static equilibrium starting from `x` (updated in place).
+pub fn solve_static(model: &Model, x: &mut [Vector3<f64>], opts: &StaticOptions, observer: &mut dyn Observer) -> SolveReport {
+    let start = Instant::now();
+    let dofs = DofMap::new(&model.fixed);
+    let w_ref = model.reference_weight();
+    let tol = opts.residual_tol_rel * w_ref;
+    let mut report = SolveReport {
+        solver: "static-newton".into(),
+        status: Status::MaxIterations,
+        iterations: 0,
+        linear_solves: 0,
+        inner_iterations: 0,
+        max_residual_N: f64::NAN,
+        max_residual_rel: f64::NAN,
+        energy_J: f64::NAN,
+        sim_time_s: None,
+        wall_time_s: 0.0,
+        divergence: None,
+        message: String::new(),
+    };
+    if dofs.n == 0 || !w_ref.is_finite() {
+        report.status = Status::Invalid;
+        report.message = "no free particle with mass: nothing to solve".into();
+        return report;
+    }
+    let mut spd = SparseSpd::new();
+    let mut g = Vec::new();
+    let mut h = HessianBlocks::default();
+    let mut rhs = vec![0.0; dofs.n];
+    let mut trial = x.to_vec();
+    let mut shift = vec![0.0; dofs.n];
+    let steps = opts.load_steps.max(1);
+    let mut iter = 0usize;
+    let mut mu = opts.lm_damping_initial;
+    'load: for step in 1..=steps {
+        let load = step as f64 / steps as f64;
+        let mut e = model.energy(x, load);
+        loop {
+            model.gradient(x, load, &mut g);
+            let r = free_max_residual(model, &g);
+            if !r.is_finite() || !e.is_finite() {
+                report.status = Status::Diverged;
+                report.divergence = Some(Divergence { step: iter, dt_s: None, reason: "non-finite".into() });
+                break 'load;
+            }
+            if observer.wants(iter) {
+                observer.observe(&StateEvent { index: iter, time_s: None, x, max_residual_N: r, energy_J: e });
+            }
+            if r <= tol && step == steps {
+                report.status = Status::Converged;
+                break 'load;
+            }
+            if r <= tol.max(1e-6 * w_ref) && step < steps {
+                continue 'load;
+            }
+            if iter >= opts.max_iterations {
+                report.message = format!("{} Newton iterations without reaching the tolerance", opts.max_iterations);
+                break 'load;
+            }
+            iter += 1;
+            model.hessian(x, &mut h);
+            // Mean diagonal of H over free DOFs sets the scale of the damping.
+            let diag = h.diagonal(model.len());
+            let mut scale = 0.0;
+            let mut cnt = 0usize;
+            for (p, d) in diag.iter().enumerate() {
+                if dofs.dof(p).is_some() {
+                    scale += d.trace();
+                    cnt += 3;
+                }
+            }
+            let scale = if cnt > 0 && scale > 0.0 { scale / cnt as f64 } else { 1.0 };
+            let mut accepted = false;
+            for _attempt in 0..40 {
+                shift.iter_mut().for_each(|s| *s = mu * scale);
+                let Some(llt) = spd.factorize(&dofs, &h, &shift) else {
+                    mu = (mu * 10.0).max(1e-8);
+                    continue;
+                };
+                report.linear_solves += 1;
+                for (p, gp) in g.iter().enumerate() {
+                    if let Some(d) = dofs.dof(p) {
+                        rhs[d] = -gp.x;
+                        rhs[d + 1] = -gp.y;
+                        rhs[d + 2] = -gp.z;
+                    }
+                }
+                solve_in_place(&llt, &mut rhs);
+                // Backtracking line search on the energy (Armijo condition).
+                let slope: f64 = g
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(p, gp)| dofs.dof(p).map(|d| gp.x * rhs[d] + gp.y * rhs[d + 1] + gp.z * rhs[d + 2]))
+                    .sum();
+                let mut alpha = 1.0;
+                for _ in 0..12 {
+                    for (p, xp) in x.iter().enumerate() {
+                        trial[p] = match dofs.dof(p) {
+                            Some(d) => xp + Vector3::new(rhs[d], rhs[d + 1], rhs[d + 2]) * alpha,
+                            None => *xp,
+                        };
+                    }
+                    let et = model.energy(&trial, load);
+                    if et.is_finite() && et <= e + 1e-4 * alpha * slope {
+                        x.copy_from_slice(&trial);
+                        e = et;
+                        accepted = true;
+                        break;
+                    }
+                    alpha *= 0.5;
+                }
+                if accepted {
+                    if alpha == 1.0 {
+                        mu = if mu < 1e-12 { 0.0 } else { mu / 4.0 };
+                    }
+                    break;
+                }
+                // A step that does not decrease the energy: near the solution, round-off; otherwise damp more.
+                if r <= 10.0 * tol {
+                    break;
+                }
+                mu = (mu * 10.0).max(1e-8);
+            }
+            if !accepted {
+                model.gradient(x, load, &mut g);
+                let r = free_max_residual(model, &g);
+                if r <= tol && step == steps {
+                    report.status = Status::Converged;
+                } else {
+                    report.message = format!("line search failed at iteration {iter} with residual {r:.3e} N");
+                }
+                break 'load;
+            }
+            let strain = model.max_strain(x);
+            if strain > opts.strain_bound {
+                report.status = Status::Diverged;
+                report.divergence = Some(Divergence { step: iter, dt_s: None, reason: format!("strain {strain:.3e} beyond bound") });
+                break 'load;
+            }
+        }
+    }
+    model.gradient(x, 1.0, &mut g);
+    report.iterations = iter;
+    report.max_residual_N = free_max_residual(model, &g);
+    report.max_residual_rel = report.max_residual_N / w_ref;
+    report.energy_J = model.energy(x, 1.0);
+    report.wall_time_s = start.elapsed().as_secs_f64();
+    if report.status == Status::Converged {
+        report.message = format!("converged in {iter} iterations");
+    }
+    report
+}

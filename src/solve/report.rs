@@ -1,0 +1,76 @@
+//! The report every solve returns.
+
+use serde::{Deserialize, Serialize};
+
+/// How a solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Status {
+    /// The largest residual force (and, in dynamics, the largest speed) fell below tolerance.
+    Converged,
+    /// The iteration, step or time budget ran out first; the state is not an equilibrium.
+    MaxIterations,
+    /// NaN, an energy blow-up or a strain beyond bound; the state is not a result.
+    Diverged,
+    /// The problem could not be solved as posed (e.g. nothing is free, a singular system).
+    Invalid,
+}
+
+impl Status {
+    /// The name written into outputs.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Converged => "converged",
+            Status::MaxIterations => "max-iterations",
+            Status::Diverged => "diverged",
+            Status::Invalid => "invalid",
+        }
+    }
+}
+
+/// Where and why a solve diverged.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Divergence {
+    /// Step or iteration at which divergence was detected.
+    pub step: usize,
+    /// Time step in s (dynamics) at divergence.
+    pub dt_s: Option<f64>,
+    /// What was detected: "non-finite", "energy blow-up", "strain beyond bound".
+    pub reason: String,
+}
+
+/// The outcome of a solve.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SolveReport {
+    /// Solver name: "static-newton", "explicit-euler", "symplectic-euler", "implicit-euler".
+    pub solver: String,
+    /// How the solve ended.
+    pub status: Status,
+    /// Newton iterations or time steps taken.
+    pub iterations: usize,
+    /// Linear solves (Cholesky factorizations or CG solves).
+    pub linear_solves: usize,
+    /// Inner iterations of the linear solver (CG), 0 for direct solves.
+    pub inner_iterations: usize,
+    /// Largest residual force on a free particle in N, at the final state.
+    pub max_residual_N: f64,
+    /// The same relative to the weight of the lightest free particle.
+    pub max_residual_rel: f64,
+    /// Total potential energy at the final state in J.
+    pub energy_J: f64,
+    /// Simulated time in s (dynamics).
+    pub sim_time_s: Option<f64>,
+    /// Wall time of the solve in s.
+    pub wall_time_s: f64,
+    /// Set when status is diverged.
+    pub divergence: Option<Divergence>,
+    /// A human-readable note (why it stopped).
+    pub message: String,
+}
+
+impl SolveReport {
+    /// Whether the final state is an equilibrium that may be written as a result.
+    pub fn is_converged(&self) -> bool {
+        self.status == Status::Converged
+    }
+}

@@ -1,0 +1,116 @@
+//! Bad input at the command line: one line naming the file and the key, exit code 2, nothing
+//! written. A failure here means a user gets a panic, a vague message or a half-written folder.
+
+use crate::support::{drapelab, root};
+use std::path::Path;
+
+/// Runs `simulate` on a scene text (or a path) and returns (exit code, stderr, whether DIR has files).
+fn simulate_text(text: Option<&str>, extra: &[&str]) -> (i32, String, bool, std::path::PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tmp.path().join("scene.toml");
+    if let Some(t) = text {
+        std::fs::write(&scene, t).unwrap();
+    }
+    let out = tmp.path().join("out");
+    let o = drapelab().arg("simulate").arg(&scene).arg("--out").arg(&out).args(extra).output().unwrap();
+    let has_files = out.exists() && std::fs::read_dir(&out).unwrap().next().is_some();
+    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).to_string(), has_files, scene)
+}
+
+fn hang4() -> String {
+    std::fs::read_to_string(root().join("datasets/scenes/hang4.toml")).unwrap()
+}
+
+fn assert_bad(text: Option<&str>, extra: &[&str], key: &str) {
+    let (code, err, has_files, scene) = simulate_text(text, extra);
+    assert_eq!(code, 2, "exit code for {key}: stderr {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line expected: {err}");
+    assert!(lines[0].contains(&scene.display().to_string()) || lines[0].contains(Path::new(&scene).file_name().unwrap().to_str().unwrap()), "file not named: {err}");
+    assert!(lines[0].contains(key), "key `{key}` not named: {err}");
+    assert!(!has_files, "files left in DIR for {key}");
+}
+
+#[test]
+fn unknown_key_is_refused_with_its_path() {
+    let t = hang4().replace("stiffness_N_per_m = 1000.0", "stiffness_N_per_m = 1000.0\nstifness = 3");
+    assert_bad(Some(&t), &[], "material.mass_spring.stifness");
+}
+
+#[test]
+fn negative_stiffness_is_refused() {
+    let t = hang4().replace("stiffness_N_per_m = 1000.0", "stiffness_N_per_m = -5.0");
+    assert_bad(Some(&t), &[], "material.mass_spring.stiffness_N_per_m");
+}
+
+#[test]
+fn nan_is_refused() {
+    let t = hang4().replace("areal_density_kg_per_m2 = 0.045", "areal_density_kg_per_m2 = nan");
+    assert_bad(Some(&t), &[], "cloth.areal_density_kg_per_m2");
+    assert_bad(Some(&hang4()), &["--set", "solver.dynamic.dt_s=inf"], "solver.dynamic.dt_s");
+}
+
+#[test]
+fn pin_outside_the_grid_is_refused() {
+    let t = hang4().replace("[boundary]", "[boundary]\npin_particles = [[3, 11]]");
+    assert_bad(Some(&t), &[], "boundary.pin_particles[0]");
+}
+
+#[test]
+fn missing_file_and_malformed_toml_are_refused() {
+    let (code, err, has, _) = simulate_text(None, &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("scene.toml") && err.contains("cannot read"), "{err}");
+    assert!(!has);
+    let (code, err, _, _) = simulate_text(Some("name = \"x\"\n[cloth\nnx = 3"), &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("malformed TOML"), "{err}");
+}
+
+#[test]
+fn set_overrides_reach_the_solve_and_outputs_are_written() {
+    let (code, err, has, _) = simulate_text(Some(&hang4()), &["--set", "cloth.nx=7", "--set", "cloth.ny=5"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(has);
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let o = drapelab()
+        .arg("simulate")
+        .arg(root().join("datasets/scenes/hang4.toml"))
+        .arg("--out")
+        .arg(&out)
+        .args(["--set", "cloth.nx=7", "--set", "cloth.ny=5"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let rows = drapelab::io::read_particles(&out.join("particles.parquet")).unwrap();
+    assert_eq!(rows.len(), 35);
+    assert!(rows.iter().any(|r| r.0 == 6 && r.1 == 4));
+    let run: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(run["status"], "converged");
+    assert_eq!(run["scene"]["cloth"]["nx"], 7);
+    // No temporary files are left behind.
+    for e in std::fs::read_dir(&out).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().to_string();
+        assert!(!name.ends_with(".partial"), "{name}");
+    }
+}
+
+#[test]
+fn a_diverged_run_writes_its_status_and_no_particles() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let o = drapelab()
+        .arg("simulate")
+        .arg(root().join("datasets/scenes/hang4.toml"))
+        .arg("--out")
+        .arg(&out)
+        .args(["--set", "solver.kind=explicit-euler", "--set", "solver.dynamic.dt_s=2e-3", "--set", "solver.dynamic.max_time_s=5"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let run: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(run["status"], "diverged");
+    assert!(run["report"]["divergence"]["step"].as_u64().is_some());
+    assert!(!out.join("particles.parquet").exists());
+}

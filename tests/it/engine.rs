@@ -1,0 +1,187 @@
+//! Physics of the engine: force balance, symmetry, solver agreement, the exact elastica, energy
+//! behaviour of the integrators. A failure here means drapelab's equilibria are wrong.
+
+use crate::support::scene;
+use drapelab::cloth::build_scene;
+use drapelab::scene::Scene;
+use drapelab::simulate::{Solution, solve_scene};
+use drapelab::solve::{DynamicOptions, Integrator, NoObserver, Status, solve_dynamic};
+use nalgebra::Vector3;
+
+fn solve(s: &Scene) -> Solution {
+    let sol = solve_scene(s, &mut NoObserver);
+    assert_eq!(sol.report.status, Status::Converged, "{}: {:?}", s.name, sol.report);
+    sol
+}
+
+/// Largest force on a free particle recomputed from the model, over the lightest particle's weight.
+fn residual_over_weight(sol: &Solution) -> f64 {
+    let mut g = Vec::new();
+    sol.model.gradient(&sol.x, 1.0, &mut g);
+    sol.model.max_residual(&g) / sol.model.reference_weight()
+}
+
+#[test]
+fn hang4_and_hang2_static_solutions_balance_forces() {
+    for name in ["hang4.toml", "hang2.toml"] {
+        for n in ["11", "21"] {
+            let s = scene(name, &[&format!("cloth.nx={n}"), &format!("cloth.ny={n}")]);
+            let sol = solve(&s);
+            let r = residual_over_weight(&sol);
+            assert!(r < 1e-6, "{name} {n}: residual {r:e} of a particle's weight");
+            // And the sheet really sags: not the trivial flat state.
+            let zmin = sol.grid_positions().iter().map(|p| p.z).fold(0.0, f64::min);
+            assert!(zmin < -1e-3, "{name}: no sag ({zmin})");
+        }
+    }
+}
+
+#[test]
+fn hang4_keeps_the_symmetries_of_the_square() {
+    let s = scene("hang4.toml", &["cloth.nx=21", "cloth.ny=21"]);
+    let sol = solve(&s);
+    let n = 21;
+    let l = 0.5;
+    let mut worst: f64 = 0.0;
+    for j in 0..n {
+        for i in 0..n {
+            let p = sol.at(i, j);
+            // mirror x → L − x
+            let q = sol.at(n - 1 - i, j);
+            worst = worst.max((Vector3::new(l - q.x, q.y, q.z) - p).norm());
+            // mirror y → L − y
+            let q = sol.at(i, n - 1 - j);
+            worst = worst.max((Vector3::new(q.x, l - q.y, q.z) - p).norm());
+            // diagonal x ↔ y
+            let q = sol.at(j, i);
+            worst = worst.max((Vector3::new(q.y, q.x, q.z) - p).norm());
+        }
+    }
+    assert!(worst < 1e-9, "symmetry broken by {worst:e} m");
+}
+
+#[test]
+fn static_and_every_dynamic_integrator_agree_on_hang4() {
+    for n in [11usize, 21] {
+        let ns = [format!("cloth.nx={n}"), format!("cloth.ny={n}")];
+        let base = scene("hang4.toml", &[&ns[0], &ns[1]]);
+        let reference = solve(&base);
+        for kind in ["implicit-euler", "symplectic-euler", "explicit-euler"] {
+            let kind_set = format!("solver.kind=\"{kind}\"");
+            let dt = if kind == "implicit-euler" { "solver.dynamic.dt_s=0.01" } else { "solver.dynamic.dt_s=1e-4" };
+            let s = scene("hang4.toml", &[&ns[0], &ns[1], &kind_set, dt]);
+            let sol = solve(&s);
+            let d = sol
+                .grid_positions()
+                .iter()
+                .zip(reference.grid_positions())
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            assert!(d < 1e-4, "{kind} at {n}×{n} differs from static by {d:e} m");
+        }
+    }
+}
+
+/// The exact large-deflection elastica of a cantilever under self-weight, by shooting on
+/// D θ'' = −q (L − s) cos θ, θ(0) = 0, θ'(L) = 0 (θ below the horizontal). Returns the free end (x, z).
+fn elastica_tip(d: f64, q: f64, l: f64) -> (f64, f64) {
+    let steps = 20_000;
+    let h = l / steps as f64;
+    let shoot = |k0: f64| -> (f64, f64, f64) {
+        // state: θ, θ', x, z
+        let f = |s: f64, y: [f64; 4]| -> [f64; 4] { [y[1], -q * (l - s) * y[0].cos() / d, y[0].cos(), -y[0].sin()] };
+        let mut y = [0.0, k0, 0.0, 0.0];
+        for k in 0..steps {
+            let s = k as f64 * h;
+            let k1 = f(s, y);
+            let y2: [f64; 4] = std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]);
+            let k2 = f(s + 0.5 * h, y2);
+            let y3: [f64; 4] = std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]);
+            let k3 = f(s + 0.5 * h, y3);
+            let y4: [f64; 4] = std::array::from_fn(|i| y[i] + h * k3[i]);
+            let k4 = f(s + h, y4);
+            y = std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+        }
+        (y[1], y[2], y[3])
+    };
+    // θ'(L) grows with θ'(0): bisect for θ'(L) = 0.
+    let (mut lo, mut hi) = (0.0, q * l * l / d);
+    assert!(shoot(hi).0 > 0.0);
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if shoot(mid).0 > 0.0 { hi = mid } else { lo = mid }
+    }
+    let (_, x, z) = shoot(0.5 * (lo + hi));
+    (x, z)
+}
+
+#[test]
+fn cantilever_converges_to_the_exact_elastica() {
+    let base = scene("cantilever_wool_warp.toml", &[]);
+    let cont = base.material.continuum.clone().unwrap();
+    let r = cont.rigidities().unwrap();
+    let q = base.cloth.areal_density_kg_per_m2 * base.gravity.g_m_per_s2; // N/m² = per width, N/m per m
+    let l = base.cloth.size_x_m;
+    let (xe, ze) = elastica_tip(r.bending_warp_N_m, q, l);
+    // The exact solution is a large deflection: the free end drops by most of the length.
+    assert!(ze < -0.5 * l, "elastica tip z = {ze}");
+    let mut errors = Vec::new();
+    for n in [11usize, 21, 41, 81] {
+        let s = scene("cantilever_wool_warp.toml", &[&format!("cloth.nx={n}")]);
+        let sol = solve(&s);
+        let tip = sol.at(n - 1, 1);
+        let disp_exact = ((xe - l).powi(2) + ze * ze).sqrt();
+        let err = ((tip.x - xe).powi(2) + (tip.z - ze).powi(2)).sqrt() / disp_exact;
+        errors.push(err);
+    }
+    for w in errors.windows(2) {
+        assert!(w[1] < w[0], "error does not fall with refinement: {errors:?}");
+    }
+    assert!(*errors.last().unwrap() < 0.01, "finest grid error {:?}", errors);
+}
+
+#[test]
+fn symplectic_euler_without_damping_conserves_energy() {
+    let s = scene("hang4.toml", &["cloth.nx=5", "cloth.ny=5"]);
+    let built = build_scene(&s);
+    let mut x = built.x0.clone();
+    let mut v = vec![Vector3::zeros(); x.len()];
+    let energy = |x: &[Vector3<f64>], v: &[Vector3<f64>]| {
+        built.model.energy(x, 1.0) + built.model.masses.iter().zip(v).map(|(m, v)| 0.5 * m * v.norm_squared()).sum::<f64>()
+    };
+    let e0 = energy(&x, &v);
+    // Energy scale: the potential energy released by the sag.
+    let opts = DynamicOptions { dt_s: 2e-5, max_time_s: 2e-5 * 10_000.0, damping: false, residual_tol_rel: 1e-300, speed_tol_m_per_s: 1e-300, ..Default::default() };
+    let rep = solve_dynamic(&built.model, Integrator::SymplecticEuler, &mut x, &mut v, &opts, &mut NoObserver);
+    assert_eq!(rep.status, Status::MaxIterations);
+    assert!(rep.iterations >= 10_000);
+    let e1 = energy(&x, &v);
+    let released = built.model.energy(&built.x0, 1.0) - built.model.energy(&solve(&s).x, 1.0);
+    assert!(released > 0.0);
+    assert!((e1 - e0).abs() < 0.01 * released, "energy drift {:e} J of {:e} J", e1 - e0, released);
+    // The motion is real: kinetic energy is a sizeable part of the released energy.
+    let ke: f64 = built.model.masses.iter().zip(&v).map(|(m, v)| 0.5 * m * v.norm_squared()).sum();
+    assert!(ke > 1e-3 * released);
+}
+
+#[test]
+fn explicit_euler_above_its_stability_limit_reports_divergence() {
+    let s = scene("hang4.toml", &["cloth.nx=11", "cloth.ny=11", "solver.kind=\"explicit-euler\"", "solver.dynamic.dt_s=2e-3", "solver.dynamic.max_time_s=5"]);
+    let sol = solve_scene(&s, &mut NoObserver);
+    assert_eq!(sol.report.status, Status::Diverged, "{:?}", sol.report);
+    let div = sol.report.divergence.expect("divergence details");
+    assert_eq!(div.dt_s, Some(2e-3));
+    // The same scene below the limit converges.
+    let s = scene("hang4.toml", &["cloth.nx=11", "cloth.ny=11", "solver.kind=\"explicit-euler\"", "solver.dynamic.dt_s=1e-4"]);
+    assert_eq!(solve_scene(&s, &mut NoObserver).report.status, Status::Converged);
+}
+
+#[test]
+fn topology_b_builds_no_bend_terms_and_c_no_shear() {
+    let b = build_scene(&scene("hang4.toml", &["material.mass_spring.topology=\"b\""]));
+    let names = b.model.term_names();
+    assert!(names.iter().any(|n| n.contains("shear")) && !names.iter().any(|n| n.contains("bend")), "{names:?}");
+    let c = build_scene(&scene("hang4.toml", &["material.mass_spring.topology=\"c\""]));
+    let names = c.model.term_names();
+    assert!(!names.iter().any(|n| n.contains("shear")) && names.iter().any(|n| n.contains("bend")), "{names:?}");
+}
