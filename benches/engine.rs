@@ -3,7 +3,9 @@
 
 fn main() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let scene = drapelab::scene::Scene::load(&root.join("datasets/scenes/hang4.toml"), &[]).expect("bundled scene").scene;
+    let scene = drapelab::scene::Scene::load(&root.join("datasets/scenes/hang4.toml"), &[])
+        .expect("bundled scene")
+        .scene;
     let rows = drapelab::benchmark::hang4_rows(&scene, &[11, 21, 41, 81], 21, |m| eprintln!("{m}"));
     println!("{}", drapelab::benchmark::markdown_table(&rows));
 }

@@ -25,9 +25,14 @@ pub struct BenchRow {
 
 /// Solves `scene` at each size with each solver and measures against the finest static solve.
 /// Explicit and symplectic Euler run only up to `max_explicit_size` (their step count grows fast).
-pub fn hang4_rows(scene: &Scene, sizes: &[usize], max_explicit_size: usize, mut log: impl FnMut(&str)) -> Vec<BenchRow> {
+pub fn hang4_rows(
+    scene: &Scene,
+    sizes: &[usize],
+    max_explicit_size: usize,
+    mut log: impl FnMut(&str),
+) -> Vec<BenchRow> {
     let finest = *sizes.iter().max().unwrap_or(&11);
-    let mut at = |n: usize, kind: SolverKind| {
+    let at = |n: usize, kind: SolverKind| {
         let mut s = scene.clone();
         s.cloth.nx = n;
         s.cloth.ny = n;
@@ -38,11 +43,24 @@ pub fn hang4_rows(scene: &Scene, sizes: &[usize], max_explicit_size: usize, mut 
     };
     let t0 = Instant::now();
     let reference = solve_scene(&at(finest, SolverKind::Static), &mut NoObserver);
-    log(&format!("reference {finest}×{finest} static: {} in {:.3} s", reference.report.status.as_str(), t0.elapsed().as_secs_f64()));
+    log(&format!(
+        "reference {finest}×{finest} static: {} in {:.3} s",
+        reference.report.status.as_str(),
+        t0.elapsed().as_secs_f64()
+    ));
     let mut rows = Vec::new();
     for &n in sizes {
-        for kind in [SolverKind::Static, SolverKind::ImplicitEuler, SolverKind::SymplecticEuler, SolverKind::ExplicitEuler] {
-            if matches!(kind, SolverKind::ExplicitEuler | SolverKind::SymplecticEuler) && n > max_explicit_size {
+        for kind in [
+            SolverKind::Static,
+            SolverKind::ImplicitEuler,
+            SolverKind::SymplecticEuler,
+            SolverKind::ExplicitEuler,
+        ] {
+            if matches!(
+                kind,
+                SolverKind::ExplicitEuler | SolverKind::SymplecticEuler
+            ) && n > max_explicit_size
+            {
                 continue;
             }
             let s = at(n, kind);
@@ -62,8 +80,20 @@ pub fn hang4_rows(scene: &Scene, sizes: &[usize], max_explicit_size: usize, mut 
             } else {
                 err = f64::NAN;
             }
-            log(&format!("{n}×{n} {:?}: {} {:.4} s", kind, sol.report.status.as_str(), wall));
-            rows.push(BenchRow { n, solver: kind, status: sol.report.status.as_str().into(), wall_time_s: wall, iterations: sol.report.iterations, error_m: err });
+            log(&format!(
+                "{n}×{n} {:?}: {} {:.4} s",
+                kind,
+                sol.report.status.as_str(),
+                wall
+            ));
+            rows.push(BenchRow {
+                n,
+                solver: kind,
+                status: sol.report.status.as_str().into(),
+                wall_time_s: wall,
+                iterations: sol.report.iterations,
+                error_m: err,
+            });
         }
     }
     rows
@@ -71,7 +101,9 @@ pub fn hang4_rows(scene: &Scene, sizes: &[usize], max_explicit_size: usize, mut 
 
 /// The rows as a Markdown table.
 pub fn markdown_table(rows: &[BenchRow]) -> String {
-    let mut s = String::from("| particles | solver | status | wall time (ms) | iterations/steps | error vs finest static (m) |\n|---|---|---|---|---|---|\n");
+    let mut s = String::from(
+        "| particles | solver | status | wall time (ms) | iterations/steps | error vs finest static (m) |\n|---|---|---|---|---|---|\n",
+    );
     for r in rows {
         s += &format!(
             "| {n}×{n} | {:?} | {} | {:.3} | {} | {:.2e} |\n",

@@ -14,9 +14,11 @@ pub mod error;
 pub mod io;
 pub mod material;
 pub mod physics;
+pub mod pipeline;
 pub mod scene;
 pub mod simulate;
 pub mod solve;
+pub mod stages;
 
 /// Standard gravity in m/s², the default of every scene.
 pub const STANDARD_GRAVITY_M_PER_S2: f64 = 9.806_65;

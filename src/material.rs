@@ -102,15 +102,18 @@ impl Default for MassSpring {
 impl MassSpring {
     /// Structural stiffness in N/m.
     pub fn structural(&self) -> f64 {
-        self.structural_stiffness_N_per_m.unwrap_or(self.stiffness_N_per_m)
+        self.structural_stiffness_N_per_m
+            .unwrap_or(self.stiffness_N_per_m)
     }
     /// Shear stiffness in N/m.
     pub fn shear(&self) -> f64 {
-        self.shear_stiffness_N_per_m.unwrap_or(self.stiffness_N_per_m)
+        self.shear_stiffness_N_per_m
+            .unwrap_or(self.stiffness_N_per_m)
     }
     /// Bend stiffness in N/m.
     pub fn bend(&self) -> f64 {
-        self.bend_stiffness_N_per_m.unwrap_or(self.stiffness_N_per_m)
+        self.bend_stiffness_N_per_m
+            .unwrap_or(self.stiffness_N_per_m)
     }
 }
 
@@ -174,20 +177,62 @@ impl Continuum {
     /// Resolves to SI rigidities. Each rigidity must be given exactly once, in KES or SI units;
     /// the error names the key (relative to the `material.continuum` table) and says what to do.
     pub fn rigidities(&self) -> Result<Rigidities, (String, String)> {
-        fn pick(kes: Option<f64>, si: Option<f64>, kes_key: &str, si_key: &str, conv: fn(f64) -> f64) -> Result<f64, (String, String)> {
+        fn pick(
+            kes: Option<f64>,
+            si: Option<f64>,
+            kes_key: &str,
+            si_key: &str,
+            conv: fn(f64) -> f64,
+        ) -> Result<f64, (String, String)> {
             match (kes, si) {
-                (Some(_), Some(_)) => Err((si_key.into(), format!("given twice: remove either `{kes_key}` or `{si_key}`"))),
+                (Some(_), Some(_)) => Err((
+                    si_key.into(),
+                    format!("given twice: remove either `{kes_key}` or `{si_key}`"),
+                )),
                 (Some(v), None) => Ok(conv(v)),
                 (None, Some(v)) => Ok(v),
-                (None, None) => Err((si_key.into(), format!("missing: give `{si_key}` or `{kes_key}`"))),
+                (None, None) => Err((
+                    si_key.into(),
+                    format!("missing: give `{si_key}` or `{kes_key}`"),
+                )),
             }
         }
         Ok(Rigidities {
-            tensile_warp_N_per_m: pick(self.tensile_warp_gf_per_cm, self.tensile_warp_N_per_m, "tensile_warp_gf_per_cm", "tensile_warp_N_per_m", gf_per_cm_to_n_per_m)?,
-            tensile_weft_N_per_m: pick(self.tensile_weft_gf_per_cm, self.tensile_weft_N_per_m, "tensile_weft_gf_per_cm", "tensile_weft_N_per_m", gf_per_cm_to_n_per_m)?,
-            shear_N_per_m: pick(self.shear_gf_per_cm, self.shear_N_per_m, "shear_gf_per_cm", "shear_N_per_m", gf_per_cm_to_n_per_m)?,
-            bending_warp_N_m: pick(self.bending_warp_gf_cm2_per_cm, self.bending_warp_N_m, "bending_warp_gf_cm2_per_cm", "bending_warp_N_m", gf_cm2_per_cm_to_n_m)?,
-            bending_weft_N_m: pick(self.bending_weft_gf_cm2_per_cm, self.bending_weft_N_m, "bending_weft_gf_cm2_per_cm", "bending_weft_N_m", gf_cm2_per_cm_to_n_m)?,
+            tensile_warp_N_per_m: pick(
+                self.tensile_warp_gf_per_cm,
+                self.tensile_warp_N_per_m,
+                "tensile_warp_gf_per_cm",
+                "tensile_warp_N_per_m",
+                gf_per_cm_to_n_per_m,
+            )?,
+            tensile_weft_N_per_m: pick(
+                self.tensile_weft_gf_per_cm,
+                self.tensile_weft_N_per_m,
+                "tensile_weft_gf_per_cm",
+                "tensile_weft_N_per_m",
+                gf_per_cm_to_n_per_m,
+            )?,
+            shear_N_per_m: pick(
+                self.shear_gf_per_cm,
+                self.shear_N_per_m,
+                "shear_gf_per_cm",
+                "shear_N_per_m",
+                gf_per_cm_to_n_per_m,
+            )?,
+            bending_warp_N_m: pick(
+                self.bending_warp_gf_cm2_per_cm,
+                self.bending_warp_N_m,
+                "bending_warp_gf_cm2_per_cm",
+                "bending_warp_N_m",
+                gf_cm2_per_cm_to_n_m,
+            )?,
+            bending_weft_N_m: pick(
+                self.bending_weft_gf_cm2_per_cm,
+                self.bending_weft_N_m,
+                "bending_weft_gf_cm2_per_cm",
+                "bending_weft_N_m",
+                gf_cm2_per_cm_to_n_m,
+            )?,
         })
     }
 }

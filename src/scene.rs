@@ -71,7 +71,9 @@ fn default_g() -> f64 {
 
 impl Default for GravitySpec {
     fn default() -> Self {
-        Self { g_m_per_s2: default_g() }
+        Self {
+            g_m_per_s2: default_g(),
+        }
     }
 }
 
@@ -138,7 +140,11 @@ fn default_every() -> usize {
 
 impl Default for RecordSpec {
     fn default() -> Self {
-        Self { timeline: false, rerun: false, every: 1 }
+        Self {
+            timeline: false,
+            rerun: false,
+            every: 1,
+        }
     }
 }
 
@@ -181,12 +187,18 @@ pub struct LoadedScene {
 /// Parses `KEY=VALUE`; VALUE is read as TOML (number, bool, array, quoted string), else as a bare string.
 pub fn parse_override(s: &str) -> Result<(String, toml::Value), InputError> {
     let Some((k, v)) = s.split_once('=') else {
-        return Err(InputError::new("--set", s, "expected KEY=VALUE, e.g. --set cloth.nx=41"));
+        return Err(InputError::new(
+            "--set",
+            s,
+            "expected KEY=VALUE, e.g. --set cloth.nx=41",
+        ));
     };
     let k = k.trim().to_string();
     let v = v.trim();
     let value = match toml::from_str::<toml::Table>(&format!("v = {v}")) {
-        Ok(mut t) => t.remove("v").unwrap_or_else(|| toml::Value::String(v.into())),
+        Ok(mut t) => t
+            .remove("v")
+            .unwrap_or_else(|| toml::Value::String(v.into())),
         Err(_) => toml::Value::String(v.into()),
     };
     Ok((k, value))
@@ -197,8 +209,12 @@ pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Res
     let parts: Vec<&str> = key.split('.').collect();
     let mut t = table;
     for part in &parts[..parts.len() - 1] {
-        let entry = t.entry(part.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        t = entry.as_table_mut().ok_or_else(|| format!("`{part}` is not a table"))?;
+        let entry = t
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        t = entry
+            .as_table_mut()
+            .ok_or_else(|| format!("`{part}` is not a table"))?;
     }
     t.insert(parts[parts.len() - 1].to_string(), value);
     Ok(())
@@ -206,7 +222,8 @@ pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Res
 
 /// Reads a TOML file into a table, with the file named in errors.
 pub fn read_toml_table(path: &Path) -> Result<toml::Table, InputError> {
-    let text = std::fs::read_to_string(path).map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
     text.parse::<toml::Table>().map_err(|e| {
         let msg = e.message().to_string();
         let line = e.span().map(|s| text[..s.start].lines().count().max(1));
@@ -216,25 +233,43 @@ pub fn read_toml_table(path: &Path) -> Result<toml::Table, InputError> {
 }
 
 /// Deserializes a table into `T`, naming the dotted key of the first error.
-pub fn from_table<T: serde::de::DeserializeOwned>(path: &Path, prefix: &str, table: toml::Table) -> Result<T, InputError> {
+pub fn from_table<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    prefix: &str,
+    table: toml::Table,
+) -> Result<T, InputError> {
     serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
         let key = e.path().to_string();
-        let key = if key == "." { prefix.trim_end_matches('.').to_string() } else { format!("{prefix}{key}") };
+        let key = if key == "." {
+            prefix.trim_end_matches('.').to_string()
+        } else {
+            format!("{prefix}{key}")
+        };
         let inner = e.into_inner().to_string();
-        InputError::new(path, key, inner.lines().next().unwrap_or("invalid value").to_string())
+        InputError::new(
+            path,
+            key,
+            inner.lines().next().unwrap_or("invalid value").to_string(),
+        )
     })
 }
 
 impl Scene {
     /// Reads, overrides and validates a scene file.
-    pub fn load(path: &Path, overrides: &[(String, toml::Value)]) -> Result<LoadedScene, InputError> {
+    pub fn load(
+        path: &Path,
+        overrides: &[(String, toml::Value)],
+    ) -> Result<LoadedScene, InputError> {
         let mut table = read_toml_table(path)?;
         for (k, v) in overrides {
             set_dotted(&mut table, k, v.clone()).map_err(|m| InputError::new(path, k, m))?;
         }
         let scene: Scene = from_table(path, "", table)?;
         scene.validate(path)?;
-        Ok(LoadedScene { scene, path: path.to_path_buf() })
+        Ok(LoadedScene {
+            scene,
+            path: path.to_path_buf(),
+        })
     }
 
     /// Checks every value's range; the error names the key.
@@ -242,13 +277,21 @@ impl Scene {
         let err = |k: &str, m: String| Err(InputError::new(path, k, m));
         let pos = |k: &str, v: f64| -> Result<(), InputError> {
             if !v.is_finite() || v <= 0.0 {
-                return Err(InputError::new(path, k, format!("must be a finite number > 0, got {v}")));
+                return Err(InputError::new(
+                    path,
+                    k,
+                    format!("must be a finite number > 0, got {v}"),
+                ));
             }
             Ok(())
         };
         let nonneg = |k: &str, v: f64| -> Result<(), InputError> {
             if !v.is_finite() || v < 0.0 {
-                return Err(InputError::new(path, k, format!("must be a finite number ≥ 0, got {v}")));
+                return Err(InputError::new(
+                    path,
+                    k,
+                    format!("must be a finite number ≥ 0, got {v}"),
+                ));
             }
             Ok(())
         };
@@ -266,15 +309,34 @@ impl Scene {
             return err("cloth.ny", format!("must be in 2..=2049, got {}", c.ny));
         }
         if !(0.0..1.0).contains(&c.grading) {
-            return err("cloth.grading", format!("must be in [0, 1), got {}", c.grading));
+            return err(
+                "cloth.grading",
+                format!("must be in [0, 1), got {}", c.grading),
+            );
         }
         match (&self.material.mass_spring, &self.material.continuum) {
-            (Some(_), Some(_)) => return err("material", "give either [material.mass_spring] or [material.continuum], not both".into()),
-            (None, None) => return err("material", "missing: add [material.mass_spring] or [material.continuum]".into()),
+            (Some(_), Some(_)) => {
+                return err(
+                    "material",
+                    "give either [material.mass_spring] or [material.continuum], not both".into(),
+                );
+            }
+            (None, None) => {
+                return err(
+                    "material",
+                    "missing: add [material.mass_spring] or [material.continuum]".into(),
+                );
+            }
             (Some(ms), None) => {
-                pos("material.mass_spring.stiffness_N_per_m", ms.stiffness_N_per_m)?;
+                pos(
+                    "material.mass_spring.stiffness_N_per_m",
+                    ms.stiffness_N_per_m,
+                )?;
                 for (k, v) in [
-                    ("structural_stiffness_N_per_m", ms.structural_stiffness_N_per_m),
+                    (
+                        "structural_stiffness_N_per_m",
+                        ms.structural_stiffness_N_per_m,
+                    ),
                     ("shear_stiffness_N_per_m", ms.shear_stiffness_N_per_m),
                     ("bend_stiffness_N_per_m", ms.bend_stiffness_N_per_m),
                     ("natural_length_m", ms.natural_length_m),
@@ -286,11 +348,16 @@ impl Scene {
                 nonneg("material.mass_spring.damping_Ns_per_m", ms.damping_Ns_per_m)?;
                 pos("material.mass_spring.elongation_rate", ms.elongation_rate)?;
                 if ms.natural_length_m.is_some() && c.spacing != Spacing::Uniform {
-                    return err("material.mass_spring.natural_length_m", "needs cloth.spacing = \"uniform\"".into());
+                    return err(
+                        "material.mass_spring.natural_length_m",
+                        "needs cloth.spacing = \"uniform\"".into(),
+                    );
                 }
             }
             (None, Some(cont)) => {
-                let r = cont.rigidities().map_err(|(k, m)| InputError::new(path, format!("material.continuum.{k}"), m))?;
+                let r = cont.rigidities().map_err(|(k, m)| {
+                    InputError::new(path, format!("material.continuum.{k}"), m)
+                })?;
                 for (k, v) in [
                     ("tensile_warp", r.tensile_warp_N_per_m),
                     ("tensile_weft", r.tensile_weft_N_per_m),
@@ -306,15 +373,27 @@ impl Scene {
             if p[0] >= c.nx || p[1] >= c.ny {
                 return err(
                     &format!("boundary.pin_particles[{n}]"),
-                    format!("[{}, {}] lies outside the {}×{} grid (i < nx, j < ny)", p[0], p[1], c.nx, c.ny),
+                    format!(
+                        "[{}, {}] lies outside the {}×{} grid (i < nx, j < ny)",
+                        p[0], p[1], c.nx, c.ny
+                    ),
                 );
             }
         }
         if !self.boundary.clamp_edges.is_empty() && (c.nx < 3 || c.ny < 3) {
-            return err("boundary.clamp_edges", "a clamp needs at least 3 particles along each side".into());
+            return err(
+                "boundary.clamp_edges",
+                "a clamp needs at least 3 particles along each side".into(),
+            );
         }
-        if self.boundary.pin_corners.is_empty() && self.boundary.pin_particles.is_empty() && self.boundary.clamp_edges.is_empty() {
-            return err("boundary", "nothing is pinned or clamped: the sheet would fall freely".into());
+        if self.boundary.pin_corners.is_empty()
+            && self.boundary.pin_particles.is_empty()
+            && self.boundary.clamp_edges.is_empty()
+        {
+            return err(
+                "boundary",
+                "nothing is pinned or clamped: the sheet would fall freely".into(),
+            );
         }
         nonneg("gravity.g_m_per_s2", self.gravity.g_m_per_s2)?;
         let s = &self.solver.static_;
@@ -322,7 +401,10 @@ impl Scene {
         pos("solver.static.lm_damping_initial", s.lm_damping_initial)?;
         pos("solver.static.strain_bound", s.strain_bound)?;
         if s.max_iterations == 0 || s.load_steps == 0 {
-            return err("solver.static", "max_iterations and load_steps must be ≥ 1".into());
+            return err(
+                "solver.static",
+                "max_iterations and load_steps must be ≥ 1".into(),
+            );
         }
         let d = &self.solver.dynamic;
         pos("solver.dynamic.dt_s", d.dt_s)?;
@@ -331,8 +413,20 @@ impl Scene {
         pos("solver.dynamic.speed_tol_m_per_s", d.speed_tol_m_per_s)?;
         pos("solver.dynamic.strain_bound", d.strain_bound)?;
         pos("solver.dynamic.cg_tol_rel", d.cg_tol_rel)?;
+        if !(0.0..=100.0).contains(&d.auto_dt_fraction) {
+            return err(
+                "solver.dynamic.auto_dt_fraction",
+                format!(
+                    "must be in [0, 100] (above 1 is beyond the estimated limit), got {}",
+                    d.auto_dt_fraction
+                ),
+            );
+        }
         if d.max_time_s / d.dt_s > 1e9 {
-            return err("solver.dynamic.max_time_s", "more than 1e9 steps: raise dt_s or lower max_time_s".into());
+            return err(
+                "solver.dynamic.max_time_s",
+                "more than 1e9 steps: raise dt_s or lower max_time_s".into(),
+            );
         }
         if self.record.every == 0 {
             return err("record.every", "must be ≥ 1".into());

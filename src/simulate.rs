@@ -4,7 +4,9 @@
 use crate::cloth::{BuiltScene, Grid, build_scene};
 use crate::io::{RerunRecorder, TimelineRecorder, write_atomic, write_particles};
 use crate::scene::{LoadedScene, Scene};
-use crate::solve::{Observer, Observers, SolveReport, StateEvent, Status, solve_dynamic, solve_static};
+use crate::solve::{
+    Observer, Observers, SolveReport, StateEvent, Status, solve_dynamic, solve_static,
+};
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -37,16 +39,105 @@ impl Solution {
 
 /// Solves a validated scene in memory with its configured solver; the observer sees each state.
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
-    let BuiltScene { grid, model, x0 } = build_scene(scene);
-    let mut x = x0;
-    let report = match scene.solver.kind.integrator() {
-        None => solve_static(&model, &mut x, &scene.solver.static_, observer),
+    let BuiltScene {
+        grid,
+        model,
+        x0: mut x,
+    } = build_scene(scene);
+    let report = solve_model(scene, &grid, &model, &mut x, observer);
+    Solution {
+        grid,
+        terms: model.term_names(),
+        x,
+        report,
+        model,
+    }
+}
+
+/// Solves a built scene from `x` (updated in place) with the scene's solver.
+fn solve_model(
+    scene: &Scene,
+    grid: &Grid,
+    model: &crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    match scene.solver.kind.integrator() {
+        None => {
+            // Nested iteration: start Newton from the interpolated solution of the scene on the grid
+            // with every other line, when that grid exists; far fewer fine iterations are needed.
+            let coarse = coarse_start(scene, grid, x);
+            let mut report = solve_static(model, x, &scene.solver.static_, observer);
+            if let Some((r, _)) = coarse {
+                report.iterations += r.iterations;
+                report.linear_solves += r.linear_solves;
+                report.wall_time_s += r.wall_time_s;
+                report.message += &format!(
+                    " (from a {}×{} start)",
+                    (grid.nx + 1) / 2,
+                    (grid.ny + 1) / 2
+                );
+            }
+            report
+        }
         Some(integ) => {
             let mut v = vec![Vector3::zeros(); x.len()];
-            solve_dynamic(&model, integ, &mut x, &mut v, &scene.solver.dynamic, observer)
+            solve_dynamic(model, integ, x, &mut v, &scene.solver.dynamic, observer)
         }
-    };
-    Solution { grid, terms: model.term_names(), x, report, model }
+    }
+}
+
+/// Solves the scene on the grid with every other line and writes the interpolated positions into
+/// the free particles of `x`. Only when both sides have an odd count ≥ 9, the coarse solve converges,
+/// and no absolute natural length ties the springs to the fine spacing.
+fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(SolveReport, ())> {
+    let (nx, ny) = (grid.nx, grid.ny);
+    let natural = scene
+        .material
+        .mass_spring
+        .as_ref()
+        .is_some_and(|m| m.natural_length_m.is_some());
+    if !scene.solver.static_.coarse_start
+        || natural
+        || nx < 9
+        || ny < 9
+        || nx % 2 == 0
+        || ny % 2 == 0
+    {
+        return None;
+    }
+    if scene
+        .boundary
+        .pin_particles
+        .iter()
+        .any(|p| p[0] % 2 == 1 || p[1] % 2 == 1)
+    {
+        return None;
+    }
+    let mut c = scene.clone();
+    c.cloth.nx = nx.div_ceil(2);
+    c.cloth.ny = ny.div_ceil(2);
+    c.boundary.pin_particles = scene
+        .boundary
+        .pin_particles
+        .iter()
+        .map(|p| [p[0] / 2, p[1] / 2])
+        .collect();
+    let coarse = solve_scene(&c, &mut crate::solve::NoObserver);
+    if !coarse.report.is_converged() {
+        return None;
+    }
+    let cg = &coarse.grid;
+    let at = |i: usize, j: usize| coarse.x[cg.index(i, j)];
+    for j in 0..ny {
+        for i in 0..nx {
+            let p = grid.index(i, j);
+            let (i0, j0) = (i / 2, j / 2);
+            let (i1, j1) = (i0 + i % 2, j0 + j % 2);
+            x[p] = (at(i0, j0) + at(i1, j0) + at(i0, j1) + at(i1, j1)) * 0.25;
+        }
+    }
+    Some((coarse.report, ()))
 }
 
 #[derive(Serialize)]
@@ -65,15 +156,43 @@ struct RunRecord<'a> {
 /// Solves `loaded` and writes its outputs into `out` (created if needed). Returns the report; a
 /// solve that did not converge writes `run.json` with its status and `last_state.parquet`, never
 /// `particles.parquet`.
-pub fn simulate_to_dir(loaded: &LoadedScene, out: &Path, progress: &mut dyn Observer) -> Result<SolveReport> {
+pub fn simulate_to_dir(
+    loaded: &LoadedScene,
+    out: &Path,
+    progress: &mut dyn Observer,
+) -> Result<SolveReport> {
     let scene = &loaded.scene;
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let BuiltScene { grid, model, x0 } = build_scene(scene);
     let pins: Vec<usize> = (0..grid.len()).filter(|&p| model.fixed[p]).collect();
     let every = scene.record.every;
-    let mut timeline = if scene.record.timeline { Some(TimelineRecorder::new(&out.join("timeline.mcap"), &grid, every)?) } else { None };
-    let mut rrd = if scene.record.rerun { Some(RerunRecorder::new(&out.join("drape.rrd"), &scene.name, &grid, &x0, &pins, every)?) } else { None };
+    let mut timeline = if scene.record.timeline {
+        Some(TimelineRecorder::new(
+            &out.join("timeline.mcap"),
+            &grid,
+            every,
+        )?)
+    } else {
+        None
+    };
+    let mut rrd = if scene.record.rerun {
+        Some(RerunRecorder::new(
+            &out.join("drape.rrd"),
+            &scene.name,
+            &grid,
+            &x0,
+            &pins,
+            every,
+        )?)
+    } else {
+        None
+    };
     let mut x = x0;
+    let coarse = if scene.solver.kind == crate::scene::SolverKind::Static {
+        coarse_start(scene, &grid, &mut x)
+    } else {
+        None
+    };
     let report = {
         let mut obs: Vec<&mut dyn Observer> = vec![progress];
         if let Some(t) = timeline.as_mut() {
@@ -84,10 +203,25 @@ pub fn simulate_to_dir(loaded: &LoadedScene, out: &Path, progress: &mut dyn Obse
         }
         let mut all = Observers(obs);
         match scene.solver.kind.integrator() {
-            None => solve_static(&model, &mut x, &scene.solver.static_, &mut all),
+            None => {
+                let mut r = solve_static(&model, &mut x, &scene.solver.static_, &mut all);
+                if let Some((c, _)) = coarse {
+                    r.iterations += c.iterations;
+                    r.linear_solves += c.linear_solves;
+                    r.wall_time_s += c.wall_time_s;
+                }
+                r
+            }
             Some(integ) => {
                 let mut v = vec![Vector3::zeros(); x.len()];
-                solve_dynamic(&model, integ, &mut x, &mut v, &scene.solver.dynamic, &mut all)
+                solve_dynamic(
+                    &model,
+                    integ,
+                    &mut x,
+                    &mut v,
+                    &scene.solver.dynamic,
+                    &mut all,
+                )
             }
         }
     };
@@ -108,7 +242,12 @@ pub fn simulate_to_dir(loaded: &LoadedScene, out: &Path, progress: &mut dyn Obse
         r.finish(finite.then_some(&final_ev))?;
         outputs.push("drape.rrd");
     }
-    let meta = [("drapelab_version", crate::VERSION.to_string()), ("status", report.status.as_str().to_string()), ("solver", report.solver.clone()), ("scene", scene.name.clone())];
+    let meta = [
+        ("drapelab_version", crate::VERSION.to_string()),
+        ("status", report.status.as_str().to_string()),
+        ("solver", report.solver.clone()),
+        ("scene", scene.name.clone()),
+    ];
     if report.status == Status::Converged {
         write_particles(&out.join("particles.parquet"), &grid, &x, &meta)?;
         outputs.push("particles.parquet");

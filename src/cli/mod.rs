@@ -41,6 +41,31 @@ pub enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
+    /// Run a pipeline make-style: only stale stages run (inputs' content, parameters or the drapelab
+    /// version changed since the stage's manifest), items in parallel, artifacts under runs/<pipeline>/.
+    ///
+    /// Example: drapelab run pipelines/main.toml --jobs 2
+    Run {
+        /// The pipeline file, e.g. pipelines/main.toml.
+        pipeline: PathBuf,
+        /// Run only this stage and the stages it depends on.
+        #[arg(long, value_name = "STAGE")]
+        until: Option<String>,
+        /// Rerun this stage and everything downstream of it even if up to date. Repeatable.
+        #[arg(long, value_name = "STAGE")]
+        force: Vec<String>,
+        /// Threads for the items of a stage (0 = all cores).
+        #[arg(long, default_value_t = 0)]
+        jobs: usize,
+        /// Print what would run and why; run nothing.
+        #[arg(long)]
+        dry_run: bool,
+    },
+    /// List each stage of a pipeline as up to date or stale, and why (which input or parameter changed).
+    Status {
+        /// The pipeline file.
+        pipeline: PathBuf,
+    },
     /// Benchmark: time to equilibrium of hang4 at several resolutions with every solver, and each
     /// result's distance to the finest static solution. Prints a Markdown table.
     Bench {
@@ -60,7 +85,10 @@ pub enum Command {
 pub fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Simulate { scene, out, set } => {
-            let overrides = set.iter().map(|s| parse_override(s)).collect::<Result<Vec<_>, InputError>>()?;
+            let overrides = set
+                .iter()
+                .map(|s| parse_override(s))
+                .collect::<Result<Vec<_>, InputError>>()?;
             let loaded = Scene::load(&scene, &overrides)?;
             let mut progress = SolveProgress::new(&loaded.scene.name);
             let report = crate::simulate::simulate_to_dir(&loaded, &out, &mut progress)?;
@@ -76,9 +104,63 @@ pub fn run(cli: Cli) -> Result<i32> {
                 report.wall_time_s,
                 out.display()
             );
-            Ok(if report.is_converged() { EXIT_OK } else { EXIT_FAILED })
+            Ok(if report.is_converged() {
+                EXIT_OK
+            } else {
+                EXIT_FAILED
+            })
         }
-        Command::Bench { scene, sizes, max_explicit_size } => {
+        Command::Run {
+            pipeline,
+            until,
+            force,
+            jobs,
+            dry_run,
+        } => {
+            let plan = crate::pipeline::load_plan(&pipeline)?;
+            let progress = crate::pipeline::progress_for_terminal();
+            let opts = crate::pipeline::RunOptions {
+                until,
+                force,
+                jobs,
+                dry_run,
+            };
+            let summary = crate::pipeline::run_pipeline(&plan, &opts, progress.as_ref())?;
+            for (name, why) in &summary.would_run {
+                println!("would run {name}: {why}");
+            }
+            eprintln!(
+                "{}: {} ran, {} up to date, {} failed{}",
+                plan.name,
+                summary.ran.len(),
+                summary.skipped.len(),
+                summary.failed.len(),
+                if opts.dry_run { " (dry run)" } else { "" }
+            );
+            for (name, why) in &summary.failed {
+                eprintln!("  {name}: {why}");
+            }
+            Ok(if summary.failed.is_empty() {
+                EXIT_OK
+            } else {
+                EXIT_FAILED
+            })
+        }
+        Command::Status { pipeline } => {
+            let plan = crate::pipeline::load_plan(&pipeline)?;
+            for (name, state) in crate::pipeline::stage_states(&plan) {
+                match state {
+                    crate::pipeline::StageState::UpToDate => println!("{name}: up to date"),
+                    crate::pipeline::StageState::Stale(why) => println!("{name}: stale ({why})"),
+                }
+            }
+            Ok(EXIT_OK)
+        }
+        Command::Bench {
+            scene,
+            sizes,
+            max_explicit_size,
+        } => {
             bench::run_bench(&scene, &sizes, max_explicit_size)?;
             Ok(EXIT_OK)
         }

@@ -13,7 +13,10 @@ impl SolveProgress {
     /// A spinner labelled `name` (drawn only on a terminal).
     pub fn new(name: &str) -> Self {
         let bar = ProgressBar::new_spinner();
-        bar.set_style(ProgressStyle::with_template("{spinner} {prefix} [{elapsed_precise}] {msg}").expect("valid template"));
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {prefix} [{elapsed_precise}] {msg}")
+                .expect("valid template"),
+        );
         bar.set_prefix(name.to_string());
         bar.enable_steady_tick(Duration::from_millis(120));
         Self { bar }
@@ -29,7 +32,13 @@ impl Observer for SolveProgress {
         !self.bar.is_hidden() && index % 100 == 0
     }
     fn observe(&mut self, ev: &StateEvent<'_>) {
-        let t = ev.time_s.map(|t| format!(" t = {t:.4} s")).unwrap_or_default();
-        self.bar.set_message(format!("step {}{t}, residual {:.3e} N", ev.index, ev.max_residual_N));
+        let t = ev
+            .time_s
+            .map(|t| format!(" t = {t:.4} s"))
+            .unwrap_or_default();
+        self.bar.set_message(format!(
+            "step {}{t}, residual {:.3e} N",
+            ev.index, ev.max_residual_N
+        ));
     }
 }

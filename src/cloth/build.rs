@@ -20,8 +20,20 @@ pub struct BuiltScene {
 /// Builds the model of a validated scene.
 pub fn build_scene(scene: &Scene) -> BuiltScene {
     let c = &scene.cloth;
-    let grid = Grid::new(c.nx, c.ny, c.size_x_m, c.size_y_m, c.spacing, if c.spacing == super::Spacing::Graded { c.grading } else { 0.0 });
-    let mut x0 = grid.flat_positions();
+    let grid = Grid::new(
+        c.nx,
+        c.ny,
+        c.size_x_m,
+        c.size_y_m,
+        c.spacing,
+        if c.spacing == super::Spacing::Graded {
+            c.grading
+        } else {
+            0.0
+        },
+    );
+    let flat = grid.flat_positions();
+    let mut x0 = flat.clone();
     if c.initial_perturbation_m != 0.0 {
         use std::f64::consts::PI;
         for p in x0.iter_mut() {
@@ -54,7 +66,7 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
         }
         let rest = |a: usize, b: usize, factor: f64| match ms.natural_length_m {
             Some(l0) => l0 * factor,
-            None => (x0[b] - x0[a]).norm(),
+            None => (flat[b] - flat[a]).norm(),
         };
         let mut family = |fam: SpringFamily, k: f64, offsets: &[(usize, usize)], factor: f64| {
             let mut pairs = Vec::new();
@@ -81,9 +93,19 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
                 terms.push(Box::new(Springs::new(fam, pairs, rests, vec![k; n])));
             }
         };
-        family(SpringFamily::Structural, ms.structural(), &[(1, 0), (0, 1)], 1.0);
+        family(
+            SpringFamily::Structural,
+            ms.structural(),
+            &[(1, 0), (0, 1)],
+            1.0,
+        );
         if ms.topology.has_shear() {
-            family(SpringFamily::Shear, ms.shear(), &[(1, 1)], std::f64::consts::SQRT_2);
+            family(
+                SpringFamily::Shear,
+                ms.shear(),
+                &[(1, 1)],
+                std::f64::consts::SQRT_2,
+            );
         }
         if ms.topology.has_bend() {
             family(SpringFamily::Bend, ms.bend(), &[(2, 0), (0, 2)], 2.0);
@@ -91,7 +113,15 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
     }
     if let Some(cont) = &scene.material.continuum {
         let r = cont.rigidities().expect("validated scene");
-        continuum_terms(&grid, &r, &scene.boundary.clamp_edges, &mut fixed, &mut masses, &mut x0, &mut terms);
+        continuum_terms(
+            &grid,
+            &r,
+            &scene.boundary.clamp_edges,
+            &mut fixed,
+            &mut masses,
+            &mut x0,
+            &mut terms,
+        );
     }
     if g > 0.0 {
         terms.push(Box::new(Gravity::new(masses.clone(), g)));
@@ -143,14 +173,24 @@ fn continuum_terms(
             }
         }
     }
-    terms.push(Box::new(Springs::new(SpringFamily::Tensile, pairs, rest, k)));
+    terms.push(Box::new(Springs::new(
+        SpringFamily::Tensile,
+        pairs,
+        rest,
+        k,
+    )));
     // Shear.
     if r.shear_N_per_m > 0.0 {
         let mut cells = Vec::new();
         let mut sides = Vec::new();
         for j in 0..ny - 1 {
             for i in 0..nx - 1 {
-                cells.push([grid.index(i, j), grid.index(i + 1, j), grid.index(i, j + 1), grid.index(i + 1, j + 1)]);
+                cells.push([
+                    grid.index(i, j),
+                    grid.index(i + 1, j),
+                    grid.index(i, j + 1),
+                    grid.index(i + 1, j + 1),
+                ]);
                 sides.push((grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]));
             }
         }
@@ -168,13 +208,31 @@ fn continuum_terms(
     for j in 0..ny {
         for i in 1..nx - 1 {
             let (h1, h2) = (grid.xs[i] - grid.xs[i - 1], grid.xs[i + 1] - grid.xs[i]);
-            add(grid.index(i - 1, j), grid.index(i, j), grid.index(i + 1, j), h1, h2, r.bending_warp_N_m, wy[j], 1.0);
+            add(
+                grid.index(i - 1, j),
+                grid.index(i, j),
+                grid.index(i + 1, j),
+                h1,
+                h2,
+                r.bending_warp_N_m,
+                wy[j],
+                1.0,
+            );
         }
     }
     for i in 0..nx {
         for j in 1..ny - 1 {
             let (h1, h2) = (grid.ys[j] - grid.ys[j - 1], grid.ys[j + 1] - grid.ys[j]);
-            add(grid.index(i, j - 1), grid.index(i, j), grid.index(i, j + 1), h1, h2, r.bending_weft_N_m, wx[i], 1.0);
+            add(
+                grid.index(i, j - 1),
+                grid.index(i, j),
+                grid.index(i, j + 1),
+                h1,
+                h2,
+                r.bending_weft_N_m,
+                wx[i],
+                1.0,
+            );
         }
     }
     for edge in clamps {
@@ -191,8 +249,9 @@ fn continuum_terms(
             fixed.push(true);
             let h = (x0[q] - x0[p]).norm();
             let w = if along_x { wy[k] } else { wx[k] };
-            // Half weight: the clamp node's tributary length is h/2.
-            add(ghost, p, q, h, h, d, w, 0.5);
+            // The turning angle at the clamp node happens over h/2 (clamp tangent to the first
+            // segment's midpoint), not h̄ = h: k = D w/(h/2), weight 2.
+            add(ghost, p, q, h, h, d, w, 2.0);
         }
     }
     if !triples.is_empty() {

@@ -40,8 +40,16 @@ pub fn tributary_lengths(coords: &[f64]) -> Vec<f64> {
     let n = coords.len();
     (0..n)
         .map(|k| {
-            let left = if k > 0 { coords[k] - coords[k - 1] } else { 0.0 };
-            let right = if k + 1 < n { coords[k + 1] - coords[k] } else { 0.0 };
+            let left = if k > 0 {
+                coords[k] - coords[k - 1]
+            } else {
+                0.0
+            };
+            let right = if k + 1 < n {
+                coords[k + 1] - coords[k]
+            } else {
+                0.0
+            };
             0.5 * (left + right)
         })
         .collect()
@@ -156,12 +164,18 @@ impl Edge {
     pub fn lines(self, grid: &Grid) -> (Vec<usize>, Vec<usize>) {
         let (nx, ny) = (grid.nx, grid.ny);
         match self {
-            Edge::Xmin => ((0..ny).map(|j| grid.index(0, j)).collect(), (0..ny).map(|j| grid.index(1, j)).collect()),
+            Edge::Xmin => (
+                (0..ny).map(|j| grid.index(0, j)).collect(),
+                (0..ny).map(|j| grid.index(1, j)).collect(),
+            ),
             Edge::Xmax => (
                 (0..ny).map(|j| grid.index(nx - 1, j)).collect(),
                 (0..ny).map(|j| grid.index(nx - 2, j)).collect(),
             ),
-            Edge::Ymin => ((0..nx).map(|i| grid.index(i, 0)).collect(), (0..nx).map(|i| grid.index(i, 1)).collect()),
+            Edge::Ymin => (
+                (0..nx).map(|i| grid.index(i, 0)).collect(),
+                (0..nx).map(|i| grid.index(i, 1)).collect(),
+            ),
             Edge::Ymax => (
                 (0..nx).map(|i| grid.index(i, ny - 1)).collect(),
                 (0..nx).map(|i| grid.index(i, ny - 2)).collect(),

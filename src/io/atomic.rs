@@ -14,14 +14,23 @@ pub struct Staged {
 impl Staged {
     /// Starts a staged file for `target` (its folder must exist).
     pub fn new(target: &Path) -> Result<Self> {
-        let dir = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let name = target.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let dir = target
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
             .suffix(".partial")
             .tempfile_in(dir)
             .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-        Ok(Self { tmp, target: target.to_path_buf() })
+        Ok(Self {
+            tmp,
+            target: target.to_path_buf(),
+        })
     }
     /// The temporary path (for writers that open files themselves).
     pub fn path(&self) -> &Path {
@@ -35,7 +44,9 @@ impl Staged {
     pub fn commit(self) -> Result<PathBuf> {
         self.tmp.as_file().sync_all().ok();
         let target = self.target.clone();
-        self.tmp.persist(&target).with_context(|| format!("cannot rename into {}", target.display()))?;
+        self.tmp
+            .persist(&target)
+            .with_context(|| format!("cannot rename into {}", target.display()))?;
         Ok(target)
     }
 }

@@ -20,17 +20,47 @@ pub struct RerunRecorder {
 
 impl RerunRecorder {
     /// Starts a recording at `path`; `pins` are the fixed grid particles.
-    pub fn new(path: &Path, app: &str, grid: &Grid, x0: &[nalgebra::Vector3<f64>], pins: &[usize], every: usize) -> Result<Self> {
+    pub fn new(
+        path: &Path,
+        app: &str,
+        grid: &Grid,
+        x0: &[nalgebra::Vector3<f64>],
+        pins: &[usize],
+        every: usize,
+    ) -> Result<Self> {
         let staged = Staged::new(path)?;
-        let rec = rerun::RecordingStreamBuilder::new(format!("drapelab/{app}")).save(staged.path())?;
+        let rec = rerun::RecordingStreamBuilder::new(rerun::ApplicationId::new_or_unknown(
+            format!("drapelab_{app}"),
+        ))
+        .save(staged.path())?;
         let tris = super::timeline::grid_triangles(grid);
         // The mesh topology is static; positions change over time.
-        rec.log_static("cloth/rest", &rerun::Mesh3D::new(x0[..grid.len()].iter().map(|p| [p.x as f32, p.y as f32, p.z as f32])).with_triangle_indices(tris.iter().copied()))?;
+        rec.log_static(
+            "cloth/rest",
+            &rerun::Mesh3D::new(
+                x0[..grid.len()]
+                    .iter()
+                    .map(|p| [p.x as f32, p.y as f32, p.z as f32]),
+            )
+            .with_triangle_indices(tris.iter().copied()),
+        )?;
         rec.log_static(
             "cloth/pins",
-            &rerun::Points3D::new(pins.iter().map(|&p| [x0[p].x as f32, x0[p].y as f32, x0[p].z as f32])).with_radii([0.004f32]),
+            &rerun::Points3D::new(
+                pins.iter()
+                    .map(|&p| [x0[p].x as f32, x0[p].y as f32, x0[p].z as f32]),
+            )
+            .with_radii([0.004f32]),
         )?;
-        Ok(Self { rec: Some(rec), staged: Some(staged), every, n_grid: grid.len(), tris, last_index: None, error: None })
+        Ok(Self {
+            rec: Some(rec),
+            staged: Some(staged),
+            every,
+            n_grid: grid.len(),
+            tris,
+            last_index: None,
+            error: None,
+        })
     }
 
     fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
@@ -39,9 +69,18 @@ impl RerunRecorder {
             Some(t) => rec.set_duration_secs("sim_time", t),
             None => rec.set_time_sequence("iteration", ev.index as i64),
         }
-        let verts: Vec<[f32; 3]> = ev.x[..self.n_grid].iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
-        rec.log("cloth/mesh", &rerun::Mesh3D::new(verts).with_triangle_indices(self.tris.iter().copied()))?;
-        rec.log("stats/max_residual_N", &rerun::Scalars::single(ev.max_residual_N))?;
+        let verts: Vec<[f32; 3]> = ev.x[..self.n_grid]
+            .iter()
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+            .collect();
+        rec.log(
+            "cloth/mesh",
+            &rerun::Mesh3D::new(verts).with_triangle_indices(self.tris.iter().copied()),
+        )?;
+        rec.log(
+            "stats/max_residual_N",
+            &rerun::Scalars::single(ev.max_residual_N),
+        )?;
         rec.log("stats/energy_J", &rerun::Scalars::single(ev.energy_J))?;
         self.last_index = Some(ev.index);
         Ok(())

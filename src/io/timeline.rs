@@ -23,7 +23,12 @@ pub fn grid_triangles(grid: &Grid) -> Vec<[u32; 3]> {
     let mut t = Vec::with_capacity(2 * (grid.nx - 1) * (grid.ny - 1));
     for j in 0..grid.ny - 1 {
         for i in 0..grid.nx - 1 {
-            let (a, b, c, d) = (grid.index(i, j), grid.index(i + 1, j), grid.index(i, j + 1), grid.index(i + 1, j + 1));
+            let (a, b, c, d) = (
+                grid.index(i, j),
+                grid.index(i + 1, j),
+                grid.index(i, j + 1),
+                grid.index(i + 1, j + 1),
+            );
             t.push([a as u32, b as u32, d as u32]);
             t.push([a as u32, d as u32, c as u32]);
         }
@@ -51,10 +56,19 @@ impl TimelineRecorder {
     pub fn new(path: &Path, grid: &Grid, every: usize) -> Result<Self> {
         let staged = Staged::new(path)?;
         let file = staged.path().to_path_buf();
-        let f = std::fs::OpenOptions::new().write(true).truncate(true).open(&file)?;
-        let opts = mcap::WriteOptions::new().compression(None).profile("drapelab");
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .truncate(true)
+            .open(&file)?;
+        let opts = mcap::WriteOptions::new()
+            .compression(None)
+            .profile("drapelab");
         let mut writer = opts.create(BufWriter::new(f))?;
-        let s1 = writer.add_schema("foxglove.SceneUpdate", "jsonschema", SCENE_UPDATE_SCHEMA.as_bytes())?;
+        let s1 = writer.add_schema(
+            "foxglove.SceneUpdate",
+            "jsonschema",
+            SCENE_UPDATE_SCHEMA.as_bytes(),
+        )?;
         let cloth = writer.add_channel(s1, "/drapelab/cloth", "json", &BTreeMap::new())?;
         let s2 = writer.add_schema("drapelab.Stats", "jsonschema", STATS_SCHEMA.as_bytes())?;
         let stats = writer.add_channel(s2, "/drapelab/stats", "json", &BTreeMap::new())?;
@@ -79,7 +93,10 @@ impl TimelineRecorder {
             None => ev.index as u64 * 1_000_000,
         };
         let stamp = json!({"sec": t_ns / 1_000_000_000, "nsec": t_ns % 1_000_000_000});
-        let points: Vec<_> = ev.x[..self.n_grid].iter().map(|p| json!({"x": p.x, "y": p.y, "z": p.z})).collect();
+        let points: Vec<_> = ev.x[..self.n_grid]
+            .iter()
+            .map(|p| json!({"x": p.x, "y": p.y, "z": p.z}))
+            .collect();
         let msg = json!({
             "deletions": [],
             "entities": [{
@@ -99,7 +116,12 @@ impl TimelineRecorder {
         let w = self.writer.as_mut().expect("open writer");
         for (ch, body) in [(self.cloth, msg), (self.stats, stats)] {
             self.seq += 1;
-            let header = MessageHeader { channel_id: ch, sequence: self.seq, log_time: t_ns, publish_time: t_ns };
+            let header = MessageHeader {
+                channel_id: ch,
+                sequence: self.seq,
+                log_time: t_ns,
+                publish_time: t_ns,
+            };
             w.write_to_known_channel(&header, serde_json::to_string(&body)?.as_bytes())?;
         }
         self.last_index = Some(ev.index);

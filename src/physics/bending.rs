@@ -19,7 +19,10 @@ impl LinearBending {
     /// Triples (a, b, c), coefficients (1/h₁, −1/h₁ − 1/h₂, 1/h₂) and stiffnesses k = D w / h̄ (N·m).
     pub fn new(triples: Vec<[usize; 3]>, coef: Vec<[f64; 3]>, stiffness_N_m: Vec<f64>) -> Self {
         Self {
-            triples: triples.into_iter().map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect(),
+            triples: triples
+                .into_iter()
+                .map(|t| [t[0] as u32, t[1] as u32, t[2] as u32])
+                .collect(),
             coef,
             stiffness_N_m,
         }
@@ -36,7 +39,9 @@ impl EnergyTerm for LinearBending {
         "bending/continuum".into()
     }
     fn energy(&self, x: &Vecs) -> f64 {
-        (0..self.triples.len()).map(|k| 0.5 * self.stiffness_N_m[k] * self.u(k, x).norm_squared()).sum()
+        (0..self.triples.len())
+            .map(|k| 0.5 * self.stiffness_N_m[k] * self.u(k, x).norm_squared())
+            .sum()
     }
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
         for k in 0..self.triples.len() {
@@ -46,11 +51,22 @@ impl EnergyTerm for LinearBending {
             }
         }
     }
-    fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks) {
+    fn stiffness_scale(&self) -> f64 {
+        self.coef
+            .iter()
+            .zip(&self.stiffness_N_m)
+            .map(|(c, k)| k * c[1] * c[1])
+            .fold(0.0, f64::max)
+    }
+    fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _project: bool) {
         for k in 0..self.triples.len() {
             let t = self.triples[k];
             let idx = [t[0] as usize, t[1] as usize, t[2] as usize];
-            h.push_outer(&idx, &self.coef[k], &(Matrix3::identity() * self.stiffness_N_m[k]));
+            h.push_outer(
+                &idx,
+                &self.coef[k],
+                &(Matrix3::identity() * self.stiffness_N_m[k]),
+            );
         }
     }
 }

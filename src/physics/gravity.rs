@@ -10,7 +10,9 @@ pub struct Gravity {
 impl Gravity {
     /// Gravity on particles of masses `masses_kg` under acceleration `g_m_per_s2`.
     pub fn new(masses_kg: Vec<f64>, g_m_per_s2: f64) -> Self {
-        Self { weights_N: masses_kg.into_iter().map(|m| m * g_m_per_s2).collect() }
+        Self {
+            weights_N: masses_kg.into_iter().map(|m| m * g_m_per_s2).collect(),
+        }
     }
 }
 
@@ -26,7 +28,7 @@ impl EnergyTerm for Gravity {
             gi.z += w;
         }
     }
-    fn add_hessian(&self, _x: &Vecs, _h: &mut HessianBlocks) {}
+    fn add_hessian(&self, _x: &Vecs, _h: &mut HessianBlocks, _project: bool) {}
     fn is_external_load(&self) -> bool {
         true
     }

@@ -83,14 +83,19 @@ pub trait EnergyTerm: Send + Sync {
     fn energy(&self, x: &Vecs) -> f64;
     /// Adds ∂E/∂x (N) to `g`.
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs);
-    /// Pushes the (projected, positive semi-definite) Hessian blocks (N/m).
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks);
+    /// Pushes the Hessian blocks (N/m): exact, or with `project` its indefinite parts dropped so
+    /// that it is positive semi-definite (projected Newton). The block pattern must not depend on `project`.
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool);
     /// Largest relative elongation of the term's springs, for divergence checks (0 if none).
     fn max_strain(&self, _x: &Vecs) -> f64 {
         0.0
     }
     /// Applies Provot's position correction at elongation rate `rate` (only spring terms do).
     fn provot_correct(&self, _x: &mut Vecs, _free: &[bool], _rate: f64) {}
+    /// The largest stiffness (N/m) the term couples particles with: sets the round-off floor of forces.
+    fn stiffness_scale(&self) -> f64 {
+        0.0
+    }
     /// Whether the term is an external load, scaled by the load factor of incremental loading.
     fn is_external_load(&self) -> bool {
         false
@@ -126,7 +131,16 @@ impl Model {
     }
     /// Total potential energy in J, external loads scaled by `load` (1 = full load).
     pub fn energy(&self, x: &Vecs, load: f64) -> f64 {
-        self.terms.iter().map(|t| if t.is_external_load() { load * t.energy(x) } else { t.energy(x) }).sum()
+        self.terms
+            .iter()
+            .map(|t| {
+                if t.is_external_load() {
+                    load * t.energy(x)
+                } else {
+                    t.energy(x)
+                }
+            })
+            .sum()
     }
     /// Gradient of the total energy (N) into `g` (overwritten), external loads scaled by `load`.
     pub fn gradient(&self, x: &Vecs, load: f64, g: &mut Vec<Vector3<f64>>) {
@@ -146,11 +160,11 @@ impl Model {
             }
         }
     }
-    /// Hessian blocks of the total energy into `h` (cleared first).
-    pub fn hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
+    /// Hessian blocks of the total energy into `h` (cleared first); `project` makes it positive semi-definite.
+    pub fn hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
         h.clear();
         for t in &self.terms {
-            t.add_hessian(x, h);
+            t.add_hessian(x, h, project);
         }
     }
     /// Largest residual force on a free particle in N, from the gradient.
@@ -163,7 +177,11 @@ impl Model {
     }
     /// The weight of the lightest free particle in N, the reference of force tolerances.
     pub fn reference_weight(&self) -> f64 {
-        let g = if self.gravity_m_per_s2 > 0.0 { self.gravity_m_per_s2 } else { crate::STANDARD_GRAVITY_M_PER_S2 };
+        let g = if self.gravity_m_per_s2 > 0.0 {
+            self.gravity_m_per_s2
+        } else {
+            crate::STANDARD_GRAVITY_M_PER_S2
+        };
         self.masses
             .iter()
             .zip(&self.fixed)
@@ -171,9 +189,23 @@ impl Model {
             .map(|(m, _)| m * g)
             .fold(f64::INFINITY, f64::min)
     }
+    /// The smallest residual force (N) that round-off lets a solver resolve at positions `x`: forces
+    /// are sums of k·(l − L) where l carries an error of about ε·|x|, so r ≈ 16 ε k_max |x|_max.
+    pub fn roundoff_force(&self, x: &Vecs) -> f64 {
+        let k = self
+            .terms
+            .iter()
+            .map(|t| t.stiffness_scale())
+            .fold(0.0, f64::max);
+        let xmax = x.iter().map(|p| p.amax()).fold(0.0, f64::max);
+        16.0 * f64::EPSILON * k * xmax
+    }
     /// Largest spring strain over all terms.
     pub fn max_strain(&self, x: &Vecs) -> f64 {
-        self.terms.iter().map(|t| t.max_strain(x)).fold(0.0, f64::max)
+        self.terms
+            .iter()
+            .map(|t| t.max_strain(x))
+            .fold(0.0, f64::max)
     }
     /// Names of the terms that were built.
     pub fn term_names(&self) -> Vec<String> {
@@ -197,7 +229,12 @@ mod tests {
                 let mut xm = x.to_vec();
                 xm[p][c] -= eps;
                 let fd = (term.energy(&xp) - term.energy(&xm)) / (2.0 * eps);
-                assert!((fd - g[p][c]).abs() < 1e-5 * (1.0 + fd.abs()), "{}: d/dx[{p}][{c}] fd {fd} vs {}", term.name(), g[p][c]);
+                assert!(
+                    (fd - g[p][c]).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "{}: d/dx[{p}][{c}] fd {fd} vs {}",
+                    term.name(),
+                    g[p][c]
+                );
             }
         }
     }
@@ -206,7 +243,11 @@ mod tests {
         (0..n)
             .map(|k| {
                 let (i, j) = ((k % 3) as f64, (k / 3) as f64);
-                Vector3::new(0.1 * i + 0.01 * (k as f64).sin(), 0.1 * j + 0.013 * (k as f64 * 1.7).cos(), 0.02 * (k as f64 * 0.9).sin())
+                Vector3::new(
+                    0.1 * i + 0.01 * (k as f64).sin(),
+                    0.1 * j + 0.013 * (k as f64 * 1.7).cos(),
+                    0.02 * (k as f64 * 0.9).sin(),
+                )
             })
             .collect()
     }
@@ -214,11 +255,24 @@ mod tests {
     #[test]
     fn gradients_match_finite_differences() {
         let x = wiggle(9);
-        let springs = Springs::new(SpringFamily::Structural, vec![(0, 1), (1, 2), (3, 4), (0, 3)], vec![0.1, 0.12, 0.09, 0.1], vec![100.0; 4]);
+        let springs = Springs::new(
+            SpringFamily::Structural,
+            vec![(0, 1), (1, 2), (3, 4), (0, 3)],
+            vec![0.1, 0.12, 0.09, 0.1],
+            vec![100.0; 4],
+        );
         check_gradient(&springs, &x);
-        let bend = LinearBending::new(vec![[0, 1, 2], [3, 4, 5]], vec![[10.0, -20.0, 10.0], [8.0, -18.0, 10.0]], vec![0.3, 0.5]);
+        let bend = LinearBending::new(
+            vec![[0, 1, 2], [3, 4, 5]],
+            vec![[10.0, -20.0, 10.0], [8.0, -18.0, 10.0]],
+            vec![0.3, 0.5],
+        );
         check_gradient(&bend, &x);
-        let shear = CellShear::new(vec![[0, 1, 3, 4], [4, 5, 7, 8]], vec![(0.1, 0.1), (0.1, 0.12)], 3.0);
+        let shear = CellShear::new(
+            vec![[0, 1, 3, 4], [4, 5, 7, 8]],
+            vec![(0.1, 0.1), (0.1, 0.12)],
+            3.0,
+        );
         check_gradient(&shear, &x);
         let grav = Gravity::new(vec![0.1; 9], 9.81);
         check_gradient(&grav, &x);

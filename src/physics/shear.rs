@@ -1,7 +1,7 @@
 //! In-plane shear of the continuum model, per grid cell: with the cell's mean edge vectors
 //! e_x = ((p₁₀ − p₀₀) + (p₁₁ − p₀₁))/2 and e_y = ((p₀₁ − p₀₀) + (p₁₁ − p₁₀))/2 and rest sides
 //! h_x, h_y, the shear strain is s = e_x·e_y/(h_x h_y) (≈ sin γ for small stretch) and the energy is
-//! E = ½ G A s², A = h_x h_y. The Hessian is the Gauss–Newton part G A ∇s∇sᵀ (positive semi-definite).
+//! E = ½ G A s², A = h_x h_y. Its projected Hessian is the Gauss–Newton part G A ∇s∇sᵀ (positive semi-definite).
 
 use super::{EnergyTerm, HessianBlocks, Vecs};
 use nalgebra::{Matrix3, Vector3};
@@ -62,14 +62,20 @@ impl EnergyTerm for CellShear {
             }
         }
     }
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
+    fn stiffness_scale(&self) -> f64 {
+        self.shear_N_per_m
+    }
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
         for k in 0..self.cells.len() {
             let (hx, hy) = self.sides_m[k];
-            let (_, gr) = self.strain(k, x);
+            let (s, gr) = self.strain(k, x);
             let w = self.shear_N_per_m * hx * hy;
+            // Exact: w (∇s∇sᵀ + s ∇²s), ∇²s = (cx_a cy_b + cy_a cx_b) I / (hx hy); projected: Gauss–Newton.
+            let curv = if project { 0.0 } else { w * s / (hx * hy) };
             for a in 0..4 {
                 for b in 0..=a {
-                    let blk: Matrix3<f64> = gr[a] * gr[b].transpose() * w;
+                    let blk: Matrix3<f64> = gr[a] * gr[b].transpose() * w
+                        + Matrix3::identity() * (curv * (CX[a] * CY[b] + CY[a] * CX[b]));
                     h.push(self.cells[k][a] as usize, self.cells[k][b] as usize, blk);
                 }
             }

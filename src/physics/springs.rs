@@ -26,11 +26,19 @@ pub struct Springs {
 
 impl Springs {
     /// Springs between `pairs` with rest lengths (m) and stiffnesses (N/m).
-    pub fn new(family: SpringFamily, pairs: Vec<(usize, usize)>, rest_m: Vec<f64>, stiffness_N_per_m: Vec<f64>) -> Self {
+    pub fn new(
+        family: SpringFamily,
+        pairs: Vec<(usize, usize)>,
+        rest_m: Vec<f64>,
+        stiffness_N_per_m: Vec<f64>,
+    ) -> Self {
         assert!(pairs.len() == rest_m.len() && pairs.len() == stiffness_N_per_m.len());
         Self {
             family,
-            pairs: pairs.into_iter().map(|(a, b)| (a as u32, b as u32)).collect(),
+            pairs: pairs
+                .into_iter()
+                .map(|(a, b)| (a as u32, b as u32))
+                .collect(),
             rest_m,
             stiffness_N_per_m,
         }
@@ -71,21 +79,25 @@ impl EnergyTerm for Springs {
             g[a] -= f;
         }
     }
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
         for (k, &(a, b)) in self.pairs.iter().enumerate() {
             let (a, b) = (a as usize, b as usize);
             let d = x[b] - x[a];
             let l = d.norm().max(1e-12 * self.rest_m[k]);
             let u = d / l;
             let uu = u * u.transpose();
-            // K = k[ûûᵀ + (1 − L0/l)(I − ûûᵀ)], with the transverse factor clamped at 0 (projected Newton):
+            // K = k[ûûᵀ + (1 − L0/l)(I − ûûᵀ)]; projected, the transverse factor is clamped at 0:
             // a compressed spring contributes no negative stiffness.
-            let t = (1.0 - self.rest_m[k] / l).max(0.0);
+            let t = 1.0 - self.rest_m[k] / l;
+            let t = if project { t.max(0.0) } else { t };
             let kk = (uu + (Matrix3::identity() - uu) * t) * self.stiffness_N_per_m[k];
             h.push(a, a, kk);
             h.push(b, b, kk);
             h.push(b, a, -kk);
         }
+    }
+    fn stiffness_scale(&self) -> f64 {
+        self.stiffness_N_per_m.iter().copied().fold(0.0, f64::max)
     }
     fn max_strain(&self, x: &Vecs) -> f64 {
         self.pairs

@@ -43,6 +43,10 @@ pub struct DynamicOptions {
     /// Time step in s. Default 1e-4.
     #[serde(default = "default_dt")]
     pub dt_s: f64,
+    /// When > 0, explicit and symplectic Euler use this fraction of their estimated stability limit
+    /// ([`stability_limit_dt`] at the initial state) instead of `dt_s`. Default 0 (use `dt_s`).
+    #[serde(default)]
+    pub auto_dt_fraction: f64,
     /// Simulated time after which the solve stops with status max-iterations, in s. Default 60.
     #[serde(default = "default_max_time")]
     pub max_time_s: f64,
@@ -96,6 +100,7 @@ impl Default for DynamicOptions {
     fn default() -> Self {
         Self {
             dt_s: default_dt(),
+            auto_dt_fraction: 0.0,
             max_time_s: default_max_time(),
             residual_tol_rel: default_tol(),
             speed_tol_m_per_s: default_vtol(),
@@ -107,9 +112,108 @@ impl Default for DynamicOptions {
     }
 }
 
+/// The highest natural frequency ω_max (rad/s) at `x` and the effective mass (kg) of its mode, by
+/// power iteration on M^{-1/2} K M^{-1/2} with the projected Hessian K (60 iterations from a fixed
+/// start; a lower bound that converges to ω_max).
+pub fn highest_mode(model: &Model, x: &[Vector3<f64>]) -> (f64, f64) {
+    let mut h = HessianBlocks::default();
+    model.hessian(x, &mut h, true);
+    let n = model.len();
+    let free: Vec<bool> = model
+        .fixed
+        .iter()
+        .zip(&model.masses)
+        .map(|(f, m)| !f && *m > 0.0)
+        .collect();
+    let inv_sqrt_m: Vec<f64> = model
+        .masses
+        .iter()
+        .zip(&free)
+        .map(|(m, f)| if *f { 1.0 / m.sqrt() } else { 0.0 })
+        .collect();
+    // A deterministic, non-symmetric start so that every mode is present.
+    let mut v: Vec<Vector3<f64>> = (0..n)
+        .map(|p| {
+            let t = p as f64;
+            Vector3::new(
+                (1.3 * t).sin() + 0.1,
+                (2.1 * t + 0.4).cos(),
+                (0.7 * t + 1.1).sin(),
+            ) * if free[p] { 1.0 } else { 0.0 }
+        })
+        .collect();
+    let mut lambda = 0.0;
+    let mut tmp = vec![Vector3::zeros(); n];
+    let mut out = vec![Vector3::zeros(); n];
+    for _ in 0..60 {
+        let norm = v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
+        if norm == 0.0 {
+            return (0.0, 0.0);
+        }
+        for p in 0..n {
+            v[p] /= norm;
+            tmp[p] = v[p] * inv_sqrt_m[p];
+        }
+        out.iter_mut().for_each(|o| *o = Vector3::zeros());
+        h.mul_add(&tmp, &mut out);
+        for p in 0..n {
+            out[p] *= inv_sqrt_m[p];
+        }
+        lambda = v.iter().zip(&out).map(|(a, b)| a.dot(b)).sum::<f64>();
+        std::mem::swap(&mut v, &mut out);
+    }
+    let (mut num, mut den) = (0.0, 0.0);
+    for p in 0..n {
+        if free[p] {
+            let w = v[p].norm_squared();
+            num += w * model.masses[p];
+            den += w;
+        }
+    }
+    (
+        lambda.max(0.0).sqrt(),
+        if den > 0.0 { num / den } else { 0.0 },
+    )
+}
+
+/// The largest stable time step of an explicit integrator at `x`, from the highest mode
+/// ([`highest_mode`]): symplectic Euler needs Δt < 2/ω; forward Euler with damping c needs
+/// |1 + Δt λ| < 1 for λ = −c/2m ± iω√(1 − ζ²), i.e. Δt < c/(m ω²) when underdamped and
+/// Δt < 2/|λ_fast| when overdamped; without damping it is unstable at any Δt (0 is returned).
+/// None for implicit Euler (unconditionally stable).
+pub fn stability_limit_dt(
+    model: &Model,
+    x: &[Vector3<f64>],
+    integrator: Integrator,
+    damping_Ns_per_m: f64,
+) -> Option<f64> {
+    if integrator == Integrator::ImplicitEuler {
+        return None;
+    }
+    let (w, m) = highest_mode(model, x);
+    if w <= 0.0 || m <= 0.0 {
+        return Some(f64::INFINITY);
+    }
+    let c = damping_Ns_per_m;
+    Some(match integrator {
+        Integrator::SymplecticEuler => 2.0 / w,
+        _ if c <= 0.0 => 0.0,
+        _ if c < 2.0 * m * w => c / (m * w * w),
+        _ => {
+            let fast = c / (2.0 * m) * (1.0 + (1.0 - 4.0 * m * m * w * w / (c * c)).sqrt());
+            2.0 / fast
+        }
+    })
+}
+
 /// Kinetic energy in J.
 pub fn kinetic_energy(model: &Model, v: &[Vector3<f64>]) -> f64 {
-    model.masses.iter().zip(v).map(|(m, vi)| 0.5 * m * vi.norm_squared()).sum()
+    model
+        .masses
+        .iter()
+        .zip(v)
+        .map(|(m, vi)| 0.5 * m * vi.norm_squared())
+        .sum()
 }
 
 /// Integrates from rest at `x` (updated in place) until equilibrium, divergence or the time limit.
@@ -124,8 +228,18 @@ pub fn solve_dynamic(
 ) -> SolveReport {
     let start = Instant::now();
     let n = model.len();
-    let dt = opts.dt_s;
-    let c = if opts.damping { model.damping_Ns_per_m } else { 0.0 };
+    let c = if opts.damping {
+        model.damping_Ns_per_m
+    } else {
+        0.0
+    };
+    let dt = match (
+        opts.auto_dt_fraction > 0.0,
+        stability_limit_dt(model, x, integrator, c),
+    ) {
+        (true, Some(lim)) if lim > 0.0 && lim.is_finite() => opts.auto_dt_fraction * lim,
+        _ => opts.dt_s,
+    };
     let free: Vec<bool> = model.fixed.iter().map(|f| !f).collect();
     let w_ref = model.reference_weight();
     let mut report = SolveReport {
@@ -138,6 +252,7 @@ pub fn solve_dynamic(
         max_residual_rel: f64::NAN,
         energy_J: f64::NAN,
         sim_time_s: Some(0.0),
+        dt_s: Some(dt),
         wall_time_s: 0.0,
         divergence: None,
         message: String::new(),
@@ -149,15 +264,24 @@ pub fn solve_dynamic(
     }
     let total_weight: f64 = model.masses.iter().sum::<f64>() * model.gravity_m_per_s2.max(1.0);
     let extent = {
-        let (lo, hi) = x.iter().fold((Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY)), |(lo, hi), p| {
-            (lo.inf(p), hi.sup(p))
-        });
+        let (lo, hi) = x.iter().fold(
+            (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
         (hi - lo).norm().max(1e-3)
     };
     let e0 = model.energy(x, 1.0) + kinetic_energy(model, v);
     let blowup = 100.0 * total_weight * extent + 100.0 * e0.abs();
     let max_steps = (opts.max_time_s / dt).ceil() as usize;
-    let inv_m: Vec<f64> = model.masses.iter().zip(&free).map(|(m, f)| if *f && *m > 0.0 { 1.0 / m } else { 0.0 }).collect();
+    let inv_m: Vec<f64> = model
+        .masses
+        .iter()
+        .zip(&free)
+        .map(|(m, f)| if *f && *m > 0.0 { 1.0 / m } else { 0.0 })
+        .collect();
     for (vi, f) in v.iter_mut().zip(&free) {
         if !f {
             *vi = Vector3::zeros();
@@ -177,7 +301,13 @@ pub fn solve_dynamic(
             let etot = epot + kinetic_energy(model, v);
             let time = step as f64 * dt;
             if want {
-                observer.observe(&StateEvent { index: step, time_s: Some(time), x, max_residual_N: r, energy_J: etot });
+                observer.observe(&StateEvent {
+                    index: step,
+                    time_s: Some(time),
+                    x,
+                    max_residual_N: r,
+                    energy_J: etot,
+                });
             }
             let reason = if !etot.is_finite() || !r.is_finite() {
                 Some("non-finite".to_string())
@@ -185,21 +315,31 @@ pub fn solve_dynamic(
                 Some(format!("energy blow-up: {etot:.3e} J from {e0:.3e} J"))
             } else {
                 let s = model.max_strain(x);
-                (s > opts.strain_bound).then(|| format!("strain {s:.3e} beyond bound {}", opts.strain_bound))
+                (s > opts.strain_bound)
+                    .then(|| format!("strain {s:.3e} beyond bound {}", opts.strain_bound))
             };
             if let Some(reason) = reason {
                 report.status = Status::Diverged;
-                report.divergence = Some(Divergence { step, dt_s: Some(dt), reason: reason.clone() });
+                report.divergence = Some(Divergence {
+                    step,
+                    dt_s: Some(dt),
+                    reason: reason.clone(),
+                });
                 report.message = format!("diverged at step {step} (dt = {dt:e} s): {reason}");
                 break;
             }
-            if r <= opts.residual_tol_rel * w_ref && vmax <= opts.speed_tol_m_per_s {
+            if r <= (opts.residual_tol_rel * w_ref).max(model.roundoff_force(x))
+                && vmax <= opts.speed_tol_m_per_s
+            {
                 report.status = Status::Converged;
                 report.message = format!("equilibrium at t = {time:.4} s after {step} steps");
                 break;
             }
             if step >= max_steps {
-                report.message = format!("no equilibrium within {} s (residual {r:.3e} N, speed {vmax:.3e} m/s)", opts.max_time_s);
+                report.message = format!(
+                    "no equilibrium within {} s (residual {r:.3e} N, speed {vmax:.3e} m/s)",
+                    opts.max_time_s
+                );
                 break;
             }
         } else {
@@ -289,23 +429,46 @@ impl ImplicitState {
 
     /// One Baraff–Witkin step; returns the CG iterations used.
     #[allow(clippy::too_many_arguments)]
-    fn step(&mut self, model: &Model, x: &mut [Vector3<f64>], v: &mut [Vector3<f64>], g: &[Vector3<f64>], c: f64, dt: f64, tol: f64) -> usize {
+    fn step(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        v: &mut [Vector3<f64>],
+        g: &[Vector3<f64>],
+        c: f64,
+        dt: f64,
+        tol: f64,
+    ) -> usize {
         let n = model.len();
-        model.hessian(x, &mut self.h);
+        model.hessian(x, &mut self.h, true);
         // b = Δt (f − Δt K v), f = −∇E − c v
         let mut kv = vec![Vector3::zeros(); n];
         self.h.mul_add(v, &mut kv);
-        let masked = |p: usize, val: Vector3<f64>| if self.dofs.dof(p).is_some() { val } else { Vector3::zeros() };
-        let b: Vec<Vector3<f64>> = (0..n).map(|p| masked(p, (-g[p] - v[p] * c - kv[p] * dt) * dt)).collect();
+        let masked = |p: usize, val: Vector3<f64>| {
+            if self.dofs.dof(p).is_some() {
+                val
+            } else {
+                Vector3::zeros()
+            }
+        };
+        let b: Vec<Vector3<f64>> = (0..n)
+            .map(|p| masked(p, (-g[p] - v[p] * c - kv[p] * dt) * dt))
+            .collect();
         let diag = self.h.diagonal(n);
         self.precond = (0..n)
             .map(|p| {
                 let a = diag[p] * (dt * dt) + Matrix3::identity() * (model.masses[p] + dt * c);
-                if self.dofs.dof(p).is_some() { a.try_inverse().unwrap_or_else(Matrix3::identity) } else { Matrix3::zeros() }
+                if self.dofs.dof(p).is_some() {
+                    a.try_inverse().unwrap_or_else(Matrix3::identity)
+                } else {
+                    Matrix3::zeros()
+                }
             })
             .collect();
         // Preconditioned conjugate gradients from Δv = 0.
-        let dot = |a: &[Vector3<f64>], b: &[Vector3<f64>]| a.iter().zip(b).map(|(x, y)| x.dot(y)).sum::<f64>();
+        let dot = |a: &[Vector3<f64>], b: &[Vector3<f64>]| {
+            a.iter().zip(b).map(|(x, y)| x.dot(y)).sum::<f64>()
+        };
         self.dv.iter_mut().for_each(|d| *d = Vector3::zeros());
         self.r.copy_from_slice(&b);
         for p in 0..n {

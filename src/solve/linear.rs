@@ -30,7 +30,10 @@ impl DofMap {
                 n += 3;
             }
         }
-        Self { first, n: n as usize }
+        Self {
+            first,
+            n: n as usize,
+        }
     }
     /// First DOF of particle p, if free.
     #[inline]
@@ -44,7 +47,11 @@ impl DofMap {
 /// pattern and its symbolic Cholesky kept between calls.
 pub struct SparseSpd {
     pattern_pairs: Vec<(u32, u32)>,
-    symbolic: Option<(SymbolicSparseColMat<usize>, Argsort<usize>, SymbolicLlt<usize>)>,
+    symbolic: Option<(
+        SymbolicSparseColMat<usize>,
+        Argsort<usize>,
+        SymbolicLlt<usize>,
+    )>,
     values: Vec<f64>,
     /// Number of numeric factorizations done.
     pub factorizations: usize,
@@ -60,12 +67,19 @@ impl SparseSpd {
     /// An empty solver; the pattern is analysed at the first factorization.
     pub fn new() -> Self {
         faer::set_global_parallelism(Par::Seq);
-        Self { pattern_pairs: Vec::new(), symbolic: None, values: Vec::new(), factorizations: 0 }
+        Self {
+            pattern_pairs: Vec::new(),
+            symbolic: None,
+            values: Vec::new(),
+            factorizations: 0,
+        }
     }
 
     fn entries(dofs: &DofMap, h: &HessianBlocks, mut visit: impl FnMut(usize, usize, f64)) {
         for (&(p, q), b) in h.pairs.iter().zip(&h.blocks) {
-            let (Some(dp), Some(dq)) = (dofs.dof(p as usize), dofs.dof(q as usize)) else { continue };
+            let (Some(dp), Some(dq)) = (dofs.dof(p as usize), dofs.dof(q as usize)) else {
+                continue;
+            };
             for r in 0..3 {
                 for c in 0..3 {
                     if p != q || r >= c {
@@ -78,7 +92,12 @@ impl SparseSpd {
 
     /// Factorizes H + diag(shift) over the free DOFs. Returns None when the matrix is not
     /// positive definite (the caller raises its damping and tries again).
-    pub fn factorize(&mut self, dofs: &DofMap, h: &HessianBlocks, shift: &[f64]) -> Option<Llt<usize, f64>> {
+    pub fn factorize(
+        &mut self,
+        dofs: &DofMap,
+        h: &HessianBlocks,
+        shift: &[f64],
+    ) -> Option<Llt<usize, f64>> {
         let n = dofs.n;
         if self.symbolic.is_none() || h.pairs != self.pattern_pairs {
             let mut idx: Vec<Pair<usize, usize>> = Vec::new();

@@ -8,7 +8,9 @@ mod linear;
 mod newton;
 mod report;
 
-pub use dynamic::{DynamicOptions, Integrator, solve_dynamic};
+pub use dynamic::{
+    DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
+};
 pub use linear::{DofMap, SparseSpd};
 pub use newton::{StaticOptions, solve_static};
 pub use report::{Divergence, SolveReport, Status};

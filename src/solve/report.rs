@@ -60,6 +60,8 @@ pub struct SolveReport {
     pub energy_J: f64,
     /// Simulated time in s (dynamics).
     pub sim_time_s: Option<f64>,
+    /// Time step used in s (dynamics).
+    pub dt_s: Option<f64>,
     /// Wall time of the solve in s.
     pub wall_time_s: f64,
     /// Set when status is diverged.

@@ -3,5 +3,6 @@
 
 mod cli;
 mod engine;
+mod pipeline;
 mod recordings;
 mod support;

@@ -12,7 +12,12 @@ fn simulate_recorded(extra: &[&str]) -> tempfile::TempDir {
         .arg(root().join("datasets/scenes/hang4.toml"))
         .arg("--out")
         .arg(&out)
-        .args(["--set", "record.timeline=true", "--set", "record.rerun=true"])
+        .args([
+            "--set",
+            "record.timeline=true",
+            "--set",
+            "record.rerun=true",
+        ])
         .args(extra)
         .output()
         .unwrap();
@@ -22,7 +27,17 @@ fn simulate_recorded(extra: &[&str]) -> tempfile::TempDir {
 
 #[test]
 fn python_mcap_reader_decodes_every_message_of_a_static_and_a_dynamic_timeline() {
-    for extra in [vec![], vec!["--set", "solver.kind=implicit-euler", "--set", "solver.dynamic.dt_s=0.01", "--set", "record.every=5"]] {
+    for extra in [
+        vec![],
+        vec![
+            "--set",
+            "solver.kind=implicit-euler",
+            "--set",
+            "solver.dynamic.dt_s=0.01",
+            "--set",
+            "record.every=5",
+        ],
+    ] {
         let tmp = simulate_recorded(&extra);
         let path = tmp.path().join("o/timeline.mcap");
         let out = run_python(

@@ -10,8 +10,13 @@ pub fn root() -> PathBuf {
 
 /// Loads a bundled scene with `--set`-style overrides.
 pub fn scene(name: &str, sets: &[&str]) -> Scene {
-    let overrides: Vec<_> = sets.iter().map(|s| parse_override(s).expect("override")).collect();
-    Scene::load(&root().join("datasets/scenes").join(name), &overrides).expect("valid scene").scene
+    let overrides: Vec<_> = sets
+        .iter()
+        .map(|s| parse_override(s).expect("override"))
+        .collect();
+    Scene::load(&root().join("datasets/scenes").join(name), &overrides)
+        .expect("valid scene")
+        .scene
 }
 
 /// The drapelab binary built for these tests.
@@ -25,14 +30,27 @@ pub fn python() -> PathBuf {
         return PathBuf::from(p);
     }
     let venv = root().join(".venv/bin/python");
-    assert!(venv.exists(), "no Python readers: run `bash .ci/run` once (it creates .venv with mcap, rerun-sdk, pyarrow, polars)");
+    assert!(
+        venv.exists(),
+        "no Python readers: run `bash .ci/run` once (it creates .venv with mcap, rerun-sdk, pyarrow, polars)"
+    );
     venv
 }
 
 /// Runs a Python snippet with arguments; panics with its output if it fails.
 pub fn run_python(code: &str, args: &[&Path]) -> String {
-    let out = std::process::Command::new(python()).arg("-c").arg(code).args(args).output().expect("python runs");
+    let out = std::process::Command::new(python())
+        .arg("-c")
+        .arg(code)
+        .args(args)
+        .output()
+        .expect("python runs");
     let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(out.status.success(), "python failed:\n{}\n{}", stdout, String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "python failed:\n{}\n{}",
+        stdout,
+        String::from_utf8_lossy(&out.stderr)
+    );
     stdout
 }

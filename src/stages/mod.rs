@@ -1,0 +1,113 @@
+//! Stage kinds: one thin file each, glue over the library. A kind checks its parameters when the
+//! plan is loaded (so typos are refused before anything runs) and runs with a [`StageContext`].
+
+mod report;
+mod simulate;
+mod sweep;
+
+pub use report::ReportParams;
+pub use simulate::SimulateParams;
+pub use sweep::{Axis, Design, SweepParams, sweep_points};
+
+use crate::pipeline::{Plan, PlannedStage, Progress};
+use anyhow::Result;
+use std::path::PathBuf;
+
+/// What a stage gets to run.
+pub struct StageContext<'a> {
+    /// The plan (for the root and run folder).
+    pub plan: &'a Plan,
+    /// The stage.
+    pub stage: &'a PlannedStage,
+    /// Input files, absolute, sorted.
+    pub inputs: Vec<PathBuf>,
+    /// Declared outputs, absolute, in declared order.
+    pub outputs: Vec<PathBuf>,
+    /// Where to report items.
+    pub progress: &'a dyn Progress,
+}
+
+/// The known stage kinds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StageKind {
+    /// Solve one scene.
+    Simulate,
+    /// Solve scenes over a grid or Latin hypercube of scene keys.
+    Sweep,
+    /// Summaries and plots over Parquet tables, as Markdown.
+    Report,
+}
+
+/// Deserializes a stage's params table into `T`, naming the bad key.
+pub(crate) fn typed_params<T: serde::de::DeserializeOwned>(
+    params: &toml::Table,
+) -> Result<T, (String, String)> {
+    serde_path_to_error::deserialize(toml::Value::Table(params.clone())).map_err(|e| {
+        let path = e.path().to_string();
+        (
+            if path == "." { String::new() } else { path },
+            e.into_inner()
+                .to_string()
+                .lines()
+                .next()
+                .unwrap_or("invalid")
+                .to_string(),
+        )
+    })
+}
+
+impl StageKind {
+    /// Names of all kinds.
+    pub const ALL: [&'static str; 3] = ["simulate", "sweep", "report"];
+
+    /// The kind of a name.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "simulate" => Some(Self::Simulate),
+            "sweep" => Some(Self::Sweep),
+            "report" => Some(Self::Report),
+            _ => None,
+        }
+    }
+    /// The kind's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Simulate => "simulate",
+            Self::Sweep => "sweep",
+            Self::Report => "report",
+        }
+    }
+    /// Checks parameters: Err((key, message)).
+    pub fn check_params(self, params: &toml::Table) -> Result<(), (String, String)> {
+        match self {
+            Self::Simulate => typed_params::<SimulateParams>(params).map(|_| ()),
+            Self::Sweep => typed_params::<SweepParams>(params).and_then(|p| p.check()),
+            Self::Report => typed_params::<ReportParams>(params).map(|_| ()),
+        }
+    }
+    /// The parameters with defaults filled in, as JSON (part of the up-to-date key).
+    pub fn resolve_params(self, params: &toml::Table) -> serde_json::Value {
+        let v = match self {
+            Self::Simulate => typed_params::<SimulateParams>(params)
+                .ok()
+                .map(|p| serde_json::to_value(p)),
+            Self::Sweep => typed_params::<SweepParams>(params)
+                .ok()
+                .map(|p| serde_json::to_value(p)),
+            Self::Report => typed_params::<ReportParams>(params)
+                .ok()
+                .map(|p| serde_json::to_value(p)),
+        };
+        v.and_then(|r| r.ok()).unwrap_or(serde_json::Value::Null)
+    }
+    /// Runs the stage.
+    pub fn run(self, ctx: &StageContext<'_>) -> Result<()> {
+        let params = &ctx.stage.spec.params;
+        let bad = |(k, m): (String, String)| anyhow::anyhow!("params.{k}: {m}");
+        match self {
+            Self::Simulate => simulate::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Sweep => sweep::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Report => report::run(ctx, &typed_params(params).map_err(bad)?),
+        }
+    }
+}

@@ -1,0 +1,352 @@
+//! `sweep`: every input scene solved at every point of a grid or a Latin hypercube over scene keys,
+//! in parallel (rayon), into one Parquet table. The schema is documented in the README.
+
+use super::StageContext;
+use crate::cloth::Corner;
+use crate::io::write_atomic;
+use crate::scene::Scene;
+use crate::simulate::solve_scene;
+use crate::solve::{NoObserver, Status};
+use anyhow::{Result, bail};
+use arrow::array::{
+    ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
+};
+use arrow::datatypes::{DataType, Field, Schema};
+use parquet::arrow::ArrowWriter;
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// How sweep points are chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Design {
+    /// The Cartesian product of every axis's values.
+    #[default]
+    Grid,
+    /// A Latin hypercube of `samples` points over the axes' ranges (or value lists).
+    Lhs,
+}
+
+/// One swept key: a list of values, or a range (Latin hypercube only).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Axis {
+    /// Values to take (numbers, strings).
+    Values(Vec<toml::Value>),
+    /// A range [min, max]; integers when both bounds are integers.
+    Range {
+        /// Lower bound.
+        min: toml::Value,
+        /// Upper bound.
+        max: toml::Value,
+    },
+}
+
+/// Parameters of a sweep stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepParams {
+    /// "grid" (default) or "lhs".
+    #[serde(default)]
+    pub design: Design,
+    /// Points of a Latin hypercube. Default 16.
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Seed of the Latin hypercube. Default 0.
+    #[serde(default)]
+    pub seed: u64,
+    /// Swept keys by dotted path; "cloth.nx,cloth.ny" sets both keys to each value.
+    pub axes: BTreeMap<String, Axis>,
+    /// Keys fixed for every point.
+    #[serde(default)]
+    pub set: BTreeMap<String, toml::Value>,
+}
+
+fn default_samples() -> usize {
+    16
+}
+
+fn as_f64(v: &toml::Value) -> Option<f64> {
+    v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
+}
+
+impl SweepParams {
+    /// Checks the axes against the design: Err((key, message)).
+    pub fn check(&self) -> Result<(), (String, String)> {
+        if self.axes.is_empty() {
+            return Err(("axes".into(), "give at least one axis".into()));
+        }
+        for (k, a) in &self.axes {
+            match a {
+                Axis::Values(v) if v.is_empty() => {
+                    return Err((format!("axes.{k}"), "an empty list of values".into()));
+                }
+                Axis::Range { min, max } => {
+                    if self.design == Design::Grid {
+                        return Err((
+                            format!("axes.{k}"),
+                            "a grid needs a list of values; ranges are for design = \"lhs\"".into(),
+                        ));
+                    }
+                    match (as_f64(min), as_f64(max)) {
+                        (Some(a), Some(b)) if a.is_finite() && b.is_finite() && a <= b => {}
+                        _ => {
+                            return Err((
+                                format!("axes.{k}"),
+                                "min and max must be finite numbers with min ≤ max".into(),
+                            ));
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+        if self.design == Design::Lhs && self.samples == 0 {
+            return Err(("samples".into(), "must be ≥ 1".into()));
+        }
+        Ok(())
+    }
+}
+
+/// The sweep's points: for each, the value of each axis (in key order).
+pub fn sweep_points(p: &SweepParams) -> Vec<Vec<toml::Value>> {
+    let axes: Vec<&Axis> = p.axes.values().collect();
+    match p.design {
+        Design::Grid => {
+            let mut pts: Vec<Vec<toml::Value>> = vec![vec![]];
+            for a in axes {
+                let Axis::Values(vals) = a else {
+                    unreachable!("checked")
+                };
+                pts = pts
+                    .into_iter()
+                    .flat_map(|pt| {
+                        vals.iter()
+                            .map(move |v| [pt.clone(), vec![v.clone()]].concat())
+                    })
+                    .collect();
+            }
+            pts
+        }
+        Design::Lhs => {
+            let n = p.samples;
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(p.seed);
+            let mut cols = Vec::new();
+            for a in axes {
+                let mut strata: Vec<usize> = (0..n).collect();
+                strata.shuffle(&mut rng);
+                let col: Vec<toml::Value> = strata
+                    .iter()
+                    .map(|&s| {
+                        let u = (s as f64 + rng.random::<f64>()) / n as f64;
+                        match a {
+                            Axis::Values(vals) => {
+                                vals[((u * vals.len() as f64) as usize).min(vals.len() - 1)].clone()
+                            }
+                            Axis::Range { min, max } => {
+                                let (lo, hi) =
+                                    (as_f64(min).unwrap_or(0.0), as_f64(max).unwrap_or(0.0));
+                                let x = lo + u * (hi - lo);
+                                if min.is_integer() && max.is_integer() {
+                                    toml::Value::Integer(x.round() as i64)
+                                } else {
+                                    toml::Value::Float(x)
+                                }
+                            }
+                        }
+                    })
+                    .collect();
+                cols.push(col);
+            }
+            (0..n)
+                .map(|i| cols.iter().map(|c| c[i].clone()).collect())
+                .collect()
+        }
+    }
+}
+
+/// Results of one point.
+struct PointResult {
+    scene: String,
+    point: u32,
+    particles: u32,
+    solver: String,
+    status: Status,
+    iterations: u64,
+    linear_solves: u64,
+    wall_time_s: f64,
+    max_residual_N: f64,
+    /// centre z, min z, corners (x, y, z) × 4; None unless converged.
+    measures: Option<Vec<f64>>,
+}
+
+const CORNERS: [(Corner, &str); 4] = [
+    (Corner::XminYmin, "xmin_ymin"),
+    (Corner::XmaxYmin, "xmax_ymin"),
+    (Corner::XminYmax, "xmin_ymax"),
+    (Corner::XmaxYmax, "xmax_ymax"),
+];
+
+/// Names of the measure columns, in order.
+pub fn measure_columns() -> Vec<String> {
+    let mut v = vec!["centre_z_m".to_string(), "min_z_m".to_string()];
+    for (_, n) in CORNERS {
+        for c in ["x", "y", "z"] {
+            v.push(format!("corner_{n}_{c}_m"));
+        }
+    }
+    v
+}
+
+/// Runs the stage.
+pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
+    if ctx.inputs.is_empty() {
+        bail!("a sweep needs at least one scene file as input");
+    }
+    let points = sweep_points(p);
+    let keys: Vec<&String> = p.axes.keys().collect();
+    // Load every scene at every point first: bad values are refused before any work.
+    let mut jobs = Vec::new();
+    for file in &ctx.inputs {
+        for (i, pt) in points.iter().enumerate() {
+            let mut overrides: Vec<(String, toml::Value)> =
+                p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
+            for (k, v) in keys.iter().zip(pt) {
+                for sub in k.split(',') {
+                    overrides.push((sub.trim().to_string(), v.clone()));
+                }
+            }
+            let mut scene = Scene::load(file, &overrides)?.scene;
+            scene.record.timeline = false;
+            scene.record.rerun = false;
+            jobs.push((i as u32, scene));
+        }
+    }
+    let name = &ctx.stage.name;
+    ctx.progress.stage_started(name, jobs.len() as u64);
+    let results: Vec<PointResult> = jobs
+        .par_iter()
+        .map(|(i, scene)| {
+            let sol = solve_scene(scene, &mut NoObserver);
+            let converged = sol.report.status == Status::Converged;
+            let measures = converged.then(|| {
+                let g = &sol.grid;
+                let mut m = vec![
+                    sol.at(g.nx / 2, g.ny / 2).z,
+                    sol.grid_positions()
+                        .iter()
+                        .map(|p| p.z)
+                        .fold(f64::INFINITY, f64::min),
+                ];
+                for (c, _) in CORNERS {
+                    let (ci, cj) = c.ij(g);
+                    let q = sol.at(ci, cj);
+                    m.extend([q.x, q.y, q.z]);
+                }
+                m
+            });
+            ctx.progress.item_done(name);
+            PointResult {
+                scene: scene.name.clone(),
+                point: *i,
+                particles: sol.grid.len() as u32,
+                solver: sol.report.solver.clone(),
+                status: sol.report.status,
+                iterations: sol.report.iterations as u64,
+                linear_solves: sol.report.linear_solves as u64,
+                wall_time_s: sol.report.wall_time_s,
+                max_residual_N: sol.report.max_residual_N,
+                measures,
+            }
+        })
+        .collect();
+    // Columns.
+    let mut fields = vec![
+        Field::new("scene", DataType::Utf8, false),
+        Field::new("point", DataType::UInt32, false),
+    ];
+    let mut cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(
+            results.iter().map(|r| r.scene.clone()),
+        )),
+        Arc::new(UInt32Array::from_iter_values(
+            results.iter().map(|r| r.point),
+        )),
+    ];
+    for (a, key) in keys.iter().enumerate() {
+        let vals: Vec<&toml::Value> = results
+            .iter()
+            .map(|r| &points[r.point as usize][a])
+            .collect();
+        let col_name = key.split(',').next().unwrap_or(key).trim().to_string();
+        if vals.iter().all(|v| v.is_integer()) {
+            fields.push(Field::new(col_name, DataType::Int64, false));
+            cols.push(Arc::new(Int64Array::from_iter_values(
+                vals.iter().map(|v| v.as_integer().unwrap_or(0)),
+            )));
+        } else if vals.iter().all(|v| as_f64(v).is_some()) {
+            fields.push(Field::new(col_name, DataType::Float64, false));
+            cols.push(Arc::new(Float64Array::from_iter_values(
+                vals.iter().map(|v| as_f64(v).unwrap_or(f64::NAN)),
+            )));
+        } else {
+            fields.push(Field::new(col_name, DataType::Utf8, false));
+            cols.push(Arc::new(StringArray::from_iter_values(vals.iter().map(
+                |v| {
+                    v.as_str()
+                        .map(str::to_string)
+                        .unwrap_or_else(|| v.to_string())
+                },
+            ))));
+        }
+    }
+    fields.extend([
+        Field::new("particles", DataType::UInt32, false),
+        Field::new("solver", DataType::Utf8, false),
+        Field::new("status", DataType::Utf8, false),
+        Field::new("iterations", DataType::UInt64, false),
+        Field::new("linear_solves", DataType::UInt64, false),
+        Field::new("wall_time_s", DataType::Float64, false),
+        Field::new("max_residual_N", DataType::Float64, true),
+    ]);
+    cols.push(Arc::new(UInt32Array::from_iter_values(
+        results.iter().map(|r| r.particles),
+    )));
+    cols.push(Arc::new(StringArray::from_iter_values(
+        results.iter().map(|r| r.solver.clone()),
+    )));
+    cols.push(Arc::new(StringArray::from_iter_values(
+        results.iter().map(|r| r.status.as_str()),
+    )));
+    cols.push(Arc::new(UInt64Array::from_iter_values(
+        results.iter().map(|r| r.iterations),
+    )));
+    cols.push(Arc::new(UInt64Array::from_iter_values(
+        results.iter().map(|r| r.linear_solves),
+    )));
+    cols.push(Arc::new(Float64Array::from_iter_values(
+        results.iter().map(|r| r.wall_time_s),
+    )));
+    cols.push(Arc::new(Float64Array::from_iter(results.iter().map(|r| {
+        r.max_residual_N.is_finite().then_some(r.max_residual_N)
+    }))));
+    for (m, name) in measure_columns().into_iter().enumerate() {
+        fields.push(Field::new(name, DataType::Float64, true));
+        cols.push(Arc::new(Float64Array::from_iter(
+            results.iter().map(|r| r.measures.as_ref().map(|v| v[m])),
+        )));
+    }
+    let schema = Arc::new(Schema::new(fields));
+    let batch = RecordBatch::try_new(schema.clone(), cols)?;
+    write_atomic(&ctx.outputs[0], |f| {
+        let mut w = ArrowWriter::try_new(f, schema, None)?;
+        w.write(&batch)?;
+        w.close()?;
+        Ok(())
+    })?;
+    Ok(())
+}

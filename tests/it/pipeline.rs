@@ -1,0 +1,282 @@
+//! Make-style pipelines: the cache, forced reruns, staleness reasons, atomicity under kill -9, bad
+//! pipeline files, and a real client reading the sweep dataset. A failure here means stale results
+//! are served as fresh, or a killed run leaves a wrong artifact.
+
+use crate::support::{drapelab, root, run_python};
+use drapelab::pipeline::{
+    LogProgress, RunOptions, StageState, load_plan, run_pipeline, stage_states,
+};
+use std::path::{Path, PathBuf};
+
+const PIPELINE: &str = r#"
+name = "t"
+[stages.a4]
+kind = "simulate"
+inputs = ["datasets/scenes/hang4.toml"]
+outputs = ["{run}/a4/particles.parquet", "{run}/a4/run.json"]
+params.set = { "cloth.nx" = 9, "cloth.ny" = 9 }
+
+[stages.a2]
+kind = "simulate"
+inputs = ["datasets/scenes/hang2.toml"]
+outputs = ["{run}/a2/particles.parquet", "{run}/a2/run.json"]
+params.set = { "cloth.nx" = 9, "cloth.ny" = 9 }
+
+[stages.sweep2]
+kind = "sweep"
+inputs = ["datasets/scenes/hang2.toml"]
+outputs = ["{run}/sweep2/sweep.parquet"]
+params.axes = { "material.mass_spring.stiffness_N_per_m" = [600.0, 1100.0], "cloth.nx,cloth.ny" = [7, 9] }
+
+[stages.report]
+kind = "report"
+inputs = ["{run}/sweep2/*.parquet"]
+outputs = ["reports/t.md", "reports/t.svg"]
+params = { title = "t", x = "material.mass_spring.stiffness_N_per_m", group_by = ["scene", "cloth.nx"] }
+"#;
+
+/// A temporary project with the bundled scenes and a pipeline file.
+fn project(pipeline: &str) -> (tempfile::TempDir, PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenes = tmp.path().join("datasets/scenes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    for s in ["hang4.toml", "hang2.toml"] {
+        std::fs::copy(root().join("datasets/scenes").join(s), scenes.join(s)).unwrap();
+    }
+    std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
+    let file = tmp.path().join("pipelines/t.toml");
+    std::fs::write(&file, pipeline).unwrap();
+    (tmp, file)
+}
+
+fn run(file: &Path, opts: RunOptions) -> drapelab::pipeline::RunSummary {
+    let plan = load_plan(file).unwrap();
+    run_pipeline(
+        &plan,
+        &RunOptions { jobs: 2, ..opts },
+        &LogProgress::default(),
+    )
+    .unwrap()
+}
+
+fn sorted(mut v: Vec<String>) -> Vec<String> {
+    v.sort();
+    v
+}
+
+#[test]
+fn second_run_skips_everything_and_a_changed_input_reruns_only_its_dependents() {
+    let (tmp, file) = project(PIPELINE);
+    let first = run(&file, RunOptions::default());
+    assert!(first.failed.is_empty(), "{:?}", first.failed);
+    assert_eq!(sorted(first.ran), ["a2", "a4", "report", "sweep2"]);
+    let second = run(&file, RunOptions::default());
+    assert!(second.ran.is_empty(), "{:?}", second.ran);
+    assert_eq!(second.skipped.len(), 4);
+    // Change hang2's scene: a2, sweep2 and report rerun, a4 does not.
+    let h2 = tmp.path().join("datasets/scenes/hang2.toml");
+    let text = std::fs::read_to_string(&h2)
+        .unwrap()
+        .replace("stiffness_N_per_m = 1000.0", "stiffness_N_per_m = 900.0");
+    std::fs::write(&h2, text).unwrap();
+    let plan = load_plan(&file).unwrap();
+    let states = stage_states(&plan);
+    let why = |n: &str| states.iter().find(|(s, _)| s == n).unwrap().1.clone();
+    assert_eq!(why("a4"), StageState::UpToDate);
+    assert!(matches!(why("a2"), StageState::Stale(w) if w.contains("hang2.toml")));
+    let third = run(&file, RunOptions::default());
+    assert_eq!(sorted(third.ran), ["a2", "report", "sweep2"]);
+    assert_eq!(third.skipped, ["a4"]);
+}
+
+#[test]
+fn force_reruns_the_stage_and_its_dependents_and_a_changed_parameter_is_reported() {
+    let (_tmp, file) = project(PIPELINE);
+    run(&file, RunOptions::default());
+    let forced = run(
+        &file,
+        RunOptions {
+            force: vec!["sweep2".into()],
+            ..Default::default()
+        },
+    );
+    assert_eq!(sorted(forced.ran), ["report", "sweep2"]);
+    let until = run(
+        &file,
+        RunOptions {
+            force: vec!["a4".into()],
+            until: Some("a4".into()),
+            ..Default::default()
+        },
+    );
+    assert_eq!(until.ran, ["a4"]);
+    // A parameter change makes the stage stale, and status says which.
+    std::fs::write(
+        &file,
+        PIPELINE.replace(
+            r#""cloth.nx" = 9, "cloth.ny" = 9 }
+"#,
+            r#""cloth.nx" = 7, "cloth.ny" = 9 }
+"#,
+        ),
+    )
+    .unwrap();
+    let plan = load_plan(&file).unwrap();
+    let states = stage_states(&plan);
+    let a4 = &states.iter().find(|(s, _)| s == "a4").unwrap().1;
+    assert!(
+        matches!(a4, StageState::Stale(w) if w.contains("parameter changed: set")),
+        "{a4:?}"
+    );
+    let out = drapelab().arg("status").arg(&file).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("a4: stale (parameter changed: set)"),
+        "{text}"
+    );
+    assert!(text.contains("sweep2: up to date"), "{text}");
+}
+
+#[test]
+fn a_run_killed_mid_stage_completes_to_the_same_artifacts() {
+    let (clean, clean_file) = project(PIPELINE);
+    assert!(
+        drapelab()
+            .arg("run")
+            .arg(&clean_file)
+            .output()
+            .unwrap()
+            .status
+            .success()
+    );
+    let (tmp, file) = project(PIPELINE);
+    // Kill at several moments; each rerun finishes only what is missing.
+    for delay_ms in [150u64, 400, 900] {
+        let mut child = drapelab()
+            .arg("run")
+            .arg(&file)
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        child.kill().unwrap(); // SIGKILL
+        child.wait().unwrap();
+    }
+    let out = drapelab().arg("run").arg(&file).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let again = drapelab().arg("run").arg(&file).output().unwrap();
+    assert!(
+        String::from_utf8_lossy(&again.stderr).contains("0 ran, 4 up to date"),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    for p in ["runs/t/a4/particles.parquet", "runs/t/a2/particles.parquet"] {
+        assert_eq!(
+            std::fs::read(tmp.path().join(p)).unwrap(),
+            std::fs::read(clean.path().join(p)).unwrap(),
+            "{p} differs"
+        );
+    }
+    // The sweep is deterministic but for its wall times.
+    let code = r#"
+import sys, pyarrow.parquet as pq
+a, b = (pq.read_table(p).drop(["wall_time_s"]) for p in sys.argv[1:3])
+assert a.equals(b), (a, b)
+"#;
+    run_python(
+        code,
+        &[
+            &tmp.path().join("runs/t/sweep2/sweep.parquet"),
+            &clean.path().join("runs/t/sweep2/sweep.parquet"),
+        ],
+    );
+}
+
+fn assert_bad_pipeline(text: &str, stage: &str, what: &str) {
+    let (_tmp, file) = project(text);
+    let out = drapelab().arg("run").arg(&file).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{what}: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{what}: {err}");
+    assert!(
+        lines[0].contains("t.toml") && lines[0].contains(stage),
+        "{what}: {err}"
+    );
+}
+
+#[test]
+fn bad_pipeline_files_are_refused_naming_file_and_stage() {
+    let cycle = r#"
+name = "t"
+[stages.x]
+kind = "report"
+inputs = ["{run}/y.parquet"]
+outputs = ["{run}/x.parquet", "reports/x.md", "reports/x.svg"]
+params = { title = "x", x = "a" }
+[stages.y]
+kind = "report"
+inputs = ["{run}/x.parquet"]
+outputs = ["{run}/y.parquet", "reports/y.md", "reports/y.svg"]
+params = { title = "y", x = "a" }
+"#;
+    assert_bad_pipeline(cycle, "stages.x", "cycle");
+    assert_bad_pipeline(
+        &PIPELINE.replace("kind = \"sweep\"", "kind = \"swep\""),
+        "stages.sweep2.kind",
+        "unknown kind",
+    );
+    assert_bad_pipeline(
+        &PIPELINE.replace("datasets/scenes/hang4.toml", "datasets/scenes/nope.toml"),
+        "stages.a4.inputs",
+        "missing input",
+    );
+    assert_bad_pipeline(
+        &PIPELINE.replace(
+            "params = { title = \"t\",",
+            "params = { titel = \"t\", title = \"t\",",
+        ),
+        "stages.report.params.titel",
+        "unknown key",
+    );
+    assert_bad_pipeline(
+        &PIPELINE.replace("{run}/a2/particles.parquet", "{run}/a4/particles.parquet"),
+        "stages.a4.outputs",
+        "two writers",
+    );
+}
+
+#[test]
+fn pyarrow_and_polars_read_the_sweep_dataset_with_documented_columns() {
+    let (tmp, file) = project(PIPELINE);
+    run(
+        &file,
+        RunOptions {
+            until: Some("sweep2".into()),
+            ..Default::default()
+        },
+    );
+    let code = r#"
+import sys, pyarrow as pa, pyarrow.parquet as pq, polars as pl
+t = pq.read_table(sys.argv[1])
+want = {"scene": pa.string(), "point": pa.uint32(), "material.mass_spring.stiffness_N_per_m": pa.float64(),
+        "cloth.nx": pa.int64(), "particles": pa.uint32(), "solver": pa.string(), "status": pa.string(),
+        "iterations": pa.uint64(), "linear_solves": pa.uint64(), "wall_time_s": pa.float64(),
+        "max_residual_N": pa.float64(), "centre_z_m": pa.float64(), "min_z_m": pa.float64(),
+        "corner_xmin_ymin_z_m": pa.float64()}
+for k, ty in want.items():
+    assert t.schema.field(k).type == ty, (k, t.schema.field(k).type)
+assert t.num_rows == 4
+df = pl.read_parquet(sys.argv[1])
+assert (df["status"] == "converged").all()
+# Stiffer springs sag less: the centre hangs higher at 1100 N/m than at 600 N/m.
+s = df.filter(pl.col("cloth.nx") == 9).sort("material.mass_spring.stiffness_N_per_m")
+assert s["centre_z_m"][0] < s["centre_z_m"][1] < 0, s
+print("ok")
+"#;
+    run_python(code, &[&tmp.path().join("runs/t/sweep2/sweep.parquet")]);
+}
