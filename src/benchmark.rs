@@ -25,10 +25,12 @@ pub struct BenchRow {
 
 /// Solves `scene` at each size with each solver and measures against the finest static solve.
 /// Explicit and symplectic Euler run only up to `max_explicit_size` (their step count grows fast).
+/// Every solver stops at the largest residual force `tol` × the lightest particle's weight.
 pub fn hang4_rows(
     scene: &Scene,
     sizes: &[usize],
     max_explicit_size: usize,
+    tol: f64,
     mut log: impl FnMut(&str),
 ) -> Vec<BenchRow> {
     let finest = *sizes.iter().max().unwrap_or(&11);
@@ -37,12 +39,27 @@ pub fn hang4_rows(
         s.cloth.nx = n;
         s.cloth.ny = n;
         s.solver.kind = kind;
+        // One force tolerance for every solver; explicit integrators at 0.8 of their stability limit,
+        // implicit Euler at a large step.
+        s.solver.static_.residual_tol_rel = tol;
+        s.solver.dynamic.residual_tol_rel = tol;
+        s.solver.dynamic.speed_tol_m_per_s = 1e-5;
+        s.solver.dynamic.max_time_s = 1e3;
+        match kind {
+            SolverKind::ImplicitEuler => s.solver.dynamic.dt_s = 0.01,
+            SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => {
+                s.solver.dynamic.auto_dt_fraction = 0.8
+            }
+            SolverKind::Static => {}
+        }
         s.record.timeline = false;
         s.record.rerun = false;
         s
     };
     let t0 = Instant::now();
-    let reference = solve_scene(&at(finest, SolverKind::Static), &mut NoObserver);
+    let mut reference_scene = at(finest, SolverKind::Static);
+    reference_scene.solver.static_.residual_tol_rel = 1e-8;
+    let reference = solve_scene(&reference_scene, &mut NoObserver);
     log(&format!(
         "reference {finest}×{finest} static: {} in {:.3} s",
         reference.report.status.as_str(),
@@ -70,7 +87,7 @@ pub fn hang4_rows(
             // Compare at grid points shared with the reference grid ((finest-1)/(n-1) must be whole).
             let ratio = (finest - 1) / (n - 1);
             let mut err: f64 = 0.0;
-            if (finest - 1) % (n - 1) == 0 {
+            if (finest - 1).is_multiple_of(n - 1) {
                 for j in 0..n {
                     for i in 0..n {
                         let d = (sol.at(i, j) - reference.at(i * ratio, j * ratio)).norm();

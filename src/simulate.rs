@@ -74,8 +74,8 @@ fn solve_model(
                 report.wall_time_s += r.wall_time_s;
                 report.message += &format!(
                     " (from a {}×{} start)",
-                    (grid.nx + 1) / 2,
-                    (grid.ny + 1) / 2
+                    grid.nx.div_ceil(2),
+                    grid.ny.div_ceil(2)
                 );
             }
             report
@@ -88,7 +88,7 @@ fn solve_model(
 }
 
 /// Solves the scene on the grid with every other line and writes the interpolated positions into
-/// the free particles of `x`. Only when both sides have an odd count ≥ 9, the coarse solve converges,
+/// the free particles of `x`. Only when both sides have an odd count ≥ 21, the coarse solve converges,
 /// and no absolute natural length ties the springs to the fine spacing.
 fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(SolveReport, ())> {
     let (nx, ny) = (grid.nx, grid.ny);
@@ -99,8 +99,8 @@ fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(S
         .is_some_and(|m| m.natural_length_m.is_some());
     if !scene.solver.static_.coarse_start
         || natural
-        || nx < 9
-        || ny < 9
+        || nx < 21
+        || ny < 21
         || nx % 2 == 0
         || ny % 2 == 0
     {

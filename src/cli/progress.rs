@@ -29,7 +29,7 @@ impl SolveProgress {
 
 impl Observer for SolveProgress {
     fn wants(&self, index: usize) -> bool {
-        !self.bar.is_hidden() && index % 100 == 0
+        !self.bar.is_hidden() && index.is_multiple_of(100)
     }
     fn observe(&mut self, ev: &StateEvent<'_>) {
         let t = ev

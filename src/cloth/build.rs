@@ -141,6 +141,7 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
 /// The continuum model on the grid: tensile springs along grid lines (k = E·w/h), cell shear (G) and
 /// quadratic bending along grid lines (k = D·w/h̄). A clamped edge pins its particles and adds
 /// virtual fixed points mirrored across it, so the bending term sees a zero slope at the edge.
+#[allow(clippy::needless_range_loop)] // grid loops index several parallel arrays
 fn continuum_terms(
     grid: &Grid,
     r: &Rigidities,

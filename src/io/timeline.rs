@@ -148,7 +148,7 @@ impl TimelineRecorder {
 
 impl Observer for TimelineRecorder {
     fn wants(&self, index: usize) -> bool {
-        self.error.is_none() && index % self.every == 0
+        self.error.is_none() && index.is_multiple_of(self.every)
     }
     fn observe(&mut self, ev: &StateEvent<'_>) {
         if let Err(e) = self.write(ev) {

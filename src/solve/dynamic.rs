@@ -257,7 +257,7 @@ pub fn solve_dynamic(
         divergence: None,
         message: String::new(),
     };
-    if !free.iter().any(|&f| f) || !w_ref.is_finite() || !(dt > 0.0) {
+    if !free.iter().any(|&f| f) || !w_ref.is_finite() || dt.is_nan() || dt <= 0.0 {
         report.status = Status::Invalid;
         report.message = "nothing free to integrate, or a non-positive time step".into();
         return report;
@@ -293,7 +293,7 @@ pub fn solve_dynamic(
     let mut step = 0usize;
     loop {
         let want = observer.wants(step);
-        if step % check == 0 || want || step == max_steps {
+        if step.is_multiple_of(check) || want || step == max_steps {
             model.gradient(x, 1.0, &mut g);
             let r = model.max_residual(&g);
             let vmax = v.iter().map(|vi| vi.norm()).fold(0.0, f64::max);
@@ -428,7 +428,7 @@ impl ImplicitState {
     }
 
     /// One Baraff–Witkin step; returns the CG iterations used.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
     fn step(
         &mut self,
         model: &Model,
@@ -482,7 +482,7 @@ impl ImplicitState {
             let mut ap = std::mem::take(&mut self.ap);
             self.apply(model, c, dt, &self.p, &mut ap);
             let pap = dot(&self.p, &ap);
-            if !(pap > 0.0) {
+            if pap.is_nan() || pap <= 0.0 {
                 self.ap = ap;
                 break;
             }

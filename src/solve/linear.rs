@@ -2,11 +2,15 @@
 //! Cholesky, with the symbolic analysis done once per sparsity pattern).
 
 use crate::physics::HessianBlocks;
-use faer::Par;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{MatMut, Side};
+use faer::{Conj, MatMut, Par, Side};
 
 /// Map from particles to free degrees of freedom (3 per free particle).
 #[derive(Debug, Clone)]
@@ -43,16 +47,18 @@ impl DofMap {
     }
 }
 
-/// A sparse SPD matrix H + shift·D over the free DOFs, assembled from Hessian blocks, with the
-/// pattern and its symbolic Cholesky kept between calls.
+/// A sparse SPD matrix H + diag(shift) over the free DOFs, assembled from Hessian blocks, with the
+/// pattern, its symbolic supernodal Cholesky and the numeric buffers kept between calls.
 pub struct SparseSpd {
     pattern_pairs: Vec<(u32, u32)>,
     symbolic: Option<(
         SymbolicSparseColMat<usize>,
         Argsort<usize>,
-        SymbolicLlt<usize>,
+        SymbolicCholesky<usize>,
     )>,
     values: Vec<f64>,
+    l_values: Vec<f64>,
+    mem: MemBuffer,
     /// Number of numeric factorizations done.
     pub factorizations: usize,
 }
@@ -64,13 +70,14 @@ impl Default for SparseSpd {
 }
 
 impl SparseSpd {
-    /// An empty solver; the pattern is analysed at the first factorization.
+    /// An empty solver; the pattern is analysed (AMD ordering, supernodal) at the first factorization.
     pub fn new() -> Self {
-        faer::set_global_parallelism(Par::Seq);
         Self {
             pattern_pairs: Vec::new(),
             symbolic: None,
             values: Vec::new(),
+            l_values: Vec::new(),
+            mem: MemBuffer::new(StackReq::empty()),
             factorizations: 0,
         }
     }
@@ -83,6 +90,7 @@ impl SparseSpd {
             for r in 0..3 {
                 for c in 0..3 {
                     if p != q || r >= c {
+                        // Lower triangle: row ≥ column (dp ≥ dq when p > q, as DOFs follow particles).
                         visit(dp + r, dq + c, b[(r, c)]);
                     }
                 }
@@ -90,38 +98,73 @@ impl SparseSpd {
         }
     }
 
-    /// Factorizes H + diag(shift) over the free DOFs. Returns None when the matrix is not
+    /// Factorizes H + diag(shift) over the free DOFs. Returns false when the matrix is not
     /// positive definite (the caller raises its damping and tries again).
-    pub fn factorize(
-        &mut self,
-        dofs: &DofMap,
-        h: &HessianBlocks,
-        shift: &[f64],
-    ) -> Option<Llt<usize, f64>> {
+    pub fn factorize(&mut self, dofs: &DofMap, h: &HessianBlocks, shift: &[f64]) -> bool {
         let n = dofs.n;
         if self.symbolic.is_none() || h.pairs != self.pattern_pairs {
             let mut idx: Vec<Pair<usize, usize>> = Vec::new();
             Self::entries(dofs, h, |r, c, _| idx.push(Pair::new(r, c)));
             idx.extend((0..n).map(|d| Pair::new(d, d)));
-            let (sym, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx).ok()?;
-            let llt = SymbolicLlt::try_new(sym.as_ref(), Side::Lower).ok()?;
-            self.symbolic = Some((sym, argsort, llt));
+            let Ok((sym, argsort)) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx) else {
+                return false;
+            };
+            let params = CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            };
+            let Ok(symbolic) = factorize_symbolic_cholesky(
+                sym.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                params,
+            ) else {
+                return false;
+            };
+            self.mem = MemBuffer::new(StackReq::any_of(&[
+                symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+                symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+            ]));
+            self.l_values = vec![0.0; symbolic.len_val()];
+            self.symbolic = Some((sym, argsort, symbolic));
             self.pattern_pairs = h.pairs.clone();
         }
         self.values.clear();
         let values = &mut self.values;
         Self::entries(dofs, h, |_, _, v| values.push(v));
         values.extend_from_slice(shift);
-        let (sym, argsort, llt) = self.symbolic.as_ref()?;
-        let mat = SparseColMat::new_from_argsort(sym.clone(), argsort, &self.values).ok()?;
+        let Some((sym, argsort, symbolic)) = self.symbolic.as_ref() else {
+            return false;
+        };
+        let Ok(mat) = SparseColMat::new_from_argsort(sym.clone(), argsort, &self.values) else {
+            return false;
+        };
         self.factorizations += 1;
-        Llt::try_new_with_symbolic(llt.clone(), mat.as_ref(), Side::Lower).ok()
+        symbolic
+            .factorize_numeric_llt(
+                &mut self.l_values,
+                mat.as_ref(),
+                Side::Lower,
+                LltRegularization::default(),
+                Par::Seq,
+                MemStack::new(&mut self.mem),
+                Default::default(),
+            )
+            .is_ok()
     }
-}
 
-/// Solves L Lᵀ y = rhs in place.
-pub fn solve_in_place(llt: &Llt<usize, f64>, rhs: &mut [f64]) {
-    let n = rhs.len();
-    let m = MatMut::from_column_major_slice_mut(rhs, n, 1);
-    llt.solve_in_place(m);
+    /// Solves (H + diag(shift)) y = rhs in place with the last successful factorization.
+    pub fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        let n = rhs.len();
+        let Some((_, _, symbolic)) = self.symbolic.as_ref() else {
+            return;
+        };
+        let llt = LltRef::new(symbolic, &self.l_values);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, n, 1),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
+    }
 }

@@ -7,7 +7,7 @@
 //! grows when a factorization or line search fails and shrinks after each accepted step, so the
 //! last iterations are plain Newton with quadratic convergence.
 
-use super::linear::{DofMap, SparseSpd, solve_in_place};
+use super::linear::{DofMap, SparseSpd};
 use super::{Divergence, Observer, SolveReport, StateEvent, Status};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
@@ -190,7 +190,7 @@ pub fn solve_static(
             let mut accepted = false;
             for _attempt in 0..40 {
                 shift.iter_mut().for_each(|s| *s = mu * scale);
-                let Some(llt) = spd.factorize(&dofs, &h, &shift) else {
+                if !spd.factorize(&dofs, &h, &shift) {
                     // Indefinite: first shift the exact Hessian (Levenberg–Marquardt), and only when a
                     // large shift is needed fall back to the projected Hessian.
                     if !projected && mu >= 1e-3 {
@@ -201,7 +201,7 @@ pub fn solve_static(
                         mu = (mu * 10.0).max(1e-8);
                     }
                     continue;
-                };
+                }
                 report.linear_solves += 1;
                 for (p, gp) in g.iter().enumerate() {
                     if let Some(d) = dofs.dof(p) {
@@ -210,7 +210,7 @@ pub fn solve_static(
                         rhs[d + 2] = -gp.z;
                     }
                 }
-                solve_in_place(&llt, &mut rhs);
+                spd.solve_in_place(&mut rhs);
                 // Backtracking line search on the energy (Armijo condition).
                 let slope: f64 = g
                     .iter()

@@ -90,13 +90,13 @@ impl StageKind {
         let v = match self {
             Self::Simulate => typed_params::<SimulateParams>(params)
                 .ok()
-                .map(|p| serde_json::to_value(p)),
+                .map(serde_json::to_value),
             Self::Sweep => typed_params::<SweepParams>(params)
                 .ok()
-                .map(|p| serde_json::to_value(p)),
+                .map(serde_json::to_value),
             Self::Report => typed_params::<ReportParams>(params)
                 .ok()
-                .map(|p| serde_json::to_value(p)),
+                .map(serde_json::to_value),
         };
         v.and_then(|r| r.ok()).unwrap_or(serde_json::Value::Null)
     }

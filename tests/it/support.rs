@@ -2,6 +2,7 @@
 
 use drapelab::scene::{Scene, parse_override};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 /// The repository root.
 pub fn root() -> PathBuf {
@@ -24,17 +25,54 @@ pub fn drapelab() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_drapelab"))
 }
 
-/// The Python interpreter with the readers installed (`.venv/`, made by `.ci/run`), or $DRAPELAB_PYTHON.
+/// The Python interpreter with the readers installed: $DRAPELAB_PYTHON, or `.venv/` in the
+/// repository, created on first use from `tests/requirements.txt` (mcap, rerun-sdk, pyarrow, polars).
 pub fn python() -> PathBuf {
-    if let Ok(p) = std::env::var("DRAPELAB_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let venv = root().join(".venv/bin/python");
-    assert!(
-        venv.exists(),
-        "no Python readers: run `bash .ci/run` once (it creates .venv with mcap, rerun-sdk, pyarrow, polars)"
-    );
-    venv
+    static PY: OnceLock<PathBuf> = OnceLock::new();
+    PY.get_or_init(|| {
+        if let Ok(p) = std::env::var("DRAPELAB_PYTHON") {
+            return PathBuf::from(p);
+        }
+        let venv = root().join(".venv");
+        let py = venv.join("bin/python");
+        let ready = |py: &Path| {
+            py.exists()
+                && std::process::Command::new(py)
+                    .args(["-c", "import mcap, rerun, pyarrow, polars"])
+                    .output()
+                    .is_ok_and(|o| o.status.success())
+        };
+        if !ready(&py) {
+            let ok = std::process::Command::new("python3")
+                .arg("-m")
+                .arg("venv")
+                .arg(&venv)
+                .status()
+                .is_ok_and(|s| s.success());
+            assert!(
+                ok,
+                "python3 -m venv failed: the tests need Python 3 with venv"
+            );
+            let ok = std::process::Command::new(&py)
+                .args([
+                    "-m",
+                    "pip",
+                    "install",
+                    "--quiet",
+                    "--disable-pip-version-check",
+                    "-r",
+                ])
+                .arg(root().join("tests/requirements.txt"))
+                .status()
+                .is_ok_and(|s| s.success());
+            assert!(
+                ok && ready(&py),
+                "installing tests/requirements.txt into .venv failed"
+            );
+        }
+        py
+    })
+    .clone()
 }
 
 /// Runs a Python snippet with arguments; panics with its output if it fails.
