@@ -6,7 +6,8 @@ fn main() {
     let scene = drapelab::scene::Scene::load(&root.join("datasets/scenes/hang4.toml"), &[])
         .expect("bundled scene")
         .scene;
-    let rows =
-        drapelab::benchmark::hang4_rows(&scene, &[11, 21, 41, 81], 21, 1e-6, |m| eprintln!("{m}"));
+    let rows = drapelab::benchmark::hang4_rows(&scene, &[11, 21, 41, 81], 21, 41, 1e-6, |m| {
+        eprintln!("{m}")
+    });
     println!("{}", drapelab::benchmark::markdown_table(&rows));
 }

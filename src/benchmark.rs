@@ -24,12 +24,14 @@ pub struct BenchRow {
 }
 
 /// Solves `scene` at each size with each solver and measures against the finest static solve.
-/// Explicit and symplectic Euler run only up to `max_explicit_size` (their step count grows fast).
+/// Explicit and symplectic Euler run only up to `max_explicit_size`, implicit Euler up to
+/// `max_implicit_size` (their step counts grow fast).
 /// Every solver stops at the largest residual force `tol` × the lightest particle's weight.
 pub fn hang4_rows(
     scene: &Scene,
     sizes: &[usize],
     max_explicit_size: usize,
+    max_implicit_size: usize,
     tol: f64,
     mut log: impl FnMut(&str),
 ) -> Vec<BenchRow> {
@@ -73,11 +75,12 @@ pub fn hang4_rows(
             SolverKind::SymplecticEuler,
             SolverKind::ExplicitEuler,
         ] {
-            if matches!(
-                kind,
-                SolverKind::ExplicitEuler | SolverKind::SymplecticEuler
-            ) && n > max_explicit_size
-            {
+            let skip = match kind {
+                SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => n > max_explicit_size,
+                SolverKind::ImplicitEuler => n > max_implicit_size,
+                SolverKind::Static => false,
+            };
+            if skip {
                 continue;
             }
             let s = at(n, kind);

@@ -78,6 +78,9 @@ pub enum Command {
         /// Largest size at which the explicit and symplectic integrators are run (they are slow).
         #[arg(long, default_value_t = 21)]
         max_explicit_size: usize,
+        /// Largest size at which implicit Euler is run.
+        #[arg(long, default_value_t = 41)]
+        max_implicit_size: usize,
         /// Force tolerance of every solver, relative to the lightest particle's weight.
         #[arg(long, default_value_t = 1e-6)]
         tol: f64,
@@ -163,9 +166,10 @@ pub fn run(cli: Cli) -> Result<i32> {
             scene,
             sizes,
             max_explicit_size,
+            max_implicit_size,
             tol,
         } => {
-            bench::run_bench(&scene, &sizes, max_explicit_size, tol)?;
+            bench::run_bench(&scene, &sizes, max_explicit_size, max_implicit_size, tol)?;
             Ok(EXIT_OK)
         }
     }

@@ -28,6 +28,10 @@ pub struct ReportParams {
     /// Columns whose values make one line each on the plot. Default: `group_by`.
     #[serde(default)]
     pub series: Vec<String>,
+    /// A column whose values each get a panel of their own (stacked), e.g. "scene" when the scenes'
+    /// values differ in scale. Default: one panel.
+    #[serde(default)]
+    pub facet: Option<String>,
     /// Free text placed under the title.
     #[serde(default)]
     pub notes: String,
@@ -125,6 +129,9 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         .iter()
         .map(|c| col(c.as_str()).cast(DataType::String))
         .collect();
+    if let Some(f) = &p.facet {
+        cols.push(col(f.as_str()).cast(DataType::String).alias("__facet"));
+    }
     cols.push(col(p.x.as_str()).cast(DataType::Float64).alias("__x"));
     cols.push(col(p.y.as_str()).cast(DataType::Float64).alias("__y"));
     let pts = lf
@@ -132,31 +139,36 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         .select(cols)
         .sort(["__x"], SortMultipleOptions::default())
         .collect()?;
-    let mut lines: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut panels: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>> = BTreeMap::new();
     let xs = pts.column("__x")?.f64()?.clone();
     let ys = pts.column("__y")?.f64()?.clone();
+    let text = |name: &str, r: usize| {
+        pts.column(name)
+            .ok()
+            .and_then(|s| s.str().ok().and_then(|s| s.get(r).map(str::to_string)))
+            .unwrap_or_default()
+    };
     for r in 0..pts.height() {
-        let label: Vec<String> = series
-            .iter()
-            .map(|c| {
-                pts.column(c)
-                    .ok()
-                    .and_then(|s| s.str().ok().and_then(|s| s.get(r).map(str::to_string)))
-                    .unwrap_or_default()
-            })
-            .map(|v| v.to_string())
-            .collect();
         let label = series
             .iter()
-            .zip(&label)
-            .map(|(k, v)| format!("{}={v}", k.rsplit('.').next().unwrap_or(k)))
+            .map(|k| format!("{}={}", k.rsplit('.').next().unwrap_or(k), text(k, r)))
             .collect::<Vec<_>>()
             .join(", ");
+        let panel = if p.facet.is_some() {
+            text("__facet", r)
+        } else {
+            String::new()
+        };
         if let (Some(x), Some(y)) = (xs.get(r), ys.get(r)) {
-            lines.entry(label).or_default().push((x, y));
+            panels
+                .entry(panel)
+                .or_default()
+                .entry(label)
+                .or_default()
+                .push((x, y));
         }
     }
-    let svg_text = plot_lines(&lines, &p.x, &p.y, &p.title)?;
+    let svg_text = plot_panels(&panels, &p.x, &p.y, p.facet.as_deref())?;
     write_atomic(svg, |f| {
         use std::io::Write;
         f.write_all(svg_text.as_bytes())?;
@@ -204,62 +216,86 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
     Ok(())
 }
 
-/// Draws lines (one per series) to an SVG string; the axes are labelled with the column names and units.
-pub fn plot_lines(
-    lines: &BTreeMap<String, Vec<(f64, f64)>>,
+/// Draws one panel per facet value (stacked), each with one line per series, to an SVG string;
+/// the axes are labelled with the column names, which carry their units.
+pub fn plot_panels(
+    panels: &BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>>,
     x_label: &str,
     y_label: &str,
-    title: &str,
+    facet: Option<&str>,
 ) -> Result<String> {
     let mut out = String::new();
     {
-        let root = SVGBackend::with_string(&mut out, (900, 560)).into_drawing_area();
+        let k = panels.len().max(1);
+        let root = SVGBackend::with_string(&mut out, (900, 420 * k as u32)).into_drawing_area();
         root.fill(&WHITE)?;
-        let all: Vec<(f64, f64)> = lines.values().flatten().copied().collect();
-        let (mut x0, mut x1, mut y0, mut y1) = all.iter().fold(
-            (
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-            ),
-            |a, &(x, y)| (a.0.min(x), a.1.max(x), a.2.min(y), a.3.max(y)),
-        );
-        if all.is_empty() {
-            (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+        let areas = root.split_evenly((k, 1));
+        for (area, (name, lines)) in areas.iter().zip(panels) {
+            let caption = match facet {
+                Some(f) => format!("{f} = {name}"),
+                None => format!("{y_label} against {x_label}"),
+            };
+            draw_lines(area, lines, x_label, y_label, &caption)?;
         }
-        let padx = ((x1 - x0) * 0.05).max(1e-12);
-        let pady = ((y1 - y0) * 0.05).max(1e-12);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(80)
-            .build_cartesian_2d((x0 - padx)..(x1 + padx), (y0 - pady)..(y1 + pady))?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .draw()?;
-        for (k, (label, pts)) in lines.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?
-                .label(label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-            chart.draw_series(
-                pts.iter()
-                    .map(|&(x, y)| Circle::new((x, y), 3, color.filled())),
-            )?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
         root.present()?;
     }
     Ok(out)
+}
+
+fn draw_lines<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    lines: &BTreeMap<String, Vec<(f64, f64)>>,
+    x_label: &str,
+    y_label: &str,
+    caption: &str,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let all: Vec<(f64, f64)> = lines.values().flatten().copied().collect();
+    let (mut x0, mut x1, mut y0, mut y1) = all.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |a, &(x, y)| (a.0.min(x), a.1.max(x), a.2.min(y), a.3.max(y)),
+    );
+    if all.is_empty() {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let padx = ((x1 - x0) * 0.05).max(1e-12);
+    let pady = ((y1 - y0) * 0.08).max(1e-12);
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(90)
+        .build_cartesian_2d((x0 - padx)..(x1 + padx), (y0 - pady)..(y1 + pady))?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .draw()?;
+    for (k, (label, pts)) in lines.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?
+            .label(label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+        chart.draw_series(
+            pts.iter()
+                .map(|&(x, y)| Circle::new((x, y), 3, color.filled())),
+        )?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
 }

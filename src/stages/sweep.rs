@@ -228,9 +228,14 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     }
     let name = &ctx.stage.name;
     ctx.progress.stage_started(name, jobs.len() as u64);
-    let results: Vec<PointResult> = jobs
+    // Largest grids first, so that the last items to finish are small (balanced threads); the rows
+    // are put back in design order afterwards.
+    let mut order: Vec<usize> = (0..jobs.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(jobs[k].1.cloth.nx * jobs[k].1.cloth.ny));
+    let mut unordered: Vec<(usize, PointResult)> = order
         .par_iter()
-        .map(|(i, scene)| {
+        .map(|&k| {
+            let (i, scene) = &jobs[k];
             let sol = solve_scene(scene, &mut NoObserver);
             let converged = sol.report.status == Status::Converged;
             let measures = converged.then(|| {
@@ -250,7 +255,7 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
                 m
             });
             ctx.progress.item_done(name);
-            PointResult {
+            let row = PointResult {
                 scene: scene.name.clone(),
                 point: *i,
                 particles: sol.grid.len() as u32,
@@ -261,9 +266,12 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
                 wall_time_s: sol.report.wall_time_s,
                 max_residual_N: sol.report.max_residual_N,
                 measures,
-            }
+            };
+            (k, row)
         })
         .collect();
+    unordered.sort_by_key(|(k, _)| *k);
+    let results: Vec<PointResult> = unordered.into_iter().map(|(_, r)| r).collect();
     // Columns.
     let mut fields = vec![
         Field::new("scene", DataType::Utf8, false),
