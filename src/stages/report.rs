@@ -37,6 +37,11 @@ pub struct ReportParams {
     pub notes: String,
 }
 
+/// Points of each series (by label) on one panel.
+type Lines = BTreeMap<String, Vec<(f64, f64)>>;
+/// Panels by facet value.
+type Panels = BTreeMap<String, Lines>;
+
 fn default_group() -> Vec<String> {
     vec!["scene".into()]
 }
@@ -139,7 +144,7 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         .select(cols)
         .sort(["__x"], SortMultipleOptions::default())
         .collect()?;
-    let mut panels: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>> = BTreeMap::new();
+    let mut panels: Panels = BTreeMap::new();
     let xs = pts.column("__x")?.f64()?.clone();
     let ys = pts.column("__y")?.f64()?.clone();
     let text = |name: &str, r: usize| {
@@ -219,7 +224,7 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
 /// Draws one panel per facet value (stacked), each with one line per series, to an SVG string;
 /// the axes are labelled with the column names, which carry their units.
 pub fn plot_panels(
-    panels: &BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>>,
+    panels: &Panels,
     x_label: &str,
     y_label: &str,
     facet: Option<&str>,
@@ -244,7 +249,7 @@ pub fn plot_panels(
 
 fn draw_lines<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
-    lines: &BTreeMap<String, Vec<(f64, f64)>>,
+    lines: &Lines,
     x_label: &str,
     y_label: &str,
     caption: &str,
