@@ -358,3 +358,85 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     })?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn latin_hypercube_hits_every_stratum_of_every_axis_once() {
+        let mut axes = BTreeMap::new();
+        axes.insert(
+            "a".to_string(),
+            Axis::Range {
+                min: toml::Value::Float(500.0),
+                max: toml::Value::Float(1200.0),
+            },
+        );
+        axes.insert(
+            "b".to_string(),
+            Axis::Range {
+                min: toml::Value::Integer(11),
+                max: toml::Value::Integer(41),
+            },
+        );
+        let p = SweepParams {
+            design: Design::Lhs,
+            samples: 7,
+            seed: 3,
+            axes,
+            set: BTreeMap::new(),
+        };
+        p.check().unwrap();
+        let pts = sweep_points(&p);
+        assert_eq!(pts.len(), 7);
+        let mut strata: Vec<usize> = pts
+            .iter()
+            .map(|pt| ((pt[0].as_float().unwrap() - 500.0) / 700.0 * 7.0) as usize)
+            .collect();
+        strata.sort();
+        assert_eq!(strata, (0..7).collect::<Vec<_>>());
+        assert!(
+            pts.iter()
+                .all(|pt| pt[1].is_integer() && (11..=41).contains(&pt[1].as_integer().unwrap()))
+        );
+        // Same seed, same design; another seed, another design.
+        assert_eq!(sweep_points(&p), pts);
+        assert_ne!(
+            sweep_points(&SweepParams {
+                seed: 4,
+                ..p.clone()
+            }),
+            pts
+        );
+    }
+
+    #[test]
+    fn grid_is_the_cartesian_product() {
+        let mut axes = BTreeMap::new();
+        axes.insert(
+            "k".to_string(),
+            Axis::Values(vec![1.into(), 2.into(), 3.into()]),
+        );
+        axes.insert(
+            "s".to_string(),
+            Axis::Values(vec!["static".into(), "implicit-euler".into()]),
+        );
+        let p = SweepParams {
+            design: Design::Grid,
+            samples: 0,
+            seed: 0,
+            axes,
+            set: BTreeMap::new(),
+        };
+        let pts = sweep_points(&p);
+        assert_eq!(pts.len(), 6);
+        assert_eq!(
+            pts[1],
+            vec![
+                toml::Value::Integer(1),
+                toml::Value::String("implicit-euler".into())
+            ]
+        );
+    }
+}

@@ -296,3 +296,23 @@ fn topology_b_builds_no_bend_terms_and_c_no_shear() {
         "{names:?}"
     );
 }
+
+#[test]
+fn incremental_loading_reaches_the_same_equilibrium_as_one_step() {
+    let one = solve(&scene("cantilever_wool_warp.toml", &["cloth.nx=21"]));
+    let five = solve(&scene(
+        "cantilever_wool_warp.toml",
+        &["cloth.nx=21", "solver.static.load_steps=5"],
+    ));
+    let d = one
+        .grid_positions()
+        .iter()
+        .zip(five.grid_positions())
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(d < 1e-9, "load stepping changed the equilibrium by {d:e} m");
+    assert!(
+        five.report.iterations > one.report.iterations / 2,
+        "five load steps cannot be cheaper than half of one"
+    );
+}

@@ -93,6 +93,19 @@ fn second_run_skips_everything_and_a_changed_input_reruns_only_its_dependents() 
 fn force_reruns_the_stage_and_its_dependents_and_a_changed_parameter_is_reported() {
     let (_tmp, file) = project(PIPELINE);
     run(&file, RunOptions::default());
+    let dry = run(
+        &file,
+        RunOptions {
+            force: vec!["sweep2".into()],
+            dry_run: true,
+            ..Default::default()
+        },
+    );
+    assert!(dry.ran.is_empty());
+    assert_eq!(
+        sorted(dry.would_run.iter().map(|(n, _)| n.clone()).collect()),
+        ["report", "sweep2"]
+    );
     let forced = run(
         &file,
         RunOptions {
