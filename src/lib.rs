@@ -10,6 +10,7 @@
 pub mod benchmark;
 pub mod cli;
 pub mod cloth;
+pub mod edges;
 pub mod error;
 pub mod io;
 pub mod material;

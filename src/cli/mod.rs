@@ -2,6 +2,7 @@
 //! [`run`] returns the process exit code.
 
 mod bench;
+pub mod edges;
 mod progress;
 
 pub use progress::SolveProgress;
@@ -65,6 +66,88 @@ pub enum Command {
     Status {
         /// The pipeline file.
         pipeline: PathBuf,
+    },
+    /// Solve a 4- or 2-corner hang and render it as a photo from a camera facing it (along +y): DIR/photo.png
+    /// (or .jpg), camera.json (exact scale and corner pixels), particles.parquet, and edges_truth.parquet
+    /// (the same edge fit made straight from the particles).
+    ///
+    /// Example: drapelab render datasets/scenes/hang4.toml --out runs/photo --px-per-cm 8 --markers --noise 4
+    Render {
+        /// The scene (4 or 2 pinned corners).
+        scene: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Scene overrides, as for simulate.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Scale in the plane of the fixed corners, px per cm.
+        #[arg(long, default_value_t = 8.0)]
+        px_per_cm: f64,
+        /// Pinhole camera at this distance (m) in front of the corners' plane; default orthographic.
+        #[arg(long)]
+        pinhole_distance_m: Option<f64>,
+        /// Draw red markers at the two fixed corners.
+        #[arg(long)]
+        markers: bool,
+        /// Gaussian noise, grey levels (σ).
+        #[arg(long, default_value_t = 0.0)]
+        noise: f64,
+        /// Gaussian blur, px (σ).
+        #[arg(long, default_value_t = 0.0)]
+        blur_px: f64,
+        /// Camera rotation about its axis, degrees.
+        #[arg(long, default_value_t = 0.0)]
+        rotate_deg: f64,
+        /// Save as JPEG with this quality (1..100) instead of PNG.
+        #[arg(long)]
+        jpeg_quality: Option<u8>,
+        /// Seed of the noise.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// Fit the edges of a photo of a hanging sheet with polynomials (seed 000, Figs 3, 11, 12): writes
+    /// DIR/edges.parquet (edge, power, coefficient of x^power in cm, RMS residual, points) and DIR/overlay.png
+    /// (fitted curves red, reference line blue). Calibrate with --px-per-cm and --corners, or --markers
+    /// and --side-cm, or --camera-json from `render`.
+    FitEdges {
+        /// The photo (PNG or JPEG).
+        photo: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Scale in the plane of the fixed corners, px per cm.
+        #[arg(long)]
+        px_per_cm: Option<f64>,
+        /// Pixel positions of the two fixed corners: x1,y1,x2,y2.
+        #[arg(long)]
+        corners: Option<String>,
+        /// Find the corners from two red markers (needs --side-cm).
+        #[arg(long)]
+        markers: bool,
+        /// Distance between the fixed corners, cm (with --markers).
+        #[arg(long)]
+        side_cm: Option<f64>,
+        /// A camera.json written by `render` (scale, corners and view).
+        #[arg(long)]
+        camera_json: Option<PathBuf>,
+        /// hang4 (one edge, the lower boundary) or hang2 (top, bottom, left, right).
+        #[arg(long, default_value = "hang4")]
+        view: String,
+        /// Polynomial degree.
+        #[arg(long, default_value_t = 4)]
+        degree: usize,
+    },
+    /// Score simulated edges against measured ones: seed 000 Eq. 5 (coefficients normalised by the side,
+    /// in %) and the RMS distance between the curves (% of the side), per edge.
+    Score {
+        /// Measured edges.parquet.
+        real: PathBuf,
+        /// Simulated edges.parquet.
+        sim: PathBuf,
+        /// Side of the sample, cm.
+        #[arg(long, default_value_t = 50.0)]
+        side_cm: f64,
     },
     /// Benchmark: time to equilibrium of hang4 at several resolutions with every solver, and each
     /// result's distance to the finest static solution. Prints a Markdown table.
@@ -159,6 +242,145 @@ pub fn run(cli: Cli) -> Result<i32> {
                     crate::pipeline::StageState::UpToDate => println!("{name}: up to date"),
                     crate::pipeline::StageState::Stale(why) => println!("{name}: stale ({why})"),
                 }
+            }
+            Ok(EXIT_OK)
+        }
+        Command::Render {
+            scene,
+            out,
+            set,
+            px_per_cm,
+            pinhole_distance_m,
+            markers,
+            noise,
+            blur_px,
+            rotate_deg,
+            jpeg_quality,
+            seed,
+        } => {
+            let overrides = set
+                .iter()
+                .map(|s| parse_override(s))
+                .collect::<Result<Vec<_>, InputError>>()?;
+            let loaded = Scene::load(&scene, &overrides)?;
+            let camera = match pinhole_distance_m {
+                Some(d) if d.is_finite() && d > 0.0 => {
+                    crate::edges::Camera::Pinhole { distance_m: d }
+                }
+                Some(d) => {
+                    return Err(InputError::new(
+                        "--pinhole-distance-m",
+                        "",
+                        format!("must be > 0, got {d}"),
+                    )
+                    .into());
+                }
+                None => crate::edges::Camera::Orthographic,
+            };
+            for (k, v) in [
+                ("--px-per-cm", px_per_cm),
+                ("--noise", noise + 1.0),
+                ("--blur-px", blur_px + 1.0),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(InputError::new(
+                        k,
+                        "",
+                        "must be a finite number ≥ 0 (> 0 for the scale)",
+                    )
+                    .into());
+                }
+            }
+            let opts = crate::edges::RenderOptions {
+                camera,
+                px_per_cm,
+                marker_radius_px: if markers { 4.0 } else { 0.0 },
+                noise_sigma: noise,
+                blur_sigma_px: blur_px,
+                rotation_deg: rotate_deg,
+                seed,
+                ..Default::default()
+            };
+            let path = edges::render_scene(&loaded, &out, &opts, jpeg_quality, 4)?;
+            eprintln!("rendered {} → {}", loaded.scene.name, path.display());
+            Ok(EXIT_OK)
+        }
+        Command::FitEdges {
+            photo,
+            out,
+            px_per_cm,
+            corners,
+            markers,
+            side_cm,
+            camera_json,
+            view,
+            degree,
+        } => {
+            let mut view = match view.as_str() {
+                "hang4" => crate::edges::View::Hang4,
+                "hang2" => crate::edges::View::Hang2,
+                v => {
+                    return Err(InputError::new(
+                        "--view",
+                        "",
+                        format!("`{v}`: expected hang4 or hang2"),
+                    )
+                    .into());
+                }
+            };
+            let calibration = if let Some(cj) = camera_json {
+                let cam = edges::read_camera(&cj)?;
+                view = cam.view;
+                crate::edges::Calibration::Given {
+                    px_per_cm: cam.px_per_cm,
+                    corners: cam.corners_px,
+                }
+            } else if markers {
+                let side = side_cm.ok_or_else(|| {
+                    InputError::new(
+                        "--side-cm",
+                        "",
+                        "--markers needs --side-cm (the distance between the corners)",
+                    )
+                })?;
+                crate::edges::Calibration::Markers { side_cm: side }
+            } else {
+                let (Some(s), Some(c)) = (px_per_cm, corners) else {
+                    return Err(InputError::new(&photo, "--corners", "give --px-per-cm and --corners x1,y1,x2,y2, or --markers --side-cm L, or --camera-json").into());
+                };
+                crate::edges::Calibration::Given {
+                    px_per_cm: s,
+                    corners: edges::parse_corners(&c)?,
+                }
+            };
+            if !(1..=8).contains(&degree) {
+                return Err(InputError::new("--degree", "", "must be in 1..=8").into());
+            }
+            let fits = edges::fit_photo(
+                &photo,
+                &out,
+                &crate::edges::FitImageOptions {
+                    view,
+                    degree,
+                    calibration,
+                },
+            )?;
+            for f in &fits {
+                eprintln!(
+                    "{}: {} points, RMS residual {:.4} cm, coefficients {:?}",
+                    f.edge, f.n_points, f.rms_residual_cm, f.coefficients
+                );
+            }
+            Ok(EXIT_OK)
+        }
+        Command::Score { real, sim, side_cm } => {
+            let rows = edges::score_files(&real, &sim, side_cm)?;
+            println!("| edge | objective (Eq. 5) % | curve distance % of side |\n|---|---|---|");
+            for r in &rows {
+                println!(
+                    "| {} | {:.4} | {:.4} |",
+                    r.edge, r.objective_pct, r.curve_distance_pct
+                );
             }
             Ok(EXIT_OK)
         }

@@ -9,4 +9,4 @@ mod timeline;
 pub use atomic::{Staged, write_atomic};
 pub use particles::{read_particles, write_particles};
 pub use rrd::RerunRecorder;
-pub use timeline::TimelineRecorder;
+pub use timeline::{TimelineRecorder, grid_triangles};

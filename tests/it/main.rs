@@ -2,6 +2,7 @@
 //! solvers, stability), the command line (bad input), and real clients reading the recordings.
 
 mod cli;
+mod edges;
 mod engine;
 mod pipeline;
 mod recordings;
