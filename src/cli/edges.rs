@@ -120,6 +120,8 @@ pub fn render_scene(
         f.write_all(&json)?;
         Ok(())
     })?;
+    let truth: Vec<(String, EdgeFit)> =
+        truth.into_iter().map(|f| (scene.name.clone(), f)).collect();
     write_edges(&out.join("edges_truth.parquet"), &truth)?;
     write_particles(
         &out.join("particles.parquet"),
@@ -166,7 +168,16 @@ pub fn fit_photo(photo: &Path, out: &Path, opts: &FitImageOptions) -> Result<Vec
             .write_to(&mut std::io::BufWriter::new(f), image::ImageFormat::Png)?;
         Ok(())
     })?;
-    write_edges(&out.join("edges.parquet"), &fit.edges)?;
+    let sample = photo
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let rows: Vec<(String, EdgeFit)> = fit
+        .edges
+        .iter()
+        .map(|f| (sample.clone(), f.clone()))
+        .collect();
+    write_edges(&out.join("edges.parquet"), &rows)?;
     Ok(fit.edges)
 }
 
@@ -178,9 +189,11 @@ pub fn read_camera(path: &Path) -> Result<CameraFile, InputError> {
         .map_err(|e| InputError::new(path, "", format!("not a camera file: {e}")))
 }
 
-/// One row of a score: per edge, Eq. 5 and the curve distance.
+/// One row of a score: per sample and edge, Eq. 5 and the curve distance.
 #[derive(Debug, Clone, Serialize)]
 pub struct ScoreRow {
+    /// Sample (of the measured table).
+    pub sample: String,
     /// Edge name.
     pub edge: String,
     /// Seed 000 Eq. 5, %.
@@ -189,13 +202,23 @@ pub struct ScoreRow {
     pub curve_distance_pct: f64,
 }
 
-/// Scores `sim` against `real` edge by edge (edges present in both).
-pub fn score_edges(real: &[EdgeFit], sim: &[EdgeFit], side_cm: f64) -> Vec<ScoreRow> {
+/// Scores `sim` against `real`, pairing fits by sample and edge; when each table holds a single sample
+/// (one photo against one simulation) fits are paired by edge alone.
+pub fn score_edges(
+    real: &[(String, EdgeFit)],
+    sim: &[(String, EdgeFit)],
+    side_cm: f64,
+) -> Vec<ScoreRow> {
+    let single = |t: &[(String, EdgeFit)]| t.iter().all(|(s, _)| *s == t[0].0);
+    let by_edge = !real.is_empty() && !sim.is_empty() && single(real) && single(sim);
     real.iter()
-        .filter_map(|r| {
-            let s = sim.iter().find(|s| s.edge == r.edge)?;
+        .filter_map(|(rs, r)| {
+            let (_, s) = sim
+                .iter()
+                .find(|(ss, s)| s.edge == r.edge && (by_edge || ss == rs))?;
             let span = r.x_max_cm.max(s.x_max_cm);
             Some(ScoreRow {
+                sample: rs.clone(),
                 edge: r.edge.clone(),
                 objective_pct: eq5_objective_pct(r, s, side_cm),
                 curve_distance_pct: curve_distance_pct(r, s, span, side_cm),

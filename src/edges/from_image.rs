@@ -368,6 +368,20 @@ pub fn fit_image(
                 }
             }
         }
+        // The bottom edge's depth at each side bounds the side edges.
+        let bottom_depth = |x: f64| {
+            edges
+                .iter()
+                .find(|e: &&EdgeFit| e.edge == "bottom")
+                .map(|e| -e.eval(x))
+                .unwrap_or(f64::INFINITY)
+        };
+        let side_depth = if name == "right" {
+            bottom_depth(span_cm)
+        } else {
+            bottom_depth(0.0)
+        };
+        let pts = super::trim_edge(name, pts, span_cm, side_depth);
         let Some(fit) = EdgeFit::from_points(name, &pts, opts.degree) else {
             return Err(InputError::new(
                 file,

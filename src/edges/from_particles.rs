@@ -61,7 +61,11 @@ pub fn edges_from_particles(
                     )
                 })
                 .collect();
-            vec![("bottom".into(), resample(pts))]
+            let span = (c1 - c0).norm() * 100.0;
+            vec![(
+                "bottom".into(),
+                super::trim_edge("bottom", resample(pts), span, 0.0),
+            )]
         }
         View::Hang2 => {
             let top_j = corners[0].1;
@@ -81,11 +85,21 @@ pub fn edges_from_particles(
                     })
                     .collect::<Vec<_>>()
             };
+            let depth = |i: usize| -cm(&x[grid.index(i, bottom_j)]).1;
+            let trim = |name: &str, pts: Vec<(f64, f64)>, d: f64| {
+                super::trim_edge(name, resample(pts), span, d)
+            };
             vec![
-                ("top".into(), resample(row(top_j))),
-                ("bottom".into(), resample(row(bottom_j))),
-                ("left".into(), resample(side(corners[0].0, 0.0))),
-                ("right".into(), resample(side(corners[1].0, span))),
+                ("top".into(), trim("top", row(top_j), 0.0)),
+                ("bottom".into(), trim("bottom", row(bottom_j), 0.0)),
+                (
+                    "left".into(),
+                    trim("left", side(corners[0].0, 0.0), depth(corners[0].0)),
+                ),
+                (
+                    "right".into(),
+                    trim("right", side(corners[1].0, span), depth(corners[1].0)),
+                ),
             ]
         }
     }

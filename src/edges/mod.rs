@@ -13,7 +13,7 @@ mod render;
 mod table;
 
 pub use from_image::{Calibration, FitImageOptions, ImageFit, fit_image, read_gray};
-pub use from_particles::edges_from_particles;
+pub use from_particles::{ReferenceLine, edges_from_particles};
 pub use poly::{Polynomial, fit_polynomial};
 pub use render::{Camera, RenderOptions, RenderedPhoto, render_drape};
 pub use table::{read_edges, write_edges};
@@ -82,6 +82,30 @@ impl EdgeFit {
         }
         .eval(x)
     }
+}
+
+/// Fraction of the corner-to-corner span left out at both ends of every edge, in photos and in
+/// simulations alike: near the fixed corners the boundary turns sharply (and markers or clamps hide it),
+/// and a quartic fitted over the same domain is what makes two measurements comparable.
+pub const EDGE_TRIM: f64 = 0.04;
+
+/// Keeps the points of an edge inside the common fitting domain: for `top`/`bottom`, x within
+/// [t, span − t]; for `left`/`right`, depth within [t, bottom_depth − t], with t = EDGE_TRIM × span.
+pub fn trim_edge(
+    edge: &str,
+    points: Vec<(f64, f64)>,
+    span_cm: f64,
+    bottom_depth_cm: f64,
+) -> Vec<(f64, f64)> {
+    let t = EDGE_TRIM * span_cm;
+    let (lo, hi) = match edge {
+        "left" | "right" => (t, bottom_depth_cm - t),
+        _ => (t, span_cm - t),
+    };
+    points
+        .into_iter()
+        .filter(|p| p.0 >= lo && p.0 <= hi)
+        .collect()
 }
 
 /// Seed 000 Eq. 5 on two fitted curves: 100 × the RMS of the differences of their coefficients, with

@@ -1,11 +1,15 @@
 //! Stage kinds: one thin file each, glue over the library. A kind checks its parameters when the
 //! plan is loaded (so typos are refused before anything runs) and runs with a [`StageContext`].
 
+mod fit_edges;
 mod report;
+mod score;
 mod simulate;
 mod sweep;
 
+pub use fit_edges::FitEdgesParams;
 pub use report::ReportParams;
+pub use score::ScoreParams;
 pub use simulate::SimulateParams;
 pub use sweep::{Axis, Design, SweepParams, sweep_points};
 
@@ -36,6 +40,10 @@ pub enum StageKind {
     Sweep,
     /// Summaries and plots over Parquet tables, as Markdown.
     Report,
+    /// Edge polynomials from photos.
+    FitEdges,
+    /// Eq. 5 and curve distance of measured against simulated edges.
+    Score,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -58,7 +66,7 @@ pub(crate) fn typed_params<T: serde::de::DeserializeOwned>(
 
 impl StageKind {
     /// Names of all kinds.
-    pub const ALL: [&'static str; 3] = ["simulate", "sweep", "report"];
+    pub const ALL: [&'static str; 5] = ["simulate", "sweep", "report", "fit-edges", "score"];
 
     /// The kind of a name.
     pub fn parse(s: &str) -> Option<Self> {
@@ -66,6 +74,8 @@ impl StageKind {
             "simulate" => Some(Self::Simulate),
             "sweep" => Some(Self::Sweep),
             "report" => Some(Self::Report),
+            "fit-edges" => Some(Self::FitEdges),
+            "score" => Some(Self::Score),
             _ => None,
         }
     }
@@ -75,6 +85,8 @@ impl StageKind {
             Self::Simulate => "simulate",
             Self::Sweep => "sweep",
             Self::Report => "report",
+            Self::FitEdges => "fit-edges",
+            Self::Score => "score",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -83,22 +95,27 @@ impl StageKind {
             Self::Simulate => typed_params::<SimulateParams>(params).map(|_| ()),
             Self::Sweep => typed_params::<SweepParams>(params).and_then(|p| p.check()),
             Self::Report => typed_params::<ReportParams>(params).map(|_| ()),
+            Self::FitEdges => typed_params::<FitEdgesParams>(params).map(|_| ()),
+            Self::Score => typed_params::<ScoreParams>(params).map(|_| ()),
         }
     }
     /// The parameters with defaults filled in, as JSON (part of the up-to-date key).
     pub fn resolve_params(self, params: &toml::Table) -> serde_json::Value {
-        let v = match self {
-            Self::Simulate => typed_params::<SimulateParams>(params)
+        fn resolved<T: serde::de::DeserializeOwned + serde::Serialize>(
+            params: &toml::Table,
+        ) -> serde_json::Value {
+            typed_params::<T>(params)
                 .ok()
-                .map(serde_json::to_value),
-            Self::Sweep => typed_params::<SweepParams>(params)
-                .ok()
-                .map(serde_json::to_value),
-            Self::Report => typed_params::<ReportParams>(params)
-                .ok()
-                .map(serde_json::to_value),
-        };
-        v.and_then(|r| r.ok()).unwrap_or(serde_json::Value::Null)
+                .and_then(|p| serde_json::to_value(p).ok())
+                .unwrap_or(serde_json::Value::Null)
+        }
+        match self {
+            Self::Simulate => resolved::<SimulateParams>(params),
+            Self::Sweep => resolved::<SweepParams>(params),
+            Self::Report => resolved::<ReportParams>(params),
+            Self::FitEdges => resolved::<FitEdgesParams>(params),
+            Self::Score => resolved::<ScoreParams>(params),
+        }
     }
     /// Runs the stage.
     pub fn run(self, ctx: &StageContext<'_>) -> Result<()> {
@@ -108,6 +125,8 @@ impl StageKind {
             Self::Simulate => simulate::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Sweep => sweep::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Report => report::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::FitEdges => fit_edges::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Score => score::run(ctx, &typed_params(params).map_err(bad)?),
         }
     }
 }

@@ -46,7 +46,11 @@ fn rendered(
     .unwrap();
     (
         fit.edges,
-        read_edges(&dir.join("edges_truth.parquet")).unwrap(),
+        read_edges(&dir.join("edges_truth.parquet"))
+            .unwrap()
+            .into_iter()
+            .map(|(_, f)| f)
+            .collect(),
     )
 }
 
@@ -272,8 +276,79 @@ fn score_is_zero_for_identical_curves_symmetric_and_follows_its_formula() {
         let eq5 = eq5_objective_pct(&a, &s, l);
         assert!((eq5 - 100.0 * c / l / 5f64.sqrt()).abs() < 1e-9, "{eq5}");
         assert!((curve_distance_pct(&a, &s, l, l) - 100.0 * c / l).abs() < 1e-9);
-        let rows = score_edges(std::slice::from_ref(&a), &[s], l);
+        let rows = score_edges(&[("x".to_string(), a.clone())], &[("y".to_string(), s)], l);
         assert_eq!(rows.len(), 1);
         assert!((rows[0].objective_pct - eq5).abs() < 1e-12);
     }
+}
+
+#[test]
+fn bundled_knitted_photos_measure_the_simulated_drapes() {
+    // The fit-edges and score stages on the bundled synthetic dataset: every photo's curves lie within
+    // 0.1 % of the side (0.05 cm) of the fits made straight from the simulated particles.
+    let tmp = tempfile::tempdir().unwrap();
+    let copy = |rel: &str| {
+        for entry in glob::glob(&root().join(rel).to_string_lossy()).unwrap() {
+            let src = entry.unwrap();
+            let dst = tmp.path().join(src.strip_prefix(root()).unwrap());
+            std::fs::create_dir_all(dst.parent().unwrap()).unwrap();
+            std::fs::copy(&src, &dst).unwrap();
+        }
+    };
+    copy("datasets/knitted/*/hang*/*");
+    std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
+    let file = tmp.path().join("pipelines/k.toml");
+    std::fs::write(
+        &file,
+        r#"
+name = "k"
+[stages.fit2]
+kind = "fit-edges"
+inputs = ["datasets/knitted/*/hang2/photo.png", "datasets/knitted/*/hang2/camera.json"]
+outputs = ["{run}/fit2/edges.parquet"]
+[stages.err2]
+kind = "score"
+inputs = ["{run}/fit2/edges.parquet", "datasets/knitted/*/hang2/edges_truth.parquet"]
+outputs = ["{run}/err2/score.parquet"]
+params = { measured = "{run}/fit2/edges.parquet", side_cm = 50.0 }
+[stages.fit4]
+kind = "fit-edges"
+inputs = ["datasets/knitted/*/hang4/photo.png", "datasets/knitted/*/hang4/camera.json"]
+outputs = ["{run}/fit4/edges.parquet"]
+[stages.err4]
+kind = "score"
+inputs = ["{run}/fit4/edges.parquet", "datasets/knitted/*/hang4/edges_truth.parquet"]
+outputs = ["{run}/err4/score.parquet"]
+params = { measured = "{run}/fit4/edges.parquet", side_cm = 50.0 }
+"#,
+    )
+    .unwrap();
+    let plan = drapelab::pipeline::load_plan(&file).unwrap();
+    let summary = drapelab::pipeline::run_pipeline(
+        &plan,
+        &Default::default(),
+        &drapelab::pipeline::LogProgress::default(),
+    )
+    .unwrap();
+    assert!(summary.failed.is_empty(), "{:?}", summary.failed);
+    let code = r#"
+import sys, polars as pl
+four = pl.read_parquet(sys.argv[1]); two = pl.read_parquet(sys.argv[2])
+assert four.height == 9 and two.height == 36, (four.height, two.height)
+assert set(two["edge"]) == {"top", "bottom", "left", "right"}
+worst = max(four["curve_distance_pct"].max(), two["curve_distance_pct"].max())
+assert worst < 0.1, worst
+print(worst)
+"#;
+    let out = crate::support::run_python(
+        code,
+        &[
+            &tmp.path().join("runs/k/err4/score.parquet"),
+            &tmp.path().join("runs/k/err2/score.parquet"),
+        ],
+    );
+    eprintln!(
+        "worst photo-vs-simulation curve distance: {}% of the side",
+        out.trim()
+    );
 }
