@@ -14,6 +14,7 @@ pub mod edges;
 pub mod error;
 pub mod io;
 pub mod material;
+pub mod optim;
 pub mod physics;
 pub mod pipeline;
 pub mod scene;

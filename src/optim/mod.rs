@@ -1,0 +1,9 @@
+//! Optimisers for calibration (seed 000): the Imperialist Competitive Algorithm and the Taguchi L27
+//! design that tunes it. Problems are cost functions over the unit box; solvers never print, and an
+//! observer receives every decade (argmin's habit).
+
+mod ica;
+mod taguchi;
+
+pub use ica::{DecadeEvent, Ica, IcaReport, IcaSettings};
+pub use taguchi::{L27, l27, main_effects, sn_smaller_the_better};
