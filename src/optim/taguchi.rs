@@ -27,7 +27,7 @@ pub fn l27() -> L27 {
     for (r, row) in t.iter_mut().enumerate() {
         let x = [(r / 9) as u8, ((r / 3) % 3) as u8, (r % 3) as u8];
         for (k, v) in V.iter().enumerate() {
-            row[k] = ((x[0] * v[0] + x[1] * v[1] + x[2] * v[2]) % 3) as u8;
+            row[k] = (x[0] * v[0] + x[1] * v[1] + x[2] * v[2]) % 3;
         }
     }
     t
