@@ -268,103 +268,57 @@ pub fn fit_image(
             vals.iter().sum::<f64>() / vals.len() as f64
         }
     };
+    let grey = |u: i64, v: i64| {
+        if u >= 0 && v >= 0 && u < w as i64 && v < h as i64 {
+            at(u as u32, v as u32)
+        } else {
+            background
+        }
+    };
+    // The boundary along one line of pixels `px(k)`, k in 0..len: the last (or first) fabric pixel
+    // that has a fabric neighbour on the line, refined to sub-pixel by summing coverages over a window
+    // that starts one pixel inside the fabric; the fabric's grey level is taken from the pixels just
+    // inside it (shading varies across the sheet).
+    let trace = |len: i64, px: &dyn Fn(i64) -> (i64, i64), last: bool| -> Option<f64> {
+        let fab = |k: i64| {
+            let (u, v) = px(k);
+            mask(u, v)
+        };
+        let mut hits = (0..len).filter(|&k| fab(k) && (fab(k + 1) || fab(k - 1)));
+        let kb = if last { hits.next_back() } else { hits.next() }?;
+        let (a, b) = if last {
+            (kb - 1, kb + 3)
+        } else {
+            (kb - 3, kb + 1)
+        };
+        let vals: Vec<(i64, f64)> = (a..=b).map(|k| (k, grey(px(k).0, px(k).1))).collect();
+        let inside_range = if last { kb - 3..kb } else { kb + 1..kb + 4 };
+        let inside: Vec<f64> = inside_range
+            .filter(|&k| fab(k))
+            .map(|k| grey(px(k).0, px(k).1))
+            .collect();
+        Some(edge_pos(&vals, local_fabric(inside), last))
+    };
     let mut edges = Vec::new();
     for &name in opts.view.edges() {
         let mut pts: Vec<(f64, f64)> = Vec::new();
         match name {
             "bottom" | "top" => {
                 for u in u_lo..=u_hi {
-                    let col: Vec<i64> = (0..h as i64)
-                        .filter(|&v| mask(u, v) && mask(u, v + 1).max(mask(u, v - 1)))
-                        .collect();
-                    let Some(&vb) = (if name == "bottom" {
-                        col.last()
-                    } else {
-                        col.first()
-                    }) else {
-                        continue;
-                    };
-                    // The window starts one pixel inside the fabric; the fabric's grey level is taken from
-                    // the pixels just inside it (shading varies across the sheet).
-                    let (a, b) = if name == "bottom" {
-                        (vb - 1, vb + 3)
-                    } else {
-                        (vb - 3, vb + 1)
-                    };
-                    let vals: Vec<(i64, f64)> = (a..=b)
-                        .map(|v| {
-                            (
-                                v,
-                                if v >= 0 && v < h as i64 {
-                                    at(u as u32, v as u32)
-                                } else {
-                                    background
-                                },
-                            )
-                        })
-                        .collect();
-                    let inside: Vec<f64> = if name == "bottom" {
-                        (vb - 3..vb)
-                            .filter(|&v| mask(u, v))
-                            .map(|v| at(u as u32, v as u32))
-                            .collect()
-                    } else {
-                        (vb + 1..vb + 4)
-                            .filter(|&v| mask(u, v))
-                            .map(|v| at(u as u32, v as u32))
-                            .collect()
-                    };
-                    let f = local_fabric(inside);
-                    let ve = edge_pos(&vals, f, name == "bottom");
-                    pts.push(to_cm(u as f64 + 0.5, ve));
+                    if let Some(ve) = trace(h as i64, &|v| (u, v), name == "bottom") {
+                        pts.push(to_cm(u as f64 + 0.5, ve));
+                    }
                 }
             }
             _ => {
                 // Side edges of a 2-corner hang: rows below the reference line.
                 let v_lo = (c0.1.max(c1.1) + guard + 2.0).ceil() as i64;
+                let offset = if name == "right" { span_cm } else { 0.0 };
                 for v in v_lo..h as i64 {
-                    let row: Vec<i64> = (0..w as i64)
-                        .filter(|&u| mask(u, v) && mask(u + 1, v).max(mask(u - 1, v)))
-                        .collect();
-                    let Some(&ub) = (if name == "right" {
-                        row.last()
-                    } else {
-                        row.first()
-                    }) else {
-                        continue;
-                    };
-                    let (a, b) = if name == "right" {
-                        (ub - 1, ub + 3)
-                    } else {
-                        (ub - 3, ub + 1)
-                    };
-                    let vals: Vec<(i64, f64)> = (a..=b)
-                        .map(|u| {
-                            (
-                                u,
-                                if u >= 0 && u < w as i64 {
-                                    at(u as u32, v as u32)
-                                } else {
-                                    background
-                                },
-                            )
-                        })
-                        .collect();
-                    let inside: Vec<f64> = if name == "right" {
-                        (ub - 3..ub)
-                            .filter(|&u| mask(u, v))
-                            .map(|u| at(u as u32, v as u32))
-                            .collect()
-                    } else {
-                        (ub + 1..ub + 4)
-                            .filter(|&u| mask(u, v))
-                            .map(|u| at(u as u32, v as u32))
-                            .collect()
-                    };
-                    let ue = edge_pos(&vals, local_fabric(inside), name == "right");
-                    let (along, upc) = to_cm(ue, v as f64 + 0.5);
-                    let offset = if name == "right" { span_cm } else { 0.0 };
-                    pts.push((-upc, along - offset));
+                    if let Some(ue) = trace(w as i64, &|u| (u, v), name == "right") {
+                        let (along, upc) = to_cm(ue, v as f64 + 0.5);
+                        pts.push((-upc, along - offset));
+                    }
                 }
             }
         }

@@ -3,11 +3,10 @@
 //! `n_points` (u32), `x_min_cm`, `x_max_cm`.
 
 use super::EdgeFit;
-use crate::io::write_atomic;
+use crate::io::write_parquet;
 use anyhow::{Context, Result};
 use arrow::array::{Array, Float64Array, RecordBatch, StringArray, UInt32Array};
 use arrow::datatypes::{DataType, Field, Schema};
-use parquet::arrow::ArrowWriter;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use std::path::Path;
 use std::sync::Arc;
@@ -58,12 +57,7 @@ pub fn write_edges(path: &Path, fits: &[(String, EdgeFit)]) -> Result<()> {
             )),
         ],
     )?;
-    write_atomic(path, |f| {
-        let mut w = ArrowWriter::try_new(f, schema, None)?;
-        w.write(&batch)?;
-        w.close()?;
-        Ok(())
-    })?;
+    write_parquet(path, &batch, None)?;
     Ok(())
 }
 

@@ -4,9 +4,11 @@
 mod atomic;
 mod particles;
 mod rrd;
+mod table;
 mod timeline;
 
 pub use atomic::{Staged, write_atomic};
 pub use particles::{read_particles, write_particles};
 pub use rrd::RerunRecorder;
+pub use table::write_parquet;
 pub use timeline::{TimelineRecorder, grid_triangles};

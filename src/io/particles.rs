@@ -1,12 +1,11 @@
 //! `particles.parquet`: one row per particle, columns `i`, `j` (u32), `x_m`, `y_m`, `z_m` (f64).
 
-use super::write_atomic;
+use super::write_parquet;
 use crate::cloth::Grid;
 use anyhow::{Context, Result};
 use arrow::array::{Array, Float64Array, RecordBatch, UInt32Array};
 use arrow::datatypes::{DataType, Field, Schema};
 use nalgebra::Vector3;
-use parquet::arrow::ArrowWriter;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use parquet::file::properties::WriterProperties;
 use std::path::Path;
@@ -47,12 +46,7 @@ pub fn write_particles(
     let props = WriterProperties::builder()
         .set_key_value_metadata(Some(kv))
         .build();
-    write_atomic(path, |f| {
-        let mut w = ArrowWriter::try_new(f, schema, Some(props))?;
-        w.write(&batch)?;
-        w.close()?;
-        Ok(())
-    })?;
+    write_parquet(path, &batch, Some(props))?;
     Ok(())
 }
 

@@ -4,11 +4,10 @@
 use super::StageContext;
 use crate::cli::edges::score_edges;
 use crate::edges::read_edges;
-use crate::io::write_atomic;
+use crate::io::write_parquet;
 use anyhow::{Context, Result, bail};
 use arrow::array::{Float64Array, RecordBatch, StringArray};
 use arrow::datatypes::{DataType, Field, Schema};
-use parquet::arrow::ArrowWriter;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -86,11 +85,6 @@ pub fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
             )),
         ],
     )?;
-    write_atomic(&ctx.outputs[0], |f| {
-        let mut w = ArrowWriter::try_new(f, schema, None)?;
-        w.write(&batch)?;
-        w.close()?;
-        Ok(())
-    })?;
+    write_parquet(&ctx.outputs[0], &batch, None)?;
     Ok(())
 }

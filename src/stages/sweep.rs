@@ -3,7 +3,7 @@
 
 use super::StageContext;
 use crate::cloth::Corner;
-use crate::io::write_atomic;
+use crate::io::write_parquet;
 use crate::scene::Scene;
 use crate::simulate::solve_scene;
 use crate::solve::{NoObserver, Status};
@@ -12,7 +12,6 @@ use arrow::array::{
     ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
 };
 use arrow::datatypes::{DataType, Field, Schema};
-use parquet::arrow::ArrowWriter;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
@@ -350,12 +349,7 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     }
     let schema = Arc::new(Schema::new(fields));
     let batch = RecordBatch::try_new(schema.clone(), cols)?;
-    write_atomic(&ctx.outputs[0], |f| {
-        let mut w = ArrowWriter::try_new(f, schema, None)?;
-        w.write(&batch)?;
-        w.close()?;
-        Ok(())
-    })?;
+    write_parquet(&ctx.outputs[0], &batch, None)?;
     Ok(())
 }
 
