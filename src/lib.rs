@@ -8,6 +8,7 @@
 #![allow(non_snake_case)] // units in names: stiffness_N_per_m, damping_Ns_per_m
 
 pub mod benchmark;
+pub mod calibrate;
 pub mod cli;
 pub mod cloth;
 pub mod edges;

@@ -1,0 +1,173 @@
+//! Calibration of seed 000's mass-spring parameters against measured edges (issue 5, started): the
+//! search space of Table 3 on the unit box, a cost that simulates a hang and scores its edges against
+//! the measured ones (cached, non-convergence penalised and counted), and one ICA run per call.
+
+use crate::cli::edges::scene_view;
+use crate::edges::{EdgeFit, curve_distance_pct, edges_from_particles};
+use crate::material::Topology;
+use crate::optim::{Ica, IcaReport, IcaSettings};
+use crate::scene::Scene;
+use crate::simulate::solve_scene;
+use crate::solve::NoObserver;
+use std::collections::HashMap;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Seed 000 Table 3's bounds, SI (elongation rate as a fraction).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bounds {
+    /// Spring stiffness, N/m.
+    pub stiffness_N_per_m: (f64, f64),
+    /// Damping, N·s/m.
+    pub damping_Ns_per_m: (f64, f64),
+    /// Provot's elongation rate.
+    pub elongation_rate: (f64, f64),
+    /// Natural length, m.
+    pub natural_length_m: (f64, f64),
+}
+
+impl Default for Bounds {
+    fn default() -> Self {
+        Self {
+            stiffness_N_per_m: (500.0, 1200.0),
+            damping_Ns_per_m: (10.0, 20.0),
+            elongation_rate: (0.05, 0.20),
+            natural_length_m: (0.04, 0.06),
+        }
+    }
+}
+
+/// A point of the search space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Params {
+    /// Spring stiffness, N/m.
+    pub stiffness_N_per_m: f64,
+    /// Damping, N·s/m.
+    pub damping_Ns_per_m: f64,
+    /// Provot's elongation rate.
+    pub elongation_rate: f64,
+    /// Natural length, m.
+    pub natural_length_m: f64,
+    /// Spring families.
+    pub topology: Topology,
+}
+
+impl Bounds {
+    /// Maps u ∈ [0, 1]^5 to parameters; the fifth coordinate picks the topology by thirds.
+    pub fn decode(&self, u: &[f64]) -> Params {
+        let lerp = |(a, b): (f64, f64), t: f64| a + t.clamp(0.0, 1.0) * (b - a);
+        Params {
+            stiffness_N_per_m: lerp(self.stiffness_N_per_m, u[0]),
+            damping_Ns_per_m: lerp(self.damping_Ns_per_m, u[1]),
+            elongation_rate: lerp(self.elongation_rate, u[2]),
+            natural_length_m: lerp(self.natural_length_m, u[3]),
+            topology: match (u[4] * 3.0) as usize {
+                0 => Topology::A,
+                1 => Topology::B,
+                _ => Topology::C,
+            },
+        }
+    }
+}
+
+/// The cost of a sample: simulate its hang with candidate parameters and score the edges.
+pub struct Problem {
+    /// The sample's scene (hang4 or hang2, with its density and grid).
+    pub scene: Scene,
+    /// Measured edges of the sample's photo.
+    pub measured: Vec<EdgeFit>,
+    /// Search bounds.
+    pub bounds: Bounds,
+    /// Side of the sample, cm.
+    pub side_cm: f64,
+    /// Cost given to a simulation that does not converge (counted in `failures`).
+    pub penalty: f64,
+    cache: Mutex<HashMap<Vec<u64>, f64>>,
+    /// Simulations run (cache misses).
+    pub simulations: AtomicUsize,
+    /// Simulations that did not converge.
+    pub failures: AtomicUsize,
+}
+
+impl Problem {
+    /// A problem over `scene` against `measured` edges.
+    pub fn new(scene: Scene, measured: Vec<EdgeFit>, side_cm: f64) -> Self {
+        Self {
+            scene,
+            measured,
+            bounds: Bounds::default(),
+            side_cm,
+            penalty: 100.0,
+            cache: Mutex::new(HashMap::new()),
+            simulations: AtomicUsize::new(0),
+            failures: AtomicUsize::new(0),
+        }
+    }
+
+    /// The scene with `p` applied.
+    pub fn scene_for(&self, p: &Params) -> Scene {
+        let mut s = self.scene.clone();
+        let ms = s.material.mass_spring.get_or_insert_with(Default::default);
+        ms.stiffness_N_per_m = p.stiffness_N_per_m;
+        ms.damping_Ns_per_m = p.damping_Ns_per_m;
+        ms.elongation_rate = p.elongation_rate;
+        ms.natural_length_m = Some(p.natural_length_m);
+        ms.topology = p.topology;
+        s
+    }
+
+    /// Mean curve distance (% of the side) over the measured edges; the penalty if the drape does not converge.
+    pub fn cost(&self, u: &[f64]) -> f64 {
+        let p = self.bounds.decode(u);
+        // Damping and elongation rate do not change a static drape: they are not part of the key.
+        let key = vec![
+            p.stiffness_N_per_m.to_bits(),
+            p.natural_length_m.to_bits(),
+            p.topology as u64,
+        ];
+        if let Some(c) = self.cache.lock().expect("cache").get(&key) {
+            return *c;
+        }
+        self.simulations.fetch_add(1, Ordering::Relaxed);
+        let scene = self.scene_for(&p);
+        let sol = solve_scene(&scene, &mut NoObserver);
+        let c = match (sol.report.is_converged(), scene_view(&scene)) {
+            (true, Ok((view, corners))) => {
+                let sim: Vec<EdgeFit> = edges_from_particles(&sol.grid, &sol.x, view, corners)
+                    .into_iter()
+                    .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
+                    .collect();
+                let d: Vec<f64> = self
+                    .measured
+                    .iter()
+                    .filter_map(|m| {
+                        sim.iter().find(|s| s.edge == m.edge).map(|s| {
+                            curve_distance_pct(m, s, m.x_max_cm.max(s.x_max_cm), self.side_cm)
+                        })
+                    })
+                    .collect();
+                if d.is_empty() {
+                    self.penalty
+                } else {
+                    d.iter().sum::<f64>() / d.len() as f64
+                }
+            }
+            _ => {
+                self.failures.fetch_add(1, Ordering::Relaxed);
+                self.penalty
+            }
+        };
+        self.cache.lock().expect("cache").insert(key, c);
+        c
+    }
+
+    /// One ICA run over the five-dimensional box.
+    pub fn run_ica(&self, settings: &IcaSettings) -> (Params, IcaReport) {
+        let report = Ica {
+            settings: settings.clone(),
+            dim: 5,
+        }
+        .run(&|u: &[f64]| self.cost(u), |_| {});
+        (self.bounds.decode(&report.best_x), report)
+    }
+}
