@@ -171,3 +171,71 @@ impl Problem {
         (self.bounds.decode(&report.best_x), report)
     }
 }
+
+/// Areal density (kg/m²) of each sample of seed 000 Table 2, read from `knitted_samples.csv`
+/// (`sample` and `weight_g_per_m2` columns; `#` lines are comments).
+pub fn read_sample_densities(path: &std::path::Path) -> anyhow::Result<HashMap<u32, f64>> {
+    let text = std::fs::read_to_string(path)?;
+    let mut lines = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty());
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| anyhow::anyhow!("{}: no column {name}", path.display()))
+    };
+    let (cs, cw) = (col("sample")?, col("weight_g_per_m2")?);
+    let mut out = HashMap::new();
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        out.insert(f[cs].trim().parse()?, f[cw].trim().parse::<f64>()? / 1000.0);
+    }
+    Ok(out)
+}
+
+/// The sample number in a path such as `datasets/knitted/sample_08/hang4`.
+pub fn sample_number(path: &str) -> Option<u32> {
+    path.split('/')
+        .find_map(|p| p.strip_prefix("sample_"))
+        .and_then(|n| n.parse().ok())
+}
+
+/// How much the cost changes when one parameter sweeps its range with the others at the optimum:
+/// (name, min cost, max cost) for stiffness, damping, elongation rate, natural length, topology.
+/// A parameter whose sweep changes the cost by less than `tol` is not identifiable from the drape.
+pub fn sensitivity(
+    problem: &Problem,
+    best_u: &[f64],
+    steps: usize,
+) -> Vec<(&'static str, f64, f64)> {
+    const NAMES: [&str; 5] = [
+        "stiffness_N_per_m",
+        "damping_Ns_per_m",
+        "elongation_rate",
+        "natural_length_m",
+        "topology",
+    ];
+    (0..5)
+        .map(|d| {
+            let n = if d == 4 { 3 } else { steps.max(2) };
+            let costs: Vec<f64> = (0..n)
+                .map(|k| {
+                    let mut u = best_u.to_vec();
+                    u[d] = if d == 4 {
+                        (k as f64 + 0.5) / 3.0
+                    } else {
+                        k as f64 / (n - 1) as f64
+                    };
+                    problem.cost(&u)
+                })
+                .collect();
+            (
+                NAMES[d],
+                costs.iter().copied().fold(f64::INFINITY, f64::min),
+                costs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            )
+        })
+        .collect()
+}

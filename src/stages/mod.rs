@@ -1,12 +1,14 @@
 //! Stage kinds: one thin file each, glue over the library. A kind checks its parameters when the
 //! plan is loaded (so typos are refused before anything runs) and runs with a [`StageContext`].
 
+mod calibrate;
 mod fit_edges;
 mod report;
 mod score;
 mod simulate;
 mod sweep;
 
+pub use calibrate::CalibrateParams;
 pub use fit_edges::FitEdgesParams;
 pub use report::ReportParams;
 pub use score::ScoreParams;
@@ -44,6 +46,8 @@ pub enum StageKind {
     FitEdges,
     /// Eq. 5 and curve distance of measured against simulated edges.
     Score,
+    /// ICA calibration of mass-spring parameters against measured edges.
+    Calibrate,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -66,7 +70,14 @@ pub(crate) fn typed_params<T: serde::de::DeserializeOwned>(
 
 impl StageKind {
     /// Names of all kinds.
-    pub const ALL: [&'static str; 5] = ["simulate", "sweep", "report", "fit-edges", "score"];
+    pub const ALL: [&'static str; 6] = [
+        "simulate",
+        "sweep",
+        "report",
+        "fit-edges",
+        "score",
+        "calibrate",
+    ];
 
     /// The kind of a name.
     pub fn parse(s: &str) -> Option<Self> {
@@ -76,6 +87,7 @@ impl StageKind {
             "report" => Some(Self::Report),
             "fit-edges" => Some(Self::FitEdges),
             "score" => Some(Self::Score),
+            "calibrate" => Some(Self::Calibrate),
             _ => None,
         }
     }
@@ -87,6 +99,7 @@ impl StageKind {
             Self::Report => "report",
             Self::FitEdges => "fit-edges",
             Self::Score => "score",
+            Self::Calibrate => "calibrate",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -97,6 +110,7 @@ impl StageKind {
             Self::Report => typed_params::<ReportParams>(params).map(|_| ()),
             Self::FitEdges => typed_params::<FitEdgesParams>(params).map(|_| ()),
             Self::Score => typed_params::<ScoreParams>(params).map(|_| ()),
+            Self::Calibrate => typed_params::<CalibrateParams>(params).and_then(|p| p.check()),
         }
     }
     /// The parameters with defaults filled in, as JSON (part of the up-to-date key).
@@ -115,6 +129,7 @@ impl StageKind {
             Self::Report => resolved::<ReportParams>(params),
             Self::FitEdges => resolved::<FitEdgesParams>(params),
             Self::Score => resolved::<ScoreParams>(params),
+            Self::Calibrate => resolved::<CalibrateParams>(params),
         }
     }
     /// Runs the stage.
@@ -127,6 +142,7 @@ impl StageKind {
             Self::Report => report::run(ctx, &typed_params(params).map_err(bad)?),
             Self::FitEdges => fit_edges::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Score => score::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Calibrate => calibrate::run(ctx, &typed_params(params).map_err(bad)?),
         }
     }
 }

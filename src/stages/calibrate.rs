@@ -1,0 +1,285 @@
+//! `calibrate`: for each sample of a fit-edges table, ICA runs over Table 3's box against the sample's
+//! measured 4-corner edges (the scene input with the sample's Table 2 density); the best run is kept.
+//! Writes `results.parquet` (one row per sample, with the runs' spread and each parameter's
+//! identifiability) and `evaluations.parquet` (every country of every decade of every run).
+
+use super::StageContext;
+use crate::calibrate::{Problem, read_sample_densities, sample_number, sensitivity};
+use crate::edges::{EdgeFit, edges_from_particles, eq5_objective_pct, read_edges};
+use crate::io::write_parquet;
+use crate::optim::IcaSettings;
+use crate::scene::{Scene, parse_override};
+use crate::simulate::solve_scene;
+use crate::solve::NoObserver;
+use anyhow::{Context, Result, bail};
+use arrow::array::{
+    ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
+};
+use arrow::datatypes::{DataType, Field, Schema};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Parameters of a calibrate stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrateParams {
+    /// Independent ICA runs per sample (seeds seed, seed+1, ...). Default 10 (seed 000).
+    #[serde(default = "default_runs")]
+    pub runs: usize,
+    /// ICA settings (seed is the first run's).
+    pub ica: IcaSettings,
+    /// Particles per side of the simulated net. Default 14.
+    #[serde(default = "default_grid")]
+    pub grid: usize,
+    /// Side of the samples, cm. Default 50.
+    #[serde(default = "default_side")]
+    pub side_cm: f64,
+    /// A parameter is identifiable when sweeping it across its range near the optimum changes the cost
+    /// (curve distance, % of the side) by more than this. Default 0.05.
+    #[serde(default = "default_ident")]
+    pub identifiable_change_pct: f64,
+}
+
+fn default_runs() -> usize {
+    10
+}
+fn default_grid() -> usize {
+    14
+}
+fn default_side() -> f64 {
+    50.0
+}
+fn default_ident() -> f64 {
+    0.05
+}
+
+impl CalibrateParams {
+    /// Checks the parameters: Err((key, message)).
+    pub fn check(&self) -> Result<(), (String, String)> {
+        self.ica.check().map_err(|(k, m)| (format!("ica.{k}"), m))?;
+        if self.runs == 0 {
+            return Err(("runs".into(), "must be ≥ 1".into()));
+        }
+        if self.grid < 3 {
+            return Err(("grid".into(), "must be ≥ 3".into()));
+        }
+        Ok(())
+    }
+}
+
+struct SampleResult {
+    sample: String,
+    best: crate::calibrate::Params,
+    curve_pct: f64,
+    eq5_pct: f64,
+    spread_pct: f64,
+    simulations: usize,
+    failures: usize,
+    identifiable: Vec<bool>,
+}
+
+/// Runs the stage.
+pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
+    let find = |name: &str| {
+        ctx.inputs
+            .iter()
+            .find(|f| f.file_name().is_some_and(|n| n == name))
+    };
+    let scene_file = ctx
+        .inputs
+        .iter()
+        .find(|f| f.extension().is_some_and(|e| e == "toml"))
+        .context("a scene (.toml) input is needed")?;
+    let densities = read_sample_densities(
+        find("knitted_samples.csv").context("knitted_samples.csv input is needed")?,
+    )?;
+    let edges_file =
+        find("edges.parquet").context("an edges.parquet input (fit-edges output) is needed")?;
+    let mut by_sample: BTreeMap<String, Vec<EdgeFit>> = BTreeMap::new();
+    for (s, e) in read_edges(edges_file)? {
+        by_sample.entry(s).or_default().push(e);
+    }
+    if by_sample.is_empty() {
+        bail!("{}: no edges", edges_file.display());
+    }
+    ctx.progress
+        .stage_started(&ctx.stage.name, (by_sample.len() * p.runs) as u64);
+    let mut results = Vec::new();
+    let mut evals: Vec<(String, u32, u32, u32, f64, crate::calibrate::Params)> = Vec::new();
+    for (sample, measured) in &by_sample {
+        let n = sample_number(sample)
+            .with_context(|| format!("`{sample}`: no sample_NN in the path"))?;
+        let rho = *densities
+            .get(&n)
+            .with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
+        let sets: Vec<(String, toml::Value)> = [
+            format!("cloth.nx={}", p.grid),
+            format!("cloth.ny={}", p.grid),
+            format!("cloth.areal_density_kg_per_m2={rho}"),
+        ]
+        .iter()
+        .map(|s| parse_override(s))
+        .collect::<Result<_, _>>()?;
+        let scene = Scene::load(scene_file, &sets)?.scene;
+        let problem = Problem::new(scene, measured.clone(), p.side_cm);
+        let mut best: Option<(f64, Vec<f64>)> = None;
+        let mut costs = Vec::new();
+        for r in 0..p.runs {
+            let settings = IcaSettings {
+                seed: p.ica.seed + r as u64,
+                ..p.ica.clone()
+            };
+            let report =
+                crate::optim::Ica { settings, dim: 5 }.run(&|u: &[f64]| problem.cost(u), |ev| {
+                    for (k, e) in ev.empires.iter().enumerate() {
+                        for c in std::iter::once(&e.imperialist).chain(&e.colonies) {
+                            evals.push((
+                                sample.clone(),
+                                r as u32,
+                                ev.decade as u32,
+                                k as u32,
+                                c.cost,
+                                problem.bounds.decode(&c.x),
+                            ));
+                        }
+                    }
+                });
+            costs.push(report.best_cost);
+            if best.as_ref().is_none_or(|b| report.best_cost < b.0) {
+                best = Some((report.best_cost, report.best_x.clone()));
+            }
+            ctx.progress.item_done(&ctx.stage.name);
+        }
+        let (cost, u) = best.expect("runs ≥ 1");
+        let params = problem.bounds.decode(&u);
+        let mean = costs.iter().sum::<f64>() / costs.len() as f64;
+        let spread =
+            (costs.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / costs.len() as f64).sqrt();
+        let sens = sensitivity(&problem, &u, 5);
+        // Eq. 5 of the best drape against the measurement.
+        let sol = solve_scene(&problem.scene_for(&params), &mut NoObserver);
+        let (view, corners) = crate::cli::edges::scene_view(&problem.scene)?;
+        let sim: Vec<EdgeFit> = edges_from_particles(&sol.grid, &sol.x, view, corners)
+            .into_iter()
+            .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
+            .collect();
+        let eq5: Vec<f64> = measured
+            .iter()
+            .filter_map(|m| {
+                sim.iter()
+                    .find(|s| s.edge == m.edge)
+                    .map(|s| eq5_objective_pct(m, s, p.side_cm))
+            })
+            .collect();
+        results.push(SampleResult {
+            sample: sample.clone(),
+            best: params,
+            curve_pct: cost,
+            eq5_pct: eq5.iter().sum::<f64>() / eq5.len().max(1) as f64,
+            spread_pct: spread,
+            simulations: problem
+                .simulations
+                .load(std::sync::atomic::Ordering::Relaxed),
+            failures: problem.failures.load(std::sync::atomic::Ordering::Relaxed),
+            identifiable: sens
+                .iter()
+                .map(|(_, lo, hi)| hi - lo > p.identifiable_change_pct)
+                .collect(),
+        });
+    }
+    let f64s = |v: Vec<f64>| -> ArrayRef { Arc::new(Float64Array::from(v)) };
+    let mut fields = vec![
+        Field::new("sample", DataType::Utf8, false),
+        Field::new("objective_pct", DataType::Float64, false),
+        Field::new("curve_distance_pct", DataType::Float64, false),
+        Field::new("stiffness_N_per_m", DataType::Float64, false),
+        Field::new("damping_Ns_per_m", DataType::Float64, false),
+        Field::new("elongation_rate", DataType::Float64, false),
+        Field::new("natural_length_m", DataType::Float64, false),
+        Field::new("topology", DataType::Utf8, false),
+        Field::new("runs", DataType::UInt32, false),
+        Field::new("spread_curve_distance_pct", DataType::Float64, false),
+        Field::new("simulations", DataType::UInt64, false),
+        Field::new("failed_simulations", DataType::UInt64, false),
+    ];
+    let mut cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(
+            results.iter().map(|r| r.sample.clone()),
+        )),
+        f64s(results.iter().map(|r| r.eq5_pct).collect()),
+        f64s(results.iter().map(|r| r.curve_pct).collect()),
+        f64s(results.iter().map(|r| r.best.stiffness_N_per_m).collect()),
+        f64s(results.iter().map(|r| r.best.damping_Ns_per_m).collect()),
+        f64s(results.iter().map(|r| r.best.elongation_rate).collect()),
+        f64s(results.iter().map(|r| r.best.natural_length_m).collect()),
+        Arc::new(StringArray::from_iter_values(
+            results.iter().map(|r| r.best.topology.letter()),
+        )),
+        Arc::new(UInt32Array::from_iter_values(
+            results.iter().map(|_| p.runs as u32),
+        )),
+        f64s(results.iter().map(|r| r.spread_pct).collect()),
+        Arc::new(UInt64Array::from_iter_values(
+            results.iter().map(|r| r.simulations as u64),
+        )),
+        Arc::new(UInt64Array::from_iter_values(
+            results.iter().map(|r| r.failures as u64),
+        )),
+    ];
+    for (k, name) in [
+        "stiffness",
+        "damping",
+        "elongation_rate",
+        "natural_length",
+        "topology",
+    ]
+    .iter()
+    .enumerate()
+    {
+        fields.push(Field::new(
+            format!("identifiable_{name}"),
+            DataType::Boolean,
+            false,
+        ));
+        cols.push(Arc::new(BooleanArray::from(
+            results
+                .iter()
+                .map(|r| r.identifiable[k])
+                .collect::<Vec<_>>(),
+        )));
+    }
+    write_parquet(
+        &ctx.outputs[0],
+        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
+        None,
+    )?;
+    if let Some(out) = ctx.outputs.get(1) {
+        let schema = Arc::new(Schema::new(vec![
+            Field::new("sample", DataType::Utf8, false),
+            Field::new("run", DataType::UInt32, false),
+            Field::new("decade", DataType::UInt32, false),
+            Field::new("empire", DataType::UInt32, false),
+            Field::new("cost_pct", DataType::Float64, false),
+            Field::new("stiffness_N_per_m", DataType::Float64, false),
+            Field::new("natural_length_m", DataType::Float64, false),
+            Field::new("topology", DataType::Utf8, false),
+        ]));
+        let cols: Vec<ArrayRef> = vec![
+            Arc::new(StringArray::from_iter_values(
+                evals.iter().map(|e| e.0.clone()),
+            )),
+            Arc::new(UInt32Array::from_iter_values(evals.iter().map(|e| e.1))),
+            Arc::new(UInt32Array::from_iter_values(evals.iter().map(|e| e.2))),
+            Arc::new(UInt32Array::from_iter_values(evals.iter().map(|e| e.3))),
+            f64s(evals.iter().map(|e| e.4).collect()),
+            f64s(evals.iter().map(|e| e.5.stiffness_N_per_m).collect()),
+            f64s(evals.iter().map(|e| e.5.natural_length_m).collect()),
+            Arc::new(StringArray::from_iter_values(
+                evals.iter().map(|e| e.5.topology.letter()),
+            )),
+        ];
+        write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)?;
+    }
+    Ok(())
+}
