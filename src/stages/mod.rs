@@ -7,6 +7,7 @@ mod report;
 mod score;
 mod simulate;
 mod sweep;
+mod validate;
 
 pub use calibrate::CalibrateParams;
 pub use fit_edges::FitEdgesParams;
@@ -14,6 +15,7 @@ pub use report::ReportParams;
 pub use score::ScoreParams;
 pub use simulate::SimulateParams;
 pub use sweep::{Axis, Design, SweepParams, sweep_points};
+pub use validate::ValidateParams;
 
 use crate::pipeline::{Plan, PlannedStage, Progress};
 use anyhow::Result;
@@ -48,6 +50,8 @@ pub enum StageKind {
     Score,
     /// ICA calibration of mass-spring parameters against measured edges.
     Calibrate,
+    /// Calibrated parameters on the 2-corner hang against its measured edges.
+    Validate,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -88,6 +92,7 @@ impl StageKind {
             "fit-edges" => Some(Self::FitEdges),
             "score" => Some(Self::Score),
             "calibrate" => Some(Self::Calibrate),
+            "validate" => Some(Self::Validate),
             _ => None,
         }
     }
@@ -100,6 +105,7 @@ impl StageKind {
             Self::FitEdges => "fit-edges",
             Self::Score => "score",
             Self::Calibrate => "calibrate",
+            Self::Validate => "validate",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -111,6 +117,7 @@ impl StageKind {
             Self::FitEdges => typed_params::<FitEdgesParams>(params).map(|_| ()),
             Self::Score => typed_params::<ScoreParams>(params).map(|_| ()),
             Self::Calibrate => typed_params::<CalibrateParams>(params).and_then(|p| p.check()),
+            Self::Validate => typed_params::<ValidateParams>(params).map(|_| ()),
         }
     }
     /// The parameters with defaults filled in, as JSON (part of the up-to-date key).
@@ -130,6 +137,7 @@ impl StageKind {
             Self::FitEdges => resolved::<FitEdgesParams>(params),
             Self::Score => resolved::<ScoreParams>(params),
             Self::Calibrate => resolved::<CalibrateParams>(params),
+            Self::Validate => resolved::<ValidateParams>(params),
         }
     }
     /// Runs the stage.
@@ -143,6 +151,7 @@ impl StageKind {
             Self::FitEdges => fit_edges::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Score => score::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Calibrate => calibrate::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Validate => validate::run(ctx, &typed_params(params).map_err(bad)?),
         }
     }
 }

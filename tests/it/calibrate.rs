@@ -66,3 +66,46 @@ fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
         report.best_cost
     );
 }
+
+#[test]
+fn bad_calibration_configs_exit_2_naming_the_key() {
+    let base = std::fs::read_to_string(root().join("pipelines/knitted.toml")).unwrap();
+    for (from, to, key) in [
+        (
+            "countries = 16",
+            "countries = 0",
+            "stages.calibrate.params.ica.countries",
+        ),
+        (
+            "imperialists = 3",
+            "imperialists = 30",
+            "stages.calibrate.params.ica.imperialists",
+        ),
+        (
+            "beta = 2.0",
+            "beta = -1.0",
+            "stages.calibrate.params.ica.beta",
+        ),
+        ("runs = 2", "runs = 0", "stages.calibrate.params.runs"),
+        (
+            "xi = 0.1,",
+            "xi = 0.1, topology = \"d\",",
+            "stages.calibrate.params.ica.topology",
+        ),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let tmp = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
+        let file = tmp.path().join("pipelines/knitted.toml");
+        std::fs::write(&file, base.replace(from, to)).unwrap();
+        let o = crate::support::drapelab()
+            .arg("run")
+            .arg(&file)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{key}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(key), "{key} not named: {err}");
+    }
+}
