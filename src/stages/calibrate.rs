@@ -27,8 +27,12 @@ pub struct CalibrateParams {
     /// Independent ICA runs per sample (seeds seed, seed+1, ...). Default 10 (seed 000).
     #[serde(default = "default_runs")]
     pub runs: usize,
-    /// ICA settings (seed is the first run's).
-    pub ica: IcaSettings,
+    /// ICA settings (seed is the first run's); or give `ica_from`.
+    #[serde(default)]
+    pub ica: Option<IcaSettings>,
+    /// A JSON file of ICA settings among the inputs (a tune stage's `best_ica.json`), instead of `ica`.
+    #[serde(default)]
+    pub ica_from: Option<String>,
     /// Particles per side of the simulated net. Default 14.
     #[serde(default = "default_grid")]
     pub grid: usize,
@@ -57,7 +61,11 @@ fn default_ident() -> f64 {
 impl CalibrateParams {
     /// Checks the parameters: Err((key, message)).
     pub fn check(&self) -> Result<(), (String, String)> {
-        self.ica.check().map_err(|(k, m)| (format!("ica.{k}"), m))?;
+        match (&self.ica, &self.ica_from) {
+            (Some(ica), None) => ica.check().map_err(|(k, m)| (format!("ica.{k}"), m))?,
+            (None, Some(_)) => {}
+            _ => return Err(("ica".into(), "give exactly one of `ica` (settings) and `ica_from` (a file)".into())),
+        }
         if self.runs == 0 {
             return Err(("runs".into(), "must be ≥ 1".into()));
         }
@@ -105,6 +113,16 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
     }
     ctx.progress
         .stage_started(&ctx.stage.name, (by_sample.len() * p.runs) as u64);
+    let ica = match (&p.ica, &p.ica_from) {
+        (Some(ica), _) => ica.clone(),
+        (None, Some(f)) => {
+            let path = ctx.plan.root.join(f.replace("{run}", &format!("runs/{}", ctx.plan.name)));
+            let ica: IcaSettings = serde_json::from_slice(&std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?)?;
+            ica.check().map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", path.display()))?;
+            ica
+        }
+        (None, None) => bail!("no ICA settings"),
+    };
     let mut results = Vec::new();
     let mut evals: Vec<(String, u32, u32, u32, f64, crate::calibrate::Params)> = Vec::new();
     for (sample, measured) in &by_sample {
@@ -127,8 +145,8 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         let mut costs = Vec::new();
         for r in 0..p.runs {
             let settings = IcaSettings {
-                seed: p.ica.seed + r as u64,
-                ..p.ica.clone()
+                seed: ica.seed + r as u64,
+                ..ica.clone()
             };
             let report =
                 crate::optim::Ica { settings, dim: 5 }.run(&|u: &[f64]| problem.cost(u), |ev| {

@@ -7,6 +7,7 @@ mod report;
 mod score;
 mod simulate;
 mod sweep;
+mod tune;
 mod validate;
 
 pub use calibrate::CalibrateParams;
@@ -15,6 +16,7 @@ pub use report::ReportParams;
 pub use score::ScoreParams;
 pub use simulate::SimulateParams;
 pub use sweep::{Axis, Design, SweepParams, sweep_points};
+pub use tune::{Levels, TuneParams};
 pub use validate::ValidateParams;
 
 use crate::pipeline::{Plan, PlannedStage, Progress};
@@ -52,6 +54,8 @@ pub enum StageKind {
     Calibrate,
     /// Calibrated parameters on the 2-corner hang against its measured edges.
     Validate,
+    /// Taguchi L27 tuning of ICA's settings.
+    Tune,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -93,6 +97,7 @@ impl StageKind {
             "score" => Some(Self::Score),
             "calibrate" => Some(Self::Calibrate),
             "validate" => Some(Self::Validate),
+            "tune" => Some(Self::Tune),
             _ => None,
         }
     }
@@ -106,6 +111,7 @@ impl StageKind {
             Self::Score => "score",
             Self::Calibrate => "calibrate",
             Self::Validate => "validate",
+            Self::Tune => "tune",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -118,6 +124,7 @@ impl StageKind {
             Self::Score => typed_params::<ScoreParams>(params).map(|_| ()),
             Self::Calibrate => typed_params::<CalibrateParams>(params).and_then(|p| p.check()),
             Self::Validate => typed_params::<ValidateParams>(params).map(|_| ()),
+            Self::Tune => typed_params::<TuneParams>(params).and_then(|p| if p.repeats == 0 { Err(("repeats".into(), "must be ≥ 1".into())) } else { Ok(()) }),
         }
     }
     /// The parameters with defaults filled in, as JSON (part of the up-to-date key).
@@ -138,6 +145,7 @@ impl StageKind {
             Self::Score => resolved::<ScoreParams>(params),
             Self::Calibrate => resolved::<CalibrateParams>(params),
             Self::Validate => resolved::<ValidateParams>(params),
+            Self::Tune => resolved::<TuneParams>(params),
         }
     }
     /// Runs the stage.
@@ -152,6 +160,7 @@ impl StageKind {
             Self::Score => score::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Calibrate => calibrate::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Validate => validate::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Tune => tune::run(ctx, &typed_params(params).map_err(bad)?),
         }
     }
 }

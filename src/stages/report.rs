@@ -38,9 +38,9 @@ pub struct ReportParams {
 }
 
 /// Points of each series (by label) on one panel.
-type Lines = BTreeMap<String, Vec<(f64, f64)>>;
+pub type Lines = BTreeMap<String, Vec<(f64, f64)>>;
 /// Panels by facet value.
-type Panels = BTreeMap<String, Lines>;
+pub type Panels = BTreeMap<String, Lines>;
 
 fn default_group() -> Vec<String> {
     vec!["scene".into()]
