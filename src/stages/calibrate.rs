@@ -64,7 +64,12 @@ impl CalibrateParams {
         match (&self.ica, &self.ica_from) {
             (Some(ica), None) => ica.check().map_err(|(k, m)| (format!("ica.{k}"), m))?,
             (None, Some(_)) => {}
-            _ => return Err(("ica".into(), "give exactly one of `ica` (settings) and `ica_from` (a file)".into())),
+            _ => {
+                return Err((
+                    "ica".into(),
+                    "give exactly one of `ica` (settings) and `ica_from` (a file)".into(),
+                ));
+            }
         }
         if self.runs == 0 {
             return Err(("runs".into(), "must be ≥ 1".into()));
@@ -116,9 +121,15 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
     let ica = match (&p.ica, &p.ica_from) {
         (Some(ica), _) => ica.clone(),
         (None, Some(f)) => {
-            let path = ctx.plan.root.join(f.replace("{run}", &format!("runs/{}", ctx.plan.name)));
-            let ica: IcaSettings = serde_json::from_slice(&std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?)?;
-            ica.check().map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", path.display()))?;
+            let path = ctx
+                .plan
+                .root
+                .join(f.replace("{run}", &format!("runs/{}", ctx.plan.name)));
+            let ica: IcaSettings = serde_json::from_slice(
+                &std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?,
+            )?;
+            ica.check()
+                .map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", path.display()))?;
             ica
         }
         (None, None) => bail!("no ICA settings"),

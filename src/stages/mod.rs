@@ -124,7 +124,13 @@ impl StageKind {
             Self::Score => typed_params::<ScoreParams>(params).map(|_| ()),
             Self::Calibrate => typed_params::<CalibrateParams>(params).and_then(|p| p.check()),
             Self::Validate => typed_params::<ValidateParams>(params).map(|_| ()),
-            Self::Tune => typed_params::<TuneParams>(params).and_then(|p| if p.repeats == 0 { Err(("repeats".into(), "must be ≥ 1".into())) } else { Ok(()) }),
+            Self::Tune => typed_params::<TuneParams>(params).and_then(|p| {
+                if p.repeats == 0 {
+                    Err(("repeats".into(), "must be ≥ 1".into()))
+                } else {
+                    Ok(())
+                }
+            }),
         }
     }
     /// The parameters with defaults filled in, as JSON (part of the up-to-date key).

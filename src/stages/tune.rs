@@ -87,7 +87,15 @@ fn default_side() -> f64 {
 
 /// L27 columns used for the factors A..G (any seven columns of L27 are pairwise orthogonal).
 const COLUMNS: [usize; 7] = [0, 1, 4, 2, 5, 7, 8];
-const FACTORS: [&str; 7] = ["A decades", "B imperialists", "C countries", "D beta", "E gamma", "F revolution_rate", "G xi"];
+const FACTORS: [&str; 7] = [
+    "A decades",
+    "B imperialists",
+    "C countries",
+    "D beta",
+    "E gamma",
+    "F revolution_rate",
+    "G xi",
+];
 
 fn settings(levels: &Levels, l: &[u8], seed: u64) -> IcaSettings {
     let k = |f: usize| l[f] as usize;
@@ -106,46 +114,97 @@ fn settings(levels: &Levels, l: &[u8], seed: u64) -> IcaSettings {
 
 /// Runs the stage.
 pub fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
-    let find = |name: &str| ctx.inputs.iter().find(|f| f.file_name().is_some_and(|n| n == name));
-    let scene_file = ctx.inputs.iter().find(|f| f.extension().is_some_and(|e| e == "toml")).context("a scene (.toml) input is needed")?;
-    let densities = read_sample_densities(find("knitted_samples.csv").context("knitted_samples.csv input is needed")?)?;
-    let measured: Vec<EdgeFit> = read_edges(find("edges.parquet").context("an edges.parquet input is needed")?)?
-        .into_iter()
-        .filter(|(s, _)| *s == p.sample)
-        .map(|(_, e)| e)
-        .collect();
-    anyhow::ensure!(!measured.is_empty(), "sample `{}` is not in the edges table", p.sample);
+    let find = |name: &str| {
+        ctx.inputs
+            .iter()
+            .find(|f| f.file_name().is_some_and(|n| n == name))
+    };
+    let scene_file = ctx
+        .inputs
+        .iter()
+        .find(|f| f.extension().is_some_and(|e| e == "toml"))
+        .context("a scene (.toml) input is needed")?;
+    let densities = read_sample_densities(
+        find("knitted_samples.csv").context("knitted_samples.csv input is needed")?,
+    )?;
+    let measured: Vec<EdgeFit> =
+        read_edges(find("edges.parquet").context("an edges.parquet input is needed")?)?
+            .into_iter()
+            .filter(|(s, _)| *s == p.sample)
+            .map(|(_, e)| e)
+            .collect();
+    anyhow::ensure!(
+        !measured.is_empty(),
+        "sample `{}` is not in the edges table",
+        p.sample
+    );
     let n = sample_number(&p.sample).context("no sample_NN in `sample`")?;
-    let rho = *densities.get(&n).with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
-    let sets: Vec<(String, toml::Value)> =
-        [format!("cloth.nx={}", p.grid), format!("cloth.ny={}", p.grid), format!("cloth.areal_density_kg_per_m2={rho}")].iter().map(|s| parse_override(s)).collect::<Result<_, _>>()?;
+    let rho = *densities
+        .get(&n)
+        .with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
+    let sets: Vec<(String, toml::Value)> = [
+        format!("cloth.nx={}", p.grid),
+        format!("cloth.ny={}", p.grid),
+        format!("cloth.areal_density_kg_per_m2={rho}"),
+    ]
+    .iter()
+    .map(|s| parse_override(s))
+    .collect::<Result<_, _>>()?;
     let problem = Problem::new(Scene::load(scene_file, &sets)?.scene, measured, p.side_cm);
     let table = l27();
-    let rows: Vec<Vec<u8>> = table.iter().map(|r| COLUMNS.iter().map(|&c| r[c]).collect()).collect();
-    ctx.progress.stage_started(&ctx.stage.name, rows.len() as u64);
+    let rows: Vec<Vec<u8>> = table
+        .iter()
+        .map(|r| COLUMNS.iter().map(|&c| r[c]).collect())
+        .collect();
+    ctx.progress
+        .stage_started(&ctx.stage.name, rows.len() as u64);
     let mut sn = Vec::new();
     let mut costs = Vec::new();
     for l in &rows {
-        let finals: Vec<f64> = (0..p.repeats).map(|r| Ica { settings: settings(&p.levels, l, p.seed + r as u64), dim: 5 }.run(&|u: &[f64]| problem.cost(u), |_| {}).best_cost).collect();
+        let finals: Vec<f64> = (0..p.repeats)
+            .map(|r| {
+                Ica {
+                    settings: settings(&p.levels, l, p.seed + r as u64),
+                    dim: 5,
+                }
+                .run(&|u: &[f64]| problem.cost(u), |_| {})
+                .best_cost
+            })
+            .collect();
         sn.push(sn_smaller_the_better(&finals));
         costs.push(finals.iter().sum::<f64>() / finals.len() as f64);
         ctx.progress.item_done(&ctx.stage.name);
     }
     let effects = main_effects(&rows, &sn);
-    let best_levels: Vec<u8> = effects.iter().map(|e| (0..3).max_by(|&a, &b| e[a].total_cmp(&e[b])).unwrap_or(0) as u8).collect();
+    let best_levels: Vec<u8> = effects
+        .iter()
+        .map(|e| (0..3).max_by(|&a, &b| e[a].total_cmp(&e[b])).unwrap_or(0) as u8)
+        .collect();
     let best = settings(&p.levels, &best_levels, p.seed);
     // tune.parquet
     let mut fields = vec![Field::new("row", DataType::UInt32, false)];
-    let mut cols: Vec<ArrayRef> = vec![Arc::new(UInt32Array::from_iter_values(1..=rows.len() as u32))];
+    let mut cols: Vec<ArrayRef> = vec![Arc::new(UInt32Array::from_iter_values(
+        1..=rows.len() as u32,
+    ))];
     for (f, name) in FACTORS.iter().enumerate() {
-        fields.push(Field::new(format!("level_{}", &name[..1]), DataType::UInt32, false));
-        cols.push(Arc::new(UInt32Array::from_iter_values(rows.iter().map(|l| l[f] as u32 + 1))));
+        fields.push(Field::new(
+            format!("level_{}", &name[..1]),
+            DataType::UInt32,
+            false,
+        ));
+        cols.push(Arc::new(UInt32Array::from_iter_values(
+            rows.iter().map(|l| l[f] as u32 + 1),
+        )));
     }
     fields.push(Field::new("mean_cost_pct", DataType::Float64, false));
     cols.push(Arc::new(Float64Array::from(costs)));
     fields.push(Field::new("sn_db", DataType::Float64, false));
     cols.push(Arc::new(Float64Array::from(sn.clone())));
-    write_parquet(&ctx.outputs[0], &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?, None)?;
+    write_parquet(
+        &ctx.outputs[0],
+        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
+        None,
+    )?;
     // main_effects.parquet
     let (mut fac, mut lev, mut val) = (Vec::new(), Vec::new(), Vec::new());
     let mut panels: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>> = BTreeMap::new();
@@ -155,10 +214,24 @@ pub fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
             lev.push(k as u32 + 1);
             val.push(*v);
         }
-        panels.entry("main effects".into()).or_default().insert(FACTORS[f].to_string(), e.iter().enumerate().map(|(k, v)| (k as f64 + 1.0, *v)).collect());
+        panels.entry("main effects".into()).or_default().insert(
+            FACTORS[f].to_string(),
+            e.iter()
+                .enumerate()
+                .map(|(k, v)| (k as f64 + 1.0, *v))
+                .collect(),
+        );
     }
-    let schema = Arc::new(Schema::new(vec![Field::new("factor", DataType::Utf8, false), Field::new("level", DataType::UInt32, false), Field::new("mean_sn_db", DataType::Float64, false)]));
-    let cols: Vec<ArrayRef> = vec![Arc::new(StringArray::from(fac)), Arc::new(UInt32Array::from(lev)), Arc::new(Float64Array::from(val))];
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("factor", DataType::Utf8, false),
+        Field::new("level", DataType::UInt32, false),
+        Field::new("mean_sn_db", DataType::Float64, false),
+    ]));
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from(fac)),
+        Arc::new(UInt32Array::from(lev)),
+        Arc::new(Float64Array::from(val)),
+    ];
     write_parquet(&ctx.outputs[1], &RecordBatch::try_new(schema, cols)?, None)?;
     let json = serde_json::to_vec_pretty(&best)?;
     write_atomic(&ctx.outputs[2], |f| {
@@ -167,7 +240,12 @@ pub fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
         Ok(())
     })?;
     if let Some(svg) = ctx.outputs.get(3) {
-        let text = plot_panels(&panels, "factor level (1..3)", "mean S/N (dB, smaller-the-better)", None)?;
+        let text = plot_panels(
+            &panels,
+            "factor level (1..3)",
+            "mean S/N (dB, smaller-the-better)",
+            None,
+        )?;
         write_atomic(svg, |f| {
             use std::io::Write;
             f.write_all(text.as_bytes())?;

@@ -69,7 +69,16 @@ fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
 
 #[test]
 fn bad_calibration_configs_exit_2_naming_the_key() {
-    let base = std::fs::read_to_string(root().join("pipelines/knitted.toml")).unwrap();
+    let base = r#"
+name = "knitted"
+[stages.calibrate]
+kind = "calibrate"
+inputs = ["edges.parquet", "knitted_samples.csv", "hang4.toml"]
+outputs = ["{run}/results.parquet"]
+[stages.calibrate.params]
+runs = 2
+ica = { decades = 12, countries = 16, imperialists = 3, beta = 2.0, gamma = 0.5, revolution_rate = 0.2, xi = 0.1, seed = 1 }
+"#;
     for (from, to, key) in [
         (
             "countries = 16",
@@ -91,6 +100,11 @@ fn bad_calibration_configs_exit_2_naming_the_key() {
             "xi = 0.1,",
             "xi = 0.1, topology = \"d\",",
             "stages.calibrate.params.ica.topology",
+        ),
+        (
+            "ica = {",
+            "ica_from = \"x.json\"\nica = {",
+            "stages.calibrate.params.ica",
         ),
     ] {
         assert!(base.contains(from), "{from}");
