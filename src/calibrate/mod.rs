@@ -239,3 +239,28 @@ pub fn sensitivity(
         })
         .collect()
 }
+
+/// The scene of a knitted sample: `scene_file` on a `grid` × `grid` net with the sample's Table 2
+/// density (`sample` is a path holding `sample_NN`).
+pub fn sample_scene(
+    scene_file: &std::path::Path,
+    densities: &HashMap<u32, f64>,
+    sample: &str,
+    grid: usize,
+) -> anyhow::Result<Scene> {
+    use anyhow::Context;
+    let n =
+        sample_number(sample).with_context(|| format!("`{sample}`: no sample_NN in the path"))?;
+    let rho = *densities
+        .get(&n)
+        .with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
+    let sets = [
+        format!("cloth.nx={grid}"),
+        format!("cloth.ny={grid}"),
+        format!("cloth.areal_density_kg_per_m2={rho}"),
+    ]
+    .iter()
+    .map(|s| crate::scene::parse_override(s))
+    .collect::<Result<Vec<_>, _>>()?;
+    Ok(Scene::load(scene_file, &sets)?.scene)
+}

@@ -4,11 +4,10 @@
 //! identifiability) and `evaluations.parquet` (every country of every decade of every run).
 
 use super::StageContext;
-use crate::calibrate::{Problem, read_sample_densities, sample_number, sensitivity};
+use crate::calibrate::{Problem, read_sample_densities, sample_scene, sensitivity};
 use crate::edges::{EdgeFit, edges_from_particles, eq5_objective_pct, read_edges};
 use crate::io::write_parquet;
 use crate::optim::IcaSettings;
-use crate::scene::{Scene, parse_override};
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
 use anyhow::{Context, Result, bail};
@@ -137,20 +136,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
     let mut results = Vec::new();
     let mut evals: Vec<(String, u32, u32, u32, f64, crate::calibrate::Params)> = Vec::new();
     for (sample, measured) in &by_sample {
-        let n = sample_number(sample)
-            .with_context(|| format!("`{sample}`: no sample_NN in the path"))?;
-        let rho = *densities
-            .get(&n)
-            .with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
-        let sets: Vec<(String, toml::Value)> = [
-            format!("cloth.nx={}", p.grid),
-            format!("cloth.ny={}", p.grid),
-            format!("cloth.areal_density_kg_per_m2={rho}"),
-        ]
-        .iter()
-        .map(|s| parse_override(s))
-        .collect::<Result<_, _>>()?;
-        let scene = Scene::load(scene_file, &sets)?.scene;
+        let scene = sample_scene(scene_file, &densities, sample, p.grid)?;
         let problem = Problem::new(scene, measured.clone(), p.side_cm);
         let mut best: Option<(f64, Vec<f64>)> = None;
         let mut costs = Vec::new();

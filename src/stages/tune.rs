@@ -6,11 +6,10 @@
 
 use super::StageContext;
 use super::report::plot_panels;
-use crate::calibrate::{Problem, read_sample_densities, sample_number};
+use crate::calibrate::{Problem, read_sample_densities, sample_scene};
 use crate::edges::{EdgeFit, read_edges};
 use crate::io::{write_atomic, write_parquet};
 use crate::optim::{Ica, IcaSettings, l27, main_effects, sn_smaller_the_better};
-use crate::scene::{Scene, parse_override};
 use anyhow::{Context, Result};
 use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt32Array};
 use arrow::datatypes::{DataType, Field, Schema};
@@ -138,19 +137,8 @@ pub fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
         "sample `{}` is not in the edges table",
         p.sample
     );
-    let n = sample_number(&p.sample).context("no sample_NN in `sample`")?;
-    let rho = *densities
-        .get(&n)
-        .with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
-    let sets: Vec<(String, toml::Value)> = [
-        format!("cloth.nx={}", p.grid),
-        format!("cloth.ny={}", p.grid),
-        format!("cloth.areal_density_kg_per_m2={rho}"),
-    ]
-    .iter()
-    .map(|s| parse_override(s))
-    .collect::<Result<_, _>>()?;
-    let problem = Problem::new(Scene::load(scene_file, &sets)?.scene, measured, p.side_cm);
+    let scene = sample_scene(scene_file, &densities, &p.sample, p.grid)?;
+    let problem = Problem::new(scene, measured, p.side_cm);
     let table = l27();
     let rows: Vec<Vec<u8>> = table
         .iter()

@@ -3,12 +3,11 @@
 //! with `sample`, `objective_pct` (Eq. 5, mean over the edges) and `curve_distance_pct` (seed 000 Table 6).
 
 use super::StageContext;
-use crate::calibrate::{Params, Problem, read_sample_densities, sample_number};
+use crate::calibrate::{Params, Problem, read_sample_densities, sample_number, sample_scene};
 use crate::cli::edges::{scene_view, score_edges};
 use crate::edges::{EdgeFit, edges_from_particles, read_edges};
 use crate::io::write_parquet;
 use crate::material::Topology;
-use crate::scene::{Scene, parse_override};
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
 use anyhow::{Context, Result};
@@ -122,18 +121,11 @@ pub fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
         let params = results
             .get(&n)
             .with_context(|| format!("sample {n} has no calibrated parameters"))?;
-        let rho = *densities
-            .get(&n)
-            .with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
-        let sets: Vec<(String, toml::Value)> = [
-            format!("cloth.nx={}", p.grid),
-            format!("cloth.ny={}", p.grid),
-            format!("cloth.areal_density_kg_per_m2={rho}"),
-        ]
-        .iter()
-        .map(|s| parse_override(s))
-        .collect::<Result<_, _>>()?;
-        let problem = Problem::new(Scene::load(scene_file, &sets)?.scene, Vec::new(), p.side_cm);
+        let problem = Problem::new(
+            sample_scene(scene_file, &densities, sample, p.grid)?,
+            Vec::new(),
+            p.side_cm,
+        );
         let scene = problem.scene_for(params);
         let sol = solve_scene(&scene, &mut NoObserver);
         let (view, corners) = scene_view(&scene)?;
