@@ -129,14 +129,8 @@ impl Problem {
             return *c;
         }
         self.simulations.fetch_add(1, Ordering::Relaxed);
-        let scene = self.scene_for(&p);
-        let sol = solve_scene(&scene, &mut NoObserver);
-        let c = match (sol.report.is_converged(), scene_view(&scene)) {
-            (true, Ok((view, corners))) => {
-                let sim: Vec<EdgeFit> = edges_from_particles(&sol.grid, &sol.x, view, corners)
-                    .into_iter()
-                    .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
-                    .collect();
+        let c = match self.drape(u) {
+            Some((_, sim)) => {
                 let d: Vec<f64> = self
                     .measured
                     .iter()
@@ -152,13 +146,28 @@ impl Problem {
                     d.iter().sum::<f64>() / d.len() as f64
                 }
             }
-            _ => {
+            None => {
                 self.failures.fetch_add(1, Ordering::Relaxed);
                 self.penalty
             }
         };
         self.cache.lock().expect("cache").insert(key, c);
         c
+    }
+
+    /// The static drape at u and its fitted edges; None when the solve does not converge.
+    pub fn drape(&self, u: &[f64]) -> Option<(crate::simulate::Solution, Vec<EdgeFit>)> {
+        let scene = self.scene_for(&self.bounds.decode(u));
+        let sol = solve_scene(&scene, &mut NoObserver);
+        let (view, corners) = scene_view(&scene).ok()?;
+        if !sol.report.is_converged() {
+            return None;
+        }
+        let sim = edges_from_particles(&sol.grid, &sol.x, view, corners)
+            .into_iter()
+            .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
+            .collect();
+        Some((sol, sim))
     }
 
     /// One ICA run over the five-dimensional box.

@@ -2,12 +2,14 @@
 //! killed run never leaves an artifact that looks finished.
 
 mod atomic;
+mod calibration_rrd;
 mod particles;
 mod rrd;
 mod table;
 mod timeline;
 
 pub use atomic::{Staged, write_atomic};
+pub use calibration_rrd::CalibrationRecorder;
 pub use particles::{read_particles, write_particles};
 pub use rrd::RerunRecorder;
 pub use table::write_parquet;

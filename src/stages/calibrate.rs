@@ -5,11 +5,9 @@
 
 use super::StageContext;
 use crate::calibrate::{Problem, read_sample_densities, sample_scene, sensitivity};
-use crate::edges::{EdgeFit, edges_from_particles, eq5_objective_pct, read_edges};
+use crate::edges::{EdgeFit, eq5_objective_pct, read_edges};
 use crate::io::write_parquet;
 use crate::optim::IcaSettings;
-use crate::simulate::solve_scene;
-use crate::solve::NoObserver;
 use anyhow::{Context, Result, bail};
 use arrow::array::{
     ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
@@ -133,6 +131,14 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         }
         (None, None) => bail!("no ICA settings"),
     };
+    let recorder = match ctx
+        .outputs
+        .iter()
+        .find(|o| o.extension().is_some_and(|e| e == "rrd"))
+    {
+        Some(path) => Some(crate::io::CalibrationRecorder::new(path)?),
+        None => None,
+    };
     let mut results = Vec::new();
     let mut evals: Vec<(String, u32, u32, u32, f64, crate::calibrate::Params)> = Vec::new();
     for (sample, measured) in &by_sample {
@@ -145,6 +151,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
                 seed: ica.seed + r as u64,
                 ..ica.clone()
             };
+            let mut record_error: Option<anyhow::Error> = None;
             let report =
                 crate::optim::Ica { settings, dim: 5 }.run(&|u: &[f64]| problem.cost(u), |ev| {
                     for (k, e) in ev.empires.iter().enumerate() {
@@ -159,7 +166,32 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
                             ));
                         }
                     }
+                    if let (Some(rec), None) = (&recorder, &record_error) {
+                        let best = ev
+                            .empires
+                            .iter()
+                            .map(|e| &e.imperialist)
+                            .min_by(|a, b| a.cost.total_cmp(&b.cost));
+                        let drape = best.and_then(|b| problem.drape(&b.x));
+                        let origin = drape.as_ref().map(|(s, _)| s.x[0]).unwrap_or_default();
+                        let logged = rec.decade(
+                            sample,
+                            r,
+                            ev,
+                            |x| [x[0] as f32, x[3] as f32, x[4] as f32],
+                            drape
+                                .as_ref()
+                                .map(|(s, e)| (&s.grid, s.x.as_slice(), e.as_slice())),
+                            measured,
+                            origin,
+                            p.side_cm,
+                        );
+                        record_error = logged.err();
+                    }
                 });
+            if let Some(e) = record_error {
+                return Err(e.context("writing the calibration recording"));
+            }
             costs.push(report.best_cost);
             if best.as_ref().is_none_or(|b| report.best_cost < b.0) {
                 best = Some((report.best_cost, report.best_x.clone()));
@@ -173,12 +205,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
             (costs.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / costs.len() as f64).sqrt();
         let sens = sensitivity(&problem, &u, 5);
         // Eq. 5 of the best drape against the measurement.
-        let sol = solve_scene(&problem.scene_for(&params), &mut NoObserver);
-        let (view, corners) = crate::cli::edges::scene_view(&problem.scene)?;
-        let sim: Vec<EdgeFit> = edges_from_particles(&sol.grid, &sol.x, view, corners)
-            .into_iter()
-            .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
-            .collect();
+        let sim: Vec<EdgeFit> = problem.drape(&u).map(|(_, e)| e).unwrap_or_default();
         let eq5: Vec<f64> = measured
             .iter()
             .filter_map(|m| {
@@ -269,7 +296,14 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
         None,
     )?;
-    if let Some(out) = ctx.outputs.get(1) {
+    if let Some(rec) = recorder {
+        rec.finish()?;
+    }
+    if let Some(out) = ctx
+        .outputs
+        .iter()
+        .find(|o| o.file_name().is_some_and(|n| n == "evaluations.parquet"))
+    {
         let schema = Arc::new(Schema::new(vec![
             Field::new("sample", DataType::Utf8, false),
             Field::new("run", DataType::UInt32, false),

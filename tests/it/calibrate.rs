@@ -123,3 +123,73 @@ ica = { decades = 12, countries = 16, imperialists = 3, beta = 2.0, gamma = 0.5,
         assert!(err.contains(key), "{key} not named: {err}");
     }
 }
+
+#[test]
+fn a_calibration_records_every_decade_for_rerun_and_writes_its_tables() {
+    let tmp = tempfile::tempdir().unwrap();
+    for rel in [
+        "datasets/knitted/sample_08/hang4/photo.png",
+        "datasets/knitted/sample_08/hang4/camera.json",
+        "datasets/knitted/knitted_samples.csv",
+        "datasets/scenes/hang4.toml",
+    ] {
+        let dst = tmp.path().join(rel);
+        std::fs::create_dir_all(dst.parent().unwrap()).unwrap();
+        std::fs::copy(root().join(rel), dst).unwrap();
+    }
+    std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
+    let file = tmp.path().join("pipelines/c.toml");
+    std::fs::write(
+        &file,
+        r#"
+name = "c"
+[stages.fit4]
+kind = "fit-edges"
+inputs = ["datasets/knitted/*/hang4/photo.png", "datasets/knitted/*/hang4/camera.json"]
+outputs = ["{run}/fit4/edges.parquet"]
+[stages.calibrate]
+kind = "calibrate"
+inputs = ["{run}/fit4/edges.parquet", "datasets/knitted/knitted_samples.csv", "datasets/scenes/hang4.toml"]
+outputs = ["{run}/calibrate/results.parquet", "{run}/calibrate/evaluations.parquet", "{run}/calibrate/calibration.rrd"]
+[stages.calibrate.params]
+runs = 1
+ica = { decades = 3, countries = 6, imperialists = 2, beta = 2.0, gamma = 0.3, revolution_rate = 0.2, xi = 0.1, seed = 2 }
+"#,
+    )
+    .unwrap();
+    let plan = drapelab::pipeline::load_plan(&file).unwrap();
+    let s = drapelab::pipeline::run_pipeline(
+        &plan,
+        &Default::default(),
+        &drapelab::pipeline::LogProgress::default(),
+    )
+    .unwrap();
+    assert!(s.failed.is_empty(), "{:?}", s.failed);
+    let code = r#"
+import sys, polars as pl
+from rerun.experimental import RrdReader
+r = pl.read_parquet(sys.argv[2])
+assert r.height == 1 and r["topology"][0] in "abc" and not r["identifiable_damping"][0], r
+e = pl.read_parquet(sys.argv[3])
+d = set(e["decade"].unique().to_list())
+assert 0 in d and len(d) >= 2 and d <= {0, 1, 2, 3}, d  # ICA may stop early when one empire remains
+paths, decades = set(), set()
+for chunk in RrdReader(sys.argv[1]).stream().to_chunks():
+    paths.add(chunk.entity_path)
+    if chunk.entity_path.endswith("/countries"):
+        decades.add(chunk.num_rows)
+want = ["/cost/best_pct", "/cost/mean_pct", "/countries", "/drape/mesh", "/drape/fitted_edges", "/drape/measured_edges"]
+for w in want:
+    assert any(p.endswith(w) for p in paths), (w, paths)
+print(sorted(paths))
+"#;
+    let dir = tmp.path().join("runs/c/calibrate");
+    crate::support::run_python(
+        code,
+        &[
+            &dir.join("calibration.rrd"),
+            &dir.join("results.parquet"),
+            &dir.join("evaluations.parquet"),
+        ],
+    );
+}
