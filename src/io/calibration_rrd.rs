@@ -12,6 +12,9 @@ use anyhow::Result;
 use nalgebra::Vector3;
 use std::path::Path;
 
+/// A drape to log: its grid, particle positions (m) and fitted edges.
+pub type Drape<'a> = (&'a Grid, &'a [Vector3<f64>], &'a [EdgeFit]);
+
 /// Writes a calibration recording.
 pub struct CalibrationRecorder {
     rec: rerun::RecordingStream,
@@ -71,7 +74,7 @@ impl CalibrationRecorder {
         run: usize,
         ev: &DecadeEvent<'_>,
         coords: impl Fn(&[f64]) -> [f32; 3],
-        drape: Option<(&Grid, &[Vector3<f64>], &[EdgeFit])>,
+        drape: Option<Drape<'_>>,
         measured: &[EdgeFit],
         origin_m: Vector3<f64>,
         span_cm: f64,
