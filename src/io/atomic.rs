@@ -40,9 +40,15 @@ impl Staged {
     pub fn file(&mut self) -> &mut File {
         self.tmp.as_file_mut()
     }
-    /// Flushes to disk and renames to the final path.
+    /// Flushes to disk, gives the file ordinary permissions (temporary files are private) and renames
+    /// it to the final path.
     pub fn commit(self) -> Result<PathBuf> {
         self.tmp.as_file().sync_all().ok();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(self.tmp.path(), std::fs::Permissions::from_mode(0o644)).ok();
+        }
         let target = self.target.clone();
         self.tmp
             .persist(&target)

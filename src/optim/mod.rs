@@ -2,8 +2,10 @@
 //! design that tunes it. Problems are cost functions over the unit box; solvers never print, and an
 //! observer receives every decade (argmin's habit).
 
+mod cmaes;
 mod ica;
 mod taguchi;
 
+pub use cmaes::{CmaesReport, cmaes};
 pub use ica::{DecadeEvent, Ica, IcaReport, IcaSettings};
 pub use taguchi::{L27, l27, main_effects, sn_smaller_the_better};

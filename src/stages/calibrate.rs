@@ -40,6 +40,10 @@ pub struct CalibrateParams {
     /// (curve distance, % of the side) by more than this. Default 0.05.
     #[serde(default = "default_ident")]
     pub identifiable_change_pct: f64,
+    /// Also run CMA-ES with the same number of cost evaluations as each ICA run (the baseline), into
+    /// the `comparison.parquet` output. Default false.
+    #[serde(default)]
+    pub baseline_cmaes: bool,
 }
 
 fn default_runs() -> usize {
@@ -139,6 +143,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         Some(path) => Some(crate::io::CalibrationRecorder::new(path)?),
         None => None,
     };
+    let mut comparison: Vec<(String, &str, u32, u64, f64)> = Vec::new();
     let mut results = Vec::new();
     let mut evals: Vec<(String, u32, u32, u32, f64, crate::calibrate::Params)> = Vec::new();
     for (sample, measured) in &by_sample {
@@ -193,6 +198,29 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
                 return Err(e.context("writing the calibration recording"));
             }
             costs.push(report.best_cost);
+            comparison.push((
+                sample.clone(),
+                "ica",
+                r as u32,
+                report.evaluations as u64,
+                report.best_cost,
+            ));
+            if p.baseline_cmaes {
+                let fresh = Problem::new(problem.scene.clone(), measured.clone(), p.side_cm);
+                let cm = crate::optim::cmaes(
+                    &|u: &[f64]| fresh.cost(u),
+                    5,
+                    report.evaluations,
+                    ica.seed + r as u64,
+                );
+                comparison.push((
+                    sample.clone(),
+                    "cma-es",
+                    r as u32,
+                    cm.evaluations as u64,
+                    cm.best_cost,
+                ));
+            }
             if best.as_ref().is_none_or(|b| report.best_cost < b.0) {
                 best = Some((report.best_cost, report.best_x.clone()));
             }
@@ -298,6 +326,35 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
     )?;
     if let Some(rec) = recorder {
         rec.finish()?;
+    }
+    if let Some(out) = ctx
+        .outputs
+        .iter()
+        .find(|o| o.file_name().is_some_and(|n| n == "comparison.parquet"))
+    {
+        let schema = Arc::new(Schema::new(vec![
+            Field::new("sample", DataType::Utf8, false),
+            Field::new("optimizer", DataType::Utf8, false),
+            Field::new("run", DataType::UInt32, false),
+            Field::new("evaluations", DataType::UInt64, false),
+            Field::new("best_cost_pct", DataType::Float64, false),
+        ]));
+        let cols: Vec<ArrayRef> = vec![
+            Arc::new(StringArray::from_iter_values(
+                comparison.iter().map(|c| c.0.clone()),
+            )),
+            Arc::new(StringArray::from_iter_values(
+                comparison.iter().map(|c| c.1),
+            )),
+            Arc::new(UInt32Array::from_iter_values(
+                comparison.iter().map(|c| c.2),
+            )),
+            Arc::new(UInt64Array::from_iter_values(
+                comparison.iter().map(|c| c.3),
+            )),
+            f64s(comparison.iter().map(|c| c.4).collect()),
+        ];
+        write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)?;
     }
     if let Some(out) = ctx
         .outputs

@@ -150,9 +150,10 @@ outputs = ["{run}/fit4/edges.parquet"]
 [stages.calibrate]
 kind = "calibrate"
 inputs = ["{run}/fit4/edges.parquet", "datasets/knitted/knitted_samples.csv", "datasets/scenes/hang4.toml"]
-outputs = ["{run}/calibrate/results.parquet", "{run}/calibrate/evaluations.parquet", "{run}/calibrate/calibration.rrd"]
+outputs = ["{run}/calibrate/results.parquet", "{run}/calibrate/evaluations.parquet", "{run}/calibrate/calibration.rrd", "{run}/calibrate/comparison.parquet"]
 [stages.calibrate.params]
 runs = 1
+baseline_cmaes = true
 ica = { decades = 3, countries = 6, imperialists = 2, beta = 2.0, gamma = 0.3, revolution_rate = 0.2, xi = 0.1, seed = 2 }
 "#,
     )
@@ -173,6 +174,14 @@ assert r.height == 1 and r["topology"][0] in "abc" and not r["identifiable_dampi
 e = pl.read_parquet(sys.argv[3])
 d = set(e["decade"].unique().to_list())
 assert 0 in d and len(d) >= 2 and d <= {0, 1, 2, 3}, d  # ICA may stop early when one empire remains
+c = pl.read_parquet(sys.argv[4])
+assert sorted(c["optimizer"].to_list()) == ["cma-es", "ica"], c
+ev = dict(zip(c["optimizer"], c["evaluations"]))
+assert ev["cma-es"] <= ev["ica"], ev  # the same budget
+c = pl.read_parquet(sys.argv[4])
+assert sorted(c["optimizer"].to_list()) == ["cma-es", "ica"], c
+ev = dict(zip(c["optimizer"], c["evaluations"]))
+assert ev["cma-es"] <= ev["ica"], ev  # the same budget
 paths, decades = set(), set()
 for chunk in RrdReader(sys.argv[1]).stream().to_chunks():
     paths.add(chunk.entity_path)
@@ -190,6 +199,7 @@ print(sorted(paths))
             &dir.join("calibration.rrd"),
             &dir.join("results.parquet"),
             &dir.join("evaluations.parquet"),
+            &dir.join("comparison.parquet"),
         ],
     );
 }
