@@ -2,6 +2,7 @@
 //! plan is loaded (so typos are refused before anything runs) and runs with a [`StageContext`].
 
 mod calibrate;
+mod calibration_report;
 mod fit_edges;
 mod report;
 mod score;
@@ -11,6 +12,7 @@ mod tune;
 mod validate;
 
 pub use calibrate::CalibrateParams;
+pub use calibration_report::CalibrationReportParams;
 pub use fit_edges::FitEdgesParams;
 pub use report::ReportParams;
 pub use score::ScoreParams;
@@ -56,6 +58,8 @@ pub enum StageKind {
     Validate,
     /// Taguchi L27 tuning of ICA's settings.
     Tune,
+    /// The Markdown report of a calibration.
+    CalibrationReport,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -98,6 +102,7 @@ impl StageKind {
             "calibrate" => Some(Self::Calibrate),
             "validate" => Some(Self::Validate),
             "tune" => Some(Self::Tune),
+            "calibration-report" => Some(Self::CalibrationReport),
             _ => None,
         }
     }
@@ -112,6 +117,7 @@ impl StageKind {
             Self::Calibrate => "calibrate",
             Self::Validate => "validate",
             Self::Tune => "tune",
+            Self::CalibrationReport => "calibration-report",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -124,6 +130,7 @@ impl StageKind {
             Self::Score => typed_params::<ScoreParams>(params).map(|_| ()),
             Self::Calibrate => typed_params::<CalibrateParams>(params).and_then(|p| p.check()),
             Self::Validate => typed_params::<ValidateParams>(params).map(|_| ()),
+            Self::CalibrationReport => typed_params::<CalibrationReportParams>(params).map(|_| ()),
             Self::Tune => typed_params::<TuneParams>(params).and_then(|p| {
                 if p.repeats == 0 {
                     Err(("repeats".into(), "must be ≥ 1".into()))
@@ -152,6 +159,7 @@ impl StageKind {
             Self::Calibrate => resolved::<CalibrateParams>(params),
             Self::Validate => resolved::<ValidateParams>(params),
             Self::Tune => resolved::<TuneParams>(params),
+            Self::CalibrationReport => resolved::<CalibrationReportParams>(params),
         }
     }
     /// Runs the stage.
@@ -167,6 +175,9 @@ impl StageKind {
             Self::Calibrate => calibrate::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Validate => validate::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Tune => tune::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::CalibrationReport => {
+                calibration_report::run(ctx, &typed_params(params).map_err(bad)?)
+            }
         }
     }
 }
