@@ -70,6 +70,17 @@ impl Bounds {
     }
 }
 
+/// One simulated candidate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaluation {
+    /// Cost: curve distance in % of the side, or the penalty.
+    pub cost: f64,
+    /// The solver's status.
+    pub status: &'static str,
+    /// Wall time of the simulation, s.
+    pub simulation_time_s: f64,
+}
+
 /// The cost of a sample: simulate its hang with candidate parameters and score the edges.
 pub struct Problem {
     /// The sample's scene (hang4 or hang2, with its density and grid).
@@ -82,7 +93,7 @@ pub struct Problem {
     pub side_cm: f64,
     /// Cost given to a simulation that does not converge (counted in `failures`).
     pub penalty: f64,
-    cache: Mutex<HashMap<Vec<u64>, f64>>,
+    cache: Mutex<HashMap<Vec<u64>, Evaluation>>,
     /// Simulations run (cache misses).
     pub simulations: AtomicUsize,
     /// Simulations that did not converge.
@@ -116,21 +127,32 @@ impl Problem {
         s
     }
 
-    /// Mean curve distance (% of the side) over the measured edges; the penalty if the drape does not converge.
-    pub fn cost(&self, u: &[f64]) -> f64 {
+    /// The cache key of u: damping and elongation rate do not change a static drape and are left out.
+    fn key(&self, u: &[f64]) -> Vec<u64> {
         let p = self.bounds.decode(u);
-        // Damping and elongation rate do not change a static drape: they are not part of the key.
-        let key = vec![
+        vec![
             p.stiffness_N_per_m.to_bits(),
             p.natural_length_m.to_bits(),
             p.topology as u64,
-        ];
-        if let Some(c) = self.cache.lock().expect("cache").get(&key) {
-            return *c;
+        ]
+    }
+
+    /// The evaluation of u if it was simulated already.
+    pub fn lookup(&self, u: &[f64]) -> Option<Evaluation> {
+        self.cache.lock().expect("cache").get(&self.key(u)).copied()
+    }
+
+    /// Simulates u (once: results are cached) and scores it: the mean curve distance (% of the side)
+    /// over the measured edges, or the penalty when the drape does not converge.
+    pub fn evaluate(&self, u: &[f64]) -> Evaluation {
+        let key = self.key(u);
+        if let Some(e) = self.cache.lock().expect("cache").get(&key) {
+            return *e;
         }
         self.simulations.fetch_add(1, Ordering::Relaxed);
-        let c = match self.drape(u) {
-            Some((_, sim)) => {
+        let (sol, sim) = self.drape(u);
+        let cost = match sim {
+            Some(sim) => {
                 let d: Vec<f64> = self
                     .measured
                     .iter()
@@ -151,23 +173,34 @@ impl Problem {
                 self.penalty
             }
         };
-        self.cache.lock().expect("cache").insert(key, c);
-        c
+        let e = Evaluation {
+            cost,
+            status: sol.report.status.as_str(),
+            simulation_time_s: sol.report.wall_time_s,
+        };
+        self.cache.lock().expect("cache").insert(key, e);
+        e
     }
 
-    /// The static drape at u and its fitted edges; None when the solve does not converge.
-    pub fn drape(&self, u: &[f64]) -> Option<(crate::simulate::Solution, Vec<EdgeFit>)> {
+    /// The cost of u (see [`Self::evaluate`]).
+    pub fn cost(&self, u: &[f64]) -> f64 {
+        self.evaluate(u).cost
+    }
+
+    /// The static drape at u, with its fitted edges when the solve converged.
+    pub fn drape(&self, u: &[f64]) -> (crate::simulate::Solution, Option<Vec<EdgeFit>>) {
         let scene = self.scene_for(&self.bounds.decode(u));
         let sol = solve_scene(&scene, &mut NoObserver);
-        let (view, corners) = scene_view(&scene).ok()?;
-        if !sol.report.is_converged() {
-            return None;
-        }
-        let sim = edges_from_particles(&sol.grid, &sol.x, view, corners)
-            .into_iter()
-            .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
-            .collect();
-        Some((sol, sim))
+        let edges = match (sol.report.is_converged(), scene_view(&scene)) {
+            (true, Ok((view, corners))) => Some(
+                edges_from_particles(&sol.grid, &sol.x, view, corners)
+                    .into_iter()
+                    .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
+                    .collect(),
+            ),
+            _ => None,
+        };
+        (sol, edges)
     }
 
     /// One ICA run over the five-dimensional box.

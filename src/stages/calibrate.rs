@@ -82,6 +82,17 @@ impl CalibrateParams {
     }
 }
 
+/// One country of one decade: sample, run, decade, empire, cost, parameters, and its simulation.
+type EvalRow = (
+    String,
+    u32,
+    u32,
+    u32,
+    f64,
+    crate::calibrate::Params,
+    Option<crate::calibrate::Evaluation>,
+);
+
 struct SampleResult {
     sample: String,
     best: crate::calibrate::Params,
@@ -145,7 +156,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
     };
     let mut comparison: Vec<(String, &str, u32, u64, f64)> = Vec::new();
     let mut results = Vec::new();
-    let mut evals: Vec<(String, u32, u32, u32, f64, crate::calibrate::Params)> = Vec::new();
+    let mut evals: Vec<EvalRow> = Vec::new();
     for (sample, measured) in &by_sample {
         let scene = sample_scene(scene_file, &densities, sample, p.grid)?;
         let problem = Problem::new(scene, measured.clone(), p.side_cm);
@@ -168,6 +179,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
                                 k as u32,
                                 c.cost,
                                 problem.bounds.decode(&c.x),
+                                problem.lookup(&c.x),
                             ));
                         }
                     }
@@ -177,7 +189,9 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
                             .iter()
                             .map(|e| &e.imperialist)
                             .min_by(|a, b| a.cost.total_cmp(&b.cost));
-                        let drape = best.and_then(|b| problem.drape(&b.x));
+                        let drape = best
+                            .map(|b| problem.drape(&b.x))
+                            .and_then(|(s, e)| Some((s, e?)));
                         let origin = drape.as_ref().map(|(s, _)| s.x[0]).unwrap_or_default();
                         let logged = rec.decade(
                             sample,
@@ -233,7 +247,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
             (costs.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / costs.len() as f64).sqrt();
         let sens = sensitivity(&problem, &u, 5);
         // Eq. 5 of the best drape against the measurement.
-        let sim: Vec<EdgeFit> = problem.drape(&u).map(|(_, e)| e).unwrap_or_default();
+        let sim: Vec<EdgeFit> = problem.drape(&u).1.unwrap_or_default();
         let eq5: Vec<f64> = measured
             .iter()
             .filter_map(|m| {
@@ -370,6 +384,8 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
             Field::new("stiffness_N_per_m", DataType::Float64, false),
             Field::new("natural_length_m", DataType::Float64, false),
             Field::new("topology", DataType::Utf8, false),
+            Field::new("solver_status", DataType::Utf8, true),
+            Field::new("simulation_time_s", DataType::Float64, true),
         ]));
         let cols: Vec<ArrayRef> = vec![
             Arc::new(StringArray::from_iter_values(
@@ -383,6 +399,12 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
             f64s(evals.iter().map(|e| e.5.natural_length_m).collect()),
             Arc::new(StringArray::from_iter_values(
                 evals.iter().map(|e| e.5.topology.letter()),
+            )),
+            Arc::new(StringArray::from_iter(
+                evals.iter().map(|e| e.6.map(|v| v.status)),
+            )),
+            Arc::new(Float64Array::from_iter(
+                evals.iter().map(|e| e.6.map(|v| v.simulation_time_s)),
             )),
         ];
         write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)?;

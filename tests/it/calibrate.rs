@@ -174,6 +174,7 @@ assert r.height == 1 and r["topology"][0] in "abc" and not r["identifiable_dampi
 e = pl.read_parquet(sys.argv[3])
 d = set(e["decade"].unique().to_list())
 assert 0 in d and len(d) >= 2 and d <= {0, 1, 2, 3}, d  # ICA may stop early when one empire remains
+assert (e["solver_status"] == "converged").all() and (e["simulation_time_s"] > 0).all(), e
 c = pl.read_parquet(sys.argv[4])
 assert sorted(c["optimizer"].to_list()) == ["cma-es", "ica"], c
 ev = dict(zip(c["optimizer"], c["evaluations"]))
