@@ -4,7 +4,7 @@
 //! identifiability) and `evaluations.parquet` (every country of every decade of every run).
 
 use super::StageContext;
-use crate::calibrate::{Problem, read_sample_densities, sample_scene, sensitivity};
+use crate::calibrate::{Problem, sample_scene, sensitivity};
 use crate::edges::{EdgeFit, eq5_objective_pct, read_edges};
 use crate::io::write_parquet;
 use crate::optim::IcaSettings;
@@ -106,21 +106,8 @@ struct SampleResult {
 
 /// Runs the stage.
 pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
-    let find = |name: &str| {
-        ctx.inputs
-            .iter()
-            .find(|f| f.file_name().is_some_and(|n| n == name))
-    };
-    let scene_file = ctx
-        .inputs
-        .iter()
-        .find(|f| f.extension().is_some_and(|e| e == "toml"))
-        .context("a scene (.toml) input is needed")?;
-    let densities = read_sample_densities(
-        find("knitted_samples.csv").context("knitted_samples.csv input is needed")?,
-    )?;
-    let edges_file =
-        find("edges.parquet").context("an edges.parquet input (fit-edges output) is needed")?;
+    let (scene_file, densities) = ctx.knitted_inputs()?;
+    let edges_file = ctx.input_named("edges.parquet")?;
     let mut by_sample: BTreeMap<String, Vec<EdgeFit>> = BTreeMap::new();
     for (s, e) in read_edges(edges_file)? {
         by_sample.entry(s).or_default().push(e);

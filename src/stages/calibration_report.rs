@@ -8,7 +8,7 @@ use super::StageContext;
 use super::report::{Panels, markdown, plot_panels};
 use crate::calibrate::sample_number;
 use crate::io::write_atomic;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use polars::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -63,12 +63,7 @@ fn write_text(path: &Path, text: &str) -> Result<()> {
 
 /// Runs the stage.
 pub fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
-    let find = |name: &str| -> Result<&PathBuf> {
-        ctx.inputs
-            .iter()
-            .find(|f| f.file_name().is_some_and(|n| n == name))
-            .with_context(|| format!("input {name} is needed"))
-    };
+    let find = |name: &str| ctx.input_named(name);
     ctx.progress.stage_started(&ctx.stage.name, 1);
     let md = &ctx.outputs[0];
     let (conv_svg, effects_svg) = (ctx.outputs.get(1), ctx.outputs.get(2));

@@ -39,6 +39,30 @@ pub struct StageContext<'a> {
     pub progress: &'a dyn Progress,
 }
 
+impl StageContext<'_> {
+    /// The input file called `name`.
+    pub fn input_named(&self, name: &str) -> Result<&PathBuf> {
+        self.inputs
+            .iter()
+            .find(|f| f.file_name().is_some_and(|n| n == name))
+            .ok_or_else(|| anyhow::anyhow!("an input named {name} is needed"))
+    }
+    /// The first input file with extension `ext`.
+    pub fn input_with_extension(&self, ext: &str) -> Result<&PathBuf> {
+        self.inputs
+            .iter()
+            .find(|f| f.extension().is_some_and(|e| e == ext))
+            .ok_or_else(|| anyhow::anyhow!("an input ending in .{ext} is needed"))
+    }
+    /// The scene file and Table 2's densities that the calibration stages read.
+    pub fn knitted_inputs(&self) -> Result<(&PathBuf, std::collections::HashMap<u32, f64>)> {
+        Ok((
+            self.input_with_extension("toml")?,
+            crate::calibrate::read_sample_densities(self.input_named("knitted_samples.csv")?)?,
+        ))
+    }
+}
+
 /// The known stage kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StageKind {

@@ -6,11 +6,11 @@
 
 use super::StageContext;
 use super::report::plot_panels;
-use crate::calibrate::{Problem, read_sample_densities, sample_scene};
+use crate::calibrate::{Problem, sample_scene};
 use crate::edges::{EdgeFit, read_edges};
 use crate::io::{write_atomic, write_parquet};
 use crate::optim::{Ica, IcaSettings, l27, main_effects, sn_smaller_the_better};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt32Array};
 use arrow::datatypes::{DataType, Field, Schema};
 use serde::{Deserialize, Serialize};
@@ -113,25 +113,12 @@ fn settings(levels: &Levels, l: &[u8], seed: u64) -> IcaSettings {
 
 /// Runs the stage.
 pub fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
-    let find = |name: &str| {
-        ctx.inputs
-            .iter()
-            .find(|f| f.file_name().is_some_and(|n| n == name))
-    };
-    let scene_file = ctx
-        .inputs
-        .iter()
-        .find(|f| f.extension().is_some_and(|e| e == "toml"))
-        .context("a scene (.toml) input is needed")?;
-    let densities = read_sample_densities(
-        find("knitted_samples.csv").context("knitted_samples.csv input is needed")?,
-    )?;
-    let measured: Vec<EdgeFit> =
-        read_edges(find("edges.parquet").context("an edges.parquet input is needed")?)?
-            .into_iter()
-            .filter(|(s, _)| *s == p.sample)
-            .map(|(_, e)| e)
-            .collect();
+    let (scene_file, densities) = ctx.knitted_inputs()?;
+    let measured: Vec<EdgeFit> = read_edges(ctx.input_named("edges.parquet")?)?
+        .into_iter()
+        .filter(|(s, _)| *s == p.sample)
+        .map(|(_, e)| e)
+        .collect();
     anyhow::ensure!(
         !measured.is_empty(),
         "sample `{}` is not in the edges table",

@@ -3,7 +3,7 @@
 //! with `sample`, `objective_pct` (Eq. 5, mean over the edges) and `curve_distance_pct` (seed 000 Table 6).
 
 use super::StageContext;
-use crate::calibrate::{Params, Problem, read_sample_densities, sample_number, sample_scene};
+use crate::calibrate::{Params, Problem, sample_number, sample_scene};
 use crate::cli::edges::{scene_view, score_edges};
 use crate::edges::{EdgeFit, edges_from_particles, read_edges};
 use crate::io::write_parquet;
@@ -87,27 +87,14 @@ fn read_results(path: &std::path::Path) -> Result<BTreeMap<u32, Params>> {
 
 /// Runs the stage.
 pub fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
-    let find = |name: &str| {
-        ctx.inputs
-            .iter()
-            .find(|f| f.file_name().is_some_and(|n| n == name))
-    };
-    let scene_file = ctx
-        .inputs
-        .iter()
-        .find(|f| f.extension().is_some_and(|e| e == "toml"))
-        .context("a 2-corner scene (.toml) input is needed")?;
-    let densities = read_sample_densities(
-        find("knitted_samples.csv").context("knitted_samples.csv input is needed")?,
-    )?;
+    let (scene_file, densities) = ctx.knitted_inputs()?;
     let results = read_results(
         &ctx.plan.root.join(
             p.results
                 .replace("{run}", &format!("runs/{}", ctx.plan.name)),
         ),
     )?;
-    let edges_file = find("edges.parquet")
-        .context("an edges.parquet input (fit-edges of the 2-corner photos) is needed")?;
+    let edges_file = ctx.input_named("edges.parquet")?;
     let mut by_sample: BTreeMap<String, Vec<(String, EdgeFit)>> = BTreeMap::new();
     for (s, e) in read_edges(edges_file)? {
         by_sample.entry(s.clone()).or_default().push((s, e));
