@@ -126,21 +126,14 @@ ica = { decades = 12, countries = 16, imperialists = 3, beta = 2.0, gamma = 0.5,
 
 #[test]
 fn a_calibration_records_every_decade_for_rerun_and_writes_its_tables() {
-    let tmp = tempfile::tempdir().unwrap();
-    for rel in [
-        "datasets/knitted/sample_08/hang4/photo.png",
-        "datasets/knitted/sample_08/hang4/camera.json",
-        "datasets/knitted/knitted_samples.csv",
-        "datasets/scenes/hang4.toml",
-    ] {
-        let dst = tmp.path().join(rel);
-        std::fs::create_dir_all(dst.parent().unwrap()).unwrap();
-        std::fs::copy(root().join(rel), dst).unwrap();
-    }
-    std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
-    let file = tmp.path().join("pipelines/c.toml");
-    std::fs::write(
-        &file,
+    let (tmp, file) = crate::support::temp_project(
+        &[
+            "datasets/knitted/sample_08/hang4/photo.png",
+            "datasets/knitted/sample_08/hang4/camera.json",
+            "datasets/knitted/knitted_samples.csv",
+            "datasets/scenes/hang4.toml",
+        ],
+        "c.toml",
         r#"
 name = "c"
 [stages.fit4]
@@ -156,8 +149,7 @@ runs = 1
 baseline_cmaes = true
 ica = { decades = 3, countries = 6, imperialists = 2, beta = 2.0, gamma = 0.3, revolution_rate = 0.2, xi = 0.1, seed = 2 }
 "#,
-    )
-    .unwrap();
+    );
     let plan = drapelab::pipeline::load_plan(&file).unwrap();
     let s = drapelab::pipeline::run_pipeline(
         &plan,

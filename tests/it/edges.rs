@@ -286,20 +286,9 @@ fn score_is_zero_for_identical_curves_symmetric_and_follows_its_formula() {
 fn bundled_knitted_photos_measure_the_simulated_drapes() {
     // The fit-edges and score stages on the bundled synthetic dataset: every photo's curves lie within
     // 0.1 % of the side (0.05 cm) of the fits made straight from the simulated particles.
-    let tmp = tempfile::tempdir().unwrap();
-    let copy = |rel: &str| {
-        for entry in glob::glob(&root().join(rel).to_string_lossy()).unwrap() {
-            let src = entry.unwrap();
-            let dst = tmp.path().join(src.strip_prefix(root()).unwrap());
-            std::fs::create_dir_all(dst.parent().unwrap()).unwrap();
-            std::fs::copy(&src, &dst).unwrap();
-        }
-    };
-    copy("datasets/knitted/*/hang*/*");
-    std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
-    let file = tmp.path().join("pipelines/k.toml");
-    std::fs::write(
-        &file,
+    let (tmp, file) = crate::support::temp_project(
+        &["datasets/knitted/*/hang*/*"],
+        "k.toml",
         r#"
 name = "k"
 [stages.fit2]
@@ -321,8 +310,7 @@ inputs = ["{run}/fit4/edges.parquet", "datasets/knitted/*/hang4/edges_truth.parq
 outputs = ["{run}/err4/score.parquet"]
 params = { measured = "{run}/fit4/edges.parquet", side_cm = 50.0 }
 "#,
-    )
-    .unwrap();
+    );
     let plan = drapelab::pipeline::load_plan(&file).unwrap();
     let summary = drapelab::pipeline::run_pipeline(
         &plan,

@@ -2,7 +2,7 @@
 //! pipeline files, and a real client reading the sweep dataset. A failure here means stale results
 //! are served as fresh, or a killed run leaves a wrong artifact.
 
-use crate::support::{drapelab, root, run_python};
+use crate::support::{drapelab, run_python, temp_project};
 use drapelab::pipeline::{
     LogProgress, RunOptions, StageState, load_plan, run_pipeline, stage_states,
 };
@@ -37,16 +37,11 @@ params = { title = "t", x = "material.mass_spring.stiffness_N_per_m", group_by =
 
 /// A temporary project with the bundled scenes and a pipeline file.
 fn project(pipeline: &str) -> (tempfile::TempDir, PathBuf) {
-    let tmp = tempfile::tempdir().unwrap();
-    let scenes = tmp.path().join("datasets/scenes");
-    std::fs::create_dir_all(&scenes).unwrap();
-    for s in ["hang4.toml", "hang2.toml"] {
-        std::fs::copy(root().join("datasets/scenes").join(s), scenes.join(s)).unwrap();
-    }
-    std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
-    let file = tmp.path().join("pipelines/t.toml");
-    std::fs::write(&file, pipeline).unwrap();
-    (tmp, file)
+    temp_project(
+        &["datasets/scenes/hang4.toml", "datasets/scenes/hang2.toml"],
+        "t.toml",
+        pipeline,
+    )
 }
 
 fn run(file: &Path, opts: RunOptions) -> drapelab::pipeline::RunSummary {

@@ -92,3 +92,21 @@ pub fn run_python(code: &str, args: &[&Path]) -> String {
     );
     stdout
 }
+
+/// A temporary project holding copies of the repository files matched by `globs` (relative to the
+/// root) and the pipeline text as `pipelines/<name>`; returns the folder and the pipeline file.
+pub fn temp_project(globs: &[&str], name: &str, pipeline: &str) -> (tempfile::TempDir, PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    for g in globs {
+        for entry in glob::glob(&root().join(g).to_string_lossy()).unwrap() {
+            let src = entry.unwrap();
+            let dst = tmp.path().join(src.strip_prefix(root()).unwrap());
+            std::fs::create_dir_all(dst.parent().unwrap()).unwrap();
+            std::fs::copy(&src, &dst).unwrap();
+        }
+    }
+    std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
+    let file = tmp.path().join("pipelines").join(name);
+    std::fs::write(&file, pipeline).unwrap();
+    (tmp, file)
+}
