@@ -22,6 +22,7 @@ pub mod scene;
 pub mod simulate;
 pub mod solve;
 pub mod stages;
+pub mod wrinkles;
 
 /// Standard gravity in m/s², the default of every scene.
 pub const STANDARD_GRAVITY_M_PER_S2: f64 = 9.806_65;

@@ -4,7 +4,8 @@
 use crate::cloth::Corner;
 use crate::edges::{
     Camera, EdgeFit, FitImageOptions, RenderOptions, View, curve_distance_pct,
-    edges_from_particles, eq5_objective_pct, fit_image, read_edges, read_gray, write_edges,
+    edges_from_particles, eq5_objective_pct, eq5_uncentred_pct, fit_image, read_edges, read_gray,
+    write_edges,
 };
 use crate::error::InputError;
 use crate::io::{write_atomic, write_particles};
@@ -196,8 +197,10 @@ pub struct ScoreRow {
     pub sample: String,
     /// Edge name.
     pub edge: String,
-    /// Seed 000 Eq. 5, %.
+    /// Seed 000 Eq. 5 in centred coordinates, % (see [`eq5_objective_pct`]).
     pub objective_pct: f64,
+    /// Seed 000 Eq. 5 with coefficients taken from the corner (x/L), % (ill-conditioned; for comparison).
+    pub objective_uncentred_pct: f64,
     /// RMS vertical distance between the curves, % of the side.
     pub curve_distance_pct: f64,
 }
@@ -221,6 +224,7 @@ pub fn score_edges(
                 sample: rs.clone(),
                 edge: r.edge.clone(),
                 objective_pct: eq5_objective_pct(r, s, side_cm),
+                objective_uncentred_pct: eq5_uncentred_pct(r, s, side_cm),
                 curve_distance_pct: curve_distance_pct(r, s, span, side_cm),
             })
         })

@@ -4,7 +4,7 @@
 //! identifiability) and `evaluations.parquet` (every country of every decade of every run).
 
 use super::StageContext;
-use crate::calibrate::{Problem, sample_scene, sensitivity};
+use crate::calibrate::{Noise, Problem, identifiability, sample_scene};
 use crate::edges::{EdgeFit, eq5_objective_pct, read_edges};
 use crate::io::write_parquet;
 use crate::optim::IcaSettings;
@@ -36,10 +36,24 @@ pub struct CalibrateParams {
     /// Side of the samples, cm. Default 50.
     #[serde(default = "default_side")]
     pub side_cm: f64,
-    /// A parameter is identifiable when sweeping it across its range near the optimum changes the cost
-    /// (curve distance, % of the side) by more than this. Default 0.05.
+    /// Measurement error of the photos in the cost's unit (curve distance, % of the side), for the
+    /// identifiability analysis: a worst-case bound (0.03 is the photo-to-particle gap of the bundled
+    /// dataset, README "Edges from photos"). Default: none, the standard error of least squares
+    /// estimated from the residual at the optimum ([`crate::calibrate::Noise`]).
+    #[serde(default)]
+    pub measurement_noise_pct: Option<f64>,
+    /// A parameter is identifiable when the photos pin it to within this fraction of its value (the
+    /// half-width over which the cost stays within the noise). Default 0.05.
     #[serde(default = "default_ident")]
-    pub identifiable_change_pct: f64,
+    pub identifiable_rel: f64,
+    /// Half-width of the window swept around the optimum for each parameter, as a fraction of its
+    /// Table 3 range. Default 0.1.
+    #[serde(default = "default_window")]
+    pub identifiability_window: f64,
+    /// Nelder–Mead iterations that polish the best ICA optimum over stiffness and natural length
+    /// ([`crate::calibrate::Problem::polish`]); 0 keeps seed 000's ICA alone. Default 60.
+    #[serde(default = "default_polish")]
+    pub polish_iterations: u64,
     /// Also run CMA-ES with the same number of cost evaluations as each ICA run (the baseline), into
     /// the `comparison.parquet` output. Default false.
     #[serde(default)]
@@ -57,6 +71,12 @@ fn default_side() -> f64 {
 }
 fn default_ident() -> f64 {
     0.05
+}
+fn default_polish() -> u64 {
+    60
+}
+fn default_window() -> f64 {
+    0.1
 }
 
 impl CalibrateParams {
@@ -78,6 +98,25 @@ impl CalibrateParams {
         if self.grid < 3 {
             return Err(("grid".into(), "must be ≥ 3".into()));
         }
+        for (key, v, lo, hi) in [
+            (
+                "measurement_noise_pct",
+                self.measurement_noise_pct.unwrap_or(1.0),
+                0.0,
+                100.0,
+            ),
+            ("identifiable_rel", self.identifiable_rel, 0.0, 1.0),
+            (
+                "identifiability_window",
+                self.identifiability_window,
+                0.0,
+                1.0,
+            ),
+        ] {
+            if !(v.is_finite() && v > lo && v <= hi) {
+                return Err((key.into(), format!("must be in ({lo}, {hi}], got {v}")));
+            }
+        }
         Ok(())
     }
 }
@@ -97,11 +136,12 @@ struct SampleResult {
     sample: String,
     best: crate::calibrate::Params,
     curve_pct: f64,
+    ica_curve_pct: f64,
     eq5_pct: f64,
     spread_pct: f64,
     simulations: usize,
     failures: usize,
-    identifiable: Vec<bool>,
+    identifiability: Vec<crate::calibrate::Identifiability>,
 }
 
 /// Runs the stage.
@@ -227,12 +267,21 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
             }
             ctx.progress.item_done(&ctx.stage.name);
         }
-        let (cost, u) = best.expect("runs ≥ 1");
+        let (ica_cost, ica_u) = best.expect("runs ≥ 1");
+        let (u, cost) = problem.polish(&ica_u, p.polish_iterations);
         let params = problem.bounds.decode(&u);
         let mean = costs.iter().sum::<f64>() / costs.len() as f64;
         let spread =
             (costs.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / costs.len() as f64).sqrt();
-        let sens = sensitivity(&problem, &u, 5);
+        let ident = identifiability(
+            &problem,
+            &u,
+            p.identifiability_window,
+            7,
+            p.measurement_noise_pct
+                .map_or(Noise::FromResidual, Noise::Given),
+            p.identifiable_rel,
+        );
         // Eq. 5 of the best drape against the measurement.
         let sim: Vec<EdgeFit> = problem.drape(&u).1.unwrap_or_default();
         let eq5: Vec<f64> = measured
@@ -247,16 +296,14 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
             sample: sample.clone(),
             best: params,
             curve_pct: cost,
+            ica_curve_pct: ica_cost,
             eq5_pct: eq5.iter().sum::<f64>() / eq5.len().max(1) as f64,
             spread_pct: spread,
             simulations: problem
                 .simulations
                 .load(std::sync::atomic::Ordering::Relaxed),
             failures: problem.failures.load(std::sync::atomic::Ordering::Relaxed),
-            identifiable: sens
-                .iter()
-                .map(|(_, lo, hi)| hi - lo > p.identifiable_change_pct)
-                .collect(),
+            identifiability: ident,
         });
     }
     let f64s = |v: Vec<f64>| -> ArrayRef { Arc::new(Float64Array::from(v)) };
@@ -264,6 +311,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         Field::new("sample", DataType::Utf8, false),
         Field::new("objective_pct", DataType::Float64, false),
         Field::new("curve_distance_pct", DataType::Float64, false),
+        Field::new("ica_curve_distance_pct", DataType::Float64, false),
         Field::new("stiffness_N_per_m", DataType::Float64, false),
         Field::new("damping_Ns_per_m", DataType::Float64, false),
         Field::new("elongation_rate", DataType::Float64, false),
@@ -280,6 +328,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         )),
         f64s(results.iter().map(|r| r.eq5_pct).collect()),
         f64s(results.iter().map(|r| r.curve_pct).collect()),
+        f64s(results.iter().map(|r| r.ica_curve_pct).collect()),
         f64s(results.iter().map(|r| r.best.stiffness_N_per_m).collect()),
         f64s(results.iter().map(|r| r.best.damping_Ns_per_m).collect()),
         f64s(results.iter().map(|r| r.best.elongation_rate).collect()),
@@ -316,9 +365,25 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         cols.push(Arc::new(BooleanArray::from(
             results
                 .iter()
-                .map(|r| r.identifiable[k])
+                .map(|r| r.identifiability[k].identifiable)
                 .collect::<Vec<_>>(),
         )));
+    }
+    // Half-widths of the intervals the photos allow (null where the cost is flat).
+    for (k, name) in [
+        "stiffness_uncertainty_N_per_m",
+        "damping_uncertainty_Ns_per_m",
+        "elongation_rate_uncertainty",
+        "natural_length_uncertainty_m",
+    ]
+    .iter()
+    .enumerate()
+    {
+        fields.push(Field::new(*name, DataType::Float64, true));
+        cols.push(Arc::new(Float64Array::from_iter(results.iter().map(|r| {
+            let u = r.identifiability[k].uncertainty;
+            u.is_finite().then_some(u)
+        }))));
     }
     write_parquet(
         &ctx.outputs[0],

@@ -10,6 +10,7 @@ mod simulate;
 mod sweep;
 mod tune;
 mod validate;
+mod wrinkles;
 
 pub use calibrate::CalibrateParams;
 pub use calibration_report::CalibrationReportParams;
@@ -20,6 +21,7 @@ pub use simulate::SimulateParams;
 pub use sweep::{Axis, Design, SweepParams, sweep_points};
 pub use tune::{Levels, TuneParams};
 pub use validate::ValidateParams;
+pub use wrinkles::{SolvedCase, WrinklesParams, report_markdown, write_wrinkles};
 
 use crate::pipeline::{Plan, PlannedStage, Progress};
 use anyhow::Result;
@@ -84,6 +86,8 @@ pub enum StageKind {
     Tune,
     /// The Markdown report of a calibration.
     CalibrationReport,
+    /// Seed 002's tension-field wrinkles of every case of a config.
+    Wrinkles,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -106,13 +110,17 @@ pub(crate) fn typed_params<T: serde::de::DeserializeOwned>(
 
 impl StageKind {
     /// Names of all kinds.
-    pub const ALL: [&'static str; 6] = [
+    pub const ALL: [&'static str; 10] = [
         "simulate",
         "sweep",
         "report",
         "fit-edges",
         "score",
         "calibrate",
+        "validate",
+        "tune",
+        "calibration-report",
+        "wrinkles",
     ];
 
     /// The kind of a name.
@@ -127,6 +135,7 @@ impl StageKind {
             "validate" => Some(Self::Validate),
             "tune" => Some(Self::Tune),
             "calibration-report" => Some(Self::CalibrationReport),
+            "wrinkles" => Some(Self::Wrinkles),
             _ => None,
         }
     }
@@ -142,6 +151,7 @@ impl StageKind {
             Self::Validate => "validate",
             Self::Tune => "tune",
             Self::CalibrationReport => "calibration-report",
+            Self::Wrinkles => "wrinkles",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -155,6 +165,7 @@ impl StageKind {
             Self::Calibrate => typed_params::<CalibrateParams>(params).and_then(|p| p.check()),
             Self::Validate => typed_params::<ValidateParams>(params).map(|_| ()),
             Self::CalibrationReport => typed_params::<CalibrationReportParams>(params).map(|_| ()),
+            Self::Wrinkles => typed_params::<WrinklesParams>(params).map(|_| ()),
             Self::Tune => typed_params::<TuneParams>(params).and_then(|p| {
                 if p.repeats == 0 {
                     Err(("repeats".into(), "must be ≥ 1".into()))
@@ -184,6 +195,7 @@ impl StageKind {
             Self::Validate => resolved::<ValidateParams>(params),
             Self::Tune => resolved::<TuneParams>(params),
             Self::CalibrationReport => resolved::<CalibrationReportParams>(params),
+            Self::Wrinkles => resolved::<WrinklesParams>(params),
         }
     }
     /// Runs the stage.
@@ -202,6 +214,7 @@ impl StageKind {
             Self::CalibrationReport => {
                 calibration_report::run(ctx, &typed_params(params).map_err(bad)?)
             }
+            Self::Wrinkles => wrinkles::run(ctx, &typed_params(params).map_err(bad)?),
         }
     }
 }

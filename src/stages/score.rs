@@ -66,6 +66,7 @@ pub fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
         Field::new("sample", DataType::Utf8, false),
         Field::new("edge", DataType::Utf8, false),
         Field::new("objective_pct", DataType::Float64, false),
+        Field::new("objective_uncentred_pct", DataType::Float64, false),
         Field::new("curve_distance_pct", DataType::Float64, false),
     ]));
     let batch = RecordBatch::try_new(
@@ -79,6 +80,9 @@ pub fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
             )),
             Arc::new(Float64Array::from_iter_values(
                 rows.iter().map(|r| r.objective_pct),
+            )),
+            Arc::new(Float64Array::from_iter_values(
+                rows.iter().map(|r| r.objective_uncentred_pct),
             )),
             Arc::new(Float64Array::from_iter_values(
                 rows.iter().map(|r| r.curve_distance_pct),

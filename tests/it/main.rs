@@ -8,3 +8,4 @@ mod engine;
 mod pipeline;
 mod recordings;
 mod support;
+mod wrinkles;
