@@ -214,3 +214,27 @@ fn invalid_wrinkle_inputs_exit_2_naming_the_key() {
         assert!(!out.exists(), "nothing is written for bad input");
     }
 }
+
+#[test]
+fn a_sweep_adds_one_case_per_value_and_n_grows_with_height() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("s.toml");
+    let base = std::fs::read_to_string(root().join("datasets/wrinkles/seed_tables.toml")).unwrap();
+    std::fs::write(
+        &file,
+        format!(
+            "{base}\n[[sweeps]]\nbase = \"I-h140\"\nkey = \"height_m\"\nvalues = [0.6, 1.0, 1.6, 2.4, 3.2]\n"
+        ),
+    )
+    .unwrap();
+    let cfg = load_config(&file).unwrap();
+    assert_eq!(cfg.cases.len(), 17);
+    let swept: Vec<_> = cfg
+        .cases
+        .iter()
+        .filter(|c| c.case.starts_with("I-h140/height_m="))
+        .map(|c| solve(&c.inputs(&cfg.defaults)).n)
+        .collect();
+    assert_eq!(swept.len(), 5);
+    assert!(swept.windows(2).all(|w| w[1] >= w[0]) && swept[4] > swept[0], "{swept:?}");
+}
