@@ -31,6 +31,14 @@ pub struct ClothSpec {
     pub grading: f64,
     /// Areal density (mass per area) in kg/m² (45 g/m² = 0.045).
     pub areal_density_kg_per_m2: f64,
+    /// "square" (default) or "disc": the circle inscribed in the sheet, the grid particles outside it
+    /// left out (a drape-tester specimen).
+    #[serde(default)]
+    pub shape: SheetShape,
+    /// Position of particle (0, 0) in m: the flat sheet spans origin + [0, size_x] × [0, size_y] at
+    /// z = origin z. Default [0, 0, 0].
+    #[serde(default)]
+    pub origin_m: [f64; 3],
     /// Amplitude of an out-of-plane initial perturbation z = a·sin(πx/Lx)·sin(πy/Ly)·(y/Ly) in m,
     /// used to break the mirror symmetry of a hang. Default 0.
     #[serde(default)]
@@ -173,6 +181,66 @@ pub struct Scene {
     /// Recording.
     #[serde(default)]
     pub record: RecordSpec,
+    /// Rigid obstacles (seed 003): `[[obstacles]]` with `kind` = plane, box, cylinder, sphere, pedestal
+    /// or revolution. Default none.
+    #[serde(default)]
+    pub obstacles: Vec<crate::contact::Obstacle>,
+    /// How contact with the obstacles is treated.
+    #[serde(default)]
+    pub contact: ContactSpec,
+}
+
+/// The outline of the sheet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SheetShape {
+    /// The whole rectangle.
+    #[default]
+    Square,
+    /// The circle inscribed in the rectangle.
+    Disc,
+}
+
+/// How contact with obstacles is treated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactMethod {
+    /// A smooth barrier energy: no particle can enter an obstacle in any direction (default).
+    #[default]
+    Barrier,
+    /// Seed 003 §10.7.1: a node that went below an obstacle's upper surface is pulled back vertically
+    /// onto it and held there while the obstacle pushes on it (active set).
+    VerticalGap,
+}
+
+/// Contact options.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// "barrier" (default) or "vertical-gap".
+    #[serde(default)]
+    pub method: ContactMethod,
+    /// Barrier activation distance d̂ in m: the gap at which contact forces start. Default 1e-3.
+    #[serde(default = "default_contact_distance")]
+    pub distance_m: f64,
+    /// Fix the particles that start above the top face of a box table or a pedestal, as seed 003 does
+    /// for the part of a sheet lying on a table (§10.5, §10.6). Default false (they slide freely).
+    #[serde(default)]
+    pub fix_supported: bool,
+}
+
+fn default_contact_distance() -> f64 {
+    1e-3
+}
+
+impl Default for ContactSpec {
+    fn default() -> Self {
+        Self {
+            method: ContactMethod::default(),
+            distance_m: default_contact_distance(),
+            fix_supported: false,
+        }
+    }
 }
 
 /// A scene with the file it came from.
@@ -389,11 +457,39 @@ impl Scene {
         if self.boundary.pin_corners.is_empty()
             && self.boundary.pin_particles.is_empty()
             && self.boundary.clamp_edges.is_empty()
+            && (!self.contact.fix_supported || self.obstacles.is_empty())
         {
             return err(
                 "boundary",
                 "nothing is pinned or clamped: the sheet would fall freely".into(),
             );
+        }
+        if c.origin_m.iter().any(|v| !v.is_finite()) {
+            return err("cloth.origin_m", "must be finite".into());
+        }
+        pos("contact.distance_m", self.contact.distance_m)?;
+        let flat = crate::cloth::initial_positions(self);
+        for (k, o) in self.obstacles.iter().enumerate() {
+            o.check()
+                .map_err(|(key, m)| InputError::new(path, format!("obstacles[{k}].{key}"), m))?;
+            if let Some((p, d)) = flat
+                .iter()
+                .enumerate()
+                .map(|(p, x)| (p, o.signed_distance(x).0))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .filter(|(_, d)| *d <= 0.0)
+            {
+                return err(
+                    &format!("obstacles[{k}]"),
+                    format!(
+                        "the sheet starts inside this obstacle (particle [{}, {}] is {:.3e} m deep): \
+                         move the obstacle down or the sheet up (cloth.origin_m)",
+                        p % c.nx,
+                        p / c.nx,
+                        -d
+                    ),
+                );
+            }
         }
         nonneg("gravity.g_m_per_s2", self.gravity.g_m_per_s2)?;
         let s = &self.solver.static_;

@@ -41,10 +41,10 @@ impl Solution {
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
     let BuiltScene {
         grid,
-        model,
+        mut model,
         x0: mut x,
     } = build_scene(scene);
-    let report = solve_model(scene, &grid, &model, &mut x, observer);
+    let report = solve_model(scene, &grid, &mut model, &mut x, observer);
     Solution {
         grid,
         terms: model.term_names(),
@@ -58,7 +58,7 @@ pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
 fn solve_model(
     scene: &Scene,
     grid: &Grid,
-    model: &crate::physics::Model,
+    model: &mut crate::physics::Model,
     x: &mut [Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> SolveReport {
@@ -67,7 +67,7 @@ fn solve_model(
             // Nested iteration: start Newton from the interpolated solution of the scene on the grid
             // with every other line, when that grid exists; far fewer fine iterations are needed.
             let coarse = coarse_start(scene, grid, x);
-            let mut report = solve_static(model, x, &scene.solver.static_, observer);
+            let mut report = static_solve(scene, model, x, observer);
             if let Some((r, _)) = coarse {
                 report.iterations += r.iterations;
                 report.linear_solves += r.linear_solves;
@@ -87,6 +87,29 @@ fn solve_model(
     }
 }
 
+/// The static solve of a built scene from `x`: Newton, wrapped in the vertical-gap active set when the
+/// scene asks for that contact treatment.
+fn static_solve(
+    scene: &Scene,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    if scene.contact.method == crate::scene::ContactMethod::VerticalGap
+        && !scene.obstacles.is_empty()
+    {
+        crate::solve::solve_vertical_gap(
+            model,
+            x,
+            &scene.obstacles,
+            &scene.solver.static_,
+            observer,
+        )
+    } else {
+        solve_static(model, x, &scene.solver.static_, observer)
+    }
+}
+
 /// Solves the scene on the grid with every other line and writes the interpolated positions into
 /// the free particles of `x`. Only when both sides have an odd count ≥ 21, the coarse solve converges,
 /// and no absolute natural length ties the springs to the fine spacing.
@@ -99,6 +122,7 @@ fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(S
         .is_some_and(|m| m.natural_length_m.is_some());
     if !scene.solver.static_.coarse_start
         || natural
+        || !scene.obstacles.is_empty()
         || nx < 21
         || ny < 21
         || nx % 2 == 0
@@ -163,7 +187,11 @@ pub fn simulate_to_dir(
 ) -> Result<SolveReport> {
     let scene = &loaded.scene;
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let BuiltScene { grid, model, x0 } = build_scene(scene);
+    let BuiltScene {
+        grid,
+        mut model,
+        x0,
+    } = build_scene(scene);
     let pins: Vec<usize> = (0..grid.len()).filter(|&p| model.fixed[p]).collect();
     let every = scene.record.every;
     let mut timeline = if scene.record.timeline {
@@ -204,7 +232,7 @@ pub fn simulate_to_dir(
         let mut all = Observers(obs);
         match scene.solver.kind.integrator() {
             None => {
-                let mut r = solve_static(&model, &mut x, &scene.solver.static_, &mut all);
+                let mut r = static_solve(scene, &mut model, &mut x, &mut all);
                 if let Some((c, _)) = coarse {
                     r.iterations += c.iterations;
                     r.linear_solves += c.linear_solves;

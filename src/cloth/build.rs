@@ -17,10 +17,10 @@ pub struct BuiltScene {
     pub x0: Vec<Vector3<f64>>,
 }
 
-/// Builds the model of a validated scene.
-pub fn build_scene(scene: &Scene) -> BuiltScene {
+/// The grid of a scene (uniform or graded).
+fn scene_grid(scene: &Scene) -> Grid {
     let c = &scene.cloth;
-    let grid = Grid::new(
+    Grid::new(
         c.nx,
         c.ny,
         c.size_x_m,
@@ -31,18 +31,65 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
         } else {
             0.0
         },
-    );
-    let flat = grid.flat_positions();
-    let mut x0 = flat.clone();
-    if c.initial_perturbation_m != 0.0 {
-        use std::f64::consts::PI;
-        for p in x0.iter_mut() {
-            let (u, w) = (p.x / c.size_x_m, p.y / c.size_y_m);
-            p.z += c.initial_perturbation_m * (PI * u).sin() * (PI * w).sin() * w;
-        }
+    )
+}
+
+/// For `cloth.shape = "disc"`, the grid particles outside the circle inscribed in the sheet (plus a
+/// hundredth of the spacing, so that the circle's four extreme points stay); none for a square sheet.
+pub fn absent_particles(scene: &Scene, x0: &[Vector3<f64>]) -> Vec<bool> {
+    let c = &scene.cloth;
+    let n = c.nx * c.ny;
+    if c.shape != crate::scene::SheetShape::Disc {
+        return vec![false; n];
     }
+    let r = 0.5 * c.size_x_m.min(c.size_y_m);
+    let centre = Vector3::new(
+        c.origin_m[0] + 0.5 * c.size_x_m,
+        c.origin_m[1] + 0.5 * c.size_y_m,
+        0.0,
+    );
+    let tol = 0.01 * c.size_x_m / (c.nx - 1) as f64;
+    x0[..n]
+        .iter()
+        .map(|p| ((p.x - centre.x).powi(2) + (p.y - centre.y).powi(2)).sqrt() > r + tol)
+        .collect()
+}
+
+/// Initial positions of the grid particles: the flat sheet at `cloth.origin_m`, with the optional
+/// perturbation z += a·sin(πu)·sin(πw)·w (u, w the fractions along x and y).
+pub fn initial_positions(scene: &Scene) -> Vec<Vector3<f64>> {
+    let c = &scene.cloth;
+    let grid = scene_grid(scene);
+    let o = Vector3::new(c.origin_m[0], c.origin_m[1], c.origin_m[2]);
+    grid.flat_positions()
+        .into_iter()
+        .map(|p| {
+            let (u, w) = (p.x / c.size_x_m, p.y / c.size_y_m);
+            let dz = c.initial_perturbation_m
+                * (std::f64::consts::PI * u).sin()
+                * (std::f64::consts::PI * w).sin()
+                * w;
+            p + o + Vector3::new(0.0, 0.0, dz)
+        })
+        .collect()
+}
+
+/// Builds the model of a validated scene.
+pub fn build_scene(scene: &Scene) -> BuiltScene {
+    let c = &scene.cloth;
+    let grid = scene_grid(scene);
+    let flat = grid.flat_positions();
+    let mut x0 = initial_positions(scene);
     let mut masses = grid.lumped_masses(c.areal_density_kg_per_m2);
     let mut fixed = vec![false; grid.len()];
+    // A disc sheet: the particles outside the inscribed circle are absent (fixed, massless, in no term).
+    let absent = absent_particles(scene, &x0);
+    for (p, &a) in absent.iter().enumerate() {
+        if a {
+            masses[p] = 0.0;
+            fixed[p] = true;
+        }
+    }
     for corner in &scene.boundary.pin_corners {
         let (i, j) = corner.ij(&grid);
         fixed[grid.index(i, j)] = true;
@@ -74,7 +121,10 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
                 for i in 0..grid.nx {
                     for &(di, dj) in offsets {
                         if i + di < grid.nx && j + dj < grid.ny {
-                            pairs.push((grid.index(i, j), grid.index(i + di, j + dj)));
+                            let (a, b) = (grid.index(i, j), grid.index(i + di, j + dj));
+                            if !absent[a] && !absent[b] {
+                                pairs.push((a, b));
+                            }
                         }
                     }
                 }
@@ -83,7 +133,10 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
             if fam == SpringFamily::Shear {
                 for j in 0..grid.ny - 1 {
                     for i in 0..grid.nx - 1 {
-                        pairs.push((grid.index(i + 1, j), grid.index(i, j + 1)));
+                        let (a, b) = (grid.index(i + 1, j), grid.index(i, j + 1));
+                        if !absent[a] && !absent[b] {
+                            pairs.push((a, b));
+                        }
                     }
                 }
             }
@@ -116,6 +169,7 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
         continuum_terms(
             &grid,
             &r,
+            &absent,
             &scene.boundary.clamp_edges,
             &mut fixed,
             &mut masses,
@@ -126,6 +180,7 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
     if g > 0.0 {
         terms.push(Box::new(Gravity::new(masses.clone(), g)));
     }
+    contact_terms(scene, &x0, &masses, &mut fixed, &mut terms);
     let model = Model {
         n_grid: grid.len(),
         masses,
@@ -138,13 +193,67 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
     BuiltScene { grid, model, x0 }
 }
 
+/// Contact with the scene's obstacles (only when it has some): with `contact.fix_supported`, the
+/// particles that start above the top face of a table or pedestal are fixed (seed 003 §10.5); with
+/// the barrier method every other particle gets the barrier term (the vertical-gap method works in the
+/// solver instead, [`crate::simulate`]).
+fn contact_terms(
+    scene: &Scene,
+    x0: &[Vector3<f64>],
+    masses: &[f64],
+    fixed: &mut [bool],
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    use crate::contact::Obstacle;
+    use crate::scene::ContactMethod;
+    if scene.obstacles.is_empty() {
+        return;
+    }
+    if scene.contact.fix_supported {
+        for (p, x) in x0.iter().enumerate().take(fixed.len()) {
+            let on_top = scene.obstacles.iter().any(|o| {
+                matches!(o, Obstacle::Box { .. } | Obstacle::Pedestal { .. })
+                    && o.top_at(x.x, x.y).is_some()
+            });
+            if on_top {
+                fixed[p] = true;
+            }
+        }
+    }
+    if scene.contact.method == ContactMethod::Barrier {
+        let g = if scene.gravity.g_m_per_s2 > 0.0 {
+            scene.gravity.g_m_per_s2
+        } else {
+            crate::STANDARD_GRAVITY_M_PER_S2
+        };
+        let d_hat = scene.contact.distance_m;
+        let kappa = masses
+            .iter()
+            .zip(fixed.iter())
+            .map(|(m, f)| {
+                if *f || *m <= 0.0 {
+                    0.0
+                } else {
+                    crate::physics::BarrierContact::kappa_for_weight(m * g, d_hat)
+                }
+            })
+            .collect();
+        terms.push(Box::new(crate::physics::BarrierContact {
+            obstacles: scene.obstacles.clone(),
+            d_hat_m: d_hat,
+            kappa_J: kappa,
+        }));
+    }
+}
+
 /// The continuum model on the grid: tensile springs along grid lines (k = E·w/h), cell shear (G) and
 /// quadratic bending along grid lines (k = D·w/h̄). A clamped edge pins its particles and adds
 /// virtual fixed points mirrored across it, so the bending term sees a zero slope at the edge.
-#[allow(clippy::needless_range_loop)] // grid loops index several parallel arrays
+#[allow(clippy::needless_range_loop, clippy::too_many_arguments)] // grid loops index several parallel arrays
 fn continuum_terms(
     grid: &Grid,
     r: &Rigidities,
+    absent: &[bool],
     clamps: &[super::Edge],
     fixed: &mut Vec<bool>,
     masses: &mut Vec<f64>,
@@ -160,13 +269,13 @@ fn continuum_terms(
     let mut k = Vec::new();
     for j in 0..ny {
         for i in 0..nx {
-            if i + 1 < nx {
+            if i + 1 < nx && !absent[grid.index(i, j)] && !absent[grid.index(i + 1, j)] {
                 let h = grid.xs[i + 1] - grid.xs[i];
                 pairs.push((grid.index(i, j), grid.index(i + 1, j)));
                 rest.push(h);
                 k.push(r.tensile_warp_N_per_m * wy[j] / h);
             }
-            if j + 1 < ny {
+            if j + 1 < ny && !absent[grid.index(i, j)] && !absent[grid.index(i, j + 1)] {
                 let h = grid.ys[j + 1] - grid.ys[j];
                 pairs.push((grid.index(i, j), grid.index(i, j + 1)));
                 rest.push(h);
@@ -186,12 +295,16 @@ fn continuum_terms(
         let mut sides = Vec::new();
         for j in 0..ny - 1 {
             for i in 0..nx - 1 {
-                cells.push([
+                let cell = [
                     grid.index(i, j),
                     grid.index(i + 1, j),
                     grid.index(i, j + 1),
                     grid.index(i + 1, j + 1),
-                ]);
+                ];
+                if cell.iter().any(|&p| absent[p]) {
+                    continue;
+                }
+                cells.push(cell);
                 sides.push((grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]));
             }
         }
@@ -202,6 +315,12 @@ fn continuum_terms(
     let mut coef = Vec::new();
     let mut stiff = Vec::new();
     let mut add = |a: usize, b: usize, c: usize, h1: f64, h2: f64, d: f64, w: f64, weight: f64| {
+        if [a, b, c]
+            .iter()
+            .any(|&p| absent.get(p).copied().unwrap_or(false))
+        {
+            return;
+        }
         triples.push([a, b, c]);
         coef.push([1.0 / h1, -1.0 / h1 - 1.0 / h2, 1.0 / h2]);
         stiff.push(weight * d * w / (0.5 * (h1 + h2)));

@@ -3,11 +3,13 @@
 //! the lumped masses and the pinned particles; solvers see nothing else.
 
 mod bending;
+mod contact;
 mod gravity;
 mod shear;
 mod springs;
 
 pub use bending::LinearBending;
+pub use contact::{BarrierContact, max_penetration_m};
 pub use gravity::Gravity;
 pub use shear::CellShear;
 pub use springs::{SpringFamily, Springs};
@@ -100,6 +102,11 @@ pub trait EnergyTerm: Send + Sync {
     fn is_external_load(&self) -> bool {
         false
     }
+    /// The largest fraction of the step `dx` from `x` that the term allows (contact: a step that
+    /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
+    fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
+        f64::INFINITY
+    }
 }
 
 /// The assembled model: masses, pins and energy terms.
@@ -166,6 +173,13 @@ impl Model {
         for t in &self.terms {
             t.add_hessian(x, h, project);
         }
+    }
+    /// The largest fraction of the step `dx` that every term allows (see [`EnergyTerm::max_step`]).
+    pub fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
+        self.terms
+            .iter()
+            .map(|t| t.max_step(x, dx))
+            .fold(f64::INFINITY, f64::min)
     }
     /// Largest residual force on a free particle in N, from the gradient.
     pub fn max_residual(&self, g: &Vecs) -> f64 {

@@ -94,11 +94,26 @@ fn mean_free_diagonal(h: &HessianBlocks, dofs: &DofMap, n: usize) -> f64 {
     }
 }
 
-/// Solves for the static equilibrium starting from `x` (updated in place).
+/// Solves for the static equilibrium starting from `x` (updated in place), the external loads raised
+/// in `opts.load_steps` equal steps.
 pub fn solve_static(
     model: &Model,
     x: &mut [Vector3<f64>],
     opts: &StaticOptions,
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let steps = opts.load_steps.max(1);
+    let loads: Vec<f64> = (1..=steps).map(|s| s as f64 / steps as f64).collect();
+    solve_static_loads(model, x, opts, &loads, observer)
+}
+
+/// [`solve_static`] through the given load factors (increasing; the last one is solved to the
+/// tolerance and reported, the others only roughly).
+pub fn solve_static_loads(
+    model: &Model,
+    x: &mut [Vector3<f64>],
+    opts: &StaticOptions,
+    loads: &[f64],
     observer: &mut dyn Observer,
 ) -> SolveReport {
     let start = Instant::now();
@@ -132,12 +147,12 @@ pub fn solve_static(
     let mut trial = x.to_vec();
     let mut g_trial = Vec::new();
     let mut shift = vec![0.0; dofs.n];
-    let steps = opts.load_steps.max(1);
+    let steps = loads.len().max(1);
     let mut iter = 0usize;
     let mut mu = opts.lm_damping_initial;
     let mut floor = false;
     'load: for step in 1..=steps {
-        let load = step as f64 / steps as f64;
+        let load = loads.get(step - 1).copied().unwrap_or(1.0);
         let mut e = model.energy(x, load);
         loop {
             model.gradient(x, load, &mut g);
@@ -220,8 +235,16 @@ pub fn solve_static(
                             .map(|d| gp.x * rhs[d] + gp.y * rhs[d + 1] + gp.z * rhs[d + 2])
                     })
                     .sum();
-                let mut alpha = 1.0;
-                for _ in 0..12 {
+                // Terms may bound the step (contact: no particle may be carried into an obstacle).
+                let dx: Vec<Vector3<f64>> = (0..x.len())
+                    .map(|p| match dofs.dof(p) {
+                        Some(d) => Vector3::new(rhs[d], rhs[d + 1], rhs[d + 2]),
+                        None => Vector3::zeros(),
+                    })
+                    .collect();
+                let mut alpha = model.max_step(x, &dx).min(1.0);
+                let full_step = alpha == 1.0;
+                for _ in 0..30 {
                     for (p, xp) in x.iter().enumerate() {
                         trial[p] = match dofs.dof(p) {
                             Some(d) => xp + Vector3::new(rhs[d], rhs[d + 1], rhs[d + 2]) * alpha,
@@ -245,7 +268,7 @@ pub fn solve_static(
                     alpha *= 0.5;
                 }
                 if accepted {
-                    if alpha == 1.0 {
+                    if alpha == 1.0 && full_step {
                         mu = if mu < 1e-12 { 0.0 } else { mu / 4.0 };
                     }
                     break;
@@ -279,11 +302,12 @@ pub fn solve_static(
             }
         }
     }
-    model.gradient(x, 1.0, &mut g);
+    let final_load = loads.last().copied().unwrap_or(1.0);
+    model.gradient(x, final_load, &mut g);
     report.iterations = iter;
     report.max_residual_N = free_max_residual(model, &g);
     report.max_residual_rel = report.max_residual_N / w_ref;
-    report.energy_J = model.energy(x, 1.0);
+    report.energy_J = model.energy(x, final_load);
     report.wall_time_s = start.elapsed().as_secs_f64();
     if report.status == Status::Converged {
         report.message = if floor {

@@ -236,5 +236,8 @@ fn a_sweep_adds_one_case_per_value_and_n_grows_with_height() {
         .map(|c| solve(&c.inputs(&cfg.defaults)).n)
         .collect();
     assert_eq!(swept.len(), 5);
-    assert!(swept.windows(2).all(|w| w[1] >= w[0]) && swept[4] > swept[0], "{swept:?}");
+    assert!(
+        swept.windows(2).all(|w| w[1] >= w[0]) && swept[4] > swept[0],
+        "{swept:?}"
+    );
 }

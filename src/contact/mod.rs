@@ -1,0 +1,418 @@
+//! Rigid obstacles of seed 003's drape scenes (§10.5–10.7): a plane, a box table, a cylindrical rod
+//! along any axis, a sphere, a disc pedestal and a body form of revolution given by its meridional
+//! profile. Each gives a signed distance (positive outside, m) with its outward normal, and the height
+//! of its upper surface above a point (for the vertical-gap method of §10.7.1).
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// A rigid obstacle. Every length in m; positions in the scene's frame (z up).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Obstacle {
+    /// The half-space below a plane through `point_m` with upward normal `normal`.
+    Plane {
+        /// A point of the plane, m.
+        point_m: [f64; 3],
+        /// The outward normal (normalised on use).
+        normal: [f64; 3],
+    },
+    /// An axis-aligned box (a table): from `min_m` to `max_m`.
+    Box {
+        /// Lower corner, m.
+        min_m: [f64; 3],
+        /// Upper corner, m.
+        max_m: [f64; 3],
+    },
+    /// An infinite round rod: axis through `point_m` along `axis`, radius `radius_m`.
+    Cylinder {
+        /// A point of the axis, m.
+        point_m: [f64; 3],
+        /// Axis direction (normalised on use), e.g. [1, -1, 0] for a diagonal rod.
+        axis: [f64; 3],
+        /// Radius, m.
+        radius_m: f64,
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre, m.
+        centre_m: [f64; 3],
+        /// Radius, m.
+        radius_m: f64,
+    },
+    /// A disc pedestal: a vertical cylinder of radius `radius_m` whose top face is at `centre_m` and
+    /// which extends `height_m` below it.
+    Pedestal {
+        /// Centre of the top face, m.
+        centre_m: [f64; 3],
+        /// Radius, m.
+        radius_m: f64,
+        /// Height below the top face, m.
+        height_m: f64,
+    },
+    /// A solid of revolution about the vertical through `axis_m` (x, y): `profile_m` lists
+    /// (height z, radius r) pairs, z increasing; the solid ends at the first and last heights.
+    Revolution {
+        /// (x, y) of the vertical axis, m.
+        axis_m: [f64; 2],
+        /// Meridional profile: (z, r) pairs in m, z strictly increasing, r ≥ 0.
+        profile_m: Vec<[f64; 2]>,
+    },
+}
+
+fn v(a: [f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+/// Signed distance from a point to a 2D segment-polygon boundary (the meridional section of a solid of
+/// revolution: axis, profile, caps) and the closest point's outward direction; positive outside.
+fn revolution_sdf(profile: &[[f64; 2]], r: f64, z: f64) -> (f64, f64, f64) {
+    // The closed section: (0, z0) → profile → (0, zn) → back along the axis.
+    let mut poly: Vec<[f64; 2]> = Vec::with_capacity(profile.len() + 2);
+    poly.push([0.0, profile[0][0]]);
+    poly.extend(profile.iter().map(|p| [p[1], p[0]]));
+    poly.push([0.0, profile[profile.len() - 1][0]]);
+    let (mut best, mut dir) = (f64::INFINITY, (0.0, 1.0));
+    let mut inside = false;
+    for k in 0..poly.len() {
+        let a = poly[k];
+        let b = poly[(k + 1) % poly.len()];
+        let (ex, ez) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = ex * ex + ez * ez;
+        let t = if len2 > 0.0 {
+            (((r - a[0]) * ex + (z - a[1]) * ez) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let (qx, qz) = (a[0] + t * ex, a[1] + t * ez);
+        let d = ((r - qx).powi(2) + (z - qz).powi(2)).sqrt();
+        if d < best {
+            best = d;
+            dir = if d > 1e-15 {
+                ((r - qx) / d, (z - qz) / d)
+            } else {
+                (ez, -ex)
+            };
+        }
+        // Even-odd rule for the inside test.
+        if (a[1] > z) != (b[1] > z) && r < a[0] + (z - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) {
+            inside = !inside;
+        }
+    }
+    if inside {
+        (-best, -dir.0, -dir.1)
+    } else {
+        (best, dir.0, dir.1)
+    }
+}
+
+impl Obstacle {
+    /// Signed distance (m, positive outside) and the unit outward normal at the closest point.
+    pub fn signed_distance(&self, p: &Vector3<f64>) -> (f64, Vector3<f64>) {
+        match self {
+            Obstacle::Plane { point_m, normal } => {
+                let n = v(*normal).normalize();
+                ((p - v(*point_m)).dot(&n), n)
+            }
+            Obstacle::Box { min_m, max_m } => {
+                let (lo, hi) = (v(*min_m), v(*max_m));
+                let c = (lo + hi) * 0.5;
+                let half = (hi - lo) * 0.5;
+                let q = p - c;
+                let d = q.abs() - half;
+                let outside = d.map(|x| x.max(0.0));
+                if outside.norm() > 0.0 {
+                    let dir = Vector3::new(
+                        outside.x * q.x.signum(),
+                        outside.y * q.y.signum(),
+                        outside.z * q.z.signum(),
+                    );
+                    (outside.norm(), dir.normalize())
+                } else {
+                    // Inside: the nearest face.
+                    let k = d.imax();
+                    let mut n = Vector3::zeros();
+                    n[k] = q[k].signum();
+                    (d[k], n)
+                }
+            }
+            Obstacle::Cylinder {
+                point_m,
+                axis,
+                radius_m,
+            } => {
+                let a = v(*axis).normalize();
+                let q = p - v(*point_m);
+                let radial = q - a * q.dot(&a);
+                let r = radial.norm();
+                let n = if r > 1e-15 { radial / r } else { Vector3::z() };
+                (r - radius_m, n)
+            }
+            Obstacle::Sphere { centre_m, radius_m } => {
+                let q = p - v(*centre_m);
+                let r = q.norm();
+                let n = if r > 1e-15 { q / r } else { Vector3::z() };
+                (r - radius_m, n)
+            }
+            Obstacle::Pedestal {
+                centre_m,
+                radius_m,
+                height_m,
+            } => {
+                let c = v(*centre_m);
+                let q = p - c;
+                let rr = (q.x * q.x + q.y * q.y).sqrt();
+                let radial = if rr > 1e-15 {
+                    Vector3::new(q.x / rr, q.y / rr, 0.0)
+                } else {
+                    Vector3::x()
+                };
+                // 2D box in (r, z) with r ∈ [0, R], z ∈ [−H, 0].
+                let zc = -0.5 * height_m;
+                let (dr, dz) = (rr - radius_m, (q.z - zc).abs() - 0.5 * height_m);
+                let zs = (q.z - zc).signum();
+                if dr > 0.0 || dz > 0.0 {
+                    let (or, oz) = (dr.max(0.0), dz.max(0.0));
+                    let d = (or * or + oz * oz).sqrt();
+                    let n = radial * (or / d) + Vector3::z() * (oz * zs / d);
+                    (d, n)
+                } else if dr > dz {
+                    (dr, radial)
+                } else {
+                    (dz, Vector3::z() * zs)
+                }
+            }
+            Obstacle::Revolution { axis_m, profile_m } => {
+                let q = Vector3::new(p.x - axis_m[0], p.y - axis_m[1], p.z);
+                let rr = (q.x * q.x + q.y * q.y).sqrt();
+                let radial = if rr > 1e-15 {
+                    Vector3::new(q.x / rr, q.y / rr, 0.0)
+                } else {
+                    Vector3::x()
+                };
+                let (d, nr, nz) = revolution_sdf(profile_m, rr, p.z);
+                (d, (radial * nr + Vector3::z() * nz).normalize())
+            }
+        }
+    }
+
+    /// Height of the obstacle's upper surface on the vertical through (x, y), if the vertical meets it
+    /// (the vertical-gap method of §10.7.1 pulls a node that went inside back up to it).
+    pub fn top_at(&self, x: f64, y: f64) -> Option<f64> {
+        match self {
+            Obstacle::Plane { point_m, normal } => {
+                let n = v(*normal).normalize();
+                (n.z.abs() > 1e-12)
+                    .then(|| point_m[2] - (n.x * (x - point_m[0]) + n.y * (y - point_m[1])) / n.z)
+            }
+            Obstacle::Box { min_m, max_m } => {
+                (x >= min_m[0] && x <= max_m[0] && y >= min_m[1] && y <= max_m[1])
+                    .then_some(max_m[2])
+            }
+            Obstacle::Cylinder {
+                point_m,
+                axis,
+                radius_m,
+            } => {
+                // Points (x, y, z) with |radial| = R: solve the quadratic in z.
+                let a = v(*axis).normalize();
+                let q0 = Vector3::new(x - point_m[0], y - point_m[1], -point_m[2]);
+                let ez = Vector3::z();
+                let u = q0 - a * q0.dot(&a);
+                let w = ez - a * ez.dot(&a);
+                let (qa, qb, qc) = (w.dot(&w), 2.0 * u.dot(&w), u.dot(&u) - radius_m * radius_m);
+                if qa < 1e-15 {
+                    return None;
+                }
+                let disc = qb * qb - 4.0 * qa * qc;
+                (disc >= 0.0).then(|| (-qb + disc.sqrt()) / (2.0 * qa))
+            }
+            Obstacle::Sphere { centre_m, radius_m } => {
+                let r2 = (x - centre_m[0]).powi(2) + (y - centre_m[1]).powi(2);
+                (r2 <= radius_m * radius_m).then(|| centre_m[2] + (radius_m * radius_m - r2).sqrt())
+            }
+            Obstacle::Pedestal {
+                centre_m, radius_m, ..
+            } => ((x - centre_m[0]).powi(2) + (y - centre_m[1]).powi(2) <= radius_m * radius_m)
+                .then_some(centre_m[2]),
+            Obstacle::Revolution { axis_m, profile_m } => {
+                let r = ((x - axis_m[0]).powi(2) + (y - axis_m[1]).powi(2)).sqrt();
+                // The highest profile point whose radius reaches r: scan the profile from the top.
+                let mut top = None;
+                for w in profile_m.windows(2).rev() {
+                    let ([z0, r0], [z1, r1]) = (w[0], w[1]);
+                    if (r0 - r) * (r1 - r) <= 0.0 && (r1 - r0).abs() > 1e-15 {
+                        top = Some(z0 + (r - r0) / (r1 - r0) * (z1 - z0));
+                        break;
+                    }
+                    if r <= r1.min(r0) {
+                        top = Some(z1);
+                        break;
+                    }
+                }
+                top
+            }
+        }
+    }
+
+    /// Checks the definition: Err((key, message)).
+    pub fn check(&self) -> Result<(), (String, String)> {
+        let finite = |k: &str, a: &[f64]| {
+            if a.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err((k.to_string(), "must be finite".to_string()))
+            }
+        };
+        let positive = |k: &str, x: f64| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err((
+                    k.to_string(),
+                    format!("must be a finite number > 0, got {x}"),
+                ))
+            }
+        };
+        let nonzero = |k: &str, a: [f64; 3]| {
+            finite(k, &a)?;
+            if v(a).norm() > 1e-12 {
+                Ok(())
+            } else {
+                Err((k.to_string(), "must be a non-zero vector".to_string()))
+            }
+        };
+        match self {
+            Obstacle::Plane { point_m, normal } => {
+                finite("point_m", point_m)?;
+                nonzero("normal", *normal)
+            }
+            Obstacle::Box { min_m, max_m } => {
+                finite("min_m", min_m)?;
+                finite("max_m", max_m)?;
+                if (0..3).all(|k| max_m[k] > min_m[k]) {
+                    Ok(())
+                } else {
+                    Err(("max_m".into(), "must exceed min_m in x, y and z".into()))
+                }
+            }
+            Obstacle::Cylinder {
+                point_m,
+                axis,
+                radius_m,
+            } => {
+                finite("point_m", point_m)?;
+                nonzero("axis", *axis)?;
+                positive("radius_m", *radius_m)
+            }
+            Obstacle::Sphere { centre_m, radius_m } => {
+                finite("centre_m", centre_m)?;
+                positive("radius_m", *radius_m)
+            }
+            Obstacle::Pedestal {
+                centre_m,
+                radius_m,
+                height_m,
+            } => {
+                finite("centre_m", centre_m)?;
+                positive("radius_m", *radius_m)?;
+                positive("height_m", *height_m)
+            }
+            Obstacle::Revolution { axis_m, profile_m } => {
+                finite("axis_m", axis_m)?;
+                if profile_m.len() < 2 {
+                    return Err((
+                        "profile_m".into(),
+                        "needs at least two (z, r) points".into(),
+                    ));
+                }
+                for (k, p) in profile_m.iter().enumerate() {
+                    if !(p[0].is_finite() && p[1].is_finite() && p[1] >= 0.0) {
+                        return Err((format!("profile_m[{k}]"), "needs finite z and r ≥ 0".into()));
+                    }
+                    if k > 0 && p[0] <= profile_m[k - 1][0] {
+                        return Err((
+                            format!("profile_m[{k}]"),
+                            "heights must increase strictly".into(),
+                        ));
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The normal is the gradient of the signed distance (finite differences).
+    #[test]
+    fn normals_are_gradients_of_the_distance() {
+        let obstacles = [
+            Obstacle::Box {
+                min_m: [-0.05, -0.05, -0.3],
+                max_m: [0.05, 0.05, -0.001],
+            },
+            Obstacle::Cylinder {
+                point_m: [0.0, 0.0, -0.026],
+                axis: [1.0, -1.0, 0.0],
+                radius_m: 0.025,
+            },
+            Obstacle::Sphere {
+                centre_m: [0.0, 0.0, -0.03],
+                radius_m: 0.025,
+            },
+            Obstacle::Pedestal {
+                centre_m: [0.0, 0.0, -0.001],
+                radius_m: 0.06,
+                height_m: 0.3,
+            },
+            Obstacle::Revolution {
+                axis_m: [0.0, 0.0],
+                profile_m: vec![[-0.5, 0.1], [-0.2, 0.14], [-0.05, 0.12], [0.0, 0.0]],
+            },
+        ];
+        let pts = [
+            Vector3::new(0.07, 0.02, 0.01),
+            Vector3::new(-0.03, 0.08, -0.04),
+            Vector3::new(0.01, -0.02, 0.05),
+            Vector3::new(0.2, 0.1, -0.3),
+        ];
+        for o in &obstacles {
+            for p in &pts {
+                let (d, n) = o.signed_distance(p);
+                let h = 1e-7;
+                let fd = Vector3::from_fn(|k, _| {
+                    let mut q = *p;
+                    q[k] += h;
+                    (o.signed_distance(&q).0 - d) / h
+                });
+                assert!((fd - n).norm() < 1e-4, "{o:?} at {p:?}: {fd:?} vs {n:?}");
+                assert!((n.norm() - 1.0).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn the_top_surface_lies_on_the_obstacle() {
+        let s = Obstacle::Sphere {
+            centre_m: [0.0, 0.0, -0.03],
+            radius_m: 0.025,
+        };
+        let c = Obstacle::Cylinder {
+            point_m: [0.0, 0.0, -0.026],
+            axis: [1.0, -1.0, 0.0],
+            radius_m: 0.025,
+        };
+        for o in [&s, &c] {
+            for (x, y) in [(0.0, 0.0), (0.01, 0.005), (-0.012, 0.003)] {
+                let z = o.top_at(x, y).unwrap();
+                let (d, n) = o.signed_distance(&Vector3::new(x, y, z));
+                assert!(d.abs() < 1e-12 && n.z > 0.0, "{o:?}: {d} {n:?}");
+            }
+        }
+        assert!(s.top_at(0.1, 0.0).is_none());
+    }
+}

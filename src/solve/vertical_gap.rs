@@ -1,0 +1,123 @@
+//! Seed 003's contact determination (§10.7.1) around the static Newton solver. The load (gravity) is
+//! raised in small increments so that no node can pass an obstacle within one; after each increment,
+//! every free node that went below an obstacle's upper surface is pulled back vertically onto it and
+//! held there, and a held node on which the net force points up (the obstacle no longer pushes) is let
+//! go; the increment is solved again until the set of held nodes settles (releases stop after a few
+//! rounds, so it cannot cycle). A held node is fixed in all directions, as the seed fixes the nodes in
+//! contact with a table: the contact is frictionless only in that nodes are let go; the barrier method
+//! is the frictionless one.
+
+use super::{NoObserver, Observer, SolveReport, StaticOptions, Status, solve_static_loads};
+use crate::contact::Obstacle;
+use crate::physics::Model;
+use nalgebra::Vector3;
+
+/// Active-set rounds per load increment before giving up.
+const MAX_ROUNDS: usize = 100;
+/// Rounds (per increment) in which held nodes may be let go.
+const RELEASE_ROUNDS: usize = 5;
+/// Load increments when the scene asks for a single step.
+const DEFAULT_INCREMENTS: usize = 20;
+
+/// Solves `model` from `x` with vertical-gap contact against `obstacles`, raising the load in
+/// `opts.load_steps` increments (20 when that is 1). Iterations and times add up over the rounds; a
+/// round that does not converge ends the solve with its status.
+pub fn solve_vertical_gap(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    obstacles: &[Obstacle],
+    opts: &StaticOptions,
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let pinned = model.fixed.clone();
+    let mut held = vec![false; model.len()];
+    let mut total: Option<SolveReport> = None;
+    let mut g = Vec::new();
+    let increments = if opts.load_steps > 1 {
+        opts.load_steps
+    } else {
+        DEFAULT_INCREMENTS
+    };
+    let mut first = true;
+    let mut rounds = 0;
+    for k in 1..=increments {
+        let load = k as f64 / increments as f64;
+        let mut settled = false;
+        for round in 0..MAX_ROUNDS {
+            rounds += 1;
+            let obs: &mut dyn Observer = if first {
+                &mut *observer
+            } else {
+                &mut NoObserver
+            };
+            first = false;
+            let r = solve_static_loads(model, x, opts, &[load], obs);
+            let report = match total.take() {
+                None => r,
+                Some(mut t) => {
+                    t.iterations += r.iterations;
+                    t.linear_solves += r.linear_solves;
+                    t.wall_time_s += r.wall_time_s;
+                    t.status = r.status;
+                    t.max_residual_N = r.max_residual_N;
+                    t.max_residual_rel = r.max_residual_rel;
+                    t.energy_J = r.energy_J;
+                    t.divergence = r.divergence;
+                    t.message = r.message;
+                    t
+                }
+            };
+            if report.status != Status::Converged {
+                return report;
+            }
+            let mut changed = false;
+            // Pull back the nodes that went in, and hold them.
+            for p in 0..model.n_grid {
+                if pinned[p] || held[p] {
+                    continue;
+                }
+                for o in obstacles {
+                    if o.signed_distance(&x[p]).0 < 0.0
+                        && let Some(z) = o.top_at(x[p].x, x[p].y)
+                    {
+                        x[p].z = z;
+                        held[p] = true;
+                        model.fixed[p] = true;
+                        changed = true;
+                    }
+                }
+            }
+            // Let go of the held nodes that the obstacle no longer supports.
+            if round < RELEASE_ROUNDS {
+                model.gradient(x, load, &mut g);
+                for p in 0..model.n_grid {
+                    if held[p] && -g[p].z > 0.0 {
+                        held[p] = false;
+                        model.fixed[p] = false;
+                        changed = true;
+                    }
+                }
+            }
+            total = Some(report);
+            if !changed {
+                settled = true;
+                break;
+            }
+        }
+        if !settled {
+            let mut report = total.expect("at least one round");
+            report.status = Status::MaxIterations;
+            report.message = format!(
+                "vertical-gap contact did not settle in {MAX_ROUNDS} rounds at load {load:.3}"
+            );
+            return report;
+        }
+    }
+    let mut report = total.expect("at least one round");
+    report.message = format!(
+        "{} ({} nodes held by vertical-gap contact; {increments} load increments, {rounds} rounds)",
+        report.message,
+        held.iter().filter(|h| **h).count(),
+    );
+    report
+}
