@@ -62,6 +62,10 @@ pub struct BoundarySpec {
     /// Edges clamped (position and slope fixed): "xmin", "xmax", "ymin", "ymax".
     #[serde(default)]
     pub clamp_edges: Vec<Edge>,
+    /// Edges on a symmetry plane (a quarter or half model): their particles keep the coordinate normal
+    /// to the edge and the bending across it is mirrored. Continuum model and static solver only.
+    #[serde(default)]
+    pub symmetry_edges: Vec<Edge>,
 }
 
 /// Gravity.
@@ -447,6 +451,14 @@ impl Scene {
                     ),
                 );
             }
+        }
+        if !self.boundary.symmetry_edges.is_empty()
+            && (self.material.continuum.is_none() || self.solver.kind != SolverKind::Static)
+        {
+            return err(
+                "boundary.symmetry_edges",
+                "symmetry planes need [material.continuum] and solver.kind = \"static\"".into(),
+            );
         }
         if !self.boundary.clamp_edges.is_empty() && (c.nx < 3 || c.ny < 3) {
             return err(

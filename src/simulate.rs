@@ -174,6 +174,8 @@ struct RunRecord<'a> {
     terms: &'a [String],
     particles: usize,
     outputs: Vec<&'a str>,
+    /// Drape coefficient, folds and penetration, for a converged scene with obstacles.
+    drape: Option<crate::measure::DrapeMeasures>,
     scene: &'a Scene,
 }
 
@@ -293,6 +295,8 @@ pub fn simulate_to_dir(
         terms: &terms,
         particles: grid.len(),
         outputs,
+        drape: (report.is_converged() && !scene.obstacles.is_empty())
+            .then(|| crate::measure::drape_measures(scene, &grid, &x)),
         scene,
     };
     let json = serde_json::to_string_pretty(&record)?;

@@ -164,8 +164,17 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
             family(SpringFamily::Bend, ms.bend(), &[(2, 0), (0, 2)], 2.0);
         }
     }
+    let mut held = Vec::new();
     if let Some(cont) = &scene.material.continuum {
         let r = cont.rigidities().expect("validated scene");
+        symmetry_planes(
+            &grid,
+            &r,
+            &scene.boundary.symmetry_edges,
+            &x0,
+            &mut held,
+            &mut terms,
+        );
         continuum_terms(
             &grid,
             &r,
@@ -185,6 +194,7 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
         n_grid: grid.len(),
         masses,
         fixed,
+        held_components: held,
         terms,
         gravity_m_per_s2: g,
         damping_Ns_per_m: damping,
@@ -243,6 +253,46 @@ fn contact_terms(
             d_hat_m: d_hat,
             kappa_J: kappa,
         }));
+    }
+}
+
+/// Symmetry planes along grid edges (a quarter or half model, seed 003 §10.4.2): the particles on the
+/// edge keep their coordinate normal to it, and the bending across the plane is kept by
+/// [`MirrorBending`](crate::physics::MirrorBending). Tensile, shear and gravity need nothing: the edge's
+/// tributary widths already halve what lies on the plane.
+fn symmetry_planes(
+    grid: &Grid,
+    r: &Rigidities,
+    edges: &[super::Edge],
+    x0: &[Vector3<f64>],
+    held: &mut Vec<[bool; 3]>,
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    if edges.is_empty() {
+        return;
+    }
+    held.resize(grid.len(), [false; 3]);
+    let wx = tributary_lengths(&grid.xs);
+    let wy = tributary_lengths(&grid.ys);
+    for edge in edges {
+        let (on, next) = edge.lines(grid);
+        let (axis, d) = match edge {
+            super::Edge::Xmin | super::Edge::Xmax => (0, r.bending_warp_N_m),
+            super::Edge::Ymin | super::Edge::Ymax => (1, r.bending_weft_N_m),
+        };
+        let mut pairs = Vec::new();
+        let (mut hs, mut ks) = (Vec::new(), Vec::new());
+        for (k, (&p, &q)) in on.iter().zip(&next).enumerate() {
+            held[p][axis] = true;
+            let h = (x0[q] - x0[p]).norm();
+            let w = if axis == 0 { wy[k] } else { wx[k] };
+            pairs.push((p, q));
+            hs.push(h);
+            ks.push(d * w / h);
+        }
+        terms.push(Box::new(crate::physics::MirrorBending::new(
+            pairs, axis, &hs, &ks,
+        )));
     }
 }
 

@@ -60,6 +60,10 @@ pub enum Obstacle {
     },
 }
 
+/// How far outside a table's or pedestal's top face a point still counts as above it (m): grid lines
+/// that fall on the edge by construction must not depend on round-off.
+const EDGE_SLACK_M: f64 = 1e-9;
+
 fn v(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
 }
@@ -206,7 +210,8 @@ impl Obstacle {
                     .then(|| point_m[2] - (n.x * (x - point_m[0]) + n.y * (y - point_m[1])) / n.z)
             }
             Obstacle::Box { min_m, max_m } => {
-                (x >= min_m[0] && x <= max_m[0] && y >= min_m[1] && y <= max_m[1])
+                let e = EDGE_SLACK_M;
+                (x >= min_m[0] - e && x <= max_m[0] + e && y >= min_m[1] - e && y <= max_m[1] + e)
                     .then_some(max_m[2])
             }
             Obstacle::Cylinder {
@@ -233,7 +238,8 @@ impl Obstacle {
             }
             Obstacle::Pedestal {
                 centre_m, radius_m, ..
-            } => ((x - centre_m[0]).powi(2) + (y - centre_m[1]).powi(2) <= radius_m * radius_m)
+            } => (((x - centre_m[0]).powi(2) + (y - centre_m[1]).powi(2)).sqrt()
+                <= radius_m + EDGE_SLACK_M)
                 .then_some(centre_m[2]),
             Obstacle::Revolution { axis_m, profile_m } => {
                 let r = ((x - axis_m[0]).powi(2) + (y - axis_m[1]).powi(2)).sqrt();

@@ -70,3 +70,71 @@ impl EnergyTerm for LinearBending {
         }
     }
 }
+
+/// The bending of the grid lines that cross a symmetry plane, in a model that keeps one side of it
+/// (a quarter or half model): the triple (p₁', p₀, p₁) centred on the plane, p₁' the mirror image of
+/// p₁, has u = (p₁ + p₁' − 2p₀)/h = (2/h) P(p₁ − p₀), P dropping the component normal to the plane
+/// (p₀ is held on it). Half of that triple's energy belongs to the kept side:
+/// E = ½ · ½ k |u|², k = D w / h.
+pub struct MirrorBending {
+    pairs: Vec<(u32, u32)>,
+    normal_axis: usize,
+    /// ½ k (2/h)² per pair, N/m.
+    stiffness_N_per_m: Vec<f64>,
+}
+
+impl MirrorBending {
+    /// Pairs (p₀ on the plane, p₁ its neighbour off it), the axis (0 = x, 1 = y) normal to the plane,
+    /// spacings h (m) and bending stiffnesses k = D w / h (N·m).
+    pub fn new(pairs: Vec<(usize, usize)>, normal_axis: usize, h_m: &[f64], k_N_m: &[f64]) -> Self {
+        Self {
+            pairs: pairs.iter().map(|&(a, b)| (a as u32, b as u32)).collect(),
+            normal_axis,
+            stiffness_N_per_m: h_m
+                .iter()
+                .zip(k_N_m)
+                .map(|(h, k)| 0.5 * k * (2.0 / h).powi(2))
+                .collect(),
+        }
+    }
+    fn v(&self, k: usize, x: &Vecs) -> Vector3<f64> {
+        let (a, b) = self.pairs[k];
+        let mut v = x[b as usize] - x[a as usize];
+        v[self.normal_axis] = 0.0;
+        v
+    }
+}
+
+impl EnergyTerm for MirrorBending {
+    fn name(&self) -> String {
+        "bending/symmetry-plane".into()
+    }
+    fn energy(&self, x: &Vecs) -> f64 {
+        (0..self.pairs.len())
+            .map(|k| 0.5 * self.stiffness_N_per_m[k] * self.v(k, x).norm_squared())
+            .sum()
+    }
+    fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
+        for k in 0..self.pairs.len() {
+            let f = self.v(k, x) * self.stiffness_N_per_m[k];
+            let (a, b) = self.pairs[k];
+            g[b as usize] += f;
+            g[a as usize] -= f;
+        }
+    }
+    fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _project: bool) {
+        let mut p = Matrix3::identity();
+        p[(self.normal_axis, self.normal_axis)] = 0.0;
+        for k in 0..self.pairs.len() {
+            let (a, b) = self.pairs[k];
+            h.push_outer(
+                &[a as usize, b as usize],
+                &[-1.0, 1.0],
+                &(p * self.stiffness_N_per_m[k]),
+            );
+        }
+    }
+    fn stiffness_scale(&self) -> f64 {
+        self.stiffness_N_per_m.iter().copied().fold(0.0, f64::max)
+    }
+}

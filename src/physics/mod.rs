@@ -8,7 +8,7 @@ mod gravity;
 mod shear;
 mod springs;
 
-pub use bending::LinearBending;
+pub use bending::{LinearBending, MirrorBending};
 pub use contact::{BarrierContact, max_penetration_m};
 pub use gravity::Gravity;
 pub use shear::CellShear;
@@ -115,6 +115,9 @@ pub struct Model {
     pub masses: Vec<f64>,
     /// `true` for particles whose position is fixed (pins, clamps, virtual clamp points).
     pub fixed: Vec<bool>,
+    /// Per particle, the position components held where they are (a particle on a symmetry plane
+    /// keeps its coordinate normal to the plane); empty when none. Static solves only.
+    pub held_components: Vec<[bool; 3]>,
     /// Number of real grid particles; particles beyond are virtual (fixed) helpers.
     pub n_grid: usize,
     /// The energy terms; only those the scene needs.
@@ -184,10 +187,24 @@ impl Model {
     /// Largest residual force on a free particle in N, from the gradient.
     pub fn max_residual(&self, g: &Vecs) -> f64 {
         g.iter()
-            .zip(&self.fixed)
-            .filter(|(_, f)| !**f)
-            .map(|(v, _)| v.norm())
+            .enumerate()
+            .filter(|(p, _)| !self.fixed[*p])
+            .map(|(p, v)| {
+                let mut v = *v;
+                if let Some(h) = self.held_components.get(p) {
+                    for c in 0..3 {
+                        if h[c] {
+                            v[c] = 0.0;
+                        }
+                    }
+                }
+                v.norm()
+            })
             .fold(0.0, f64::max)
+    }
+    /// Whether component `c` of particle `p` is held (see `held_components`).
+    pub fn is_held(&self, p: usize, c: usize) -> bool {
+        self.held_components.get(p).is_some_and(|h| h[c])
     }
     /// The weight of the lightest free particle in N, the reference of force tolerances.
     pub fn reference_weight(&self) -> f64 {

@@ -140,6 +140,15 @@ pub fn solve_static_loads(
         report.message = "no free particle with mass: nothing to solve".into();
         return report;
     }
+    // (first DOF, component) of every held component.
+    let held: Vec<(usize, usize)> = (0..model.len())
+        .filter_map(|p| dofs.dof(p).map(|d| (p, d)))
+        .flat_map(|(p, d)| {
+            (0..3)
+                .filter(move |&c| model.is_held(p, c))
+                .map(move |c| (d, c))
+        })
+        .collect();
     let mut spd = SparseSpd::new();
     let mut g = Vec::new();
     let mut h = HessianBlocks::default();
@@ -205,6 +214,11 @@ pub fn solve_static_loads(
             let mut accepted = false;
             for _attempt in 0..40 {
                 shift.iter_mut().for_each(|s| *s = mu * scale);
+                // Held components (symmetry planes): a diagonal far above the rest decouples them,
+                // and their step is set to zero below.
+                for &(d, c) in &held {
+                    shift[d + c] += 1e12 * scale.max(1e-300);
+                }
                 if !spd.factorize(&dofs, &h, &shift) {
                     // Indefinite: first shift the exact Hessian (Levenberg–Marquardt), and only when a
                     // large shift is needed fall back to the projected Hessian.
@@ -225,7 +239,13 @@ pub fn solve_static_loads(
                         rhs[d + 2] = -gp.z;
                     }
                 }
+                for &(d, c) in &held {
+                    rhs[d + c] = 0.0;
+                }
                 spd.solve_in_place(&mut rhs);
+                for &(d, c) in &held {
+                    rhs[d + c] = 0.0;
+                }
                 // Backtracking line search on the energy (Armijo condition).
                 let slope: f64 = g
                     .iter()

@@ -4,8 +4,9 @@
 //! held there, and a held node on which the net force points up (the obstacle no longer pushes) is let
 //! go; the increment is solved again until the set of held nodes settles (releases stop after a few
 //! rounds, so it cannot cycle). A held node is fixed in all directions, as the seed fixes the nodes in
-//! contact with a table: the contact is frictionless only in that nodes are let go; the barrier method
-//! is the frictionless one.
+//! contact with a table: the contact is sticky (a node that touched stays where it touched until it is
+//! let go), which suits tables, pedestals and rods; on a sphere the sheet stays where it first touched.
+//! The barrier method is the frictionless one.
 
 use super::{NoObserver, Observer, SolveReport, StaticOptions, Status, solve_static_loads};
 use crate::contact::Obstacle;
@@ -18,6 +19,35 @@ const MAX_ROUNDS: usize = 100;
 const RELEASE_ROUNDS: usize = 5;
 /// Load increments when the scene asks for a single step.
 const DEFAULT_INCREMENTS: usize = 20;
+
+/// The highest upper surface of the obstacles under (x, y), if any.
+fn surface_below(obstacles: &[Obstacle], p: &Vector3<f64>) -> Option<f64> {
+    obstacles
+        .iter()
+        .filter_map(|o| o.top_at(p.x, p.y))
+        .fold(None, |best: Option<f64>, z| {
+            Some(best.map_or(z, |b| b.max(z)))
+        })
+}
+
+/// Adds a round's report to the running total.
+fn accumulate(total: Option<SolveReport>, r: SolveReport) -> SolveReport {
+    match total {
+        None => r,
+        Some(mut t) => {
+            t.iterations += r.iterations;
+            t.linear_solves += r.linear_solves;
+            t.wall_time_s += r.wall_time_s;
+            t.status = r.status;
+            t.max_residual_N = r.max_residual_N;
+            t.max_residual_rel = r.max_residual_rel;
+            t.energy_J = r.energy_J;
+            t.divergence = r.divergence;
+            t.message = r.message;
+            t
+        }
+    }
+}
 
 /// Solves `model` from `x` with vertical-gap contact against `obstacles`, raising the load in
 /// `opts.load_steps` increments (20 when that is 1). Iterations and times add up over the rounds; a
@@ -51,22 +81,10 @@ pub fn solve_vertical_gap(
                 &mut NoObserver
             };
             first = false;
-            let r = solve_static_loads(model, x, opts, &[load], obs);
-            let report = match total.take() {
-                None => r,
-                Some(mut t) => {
-                    t.iterations += r.iterations;
-                    t.linear_solves += r.linear_solves;
-                    t.wall_time_s += r.wall_time_s;
-                    t.status = r.status;
-                    t.max_residual_N = r.max_residual_N;
-                    t.max_residual_rel = r.max_residual_rel;
-                    t.energy_J = r.energy_J;
-                    t.divergence = r.divergence;
-                    t.message = r.message;
-                    t
-                }
-            };
+            let report = accumulate(
+                total.take(),
+                solve_static_loads(model, x, opts, &[load], obs),
+            );
             if report.status != Status::Converged {
                 return report;
             }
@@ -76,15 +94,12 @@ pub fn solve_vertical_gap(
                 if pinned[p] || held[p] {
                     continue;
                 }
-                for o in obstacles {
-                    if o.signed_distance(&x[p]).0 < 0.0
-                        && let Some(z) = o.top_at(x[p].x, x[p].y)
-                    {
-                        x[p].z = z;
-                        held[p] = true;
-                        model.fixed[p] = true;
-                        changed = true;
-                    }
+                let inside = obstacles.iter().any(|o| o.signed_distance(&x[p]).0 < 0.0);
+                if inside && let Some(z) = surface_below(obstacles, &x[p]) {
+                    x[p].z = z;
+                    held[p] = true;
+                    model.fixed[p] = true;
+                    changed = true;
                 }
             }
             // Let go of the held nodes that the obstacle no longer supports.

@@ -179,7 +179,8 @@ struct PointResult {
     linear_solves: u64,
     wall_time_s: f64,
     max_residual_N: f64,
-    /// centre z, min z, corners (x, y, z) × 4; None unless converged.
+    /// centre z, min z, corners (x, y, z) × 4, drape coefficient, folds, projected area, penetration
+    /// (NaN where not defined); None unless converged.
     measures: Option<Vec<f64>>,
 }
 
@@ -198,6 +199,15 @@ pub fn measure_columns() -> Vec<String> {
             v.push(format!("corner_{n}_{c}_m"));
         }
     }
+    v.extend(
+        [
+            "drape_coefficient_pct",
+            "folds",
+            "projected_area_m2",
+            "max_penetration_m",
+        ]
+        .map(String::from),
+    );
     v
 }
 
@@ -251,6 +261,13 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
                     let q = sol.at(ci, cj);
                     m.extend([q.x, q.y, q.z]);
                 }
+                let d = crate::measure::drape_measures(scene, g, &sol.x);
+                m.extend([
+                    d.drape_coefficient_pct.unwrap_or(f64::NAN),
+                    d.folds.map_or(f64::NAN, |f| f as f64),
+                    d.projected_area_m2,
+                    d.max_penetration_m,
+                ]);
                 m
             });
             ctx.progress.item_done(name);
@@ -343,9 +360,11 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     }))));
     for (m, name) in measure_columns().into_iter().enumerate() {
         fields.push(Field::new(name, DataType::Float64, true));
-        cols.push(Arc::new(Float64Array::from_iter(
-            results.iter().map(|r| r.measures.as_ref().map(|v| v[m])),
-        )));
+        cols.push(Arc::new(Float64Array::from_iter(results.iter().map(|r| {
+            r.measures
+                .as_ref()
+                .and_then(|v| v[m].is_finite().then_some(v[m]))
+        }))));
     }
     let schema = Arc::new(Schema::new(fields));
     let batch = RecordBatch::try_new(schema.clone(), cols)?;

@@ -3,6 +3,7 @@
 
 mod calibrate;
 mod cli;
+mod contact;
 mod edges;
 mod engine;
 mod pipeline;

@@ -1,0 +1,275 @@
+//! Seed 003's contact scenes: no particle inside an obstacle with either contact treatment, the
+//! symmetry of the concentric table drape, the limits of the drape coefficient, the rod drape against
+//! Table 10.4, and bad obstacle definitions. A failure means contact or the drape measures broke.
+
+use crate::support::{drapelab, root, scene};
+use drapelab::measure::drape_measures;
+use drapelab::physics::max_penetration_m;
+use drapelab::simulate::solve_scene;
+use drapelab::solve::NoObserver;
+
+#[test]
+fn no_particle_ends_inside_an_obstacle_with_either_contact_treatment() {
+    let cases: [(&str, &[&str]); 4] = [
+        (
+            "sphere_wool.toml",
+            &[
+                "cloth.nx=21",
+                "cloth.ny=21",
+                "boundary.pin_particles=[[10, 10]]",
+            ],
+        ),
+        (
+            "rod_polyester.toml",
+            &[
+                "cloth.nx=17",
+                "cloth.ny=17",
+                "boundary.pin_particles=[[8, 8], [4, 12], [12, 4]]",
+            ],
+        ),
+        ("table_wool.toml", &["cloth.nx=21", "cloth.ny=21"]),
+        ("pedestal_wool.toml", &["cloth.nx=21", "cloth.ny=21"]),
+    ];
+    for (file, sets) in cases {
+        for method in ["barrier", "vertical-gap"] {
+            let mut all = sets.to_vec();
+            let m = format!("contact.method=\"{method}\"");
+            all.push(&m);
+            let s = scene(file, &all);
+            let sol = solve_scene(&s, &mut NoObserver);
+            assert!(
+                sol.report.is_converged(),
+                "{file} {method}: {}",
+                sol.report.message
+            );
+            let pen = max_penetration_m(&s.obstacles, sol.grid_positions());
+            eprintln!(
+                "{file} {method}: penetration {pen:.2e} m, lowest z {:.4} m, {} iterations",
+                sol.grid_positions()
+                    .iter()
+                    .map(|p| p.z)
+                    .fold(f64::INFINITY, f64::min),
+                sol.report.iterations
+            );
+            assert!(pen < 1e-6, "{file} {method}: penetration {pen} m");
+            // With the barrier the sheet drapes: something falls well below where it started. (The
+            // vertical-gap contact is sticky: a node that reaches a sphere, or a pedestal's side, is
+            // pulled up onto the top and held, so there it need not drape far.)
+            if method == "vertical-gap" {
+                continue;
+            }
+            let low = sol
+                .grid_positions()
+                .iter()
+                .map(|p| p.z)
+                .fold(f64::INFINITY, f64::min);
+            assert!(low < -0.02, "{file} {method}: lowest z {low}");
+        }
+    }
+}
+
+#[test]
+fn the_concentric_table_drape_is_symmetric_in_the_full_model() {
+    // x → −x and y → −y are symmetries of the scene (warp along x, weft along y): the drape must
+    // keep them within 0.1 mm.
+    let s = scene("table_wool.toml", &[]);
+    let sol = solve_scene(&s, &mut NoObserver);
+    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let n = s.cloth.nx;
+    let (mut ex, mut ey) = (0.0f64, 0.0f64);
+    for j in 0..n {
+        for i in 0..n {
+            let (p, q, r) = (sol.at(i, j), sol.at(n - 1 - i, j), sol.at(i, n - 1 - j));
+            ex = ex
+                .max((p.x + q.x).abs())
+                .max((p.y - q.y).abs())
+                .max((p.z - q.z).abs());
+            ey = ey
+                .max((p.x - r.x).abs())
+                .max((p.y + r.y).abs())
+                .max((p.z - r.z).abs());
+        }
+    }
+    eprintln!("largest mirror differences: x {ex:.2e} m, y {ey:.2e} m");
+    assert!(ex < 1e-4 && ey < 1e-4, "x {ex} y {ey}");
+    // The edge midpoint drops by about the seed's 4.57 cm (Table 10.2, point 1), within 1 cm.
+    let drop = -sol.at(n / 2, n - 1).z * 100.0;
+    assert!((drop - 4.57).abs() < 1.0, "edge midpoint drop {drop} cm");
+}
+
+#[test]
+fn the_drape_coefficient_is_100_for_a_flat_sheet_and_0_for_one_hanging_straight_down() {
+    // DC = (S − S_s)/(S_f − S_s): a very stiff disc stays flat on its pedestal (S = S_f), a limp
+    // sheet on a table hangs straight down around it (S ≈ S_s).
+    let flat = scene(
+        "pedestal_wool.toml",
+        &[
+            "material.continuum.bending_warp_gf_cm2_per_cm=10000",
+            "material.continuum.bending_weft_gf_cm2_per_cm=10000",
+        ],
+    );
+    let sol = solve_scene(&flat, &mut NoObserver);
+    assert!(sol.report.is_converged());
+    let m = drape_measures(&flat, &sol.grid, &sol.x);
+    let dc = m.drape_coefficient_pct.unwrap();
+    assert!((dc - 100.0).abs() < 1.0, "flat: DC {dc} %");
+    assert_eq!(m.folds, Some(0));
+    let limp = scene(
+        "table_wool.toml",
+        &[
+            "cloth.nx=31",
+            "cloth.ny=31",
+            "material.continuum.bending_warp_gf_cm2_per_cm=0.0001",
+            "material.continuum.bending_weft_gf_cm2_per_cm=0.0001",
+            "material.continuum.shear_gf_per_cm=0.01",
+        ],
+    );
+    let sol = solve_scene(&limp, &mut NoObserver);
+    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let dc = drape_measures(&limp, &sol.grid, &sol.x)
+        .drape_coefficient_pct
+        .unwrap();
+    assert!(dc.abs() < 5.0, "hanging: DC {dc} %");
+    // And the wool between them, with folds.
+    let wool = scene("pedestal_wool.toml", &[]);
+    let sol = solve_scene(&wool, &mut NoObserver);
+    let m = drape_measures(&wool, &sol.grid, &sol.x);
+    let dc = m.drape_coefficient_pct.unwrap();
+    eprintln!("wool on the pedestal: DC {dc:.1} %, {:?} folds", m.folds);
+    assert!(dc > 10.0 && dc < 90.0 && m.folds.unwrap() >= 4, "{m:?}");
+}
+
+#[test]
+fn the_rod_drape_hangs_corner_a_near_the_experiment_of_table_10_4() {
+    // Table 10.4: corner A from (10, 10, 0) cm to (3.27, 3.27, 12.25) cm in the experiment; the
+    // finite-element prediction (2.70, 2.70, 12.56) is 0.87 cm from it, seed 003's own 0.56 cm.
+    // drapelab (vertical-gap contact) lands within 1.5 cm: the must-show "closer than the finite
+    // elements" is NOT met yet (README, Status), this guards what is.
+    let s = scene("rod_polyester.toml", &["contact.method=\"vertical-gap\""]);
+    let sol = solve_scene(&s, &mut NoObserver);
+    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let n = s.cloth.nx;
+    let a = sol.at(n - 1, n - 1) * 100.0;
+    let b = sol.at(0, 0) * 100.0;
+    let dist = ((a.x - 3.27).powi(2) + (a.y - 3.27).powi(2) + (-a.z - 12.25).powi(2)).sqrt();
+    eprintln!(
+        "corner A at ({:.2}, {:.2}, {:.2}) cm, {dist:.2} cm from the experiment",
+        a.x, a.y, -a.z
+    );
+    assert!(dist < 1.5, "{dist} cm");
+    // The drape keeps the scene's 180° symmetry about the vertical: B mirrors A.
+    assert!(
+        (a + b).xy().norm() < 0.01 && (a.z - b.z).abs() < 0.01,
+        "{a:?} {b:?}"
+    );
+    assert!(max_penetration_m(&s.obstacles, sol.grid_positions()) < 1e-6);
+}
+
+#[test]
+fn bad_obstacles_exit_2_naming_the_key() {
+    let base = std::fs::read_to_string(root().join("datasets/scenes/sphere_wool.toml")).unwrap();
+    for (from, to, key) in [
+        (
+            "radius_m = 0.05",
+            "radius_m = -0.05",
+            "obstacles[0].radius_m",
+        ),
+        (
+            "centre_m = [0.0, 0.0, -0.0505]",
+            "centre_m = [0.0, 0.0, -0.02]",
+            "obstacles[0]",
+        ),
+        ("kind = \"sphere\"", "kind = \"cone\"", "obstacles"),
+        (
+            "distance_m = 0.001",
+            "distance_m = -1.0",
+            "contact.distance_m",
+        ),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let tmp = tempfile::tempdir().unwrap();
+        let file = tmp.path().join("s.toml");
+        std::fs::write(&file, base.replace(from, to)).unwrap();
+        let out = tmp.path().join("out");
+        let o = drapelab()
+            .arg("simulate")
+            .arg(&file)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{key}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(key) && err.contains("s.toml"), "{key}: {err}");
+        assert!(!out.join("particles.parquet").exists());
+    }
+}
+
+#[test]
+fn the_quarter_table_model_is_an_equilibrium_of_the_full_model_and_matches_table_10_2() {
+    use drapelab::cloth::build_scene;
+    let quarter = scene("table_wool_quarter.toml", &[]);
+    let q = solve_scene(&quarter, &mut NoObserver);
+    assert!(q.report.is_converged(), "{}", q.report.message);
+    // Unfold the quarter (x, y ≥ 0) into the full 41 × 41 sheet by the two mirrors.
+    let full = scene("table_wool.toml", &[]);
+    let built = build_scene(&full);
+    let (nq, nf) = (quarter.cloth.nx, full.cloth.nx);
+    assert_eq!(2 * nq - 1, nf);
+    let mut x = built.x0.clone();
+    for j in 0..nf {
+        for i in 0..nf {
+            let (qi, qj) = (
+                (i as i64 - (nq as i64 - 1)).unsigned_abs() as usize,
+                (j as i64 - (nq as i64 - 1)).unsigned_abs() as usize,
+            );
+            let mut p = q.at(qi, qj);
+            if i < nq - 1 {
+                p.x = -p.x;
+            }
+            if j < nq - 1 {
+                p.y = -p.y;
+            }
+            x[built.grid.index(i, j)] = p;
+        }
+    }
+    let mut g = Vec::new();
+    built.model.gradient(&x, 1.0, &mut g);
+    let r = built.model.max_residual(&g) / built.model.reference_weight();
+    eprintln!("full-model residual at the unfolded quarter drape: {r:.2e} of a particle's weight");
+    assert!(r < 1e-5, "{r}");
+    // The full model, solved from the flat sheet, lands on the same drape.
+    let f = solve_scene(&full, &mut NoObserver);
+    assert!(f.report.is_converged(), "{}", f.report.message);
+    let gap = f.x[..built.grid.len()]
+        .iter()
+        .zip(&x)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    eprintln!("full against unfolded quarter: largest gap {gap:.2e} m");
+    assert!(gap < 1e-4, "{gap} m");
+    // Table 10.2: the edge points of seed 003's quarter model (cm; z is the drop), within 3 mm.
+    let table = [
+        (0, 20, 0.0, 6.5289, 4.5662),
+        (5, 20, 2.4892, 6.7319, 4.5169),
+        (10, 20, 4.8289, 7.5258, 4.2028),
+        (15, 20, 6.9641, 8.7134, 3.6763),
+        (20, 20, 9.3813, 9.2186, 3.6625),
+        (20, 15, 9.3281, 6.8742, 3.0236),
+        (20, 10, 8.2324, 4.7471, 3.7170),
+        (20, 5, 7.3465, 2.4851, 4.2436),
+        (20, 0, 7.1206, 0.0, 4.3385),
+    ];
+    let mut worst = 0.0f64;
+    for (i, j, sx, sy, sz) in table {
+        let p = q.at(i, j) * 100.0;
+        let d = ((p.x - sx).powi(2) + (p.y - sy).powi(2) + (-p.z - sz).powi(2)).sqrt();
+        eprintln!(
+            "point ({i}, {j}): ({:.2}, {:.2}, {:.2}) cm vs ({sx}, {sy}, {sz}): {d:.2} cm",
+            p.x, p.y, -p.z
+        );
+        worst = worst.max(d);
+    }
+    assert!(worst < 0.3, "worst {worst} cm");
+}
