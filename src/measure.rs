@@ -249,7 +249,8 @@ pub struct DrapeMeasures {
 const PIXELS: usize = 600;
 
 /// The drape coefficient, folds and penetration of a drape `x` of `scene` on `grid`. The support is the
-/// first pedestal or box among the obstacles; folds are counted about its centre (outline in 360
+/// first pedestal or box among the obstacles (its area: the part of the flat specimen above it); folds
+/// are counted about its centre (outline in 360
 /// sectors smoothed over ±3°, prominence 8 % of the mean radius: more than the steps of a disc cut
 /// from a square grid, far less than a fold).
 pub fn drape_measures(
@@ -264,26 +265,39 @@ pub fn drape_measures(
         .map(|a| !a)
         .collect();
     let proj = vertical_projection(grid, x, &present, PIXELS);
-    let flat = vertical_projection(grid, &x0, &present, PIXELS).area_m2();
-    let support = scene.obstacles.iter().find_map(|o| match o {
-        Obstacle::Pedestal {
-            centre_m, radius_m, ..
-        } => Some((
-            std::f64::consts::PI * radius_m * radius_m,
-            [centre_m[0], centre_m[1]],
-        )),
-        Obstacle::Box { min_m, max_m } => Some((
-            (max_m[0] - min_m[0]) * (max_m[1] - min_m[1]),
-            [0.5 * (min_m[0] + max_m[0]), 0.5 * (min_m[1] + max_m[1])],
-        )),
-        _ => None,
-    });
+    let flat_proj = vertical_projection(grid, &x0, &present, PIXELS);
+    // The support: the first table or pedestal; its area is the part of the flat specimen above its
+    // top face (on the same raster, so that a flat specimen reads DC = 100 % exactly).
+    let support = scene
+        .obstacles
+        .iter()
+        .find(|o| matches!(o, Obstacle::Pedestal { .. } | Obstacle::Box { .. }))
+        .map(|o| {
+            let mut cells = 0usize;
+            for row in 0..flat_proj.ny {
+                for col in 0..flat_proj.nx {
+                    let [px, py] = flat_proj.centre(col, row);
+                    if flat_proj.covered[row * flat_proj.nx + col] && o.top_at(px, py).is_some() {
+                        cells += 1;
+                    }
+                }
+            }
+            let centre = match o {
+                Obstacle::Pedestal { centre_m, .. } => [centre_m[0], centre_m[1]],
+                Obstacle::Box { min_m, max_m } => {
+                    [0.5 * (min_m[0] + max_m[0]), 0.5 * (min_m[1] + max_m[1])]
+                }
+                _ => [0.0, 0.0],
+            };
+            (cells as f64 * flat_proj.pixel_m * flat_proj.pixel_m, centre)
+        });
     // A quarter or half model stands for 2^k times itself (k symmetry planes); its outline covers a
     // sector only, so its folds are not counted.
     let k = scene.boundary.symmetry_edges.len();
     let factor = (1u32 << k) as f64;
     let s = proj.area_m2() * factor;
-    let flat = flat * factor;
+    let flat = flat_proj.area_m2() * factor;
+    let support = support.map(|(a, c)| (a * factor, c));
     let n = grid.len();
     DrapeMeasures {
         projected_area_m2: s,

@@ -30,7 +30,7 @@ fn scan(p: &Path) -> Result<LazyFrame> {
 }
 
 /// Rows of a seed CSV (comment lines skipped) as maps of column → value.
-fn read_csv(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
+pub(crate) fn read_csv(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
     let text = std::fs::read_to_string(path)?;
     let mut lines = text
         .lines()

@@ -6,6 +6,7 @@ mod calibration_report;
 mod fit_edges;
 mod report;
 mod score;
+mod seed003_report;
 mod simulate;
 mod sweep;
 mod tune;
@@ -17,6 +18,7 @@ pub use calibration_report::CalibrationReportParams;
 pub use fit_edges::FitEdgesParams;
 pub use report::ReportParams;
 pub use score::ScoreParams;
+pub use seed003_report::Seed003ReportParams;
 pub use simulate::SimulateParams;
 pub use sweep::{Axis, Design, SweepParams, sweep_points};
 pub use tune::{Levels, TuneParams};
@@ -88,6 +90,8 @@ pub enum StageKind {
     CalibrationReport,
     /// Seed 002's tension-field wrinkles of every case of a config.
     Wrinkles,
+    /// Seed 003's drape scenes beside the seed's numbers.
+    Seed003Report,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -110,7 +114,7 @@ pub(crate) fn typed_params<T: serde::de::DeserializeOwned>(
 
 impl StageKind {
     /// Names of all kinds.
-    pub const ALL: [&'static str; 10] = [
+    pub const ALL: [&'static str; 11] = [
         "simulate",
         "sweep",
         "report",
@@ -121,6 +125,7 @@ impl StageKind {
         "tune",
         "calibration-report",
         "wrinkles",
+        "seed003-report",
     ];
 
     /// The kind of a name.
@@ -136,6 +141,7 @@ impl StageKind {
             "tune" => Some(Self::Tune),
             "calibration-report" => Some(Self::CalibrationReport),
             "wrinkles" => Some(Self::Wrinkles),
+            "seed003-report" => Some(Self::Seed003Report),
             _ => None,
         }
     }
@@ -152,6 +158,7 @@ impl StageKind {
             Self::Tune => "tune",
             Self::CalibrationReport => "calibration-report",
             Self::Wrinkles => "wrinkles",
+            Self::Seed003Report => "seed003-report",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -166,6 +173,7 @@ impl StageKind {
             Self::Validate => typed_params::<ValidateParams>(params).map(|_| ()),
             Self::CalibrationReport => typed_params::<CalibrationReportParams>(params).map(|_| ()),
             Self::Wrinkles => typed_params::<WrinklesParams>(params).map(|_| ()),
+            Self::Seed003Report => typed_params::<Seed003ReportParams>(params).map(|_| ()),
             Self::Tune => typed_params::<TuneParams>(params).and_then(|p| {
                 if p.repeats == 0 {
                     Err(("repeats".into(), "must be ≥ 1".into()))
@@ -196,6 +204,7 @@ impl StageKind {
             Self::Tune => resolved::<TuneParams>(params),
             Self::CalibrationReport => resolved::<CalibrationReportParams>(params),
             Self::Wrinkles => resolved::<WrinklesParams>(params),
+            Self::Seed003Report => resolved::<Seed003ReportParams>(params),
         }
     }
     /// Runs the stage.
@@ -215,6 +224,7 @@ impl StageKind {
                 calibration_report::run(ctx, &typed_params(params).map_err(bad)?)
             }
             Self::Wrinkles => wrinkles::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Seed003Report => seed003_report::run(ctx, &typed_params(params).map_err(bad)?),
         }
     }
 }

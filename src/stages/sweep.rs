@@ -58,7 +58,9 @@ pub struct SweepParams {
     /// Seed of the Latin hypercube. Default 0.
     #[serde(default)]
     pub seed: u64,
-    /// Swept keys by dotted path; "cloth.nx,cloth.ny" sets both keys to each value.
+    /// Swept keys by dotted path; "cloth.nx,cloth.ny" sets both keys to each value. None: each scene
+    /// is solved once (a grid of one point).
+    #[serde(default)]
     pub axes: BTreeMap<String, Axis>,
     /// Keys fixed for every point.
     #[serde(default)]
@@ -76,8 +78,11 @@ fn as_f64(v: &toml::Value) -> Option<f64> {
 impl SweepParams {
     /// Checks the axes against the design: Err((key, message)).
     pub fn check(&self) -> Result<(), (String, String)> {
-        if self.axes.is_empty() {
-            return Err(("axes".into(), "give at least one axis".into()));
+        if self.axes.is_empty() && self.design == Design::Lhs {
+            return Err((
+                "axes".into(),
+                "a Latin hypercube needs at least one axis".into(),
+            ));
         }
         for (k, a) in &self.axes {
             match a {
