@@ -1,139 +1,297 @@
-//! The engine benchmark: time to equilibrium of a scene at several resolutions with every solver,
-//! and each result's largest particle distance to the finest static solution.
+//! The accuracy–speed benchmark: a scene solved at several resolutions, tolerances and with every
+//! solver, each result's wall time, work (iterations or steps, linear solves), peak memory, and its
+//! error: the largest distance to the finest static solution at the grid points both share.
 
 use crate::scene::{Scene, SolverKind};
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
 use std::time::Instant;
 
-/// One benchmark row.
+/// One benchmark point.
 #[derive(Debug, Clone)]
 pub struct BenchRow {
+    /// Scene name.
+    pub scene: String,
     /// Particles per side.
     pub n: usize,
     /// Solver.
     pub solver: SolverKind,
+    /// Force tolerance: largest residual force / lightest particle's weight.
+    pub tol: f64,
     /// Solver status.
     pub status: String,
     /// Wall time in s (whole solve including assembly).
     pub wall_time_s: f64,
-    /// Iterations or steps.
+    /// Newton iterations or time steps.
     pub iterations: usize,
-    /// Largest distance to the finest static solution, at the shared grid points, in m.
+    /// Linear solves (factorizations or CG solves).
+    pub linear_solves: usize,
+    /// Largest distance to the finest static solution, at the shared grid points, in m (NaN when the
+    /// grids share no points or the solve did not converge).
     pub error_m: f64,
+    /// Peak resident memory of the process during the point, bytes (Linux; None elsewhere).
+    pub peak_rss_bytes: Option<u64>,
 }
 
-/// Solves `scene` at each size with each solver and measures against the finest static solve.
-/// Explicit and symplectic Euler run only up to `max_explicit_size`, implicit Euler up to
-/// `max_implicit_size` (their step counts grow fast).
-/// Every solver stops at the largest residual force `tol` × the lightest particle's weight.
+/// Which solvers run up to which size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchLimits {
+    /// The solvers to run.
+    pub solvers: Vec<SolverKind>,
+    /// Largest side for explicit and symplectic Euler (their step counts grow as (ω_max/ω_min)²).
+    pub max_explicit_size: usize,
+    /// Largest side for implicit Euler.
+    pub max_implicit_size: usize,
+}
+
+/// Every solver, cheapest first.
+pub const ALL_SOLVERS: [SolverKind; 4] = [
+    SolverKind::Static,
+    SolverKind::ImplicitEuler,
+    SolverKind::SymplecticEuler,
+    SolverKind::ExplicitEuler,
+];
+
+/// Resets the peak-RSS counter of this process (Linux: `5` into /proc/self/clear_refs).
+fn reset_peak_rss() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// Peak resident memory since the last reset, bytes (Linux: VmHWM of /proc/self/status).
+fn peak_rss_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// The scene at side `n` with solver `kind` stopping at force tolerance `tol`: explicit integrators at
+/// 0.8 of their stability limit, implicit Euler at 10 ms steps; pinned particles scaled with the grid.
+pub fn bench_scene(scene: &Scene, n: usize, kind: SolverKind, tol: f64) -> Scene {
+    let mut s = scene.clone();
+    let (nx0, ny0) = (s.cloth.nx, s.cloth.ny);
+    if s.cloth.ny == s.cloth.nx {
+        s.cloth.ny = n;
+    } else {
+        // Keep the aspect: a strip keeps its particle count across.
+        s.cloth.ny = nx0
+            .min(ny0)
+            .max(((n - 1) * (ny0 - 1)).div_ceil(nx0 - 1) + 1);
+    }
+    s.cloth.nx = n;
+    for p in &mut s.boundary.pin_particles {
+        p[0] = p[0] * (n - 1) / (nx0 - 1);
+        p[1] = p[1] * (s.cloth.ny - 1) / (ny0 - 1).max(1);
+    }
+    s.solver.kind = kind;
+    s.solver.static_.residual_tol_rel = tol;
+    s.solver.dynamic.residual_tol_rel = tol;
+    s.solver.dynamic.speed_tol_m_per_s = 1e-5;
+    s.solver.dynamic.max_time_s = 1e3;
+    match kind {
+        SolverKind::ImplicitEuler => s.solver.dynamic.dt_s = 0.01,
+        SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => {
+            s.solver.dynamic.auto_dt_fraction = 0.8
+        }
+        SolverKind::Static => {}
+    }
+    s.record.timeline = false;
+    s.record.rerun = false;
+    s
+}
+
+/// Solves `scene` at each size, tolerance and solver (within `limits`), and measures each against the
+/// static solution at the finest size and a tolerance 100 times below the tightest.
+pub fn bench_rows(
+    scene: &Scene,
+    sizes: &[usize],
+    tols: &[f64],
+    limits: &BenchLimits,
+    mut log: impl FnMut(&str),
+) -> Vec<BenchRow> {
+    let finest = *sizes.iter().max().unwrap_or(&11);
+    let tightest = tols.iter().copied().fold(1e-6, f64::min);
+    let t0 = Instant::now();
+    let reference = solve_scene(
+        &bench_scene(scene, finest, SolverKind::Static, tightest * 1e-2),
+        &mut NoObserver,
+    );
+    log(&format!(
+        "{}: reference {finest} static: {} in {:.3} s",
+        scene.name,
+        reference.report.status.as_str(),
+        t0.elapsed().as_secs_f64()
+    ));
+    let mut rows = Vec::new();
+    for &n in sizes {
+        for &tol in tols {
+            for &kind in &limits.solvers {
+                let skip = match kind {
+                    SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => {
+                        n > limits.max_explicit_size
+                    }
+                    SolverKind::ImplicitEuler => n > limits.max_implicit_size,
+                    SolverKind::Static => false,
+                };
+                if skip {
+                    continue;
+                }
+                let s = bench_scene(scene, n, kind, tol);
+                reset_peak_rss();
+                let t = Instant::now();
+                let sol = solve_scene(&s, &mut NoObserver);
+                let wall = t.elapsed().as_secs_f64();
+                let peak = peak_rss_bytes();
+                let error_m = distance_to(&sol, &reference);
+                log(&format!(
+                    "{} {n} tol {tol:.0e} {kind:?}: {} {wall:.4} s, error {error_m:.2e} m",
+                    scene.name,
+                    sol.report.status.as_str(),
+                ));
+                rows.push(BenchRow {
+                    scene: scene.name.clone(),
+                    n,
+                    solver: kind,
+                    tol,
+                    status: sol.report.status.as_str().into(),
+                    wall_time_s: wall,
+                    iterations: sol.report.iterations,
+                    linear_solves: sol.report.linear_solves,
+                    error_m,
+                    peak_rss_bytes: peak,
+                });
+            }
+        }
+    }
+    rows
+}
+
+/// Largest distance between `sol` and `reference` at the grid points they share (the coarse grid's
+/// lines must fall on the fine grid's); NaN when they share none or either did not converge.
+pub fn distance_to(sol: &crate::simulate::Solution, reference: &crate::simulate::Solution) -> f64 {
+    if !sol.report.is_converged() || !reference.report.is_converged() {
+        return f64::NAN;
+    }
+    let (g, r) = (&sol.grid, &reference.grid);
+    if g.nx < 2 || g.ny < 2 {
+        return f64::NAN;
+    }
+    if !(r.nx - 1).is_multiple_of(g.nx - 1) || !(r.ny - 1).is_multiple_of(g.ny - 1) {
+        return f64::NAN;
+    }
+    let (sx, sy) = ((r.nx - 1) / (g.nx - 1), (r.ny - 1) / (g.ny - 1));
+    let mut err: f64 = 0.0;
+    for j in 0..g.ny {
+        for i in 0..g.nx {
+            err = err.max((sol.at(i, j) - reference.at(i * sx, j * sy)).norm());
+        }
+    }
+    err
+}
+
+/// The hang4 table of `drapelab bench` and `cargo bench`: every solver at tolerance `tol`.
 pub fn hang4_rows(
     scene: &Scene,
     sizes: &[usize],
     max_explicit_size: usize,
     max_implicit_size: usize,
     tol: f64,
-    mut log: impl FnMut(&str),
+    log: impl FnMut(&str),
 ) -> Vec<BenchRow> {
-    let finest = *sizes.iter().max().unwrap_or(&11);
-    let at = |n: usize, kind: SolverKind| {
-        let mut s = scene.clone();
-        s.cloth.nx = n;
-        s.cloth.ny = n;
-        s.solver.kind = kind;
-        // One force tolerance for every solver; explicit integrators at 0.8 of their stability limit,
-        // implicit Euler at a large step.
-        s.solver.static_.residual_tol_rel = tol;
-        s.solver.dynamic.residual_tol_rel = tol;
-        s.solver.dynamic.speed_tol_m_per_s = 1e-5;
-        s.solver.dynamic.max_time_s = 1e3;
-        match kind {
-            SolverKind::ImplicitEuler => s.solver.dynamic.dt_s = 0.01,
-            SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => {
-                s.solver.dynamic.auto_dt_fraction = 0.8
-            }
-            SolverKind::Static => {}
-        }
-        s.record.timeline = false;
-        s.record.rerun = false;
-        s
-    };
-    let t0 = Instant::now();
-    let mut reference_scene = at(finest, SolverKind::Static);
-    reference_scene.solver.static_.residual_tol_rel = 1e-8;
-    let reference = solve_scene(&reference_scene, &mut NoObserver);
-    log(&format!(
-        "reference {finest}×{finest} static: {} in {:.3} s",
-        reference.report.status.as_str(),
-        t0.elapsed().as_secs_f64()
-    ));
-    let mut rows = Vec::new();
-    for &n in sizes {
-        for kind in [
-            SolverKind::Static,
-            SolverKind::ImplicitEuler,
-            SolverKind::SymplecticEuler,
-            SolverKind::ExplicitEuler,
-        ] {
-            let skip = match kind {
-                SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => n > max_explicit_size,
-                SolverKind::ImplicitEuler => n > max_implicit_size,
-                SolverKind::Static => false,
-            };
-            if skip {
-                continue;
-            }
-            let s = at(n, kind);
-            let t = Instant::now();
-            let sol = solve_scene(&s, &mut NoObserver);
-            let wall = t.elapsed().as_secs_f64();
-            // Compare at grid points shared with the reference grid ((finest-1)/(n-1) must be whole).
-            let ratio = (finest - 1) / (n - 1);
-            let mut err: f64 = 0.0;
-            if (finest - 1).is_multiple_of(n - 1) {
-                for j in 0..n {
-                    for i in 0..n {
-                        let d = (sol.at(i, j) - reference.at(i * ratio, j * ratio)).norm();
-                        err = err.max(d);
-                    }
-                }
-            } else {
-                err = f64::NAN;
-            }
-            log(&format!(
-                "{n}×{n} {:?}: {} {:.4} s",
-                kind,
-                sol.report.status.as_str(),
-                wall
-            ));
-            rows.push(BenchRow {
-                n,
-                solver: kind,
-                status: sol.report.status.as_str().into(),
-                wall_time_s: wall,
-                iterations: sol.report.iterations,
-                error_m: err,
-            });
-        }
-    }
-    rows
+    bench_rows(
+        scene,
+        sizes,
+        &[tol],
+        &BenchLimits {
+            solvers: ALL_SOLVERS.to_vec(),
+            max_explicit_size,
+            max_implicit_size,
+        },
+        log,
+    )
 }
 
 /// The rows as a Markdown table.
 pub fn markdown_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| particles | solver | status | wall time (ms) | iterations/steps | error vs finest static (m) |\n|---|---|---|---|---|---|\n",
+        "| scene | particles | solver | tolerance | status | wall time (ms) | iterations/steps | linear solves | error vs finest static (m) | peak RSS (MB) |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s += &format!(
-            "| {n}×{n} | {:?} | {} | {:.3} | {} | {:.2e} |\n",
+            "| {} | {n}×{n} | {:?} | {:.0e} | {} | {:.3} | {} | {} | {:.2e} | {} |\n",
+            r.scene,
             r.solver,
+            r.tol,
             r.status,
             r.wall_time_s * 1e3,
             r.iterations,
+            r.linear_solves,
             r.error_m,
+            r.peak_rss_bytes
+                .map_or("–".into(), |b| format!("{:.1}", b as f64 / 1e6)),
             n = r.n
         );
     }
     s
+}
+
+/// Least-squares slope of log(y) against log(x) over the pairs with both positive: the exponent p
+/// of y ∝ x^p.
+pub fn fitted_exponent(points: &[(f64, f64)]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite())
+        .map(|(x, y)| (x.ln(), y.ln()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// The Pareto front of (time, error) points: those no other point beats in both, sorted by time.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut pts: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(t, e)| t.is_finite() && e.is_finite())
+        .collect();
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    for p in pts {
+        if front.last().is_none_or(|l| p.1 < l.1) {
+            front.push(p);
+        }
+    }
+    front
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fitted_exponent_of_a_power_law_is_its_power() {
+        let pts: Vec<(f64, f64)> = [10.0, 20.0, 40.0, 80.0]
+            .iter()
+            .map(|&x: &f64| (x, 3.0 * x.powf(1.5)))
+            .collect();
+        assert!((fitted_exponent(&pts).unwrap() - 1.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_pareto_front_keeps_only_undominated_points() {
+        let pts = [(1.0, 5.0), (2.0, 3.0), (3.0, 4.0), (4.0, 1.0), (0.5, 9.0)];
+        assert_eq!(
+            pareto_front(&pts),
+            vec![(0.5, 9.0), (1.0, 5.0), (2.0, 3.0), (4.0, 1.0)]
+        );
+    }
 }

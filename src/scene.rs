@@ -105,6 +105,15 @@ pub enum SolverKind {
 }
 
 impl SolverKind {
+    /// The name as written in scenes.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::Static => "static",
+            SolverKind::ExplicitEuler => "explicit-euler",
+            SolverKind::SymplecticEuler => "symplectic-euler",
+            SolverKind::ImplicitEuler => "implicit-euler",
+        }
+    }
     /// The dynamic integrator, if this is one.
     pub fn integrator(self) -> Option<Integrator> {
         match self {

@@ -1,6 +1,7 @@
 //! Stage kinds: one thin file each, glue over the library. A kind checks its parameters when the
 //! plan is loaded (so typos are refused before anything runs) and runs with a [`StageContext`].
 
+mod benchmark;
 mod calibrate;
 mod calibration_report;
 mod fit_edges;
@@ -13,6 +14,7 @@ mod tune;
 mod validate;
 mod wrinkles;
 
+pub use benchmark::{BenchmarkParams, BenchmarkReportParams, PeersParams};
 pub use calibrate::CalibrateParams;
 pub use calibration_report::CalibrationReportParams;
 pub use fit_edges::FitEdgesParams;
@@ -92,6 +94,12 @@ pub enum StageKind {
     Wrinkles,
     /// Seed 003's drape scenes beside the seed's numbers.
     Seed003Report,
+    /// Every scene × size × tolerance × solver: time, work, memory, error.
+    Benchmark,
+    /// scipy and numpy peers run beside drapelab.
+    Peers,
+    /// Pareto fronts, scaling exponents and peer ratios from the benchmark tables.
+    BenchmarkReport,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -114,7 +122,7 @@ pub(crate) fn typed_params<T: serde::de::DeserializeOwned>(
 
 impl StageKind {
     /// Names of all kinds.
-    pub const ALL: [&'static str; 11] = [
+    pub const ALL: [&'static str; 14] = [
         "simulate",
         "sweep",
         "report",
@@ -126,6 +134,9 @@ impl StageKind {
         "calibration-report",
         "wrinkles",
         "seed003-report",
+        "benchmark",
+        "peers",
+        "benchmark-report",
     ];
 
     /// The kind of a name.
@@ -142,6 +153,9 @@ impl StageKind {
             "calibration-report" => Some(Self::CalibrationReport),
             "wrinkles" => Some(Self::Wrinkles),
             "seed003-report" => Some(Self::Seed003Report),
+            "benchmark" => Some(Self::Benchmark),
+            "peers" => Some(Self::Peers),
+            "benchmark-report" => Some(Self::BenchmarkReport),
             _ => None,
         }
     }
@@ -159,6 +173,9 @@ impl StageKind {
             Self::CalibrationReport => "calibration-report",
             Self::Wrinkles => "wrinkles",
             Self::Seed003Report => "seed003-report",
+            Self::Benchmark => "benchmark",
+            Self::Peers => "peers",
+            Self::BenchmarkReport => "benchmark-report",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -174,6 +191,9 @@ impl StageKind {
             Self::CalibrationReport => typed_params::<CalibrationReportParams>(params).map(|_| ()),
             Self::Wrinkles => typed_params::<WrinklesParams>(params).map(|_| ()),
             Self::Seed003Report => typed_params::<Seed003ReportParams>(params).map(|_| ()),
+            Self::Benchmark => typed_params::<BenchmarkParams>(params).map(|_| ()),
+            Self::Peers => typed_params::<PeersParams>(params).map(|_| ()),
+            Self::BenchmarkReport => typed_params::<BenchmarkReportParams>(params).map(|_| ()),
             Self::Tune => typed_params::<TuneParams>(params).and_then(|p| {
                 if p.repeats == 0 {
                     Err(("repeats".into(), "must be ≥ 1".into()))
@@ -205,6 +225,9 @@ impl StageKind {
             Self::CalibrationReport => resolved::<CalibrationReportParams>(params),
             Self::Wrinkles => resolved::<WrinklesParams>(params),
             Self::Seed003Report => resolved::<Seed003ReportParams>(params),
+            Self::Benchmark => resolved::<BenchmarkParams>(params),
+            Self::Peers => resolved::<PeersParams>(params),
+            Self::BenchmarkReport => resolved::<BenchmarkReportParams>(params),
         }
     }
     /// Runs the stage.
@@ -225,6 +248,11 @@ impl StageKind {
             }
             Self::Wrinkles => wrinkles::run(ctx, &typed_params(params).map_err(bad)?),
             Self::Seed003Report => seed003_report::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Benchmark => benchmark::run(ctx, &typed_params(params).map_err(bad)?),
+            Self::Peers => benchmark::run_peers(ctx, &typed_params(params).map_err(bad)?),
+            Self::BenchmarkReport => {
+                benchmark::run_report(ctx, &typed_params(params).map_err(bad)?)
+            }
         }
     }
 }

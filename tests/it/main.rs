@@ -8,5 +8,6 @@ mod edges;
 mod engine;
 mod pipeline;
 mod recordings;
+mod stress;
 mod support;
 mod wrinkles;

@@ -1,0 +1,43 @@
+"""The hang4 mass-spring model of seed 000 (topology a: structural, shear and bend springs, every one at
+k N/m with its initial length at rest; area-lumped masses; the four corners pinned; gravity along -z),
+shared by the peer scripts that drapelab's benchmark runs beside itself."""
+import numpy as np
+
+G = 9.80665
+
+
+def hang4(n, side=0.5, density=0.045, k=1000.0):
+    h = side / (n - 1)
+    xs = np.linspace(0.0, side, n)
+    X, Y = np.meshgrid(xs, xs)  # row j, column i
+    x0 = np.stack([X.ravel(), Y.ravel(), np.zeros(n * n)], axis=1)
+    idx = lambda i, j: j * n + i
+    pairs = []
+    for j in range(n):
+        for i in range(n):
+            for di, dj in [(1, 0), (0, 1), (1, 1), (2, 0), (0, 2)]:
+                if i + di < n and j + dj < n:
+                    pairs.append((idx(i, j), idx(i + di, j + dj)))
+            if i + 1 < n and j + 1 < n:
+                pairs.append((idx(i + 1, j), idx(i, j + 1)))
+    pairs = np.array(pairs)
+    rest = np.linalg.norm(x0[pairs[:, 1]] - x0[pairs[:, 0]], axis=1)
+    w = np.full(n, h)
+    w[0] = w[-1] = h / 2
+    mass = density * np.outer(w, w).ravel()
+    fixed = np.zeros(n * n, bool)
+    for i, j in [(0, 0), (n - 1, 0), (0, n - 1), (n - 1, n - 1)]:
+        fixed[idx(i, j)] = True
+    return x0, pairs, rest, np.full(len(pairs), k), mass, fixed
+
+
+def forces(x, pairs, rest, k, mass):
+    """Internal + gravity force on each particle (N)."""
+    d = x[pairs[:, 1]] - x[pairs[:, 0]]
+    l = np.linalg.norm(d, axis=1)
+    f = (k * (l - rest) / l)[:, None] * d
+    F = np.zeros_like(x)
+    np.add.at(F, pairs[:, 0], f)
+    np.add.at(F, pairs[:, 1], -f)
+    F[:, 2] -= mass * G
+    return F

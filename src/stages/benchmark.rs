@@ -1,0 +1,464 @@
+//! Benchmark stages (issue 8): `benchmark` (every input scene × size × tolerance × solver, with its
+//! time, work, memory and error, into a Parquet table), `peers` (a scipy sparse-Newton script and a
+//! numpy explicit-Euler script from `benches/peers/`, run beside drapelab in the same stage so that the
+//! ratios hold on a noisy machine) and `benchmark-report` (Pareto fronts of time against error per
+//! scene, the fitted scaling exponents, the peer ratios: all from the measured tables).
+
+use super::StageContext;
+use super::report::{Panels, markdown, plot_panels};
+use crate::benchmark::{
+    BenchLimits, BenchRow, bench_rows, bench_scene, fitted_exponent, pareto_front,
+};
+use crate::io::{write_atomic, write_parquet};
+use crate::scene::{Scene, SolverKind};
+use crate::simulate::solve_scene;
+use crate::solve::NoObserver;
+use anyhow::{Context, Result, bail};
+use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
+use arrow::datatypes::{DataType, Field, Schema};
+use polars::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::sync::Arc;
+
+/// Parameters of a benchmark stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BenchmarkParams {
+    /// Particles per side, per scene name; scenes not named use `default_sizes`.
+    #[serde(default)]
+    pub sizes: BTreeMap<String, Vec<usize>>,
+    /// Particles per side for scenes not in `sizes`. Default [11, 21, 41].
+    #[serde(default = "default_sizes")]
+    pub default_sizes: Vec<usize>,
+    /// Force tolerances (largest residual / lightest particle's weight). Default [1e-4, 1e-6, 1e-8].
+    #[serde(default = "default_tols")]
+    pub tolerances: Vec<f64>,
+    /// Solvers to run: "static", "implicit-euler", "symplectic-euler", "explicit-euler". Default all.
+    #[serde(default)]
+    pub solvers: Option<Vec<SolverKind>>,
+    /// Largest side for the explicit integrators. Default 21.
+    #[serde(default = "default_explicit")]
+    pub max_explicit_size: usize,
+    /// Largest side for implicit Euler. Default 21.
+    #[serde(default = "default_explicit")]
+    pub max_implicit_size: usize,
+}
+
+fn default_sizes() -> Vec<usize> {
+    vec![11, 21, 41]
+}
+fn default_tols() -> Vec<f64> {
+    vec![1e-4, 1e-6, 1e-8]
+}
+fn default_explicit() -> usize {
+    21
+}
+
+fn f64s(v: Vec<f64>) -> ArrayRef {
+    Arc::new(Float64Array::from(v))
+}
+
+/// Runs a benchmark stage.
+pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
+    let scenes: Vec<Scene> = ctx
+        .inputs
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "toml"))
+        .map(|f| Ok(Scene::load(f, &[])?.scene))
+        .collect::<Result<_>>()?;
+    if scenes.is_empty() {
+        bail!("a benchmark needs at least one scene file as input");
+    }
+    ctx.progress
+        .stage_started(&ctx.stage.name, scenes.len() as u64);
+    let limits = BenchLimits {
+        solvers: p
+            .solvers
+            .clone()
+            .unwrap_or_else(|| crate::benchmark::ALL_SOLVERS.to_vec()),
+        max_explicit_size: p.max_explicit_size,
+        max_implicit_size: p.max_implicit_size,
+    };
+    // Serial on purpose: the points are timed, and peak memory is per process.
+    let mut rows: Vec<BenchRow> = Vec::new();
+    for s in &scenes {
+        let sizes = p.sizes.get(&s.name).unwrap_or(&p.default_sizes);
+        rows.extend(bench_rows(s, sizes, &p.tolerances, &limits, |_| {}));
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("scene", DataType::Utf8, false),
+        Field::new("particles_per_side", DataType::UInt64, false),
+        Field::new("solver", DataType::Utf8, false),
+        Field::new("tolerance_rel", DataType::Float64, false),
+        Field::new("status", DataType::Utf8, false),
+        Field::new("wall_time_s", DataType::Float64, false),
+        Field::new("iterations", DataType::UInt64, false),
+        Field::new("linear_solves", DataType::UInt64, false),
+        Field::new("error_m", DataType::Float64, true),
+        Field::new("peak_rss_bytes", DataType::UInt64, true),
+    ]));
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(
+            rows.iter().map(|r| r.scene.clone()),
+        )),
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|r| r.n as u64),
+        )),
+        Arc::new(StringArray::from_iter_values(
+            rows.iter().map(|r| r.solver.name().to_string()),
+        )),
+        f64s(rows.iter().map(|r| r.tol).collect()),
+        Arc::new(StringArray::from_iter_values(
+            rows.iter().map(|r| r.status.clone()),
+        )),
+        f64s(rows.iter().map(|r| r.wall_time_s).collect()),
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|r| r.iterations as u64),
+        )),
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|r| r.linear_solves as u64),
+        )),
+        Arc::new(Float64Array::from_iter(
+            rows.iter()
+                .map(|r| r.error_m.is_finite().then_some(r.error_m)),
+        )),
+        Arc::new(UInt64Array::from_iter(
+            rows.iter().map(|r| r.peak_rss_bytes),
+        )),
+    ];
+    write_parquet(&ctx.outputs[0], &RecordBatch::try_new(schema, cols)?, None)
+}
+
+/// Parameters of a peers stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeersParams {
+    /// The Python interpreter (of a virtual environment; numpy and scipy are installed into it when
+    /// missing). Default ".venv/bin/python".
+    #[serde(default = "default_python")]
+    pub python: String,
+    /// Sides of the hang4 grid for the static comparison. Default [11, 21, 41].
+    #[serde(default = "default_sizes")]
+    pub static_sizes: Vec<usize>,
+    /// Sides for the per-step explicit Euler comparison. Default [21, 41].
+    #[serde(default = "default_step_sizes")]
+    pub explicit_sizes: Vec<usize>,
+    /// Explicit steps timed. Default 2000.
+    #[serde(default = "default_steps")]
+    pub explicit_steps: usize,
+}
+
+fn default_python() -> String {
+    ".venv/bin/python".into()
+}
+fn default_step_sizes() -> Vec<usize> {
+    vec![21, 41]
+}
+fn default_steps() -> usize {
+    2000
+}
+
+/// Runs a peers stage: inputs are the hang4 scene and the scripts of `benches/peers/`.
+pub fn run_peers(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
+    let scene = Scene::load(ctx.input_with_extension("toml")?, &[])?.scene;
+    let script = |name: &str| -> Result<std::path::PathBuf> {
+        Ok(std::fs::canonicalize(ctx.input_named(name)?)?)
+    };
+    let (newton, explicit) = (script("scipy_newton.py")?, script("numpy_explicit.py")?);
+    let python = std::path::absolute(ctx.plan.root.join(&p.python))?;
+    let has = |py: &std::path::Path| {
+        std::process::Command::new(py)
+            .args(["-c", "import numpy, scipy"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !has(&python) {
+        let venv = python
+            .parent()
+            .and_then(|b| b.parent())
+            .context("python is not inside a virtual environment")?;
+        if !python.exists() {
+            std::process::Command::new("python3")
+                .args(["-m", "venv"])
+                .arg(venv)
+                .status()
+                .context("python3 -m venv")?;
+        }
+        let ok = std::process::Command::new(&python)
+            .args(["-m", "pip", "install", "-q", "numpy", "scipy"])
+            .status()
+            .context("pip install numpy scipy")?;
+        if !ok.success() || !has(&python) {
+            bail!("{}: cannot install numpy and scipy", python.display());
+        }
+    }
+    let run_py = |script: &std::path::Path, args: &[String]| -> Result<serde_json::Value> {
+        let o = std::process::Command::new(&python)
+            .arg(script)
+            .args(args)
+            .current_dir(script.parent().unwrap_or(std::path::Path::new(".")))
+            .output()?;
+        if !o.status.success() {
+            bail!(
+                "{}: {}",
+                script.display(),
+                String::from_utf8_lossy(&o.stderr)
+                    .lines()
+                    .last()
+                    .unwrap_or("failed")
+            );
+        }
+        Ok(serde_json::from_slice(&o.stdout)?)
+    };
+    let total = p.static_sizes.len() + p.explicit_sizes.len();
+    ctx.progress.stage_started(&ctx.stage.name, total as u64);
+    // (comparison, n, peer time, drapelab time, peer centre z, drapelab centre z)
+    let mut rows: Vec<(&str, usize, f64, f64, f64, f64)> = Vec::new();
+    for &n in &p.static_sizes {
+        let peer = run_py(&newton, &[n.to_string(), "1e-6".into()])?;
+        let s = bench_scene(&scene, n, SolverKind::Static, 1e-6);
+        let sol = solve_scene(&s, &mut NoObserver);
+        rows.push((
+            "static: scipy sparse Newton / drapelab",
+            n,
+            peer["wall_time_s"].as_f64().unwrap_or(f64::NAN),
+            sol.report.wall_time_s,
+            peer["centre_z_m"].as_f64().unwrap_or(f64::NAN),
+            sol.at(n / 2, n / 2).z,
+        ));
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    for &n in &p.explicit_sizes {
+        let peer = run_py(&explicit, &[n.to_string(), p.explicit_steps.to_string()])?;
+        let mut s = bench_scene(&scene, n, SolverKind::ExplicitEuler, 1e-30);
+        // A fixed number of steps at half the stability limit: stop by time, not by convergence.
+        let built = crate::cloth::build_scene(&s);
+        let dt = 0.5
+            * crate::solve::stability_limit_dt(
+                &built.model,
+                &built.x0,
+                crate::solve::Integrator::ExplicitEuler,
+                built.model.damping_Ns_per_m,
+            )
+            .unwrap_or(1e-4);
+        s.solver.dynamic.auto_dt_fraction = 0.0;
+        s.solver.dynamic.dt_s = dt;
+        s.solver.dynamic.max_time_s = dt * p.explicit_steps as f64;
+        let sol = solve_scene(&s, &mut NoObserver);
+        let steps = sol.report.iterations.max(1) as f64;
+        rows.push((
+            "explicit Euler per step: numpy / drapelab",
+            n,
+            peer["per_step_s"].as_f64().unwrap_or(f64::NAN),
+            sol.report.wall_time_s / steps,
+            f64::NAN,
+            f64::NAN,
+        ));
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("comparison", DataType::Utf8, false),
+        Field::new("particles_per_side", DataType::UInt64, false),
+        Field::new("peer_time_s", DataType::Float64, false),
+        Field::new("drapelab_time_s", DataType::Float64, false),
+        Field::new("ratio", DataType::Float64, false),
+        Field::new("peer_centre_z_m", DataType::Float64, true),
+        Field::new("drapelab_centre_z_m", DataType::Float64, true),
+    ]));
+    let opt = |v: f64| v.is_finite().then_some(v);
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.0))),
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|r| r.1 as u64),
+        )),
+        f64s(rows.iter().map(|r| r.2).collect()),
+        f64s(rows.iter().map(|r| r.3).collect()),
+        f64s(rows.iter().map(|r| r.2 / r.3).collect()),
+        Arc::new(Float64Array::from_iter(rows.iter().map(|r| opt(r.4)))),
+        Arc::new(Float64Array::from_iter(rows.iter().map(|r| opt(r.5)))),
+    ];
+    write_parquet(&ctx.outputs[0], &RecordBatch::try_new(schema, cols)?, None)
+}
+
+/// Parameters of a benchmark-report stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BenchmarkReportParams {
+    /// Title of the report.
+    pub title: String,
+    /// The tolerance whose rows make the scaling fits. Default 1e-6.
+    #[serde(default = "default_scaling_tol")]
+    pub scaling_tolerance: f64,
+}
+
+fn default_scaling_tol() -> f64 {
+    1e-6
+}
+
+fn read(path: &std::path::Path) -> Result<DataFrame> {
+    Ok(LazyFrame::scan_parquet(
+        PlRefPath::from(path.to_string_lossy().as_ref()),
+        ScanArgsParquet::default(),
+    )?
+    .collect()?)
+}
+
+/// Runs a benchmark-report stage: inputs `bench.parquet` (and optionally `peers.parquet`); outputs the
+/// Markdown report and the SVG of the Pareto fronts.
+pub fn run_report(ctx: &StageContext<'_>, p: &BenchmarkReportParams) -> Result<()> {
+    ctx.progress.stage_started(&ctx.stage.name, 1);
+    let mut bench: Option<DataFrame> = None;
+    for f in ctx
+        .inputs
+        .iter()
+        .filter(|f| f.file_name().is_some_and(|n| n == "bench.parquet"))
+    {
+        let df = read(f)?;
+        bench = Some(match bench {
+            None => df,
+            Some(b) => b.vstack(&df)?,
+        });
+    }
+    let bench = bench.context("a benchmark report needs bench.parquet inputs")?;
+    let scene = bench.column("scene")?.str()?.clone();
+    let solver = bench.column("solver")?.str()?.clone();
+    let status = bench.column("status")?.str()?.clone();
+    let n = bench.column("particles_per_side")?.u64()?.clone();
+    let tol = bench.column("tolerance_rel")?.f64()?.clone();
+    let wall = bench.column("wall_time_s")?.f64()?.clone();
+    let iters = bench.column("iterations")?.u64()?.clone();
+    let err = bench.column("error_m")?.f64()?.clone();
+    let mut panels = Panels::new();
+    let mut all: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut md = format!(
+        "# {}\n\nMade by `drapelab run {}` (drapelab {}) from the measured tables: every number and \
+point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
+        p.title,
+        ctx.plan
+            .file
+            .strip_prefix(&ctx.plan.root)
+            .unwrap_or(&ctx.plan.file)
+            .display(),
+        crate::VERSION
+    );
+    for r in 0..bench.height() {
+        let (Some(s), Some(sv), Some(t), Some(e)) =
+            (scene.get(r), solver.get(r), wall.get(r), err.get(r))
+        else {
+            continue;
+        };
+        if status.get(r) != Some("converged") || e <= 0.0 {
+            continue;
+        }
+        let pt = (t.log10(), e.log10());
+        panels
+            .entry(s.to_string())
+            .or_default()
+            .entry(sv.to_string())
+            .or_default()
+            .push(pt);
+        all.entry(s.to_string()).or_default().push((t, e));
+    }
+    for (s, pts) in &all {
+        panels.entry(s.clone()).or_default().insert(
+            "Pareto front".into(),
+            pareto_front(pts)
+                .iter()
+                .map(|(t, e)| (t.log10(), e.log10()))
+                .collect(),
+        );
+    }
+    for lines in panels.values_mut() {
+        for pts in lines.values_mut() {
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+    }
+    let svg = plot_panels(
+        &panels,
+        "log10 wall time (s)",
+        "log10 error vs finest static (m)",
+        Some("scene"),
+    )?;
+    md += "## Run time against error\n\n![Pareto fronts](benchmark_pareto.svg)\n\n| scene | Pareto front: (wall time s, error m) |\n|---|---|\n";
+    for (s, pts) in &all {
+        let front: Vec<String> = pareto_front(pts)
+            .iter()
+            .map(|(t, e)| format!("({t:.3e}, {e:.2e})"))
+            .collect();
+        let _ = writeln!(md, "| {s} | {} |", front.join(" "));
+    }
+    // Scaling: static wall time against particle count, and explicit time per step, per scene at the
+    // tightest tolerance.
+    let _ = write!(
+        md,
+        "\n## Scaling\n\nConverged runs at tolerance {:.0e}; the exponent p of wall time ∝ (particles)^p by least \
+squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall time against particle count |\n|---|---|---|---|\n",
+        p.scaling_tolerance
+    );
+    let mut series: BTreeMap<(String, String), Vec<(f64, f64)>> = BTreeMap::new();
+    for r in 0..bench.height() {
+        let (Some(s), Some(sv), Some(k), Some(t), Some(tl), Some(it)) = (
+            scene.get(r),
+            solver.get(r),
+            n.get(r),
+            wall.get(r),
+            tol.get(r),
+            iters.get(r),
+        ) else {
+            continue;
+        };
+        if status.get(r) != Some("converged") || (tl / p.scaling_tolerance - 1.0).abs() > 1e-9 {
+            continue;
+        }
+        let particles = (k * k) as f64;
+        if sv == "static" {
+            series
+                .entry((s.into(), "static (whole solve)".into()))
+                .or_default()
+                .push((particles, t));
+        } else if sv == "explicit-euler" && it > 0 {
+            series
+                .entry((s.into(), "explicit Euler (one step)".into()))
+                .or_default()
+                .push((particles, t / it as f64));
+        }
+    }
+    for ((s, sv), pts) in &series {
+        let sides: Vec<String> = pts
+            .iter()
+            .map(|(p, _)| format!("{}", p.sqrt().round()))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {s} | {sv} | {} | {} |",
+            sides.join(", "),
+            fitted_exponent(pts).map_or("–".into(), |e| format!("{e:.2}"))
+        );
+    }
+    md += "\n## Every point\n\n";
+    md += &markdown(&bench);
+    if let Ok(peers) = ctx.input_named("peers.parquet") {
+        md += "\n## Peers, run beside drapelab in the same stage\n\n";
+        md += &markdown(&read(peers)?);
+        md += "\nratio = peer time / drapelab time (> 1: drapelab is faster). The scipy script solves the same \
+hang4 model by sparse Newton to the same force tolerance; the centre heights show both reach the same \
+equilibrium.\n";
+    }
+    for out in &ctx.outputs {
+        let text = if out.extension().is_some_and(|e| e == "md") {
+            &md
+        } else {
+            &svg
+        };
+        write_atomic(out, |f| {
+            use std::io::Write;
+            f.write_all(text.as_bytes())?;
+            Ok(())
+        })?;
+    }
+    ctx.progress.item_done(&ctx.stage.name);
+    Ok(())
+}
