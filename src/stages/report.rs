@@ -83,6 +83,9 @@ pub fn markdown(df: &DataFrame) -> String {
             .columns()
             .iter()
             .map(|c| match c.get(r) {
+                Ok(AnyValue::Float64(v)) if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) => {
+                    format!("{v:.3e}")
+                }
                 Ok(AnyValue::Float64(v)) => format!("{v:.6}"),
                 Ok(AnyValue::String(v)) => v.to_string(),
                 Ok(v) => v.to_string(),
