@@ -177,7 +177,8 @@ pub fn highest_mode(model: &Model, x: &[Vector3<f64>]) -> (f64, f64) {
 }
 
 /// The largest stable time step of an explicit integrator at `x`, from the highest mode
-/// ([`highest_mode`]): symplectic Euler needs Δt < 2/ω; forward Euler with damping c needs
+/// ([`highest_mode`]): symplectic Euler needs Δt < (√(γ² + 4ω²) − γ)/ω² with γ = c/m (2/ω without
+/// damping); forward Euler with damping c needs
 /// |1 + Δt λ| < 1 for λ = −c/2m ± iω√(1 − ζ²), i.e. Δt < c/(m ω²) when underdamped and
 /// Δt < 2/|λ_fast| when overdamped; without damping it is unstable at any Δt (0 is returned).
 /// None for implicit Euler (unconditionally stable).
@@ -196,7 +197,12 @@ pub fn stability_limit_dt(
     }
     let c = damping_Ns_per_m;
     Some(match integrator {
-        Integrator::SymplecticEuler => 2.0 / w,
+        // v' = v + Δt(−ω²x − γv), x' = x + Δt v' (γ = c/m) is stable for Δt²ω² + 2Δtγ < 4, i.e.
+        // Δt < (√(γ² + 4ω²) − γ)/ω²: 2/ω undamped, 2/γ when damping dominates.
+        Integrator::SymplecticEuler => {
+            let g = c / m;
+            ((g * g + 4.0 * w * w).sqrt() - g) / (w * w)
+        }
         _ if c <= 0.0 => 0.0,
         _ if c < 2.0 * m * w => c / (m * w * w),
         _ => {
