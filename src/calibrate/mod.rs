@@ -93,6 +93,9 @@ pub struct Problem {
     pub side_cm: f64,
     /// Cost given to a simulation that does not converge (counted in `failures`).
     pub penalty: f64,
+    /// Reuse the evaluation of a parameter vector seen before (default true; off only to measure what
+    /// the cache saves).
+    pub caching: bool,
     cache: Mutex<HashMap<Vec<u64>, Evaluation>>,
     /// Simulations run (cache misses).
     pub simulations: AtomicUsize,
@@ -109,6 +112,7 @@ impl Problem {
             bounds: Bounds::default(),
             side_cm,
             penalty: 100.0,
+            caching: true,
             cache: Mutex::new(HashMap::new()),
             simulations: AtomicUsize::new(0),
             failures: AtomicUsize::new(0),
@@ -146,7 +150,9 @@ impl Problem {
     /// over the measured edges, or the penalty when the drape does not converge.
     pub fn evaluate(&self, u: &[f64]) -> Evaluation {
         let key = self.key(u);
-        if let Some(e) = self.cache.lock().expect("cache").get(&key) {
+        if self.caching
+            && let Some(e) = self.cache.lock().expect("cache").get(&key)
+        {
             return *e;
         }
         self.simulations.fetch_add(1, Ordering::Relaxed);

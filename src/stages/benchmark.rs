@@ -440,6 +440,11 @@ squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall
     }
     md += "\n## Every point\n\n";
     md += &markdown(&bench);
+    if let Ok(skips) = ctx.input_named("skips.parquet") {
+        md += "\n## What skipping saves, measured on and off in the same run\n\n";
+        md += &markdown(&read(skips)?);
+        md += "\nsaved_fraction = 1 − time with the skip / time without it.\n";
+    }
     if let Ok(peers) = ctx.input_named("peers.parquet") {
         md += "\n## Peers, run beside drapelab in the same stage\n\n";
         md += &markdown(&read(peers)?);
@@ -461,4 +466,161 @@ equilibrium.\n";
     }
     ctx.progress.item_done(&ctx.stage.name);
     Ok(())
+}
+
+/// Parameters of a skips stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SkipsParams {}
+
+/// Runs a skips stage: each skip the engine makes (a quarter model, recording off, the cost cache, an
+/// up-to-date stage; building only the terms a scene needs is not measured: the builder cannot build
+/// the others), measured on and off in the same run, into a Parquet
+/// table (`skip`, `scene`, `time_with_skip_s`, `time_without_skip_s`, `saved_fraction`). Inputs:
+/// `table_wool.toml`, `table_wool_quarter.toml` and `hang4.toml`.
+pub fn run_skips(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
+    use std::time::Instant;
+    let load =
+        |name: &str| -> Result<Scene> { Ok(Scene::load(ctx.input_named(name)?, &[])?.scene) };
+    ctx.progress.stage_started(&ctx.stage.name, 4);
+    let mut rows: Vec<(String, String, f64, f64)> = Vec::new();
+    let timed = |f: &mut dyn FnMut()| {
+        let t = Instant::now();
+        f();
+        t.elapsed().as_secs_f64()
+    };
+    // 1. Symmetry: the quarter model instead of the full one (the same drape, tests/it/contact.rs).
+    let (full, quarter) = (load("table_wool.toml")?, load("table_wool_quarter.toml")?);
+    let tq = timed(&mut || {
+        solve_scene(&quarter, &mut NoObserver);
+    });
+    let tf = timed(&mut || {
+        solve_scene(&full, &mut NoObserver);
+    });
+    rows.push((
+        "symmetry reduction (quarter model)".into(),
+        full.name.clone(),
+        tq,
+        tf,
+    ));
+    ctx.progress.item_done(&ctx.stage.name);
+    // 2. Recording off: simulate with the timeline and the rerun recording off and on.
+    let mut hang4 = load("hang4.toml")?;
+    hang4.cloth.nx = 21;
+    hang4.cloth.ny = 21;
+    let tmp = tempfile::tempdir()?;
+    let mut with_rec = hang4.clone();
+    with_rec.record.timeline = true;
+    with_rec.record.rerun = true;
+    let mut times = Vec::new();
+    for (k, s) in [&hang4, &with_rec].iter().enumerate() {
+        let loaded = crate::scene::LoadedScene {
+            scene: (*s).clone(),
+            path: ctx.input_named("hang4.toml")?.to_path_buf(),
+        };
+        let out = tmp.path().join(format!("r{k}"));
+        let t = Instant::now();
+        crate::simulate::simulate_to_dir(&loaded, &out, &mut NoObserver)?;
+        times.push(t.elapsed().as_secs_f64());
+    }
+    rows.push((
+        "timeline and rerun recording off".into(),
+        hang4.name.clone(),
+        times[0],
+        times[1],
+    ));
+    ctx.progress.item_done(&ctx.stage.name);
+    // 3. Cached parameter vectors: the same ICA run with the cost cache on and off.
+    let mut net = load("hang4.toml")?;
+    net.cloth.nx = 11;
+    net.cloth.ny = 11;
+    let probe = crate::calibrate::Problem::new(net.clone(), vec![], 50.0);
+    let measured = probe
+        .drape(&[0.4, 0.5, 0.5, 0.3, 0.1])
+        .1
+        .context("the reference drape did not converge")?;
+    // The identifiability analysis sweeps damping and the elongation rate, which a static drape does not
+    // see: the cache (keyed on stiffness, natural length and topology) answers those sweeps.
+    let best = [0.4, 0.5, 0.5, 0.3, 0.1];
+    let mut t_cache = [0.0; 2];
+    for (k, caching) in [true, false].into_iter().enumerate() {
+        let mut problem = crate::calibrate::Problem::new(net.clone(), measured.clone(), 50.0);
+        problem.caching = caching;
+        let t = Instant::now();
+        crate::calibrate::identifiability(
+            &problem,
+            &best,
+            0.1,
+            7,
+            crate::calibrate::Noise::FromResidual,
+            0.05,
+        );
+        t_cache[k] = t.elapsed().as_secs_f64();
+    }
+    rows.push((
+        "cached parameter vectors (identifiability analysis)".into(),
+        net.name.clone(),
+        t_cache[0],
+        t_cache[1],
+    ));
+    ctx.progress.item_done(&ctx.stage.name);
+    // 4. Up-to-date stages: a one-stage pipeline run from scratch, then again (nothing to do).
+    let proj = tempfile::tempdir()?;
+    std::fs::create_dir_all(proj.path().join("pipelines"))?;
+    std::fs::create_dir_all(proj.path().join("datasets/scenes"))?;
+    std::fs::copy(
+        ctx.input_named("hang4.toml")?,
+        proj.path().join("datasets/scenes/hang4.toml"),
+    )?;
+    let file = proj.path().join("pipelines/p.toml");
+    std::fs::write(
+        &file,
+        "name = \"p\"\n[stages.h]\nkind = \"simulate\"\ninputs = [\"datasets/scenes/hang4.toml\"]\n\
+         outputs = [\"{run}/h/particles.parquet\", \"{run}/h/run.json\"]\n\
+         params.set = { \"cloth.nx\" = 41, \"cloth.ny\" = 41 }\n",
+    )?;
+    let plan = crate::pipeline::load_plan(&file)?;
+    let quiet = Silent;
+    let mut t_pipe = [0.0; 2];
+    for t in &mut t_pipe {
+        let start = Instant::now();
+        crate::pipeline::run_pipeline(&plan, &Default::default(), &quiet)?;
+        *t = start.elapsed().as_secs_f64();
+    }
+    rows.push((
+        "up-to-date stage skipped".into(),
+        "hang4 41×41".into(),
+        t_pipe[1],
+        t_pipe[0],
+    ));
+    ctx.progress.item_done(&ctx.stage.name);
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("skip", DataType::Utf8, false),
+        Field::new("scene", DataType::Utf8, false),
+        Field::new("time_with_skip_s", DataType::Float64, false),
+        Field::new("time_without_skip_s", DataType::Float64, false),
+        Field::new("saved_fraction", DataType::Float64, false),
+    ]));
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(
+            rows.iter().map(|r| r.0.clone()),
+        )),
+        Arc::new(StringArray::from_iter_values(
+            rows.iter().map(|r| r.1.clone()),
+        )),
+        f64s(rows.iter().map(|r| r.2).collect()),
+        f64s(rows.iter().map(|r| r.3).collect()),
+        f64s(rows.iter().map(|r| 1.0 - r.2 / r.3).collect()),
+    ];
+    write_parquet(&ctx.outputs[0], &RecordBatch::try_new(schema, cols)?, None)
+}
+
+/// A progress that says nothing (the skips stage runs a pipeline of its own inside).
+struct Silent;
+
+impl crate::pipeline::Progress for Silent {
+    fn stage_started(&self, _: &str, _: u64) {}
+    fn item_done(&self, _: &str) {}
+    fn stage_finished(&self, _: &str, _: &str, _: f64) {}
+    fn stage_skipped(&self, _: &str, _: &str) {}
 }

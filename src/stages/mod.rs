@@ -14,7 +14,7 @@ mod tune;
 mod validate;
 mod wrinkles;
 
-pub use benchmark::{BenchmarkParams, BenchmarkReportParams, PeersParams};
+pub use benchmark::{BenchmarkParams, BenchmarkReportParams, PeersParams, SkipsParams};
 pub use calibrate::CalibrateParams;
 pub use calibration_report::CalibrationReportParams;
 pub use fit_edges::FitEdgesParams;
@@ -100,6 +100,8 @@ pub enum StageKind {
     Peers,
     /// Pareto fronts, scaling exponents and peer ratios from the benchmark tables.
     BenchmarkReport,
+    /// Each skip the engine makes, measured on and off.
+    Skips,
 }
 
 /// Deserializes a stage's params table into `T`, naming the bad key.
@@ -122,7 +124,7 @@ pub(crate) fn typed_params<T: serde::de::DeserializeOwned>(
 
 impl StageKind {
     /// Names of all kinds.
-    pub const ALL: [&'static str; 14] = [
+    pub const ALL: [&'static str; 15] = [
         "simulate",
         "sweep",
         "report",
@@ -137,6 +139,7 @@ impl StageKind {
         "benchmark",
         "peers",
         "benchmark-report",
+        "skips",
     ];
 
     /// The kind of a name.
@@ -156,6 +159,7 @@ impl StageKind {
             "benchmark" => Some(Self::Benchmark),
             "peers" => Some(Self::Peers),
             "benchmark-report" => Some(Self::BenchmarkReport),
+            "skips" => Some(Self::Skips),
             _ => None,
         }
     }
@@ -176,6 +180,7 @@ impl StageKind {
             Self::Benchmark => "benchmark",
             Self::Peers => "peers",
             Self::BenchmarkReport => "benchmark-report",
+            Self::Skips => "skips",
         }
     }
     /// Checks parameters: Err((key, message)).
@@ -194,6 +199,7 @@ impl StageKind {
             Self::Benchmark => typed_params::<BenchmarkParams>(params).map(|_| ()),
             Self::Peers => typed_params::<PeersParams>(params).map(|_| ()),
             Self::BenchmarkReport => typed_params::<BenchmarkReportParams>(params).map(|_| ()),
+            Self::Skips => typed_params::<SkipsParams>(params).map(|_| ()),
             Self::Tune => typed_params::<TuneParams>(params).and_then(|p| {
                 if p.repeats == 0 {
                     Err(("repeats".into(), "must be ≥ 1".into()))
@@ -228,6 +234,7 @@ impl StageKind {
             Self::Benchmark => resolved::<BenchmarkParams>(params),
             Self::Peers => resolved::<PeersParams>(params),
             Self::BenchmarkReport => resolved::<BenchmarkReportParams>(params),
+            Self::Skips => resolved::<SkipsParams>(params),
         }
     }
     /// Runs the stage.
@@ -253,6 +260,7 @@ impl StageKind {
             Self::BenchmarkReport => {
                 benchmark::run_report(ctx, &typed_params(params).map_err(bad)?)
             }
+            Self::Skips => benchmark::run_skips(ctx, &typed_params(params).map_err(bad)?),
         }
     }
 }
