@@ -204,7 +204,8 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
 }
 
 /// Contact with the scene's obstacles (only when it has some): with `contact.fix_supported`, the
-/// particles that start above the top face of a table or pedestal are fixed (seed 003 §10.5); with
+/// particles that start above the top face of a table or pedestal, or above the flat top of a body
+/// form (a skirt's waist), are fixed (seed 003 §10.5, §10.7.2.3); with
 /// the barrier method every other particle gets the barrier term (the vertical-gap method works in the
 /// solver instead, [`crate::simulate`]).
 fn contact_terms(
@@ -221,9 +222,14 @@ fn contact_terms(
     }
     if scene.contact.fix_supported {
         for (p, x) in x0.iter().enumerate().take(fixed.len()) {
-            let on_top = scene.obstacles.iter().any(|o| {
-                matches!(o, Obstacle::Box { .. } | Obstacle::Pedestal { .. })
-                    && o.top_at(x.x, x.y).is_some()
+            let on_top = scene.obstacles.iter().any(|o| match o {
+                Obstacle::Box { .. } | Obstacle::Pedestal { .. } => o.top_at(x.x, x.y).is_some(),
+                // A body form: the part over its flat top (the waist of a skirt).
+                Obstacle::Revolution { axis_m, profile_m } => {
+                    let top = profile_m[profile_m.len() - 1];
+                    ((x.x - axis_m[0]).powi(2) + (x.y - axis_m[1]).powi(2)).sqrt() <= top[1]
+                }
+                _ => false,
             });
             if on_top {
                 fixed[p] = true;

@@ -273,3 +273,28 @@ fn the_quarter_table_model_is_an_equilibrium_of_the_full_model_and_matches_table
     }
     assert!(worst < 0.3, "worst {worst} cm");
 }
+
+#[test]
+fn the_skirt_drapes_over_the_body_form_without_entering_it() {
+    // A disc skirt held at the waist of a body form of revolution (seed 003 §10.7.2.3): it must hang
+    // over the hips, below the waist, outside the form everywhere.
+    let s = scene("skirt_wool.toml", &["cloth.nx=31", "cloth.ny=31"]);
+    let sol = solve_scene(&s, &mut NoObserver);
+    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let x = sol.grid_positions();
+    assert!(max_penetration_m(&s.obstacles, x) < 1e-6);
+    let present: Vec<_> = x
+        .iter()
+        .zip(&sol.model.masses)
+        .filter(|(_, m)| **m > 0.0)
+        .map(|(p, _)| *p)
+        .collect();
+    let low = present.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    assert!(low < -0.15, "the hem hangs below the hips: lowest z {low}");
+    // The hem lies outside the hips' radius (17 cm) wherever it is below them.
+    for p in &present {
+        if p.z < -0.2 && p.z > -0.35 {
+            assert!(p.xy().norm() > 0.165, "{p:?}");
+        }
+    }
+}
