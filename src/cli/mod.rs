@@ -182,7 +182,41 @@ pub enum Command {
         /// Force tolerance of every solver, relative to the lightest particle's weight.
         #[arg(long, default_value_t = 1e-6)]
         tol: f64,
+        /// Run the whole benchmark pipeline instead (pipelines/benchmark.toml: every reference scene,
+        /// solver, size and tolerance, the scipy/numpy peers, the skips, reports/benchmark.md; only
+        /// stale stages run).
+        #[arg(long)]
+        all: bool,
     },
+}
+
+/// `drapelab run`: runs a pipeline make-style with a progress display; returns the exit code.
+fn run_pipeline_command(
+    pipeline: &std::path::Path,
+    opts: crate::pipeline::RunOptions,
+) -> Result<i32> {
+    let plan = crate::pipeline::load_plan(pipeline)?;
+    let progress = crate::pipeline::progress_for_terminal();
+    let summary = crate::pipeline::run_pipeline(&plan, &opts, progress.as_ref())?;
+    for (name, why) in &summary.would_run {
+        println!("would run {name}: {why}");
+    }
+    eprintln!(
+        "{}: {} ran, {} up to date, {} failed{}",
+        plan.name,
+        summary.ran.len(),
+        summary.skipped.len(),
+        summary.failed.len(),
+        if opts.dry_run { " (dry run)" } else { "" }
+    );
+    for (name, why) in &summary.failed {
+        eprintln!("  {name}: {why}");
+    }
+    Ok(if summary.failed.is_empty() {
+        EXIT_OK
+    } else {
+        EXIT_FAILED
+    })
 }
 
 /// Runs the parsed command line; returns the exit code.
@@ -220,36 +254,15 @@ pub fn run(cli: Cli) -> Result<i32> {
             force,
             jobs,
             dry_run,
-        } => {
-            let plan = crate::pipeline::load_plan(&pipeline)?;
-            let progress = crate::pipeline::progress_for_terminal();
-            let opts = crate::pipeline::RunOptions {
+        } => run_pipeline_command(
+            &pipeline,
+            crate::pipeline::RunOptions {
                 until,
                 force,
                 jobs,
                 dry_run,
-            };
-            let summary = crate::pipeline::run_pipeline(&plan, &opts, progress.as_ref())?;
-            for (name, why) in &summary.would_run {
-                println!("would run {name}: {why}");
-            }
-            eprintln!(
-                "{}: {} ran, {} up to date, {} failed{}",
-                plan.name,
-                summary.ran.len(),
-                summary.skipped.len(),
-                summary.failed.len(),
-                if opts.dry_run { " (dry run)" } else { "" }
-            );
-            for (name, why) in &summary.failed {
-                eprintln!("  {name}: {why}");
-            }
-            Ok(if summary.failed.is_empty() {
-                EXIT_OK
-            } else {
-                EXIT_FAILED
-            })
-        }
+            },
+        ),
         Command::Status { pipeline } => {
             let plan = crate::pipeline::load_plan(&pipeline)?;
             for (name, state) in crate::pipeline::stage_states(&plan) {
@@ -434,7 +447,14 @@ pub fn run(cli: Cli) -> Result<i32> {
             max_explicit_size,
             max_implicit_size,
             tol,
+            all,
         } => {
+            if all {
+                return run_pipeline_command(
+                    std::path::Path::new("pipelines/benchmark.toml"),
+                    Default::default(),
+                );
+            }
             bench::run_bench(&scene, &sizes, max_explicit_size, max_implicit_size, tol)?;
             Ok(EXIT_OK)
         }
