@@ -130,7 +130,7 @@ fn the_mesh_has_n_folds_and_passes_through_the_supports() {
 }
 
 #[test]
-fn wrinkles_command_writes_tables_readable_by_polars() {
+fn wrinkles_command_writes_tables_and_a_recording_read_by_polars_and_rerun() {
     let tmp = tempfile::tempdir().unwrap();
     let o = drapelab()
         .arg("wrinkles")
@@ -142,6 +142,12 @@ fn wrinkles_command_writes_tables_readable_by_polars() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let code = r#"
 import sys, polars as pl
+from rerun.experimental import RrdReader
+meshes = set()
+for chunk in RrdReader(sys.argv[3]).stream().to_chunks():
+    if chunk.entity_path.endswith("/mesh"):
+        meshes.add(chunk.entity_path)
+assert len(meshes) == 12, meshes
 t = pl.read_parquet(sys.argv[1])
 assert t.height == 12, t
 for c in ["case", "length_m", "height_m", "thickness_m", "youngs_modulus_Pa", "weight_N_per_m2",
@@ -157,9 +163,9 @@ assert m.group_by("case").len()["len"].unique().to_list() == [41 * 81]
         &[
             &tmp.path().join("wrinkles.parquet"),
             &tmp.path().join("mesh.parquet"),
+            &tmp.path().join("wrinkles.rrd"),
         ],
     );
-    assert!(tmp.path().join("wrinkles.rrd").exists());
 }
 
 #[test]
