@@ -7,15 +7,13 @@ use drapelab::cli::edges::read_camera;
 use drapelab::edges::{Calibration, FitImageOptions, fit_image, read_gray};
 use drapelab::optim::IcaSettings;
 
-#[test]
-fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
-    // Sample 8: 54.41 g/m², 1100 N/m, natural length 55 mm (datasets/knitted/README.md).
+/// The edges fitted from sample 8's bundled 4-corner photo with its camera calibration.
+fn sample_8_edges() -> Vec<drapelab::edges::EdgeFit> {
     let dir = root().join("datasets/knitted/sample_08/hang4");
     let cam = read_camera(&dir.join("camera.json")).unwrap();
     let photo = dir.join("photo.png");
-    let img = read_gray(&photo).unwrap();
-    let measured = fit_image(
-        &img,
+    fit_image(
+        &read_gray(&photo).unwrap(),
         &FitImageOptions {
             view: cam.view,
             degree: 4,
@@ -27,7 +25,13 @@ fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
         &photo,
     )
     .unwrap()
-    .edges;
+    .edges
+}
+
+#[test]
+fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
+    // Sample 8: 54.41 g/m², 1100 N/m, natural length 55 mm (datasets/knitted/README.md).
+    let measured = sample_8_edges();
     let s = scene(
         "hang4.toml",
         &[
@@ -269,4 +273,56 @@ print("mean Eq. 5", mean_eq5)
         ],
     );
     eprintln!("{out}");
+}
+
+#[test]
+fn a_whole_calibration_is_identical_on_one_and_two_threads() {
+    // ICA (costs evaluated in parallel), the Nelder–Mead polish and the identifiability fits, for
+    // sample 8's photo, with rayon pools of 1 and 2 threads: every number must agree bit for bit.
+    let measured = sample_8_edges();
+    let settings = IcaSettings {
+        decades: 5,
+        countries: 10,
+        imperialists: 2,
+        beta: 2.0,
+        gamma: 0.3,
+        revolution_rate: 0.2,
+        xi: 0.1,
+        seed: 11,
+    };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let s = scene(
+                "hang4.toml",
+                &[
+                    "cloth.nx=14",
+                    "cloth.ny=14",
+                    "cloth.areal_density_kg_per_m2=0.05441",
+                ],
+            );
+            let problem = Problem::new(s, measured.clone(), 50.0);
+            let (_, report) = problem.run_ica(&settings);
+            let (u, cost) = problem.polish(&report.best_x, 20);
+            let ident = drapelab::calibrate::identifiability(
+                &problem,
+                &u,
+                0.1,
+                5,
+                drapelab::calibrate::Noise::FromResidual,
+                0.05,
+            );
+            let widths: Vec<u64> = ident.iter().map(|i| i.uncertainty.to_bits()).collect();
+            (
+                report.best_cost.to_bits(),
+                u.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                cost.to_bits(),
+                widths,
+            )
+        })
+    };
+    assert_eq!(run(1), run(2));
 }
