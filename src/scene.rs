@@ -240,6 +240,10 @@ pub struct ContactSpec {
     /// for the part of a sheet lying on a table (§10.5, §10.6). Default false (they slide freely).
     #[serde(default)]
     pub fix_supported: bool,
+    /// Coulomb friction coefficient μ of the barrier contact (lagged, refreshed over 20 load
+    /// increments). Default 0 (frictionless).
+    #[serde(default)]
+    pub friction_coefficient: f64,
 }
 
 fn default_contact_distance() -> f64 {
@@ -252,6 +256,7 @@ impl Default for ContactSpec {
             method: ContactMethod::default(),
             distance_m: default_contact_distance(),
             fix_supported: false,
+            friction_coefficient: 0.0,
         }
     }
 }
@@ -489,6 +494,10 @@ impl Scene {
             return err("cloth.origin_m", "must be finite".into());
         }
         pos("contact.distance_m", self.contact.distance_m)?;
+        nonneg(
+            "contact.friction_coefficient",
+            self.contact.friction_coefficient,
+        )?;
         let flat = crate::cloth::initial_positions(self);
         for (k, o) in self.obstacles.iter().enumerate() {
             o.check()

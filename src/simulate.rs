@@ -105,9 +105,83 @@ fn static_solve(
             &scene.solver.static_,
             observer,
         )
+    } else if scene.contact.friction_coefficient > 0.0 && !scene.obstacles.is_empty() {
+        solve_with_friction(scene, model, x, observer)
     } else {
         solve_static(model, x, &scene.solver.static_, observer)
     }
+}
+
+/// The static solve with lagged friction: the load raised in increments (20 when the scene asks for
+/// one step), the friction anchors refreshed before each, then up to 10 more refreshes at full load
+/// until no particle moves by more than 1e-7 m.
+fn solve_with_friction(
+    scene: &Scene,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    use crate::physics::{FrictionAnchor, LaggedFriction};
+    let contact = crate::cloth::barrier_contact(scene, &model.masses, &model.fixed);
+    let mu = scene.contact.friction_coefficient;
+    let opts = &scene.solver.static_;
+    let steps = if opts.load_steps > 1 {
+        opts.load_steps
+    } else {
+        20
+    };
+    let mut loads: Vec<f64> = (1..=steps).map(|k| k as f64 / steps as f64).collect();
+    loads.extend([1.0; 10]);
+    model.terms.push(Box::new(LaggedFriction {
+        anchors: vec![],
+        eps_m: 1e-5,
+    }));
+    let mut total: Option<SolveReport> = None;
+    for (k, &load) in loads.iter().enumerate() {
+        let anchors = contact
+            .contacts(x)
+            .into_iter()
+            .map(|(p, n, force)| FrictionAnchor {
+                particle: p,
+                anchor_m: x[p],
+                normal: n,
+                limit_N: mu * force,
+            })
+            .collect();
+        if let Some(t) = model.terms.last_mut() {
+            *t = Box::new(LaggedFriction {
+                anchors,
+                eps_m: 1e-5,
+            });
+        }
+        let before = x.to_vec();
+        let obs: &mut dyn Observer = if k == 0 {
+            &mut *observer
+        } else {
+            &mut crate::solve::NoObserver
+        };
+        let r = crate::solve::solve_static_loads(model, x, opts, &[load], obs);
+        let moved = x
+            .iter()
+            .zip(&before)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        let mut t = SolveReport::accumulate(total.take(), r);
+        if !t.is_converged() {
+            return t;
+        }
+        if k >= steps && moved < 1e-7 {
+            t.message = format!("{} (friction μ = {mu}, {} lag updates)", t.message, k + 1);
+            return t;
+        }
+        total = Some(t);
+    }
+    let mut t = total.expect("at least one solve");
+    t.message = format!(
+        "{} (friction μ = {mu}: lag updates still moving the sheet)",
+        t.message
+    );
+    t
 }
 
 /// Solves the scene on the grid with every other line and writes the interpolated positions into

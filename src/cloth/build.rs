@@ -237,28 +237,38 @@ fn contact_terms(
         }
     }
     if scene.contact.method == ContactMethod::Barrier {
-        let g = if scene.gravity.g_m_per_s2 > 0.0 {
-            scene.gravity.g_m_per_s2
-        } else {
-            crate::STANDARD_GRAVITY_M_PER_S2
-        };
-        let d_hat = scene.contact.distance_m;
-        let kappa = masses
-            .iter()
-            .zip(fixed.iter())
-            .map(|(m, f)| {
-                if *f || *m <= 0.0 {
-                    0.0
-                } else {
-                    crate::physics::BarrierContact::kappa_for_weight(m * g, d_hat)
-                }
-            })
-            .collect();
-        terms.push(Box::new(crate::physics::BarrierContact {
-            obstacles: scene.obstacles.clone(),
-            d_hat_m: d_hat,
-            kappa_J: kappa,
-        }));
+        terms.push(Box::new(barrier_contact(scene, masses, fixed)));
+    }
+}
+
+/// The barrier contact term of a scene: every free particle with mass against every obstacle, κ from
+/// its weight ([`BarrierContact::kappa_for_weight`](crate::physics::BarrierContact::kappa_for_weight)).
+pub fn barrier_contact(
+    scene: &Scene,
+    masses: &[f64],
+    fixed: &[bool],
+) -> crate::physics::BarrierContact {
+    let g = if scene.gravity.g_m_per_s2 > 0.0 {
+        scene.gravity.g_m_per_s2
+    } else {
+        crate::STANDARD_GRAVITY_M_PER_S2
+    };
+    let d_hat = scene.contact.distance_m;
+    let kappa = masses
+        .iter()
+        .zip(fixed.iter())
+        .map(|(m, f)| {
+            if *f || *m <= 0.0 {
+                0.0
+            } else {
+                crate::physics::BarrierContact::kappa_for_weight(m * g, d_hat)
+            }
+        })
+        .collect();
+    crate::physics::BarrierContact {
+        obstacles: scene.obstacles.clone(),
+        d_hat_m: d_hat,
+        kappa_J: kappa,
     }
 }
 

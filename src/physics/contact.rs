@@ -129,6 +129,18 @@ impl EnergyTerm for BarrierContact {
     }
 }
 
+impl BarrierContact {
+    /// The contacts at `x`: (particle, outward normal, barrier force magnitude in N) for every free
+    /// particle within d̂ of an obstacle.
+    pub fn contacts(&self, x: &Vecs) -> Vec<(usize, Vector3<f64>, f64)> {
+        let mut out = Vec::new();
+        self.each(x, |p, d, n, _| {
+            out.push((p, n, -self.kappa_J[p] * barrier(d, self.d_hat_m).1));
+        });
+        out
+    }
+}
+
 /// The largest penetration (m) of any particle into any obstacle: max(0, −d).
 pub fn max_penetration_m(obstacles: &[Obstacle], x: &Vecs) -> f64 {
     x.iter()

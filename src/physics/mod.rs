@@ -4,12 +4,14 @@
 
 mod bending;
 mod contact;
+mod friction;
 mod gravity;
 mod shear;
 mod springs;
 
 pub use bending::{LinearBending, MirrorBending};
 pub use contact::{BarrierContact, max_penetration_m};
+pub use friction::{FrictionAnchor, LaggedFriction};
 pub use gravity::Gravity;
 pub use shear::CellShear;
 pub use springs::{SpringFamily, Springs};

@@ -76,3 +76,25 @@ impl SolveReport {
         self.status == Status::Converged
     }
 }
+
+impl SolveReport {
+    /// The running total of a solve made of several solves (load increments, contact rounds): work
+    /// and time add up, the status, residual, energy and message are the latest one's.
+    pub fn accumulate(total: Option<SolveReport>, latest: SolveReport) -> SolveReport {
+        match total {
+            None => latest,
+            Some(mut t) => {
+                t.iterations += latest.iterations;
+                t.linear_solves += latest.linear_solves;
+                t.wall_time_s += latest.wall_time_s;
+                t.status = latest.status;
+                t.max_residual_N = latest.max_residual_N;
+                t.max_residual_rel = latest.max_residual_rel;
+                t.energy_J = latest.energy_J;
+                t.divergence = latest.divergence;
+                t.message = latest.message;
+                t
+            }
+        }
+    }
+}

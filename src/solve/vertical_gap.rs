@@ -30,25 +30,6 @@ fn surface_below(obstacles: &[Obstacle], p: &Vector3<f64>) -> Option<f64> {
         })
 }
 
-/// Adds a round's report to the running total.
-fn accumulate(total: Option<SolveReport>, r: SolveReport) -> SolveReport {
-    match total {
-        None => r,
-        Some(mut t) => {
-            t.iterations += r.iterations;
-            t.linear_solves += r.linear_solves;
-            t.wall_time_s += r.wall_time_s;
-            t.status = r.status;
-            t.max_residual_N = r.max_residual_N;
-            t.max_residual_rel = r.max_residual_rel;
-            t.energy_J = r.energy_J;
-            t.divergence = r.divergence;
-            t.message = r.message;
-            t
-        }
-    }
-}
-
 /// Solves `model` from `x` with vertical-gap contact against `obstacles`, raising the load in
 /// `opts.load_steps` increments (20 when that is 1). Iterations and times add up over the rounds; a
 /// round that does not converge ends the solve with its status.
@@ -81,7 +62,7 @@ pub fn solve_vertical_gap(
                 &mut NoObserver
             };
             first = false;
-            let report = accumulate(
+            let report = SolveReport::accumulate(
                 total.take(),
                 solve_static_loads(model, x, opts, &[load], obs),
             );
