@@ -88,19 +88,10 @@ pub fn vertical_projection(
             }
         }
     };
-    for j in 0..grid.ny - 1 {
-        for i in 0..grid.nx - 1 {
-            let (p, r, d, dr) = (
-                grid.index(i, j),
-                grid.index(i + 1, j),
-                grid.index(i, j + 1),
-                grid.index(i + 1, j + 1),
-            );
-            for [a, b, c] in [[p, r, dr], [p, dr, d]] {
-                if present[a] && present[b] && present[c] {
-                    fill(&x[a], &x[b], &x[c]);
-                }
-            }
+    for tri in crate::io::grid_triangles(grid) {
+        let [a, b, c] = tri.map(|v| v as usize);
+        if present[a] && present[b] && present[c] {
+            fill(&x[a], &x[b], &x[c]);
         }
     }
     Projection {

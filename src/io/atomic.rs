@@ -64,3 +64,12 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut File) -> Result<()>) ->
     staged.file().flush()?;
     staged.commit()
 }
+
+/// Writes `text` to `path` atomically (see [`write_atomic`]).
+pub fn write_text(path: &Path, text: &str) -> Result<PathBuf> {
+    write_atomic(path, |f| {
+        use std::io::Write;
+        f.write_all(text.as_bytes())?;
+        Ok(())
+    })
+}

@@ -8,9 +8,9 @@ mod rrd;
 mod table;
 mod timeline;
 
-pub use atomic::{Staged, write_atomic};
+pub use atomic::{Staged, write_atomic, write_text};
 pub use calibration_rrd::CalibrationRecorder;
 pub use particles::{read_particles, write_particles};
 pub use rrd::RerunRecorder;
 pub use table::write_parquet;
-pub use timeline::{TimelineRecorder, grid_triangles};
+pub use timeline::{TimelineRecorder, cell_triangles, grid_triangles};

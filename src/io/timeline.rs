@@ -20,14 +20,19 @@ const STATS_SCHEMA: &str = r#"{"title":"drapelab.Stats","type":"object","propert
 
 /// Triangle indices of the grid (two per cell), for meshes.
 pub fn grid_triangles(grid: &Grid) -> Vec<[u32; 3]> {
-    let mut t = Vec::with_capacity(2 * (grid.nx - 1) * (grid.ny - 1));
-    for j in 0..grid.ny - 1 {
-        for i in 0..grid.nx - 1 {
+    cell_triangles(grid.nx, grid.ny)
+}
+
+/// Two triangles per cell of a row-major `nx` × `ny` point array (point (i, j) at j·nx + i).
+pub fn cell_triangles(nx: usize, ny: usize) -> Vec<[u32; 3]> {
+    let mut t = Vec::with_capacity(2 * (nx - 1) * (ny - 1));
+    for j in 0..ny - 1 {
+        for i in 0..nx - 1 {
             let (a, b, c, d) = (
-                grid.index(i, j),
-                grid.index(i + 1, j),
-                grid.index(i, j + 1),
-                grid.index(i + 1, j + 1),
+                j * nx + i,
+                j * nx + i + 1,
+                (j + 1) * nx + i,
+                (j + 1) * nx + i + 1,
             );
             t.push([a as u32, b as u32, d as u32]);
             t.push([a as u32, d as u32, c as u32]);

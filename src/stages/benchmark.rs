@@ -9,7 +9,7 @@ use super::report::{Panels, markdown, plot_panels};
 use crate::benchmark::{
     BenchLimits, BenchRow, bench_rows, bench_scene, fitted_exponent, pareto_front,
 };
-use crate::io::{write_atomic, write_parquet};
+use crate::io::{write_parquet, write_text};
 use crate::scene::{Scene, SolverKind};
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
@@ -458,11 +458,7 @@ equilibrium.\n";
         } else {
             &svg
         };
-        write_atomic(out, |f| {
-            use std::io::Write;
-            f.write_all(text.as_bytes())?;
-            Ok(())
-        })?;
+        write_text(out, text)?;
     }
     ctx.progress.item_done(&ctx.stage.name);
     Ok(())

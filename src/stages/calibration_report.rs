@@ -7,7 +7,7 @@
 use super::StageContext;
 use super::report::{Panels, markdown, plot_panels};
 use crate::calibrate::sample_number;
-use crate::io::write_atomic;
+use crate::io::write_text;
 use anyhow::Result;
 use polars::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -50,15 +50,6 @@ pub(crate) fn read_csv(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
                 .collect()
         })
         .collect())
-}
-
-fn write_text(path: &Path, text: &str) -> Result<()> {
-    write_atomic(path, |f| {
-        use std::io::Write;
-        f.write_all(text.as_bytes())?;
-        Ok(())
-    })?;
-    Ok(())
 }
 
 /// Runs the stage.

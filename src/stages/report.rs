@@ -3,7 +3,7 @@
 //! Markdown (the first output, e.g. `reports/main.md`) beside the plot (the `.svg` output).
 
 use super::StageContext;
-use crate::io::write_atomic;
+use crate::io::write_text;
 use anyhow::{Context, Result, bail};
 use plotters::prelude::*;
 use polars::prelude::*;
@@ -177,11 +177,7 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         }
     }
     let svg_text = plot_panels(&panels, &p.x, &p.y, p.facet.as_deref())?;
-    write_atomic(svg, |f| {
-        use std::io::Write;
-        f.write_all(svg_text.as_bytes())?;
-        Ok(())
-    })?;
+    write_text(svg, &svg_text)?;
     let svg_rel = svg
         .strip_prefix(md.parent().unwrap_or(Path::new("")))
         .unwrap_or(svg)
@@ -215,11 +211,7 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         "\n## `{}` against `{}` (converged points)\n\n![{} against {}]({svg_rel})\n",
         p.y, p.x, p.y, p.x
     );
-    write_atomic(md, |f| {
-        use std::io::Write;
-        f.write_all(text.as_bytes())?;
-        Ok(())
-    })?;
+    write_text(md, &text)?;
     ctx.progress.item_done(&ctx.stage.name);
     Ok(())
 }

@@ -8,7 +8,7 @@
 
 use super::StageContext;
 use super::report::{Panels, markdown, plot_panels};
-use crate::io::write_atomic;
+use crate::io::write_text;
 use crate::measure::drape_measures;
 use crate::scene::{ContactMethod, Scene};
 use crate::simulate::{Solution, solve_scene};
@@ -76,10 +76,6 @@ fn solve_pair(scene: &Scene) -> Solved {
         fine,
         gap_m,
     }
-}
-
-fn read_reference(path: &std::path::Path) -> Result<Vec<BTreeMap<String, String>>> {
-    super::calibration_report::read_csv(path)
 }
 
 /// Runs the stage.
@@ -164,7 +160,7 @@ pattern changing with the grid (the folds' number and place are a bifurcation), 
         md += "## Table 10.2: edge points of the concentric table drape (quarter model)\n\n| point | initial cm | seed 003 cm | drapelab cm | distance cm |\n|---|---|---|---|---|\n";
         let g = &q.coarse.grid;
         let size = q.scene.cloth.size_x_m * 100.0;
-        for row in read_reference(file)? {
+        for row in super::calibration_report::read_csv(file)? {
             let f = |k: &str| {
                 row.get(k)
                     .and_then(|v| v.parse::<f64>().ok())
@@ -199,7 +195,7 @@ y = 0, the part on the table fixed, a uniform grid where the seed's is graded.\n
         ctx.input_named("fvm_rod_corner.csv"),
     ) {
         md += "## Table 10.4: corner A of the polyester sheet on the rod\n\n| source | x cm | y cm | drop cm | distance to the experiment cm |\n|---|---|---|---|---|\n";
-        let rows = read_reference(file)?;
+        let rows = super::calibration_report::read_csv(file)?;
         let f = |row: &BTreeMap<String, String>, k: &str| {
             row.get(k)
                 .and_then(|v| v.parse::<f64>().ok())
@@ -349,11 +345,7 @@ iterations, {t_inc:.3} s, tip deflection {:.4} cm; single step: {} iterations, {
         } else {
             &drapes_svg
         };
-        write_atomic(out, |f| {
-            use std::io::Write;
-            f.write_all(text.as_bytes())?;
-            Ok(())
-        })?;
+        write_text(out, text)?;
     }
     ctx.progress.item_done(&ctx.stage.name);
     Ok(())

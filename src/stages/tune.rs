@@ -221,11 +221,7 @@ pub fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
             "mean S/N (dB, smaller-the-better)",
             None,
         )?;
-        write_atomic(svg, |f| {
-            use std::io::Write;
-            f.write_all(text.as_bytes())?;
-            Ok(())
-        })?;
+        crate::io::write_text(svg, &text)?;
     }
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! the seed's results beside drapelab's.
 
 use super::StageContext;
-use crate::io::{Staged, write_atomic, write_parquet};
+use crate::io::{Staged, write_parquet, write_text};
 use crate::wrinkles::{WrinkleConfig, WrinkleResult, load_config, solve, wrinkle_mesh};
 use anyhow::{Result, bail};
 use arrow::array::{
@@ -74,13 +74,8 @@ pub fn write_wrinkles(
             Some("parquet") => write_table(out, cfg, &solved)?,
             Some("rrd") => write_rrd(out, cfg, &solved, p)?,
             Some("md") => {
-                write_atomic(out, |f| {
-                    use std::io::Write;
-                    f.write_all(REPORT_HEAD.as_bytes())?;
-                    f.write_all(report_markdown(cfg, &solved).as_bytes())?;
-                    f.write_all(REPORT_TAIL.as_bytes())?;
-                    Ok(())
-                })?;
+                let body = report_markdown(cfg, &solved);
+                write_text(out, &format!("{REPORT_HEAD}{body}{REPORT_TAIL}"))?;
             }
             _ => bail!(
                 "{}: unknown wrinkles output (want wrinkles.parquet, *mesh*.parquet, .rrd or .md)",

@@ -24,16 +24,7 @@ impl WrinkleMesh {
     }
     /// Two triangles per cell, for renderers.
     pub fn triangles(&self) -> Vec<[u32; 3]> {
-        let mut t = Vec::with_capacity(2 * (self.nx - 1) * (self.ny - 1));
-        for j in 0..self.ny - 1 {
-            for i in 0..self.nx - 1 {
-                let p = (j * self.nx + i) as u32;
-                let (r, d) = (p + 1, p + self.nx as u32);
-                t.push([p, r, d + 1]);
-                t.push([p, d + 1, d]);
-            }
-        }
-        t
+        crate::io::cell_triangles(self.nx, self.ny)
     }
 }
 

@@ -116,15 +116,7 @@ ica = { decades = 12, countries = 16, imperialists = 3, beta = 2.0, gamma = 0.5,
         std::fs::create_dir_all(tmp.path().join("pipelines")).unwrap();
         let file = tmp.path().join("pipelines/knitted.toml");
         std::fs::write(&file, base.replace(from, to)).unwrap();
-        let o = crate::support::drapelab()
-            .arg("run")
-            .arg(&file)
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{key}: {err}");
-        assert_eq!(err.lines().count(), 1, "{err}");
-        assert!(err.contains(key), "{key} not named: {err}");
+        crate::support::assert_bad_input([std::path::Path::new("run"), &file], &[key]);
     }
 }
 
@@ -154,14 +146,7 @@ baseline_cmaes = true
 ica = { decades = 3, countries = 6, imperialists = 2, beta = 2.0, gamma = 0.3, revolution_rate = 0.2, xi = 0.1, seed = 2 }
 "#,
     );
-    let plan = drapelab::pipeline::load_plan(&file).unwrap();
-    let s = drapelab::pipeline::run_pipeline(
-        &plan,
-        &Default::default(),
-        &drapelab::pipeline::LogProgress::default(),
-    )
-    .unwrap();
-    assert!(s.failed.is_empty(), "{:?}", s.failed);
+    crate::support::run_plan(&file);
     let code = r#"
 import sys, polars as pl
 from rerun.experimental import RrdReader
@@ -229,14 +214,7 @@ runs = 1
 ica = { decades = 40, countries = 15, imperialists = 5, beta = 2.0, gamma = 0.1, revolution_rate = 0.2, xi = 0.2, seed = 1 }
 "#,
     );
-    let plan = drapelab::pipeline::load_plan(&file).unwrap();
-    let s = drapelab::pipeline::run_pipeline(
-        &plan,
-        &Default::default(),
-        &drapelab::pipeline::LogProgress::default(),
-    )
-    .unwrap();
-    assert!(s.failed.is_empty(), "{:?}", s.failed);
+    crate::support::run_plan(&file);
     let code = r##"
 import sys, polars as pl
 r = pl.read_parquet(sys.argv[1]).with_columns(

@@ -2,11 +2,12 @@
 //! symmetry of the concentric table drape, the limits of the drape coefficient, the rod drape against
 //! Table 10.4, and bad obstacle definitions. A failure means contact or the drape measures broke.
 
-use crate::support::{drapelab, root, scene};
+use crate::support::{root, scene};
 use drapelab::measure::drape_measures;
 use drapelab::physics::max_penetration_m;
 use drapelab::simulate::solve_scene;
 use drapelab::solve::NoObserver;
+use std::path::Path;
 
 #[test]
 fn no_particle_ends_inside_an_obstacle_with_either_contact_treatment() {
@@ -191,17 +192,8 @@ fn bad_obstacles_exit_2_naming_the_key() {
         let file = tmp.path().join("s.toml");
         std::fs::write(&file, base.replace(from, to)).unwrap();
         let out = tmp.path().join("out");
-        let o = drapelab()
-            .arg("simulate")
-            .arg(&file)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{key}: {err}");
-        assert_eq!(err.trim().lines().count(), 1, "{err}");
-        assert!(err.contains(key) && err.contains("s.toml"), "{key}: {err}");
+        let args = [Path::new("simulate"), &file, Path::new("--out"), &out];
+        crate::support::assert_bad_input(args, &[key, "s.toml"]);
         assert!(!out.join("particles.parquet").exists());
     }
 }

@@ -311,14 +311,7 @@ outputs = ["{run}/err4/score.parquet"]
 params = { measured = "{run}/fit4/edges.parquet", side_cm = 50.0 }
 "#,
     );
-    let plan = drapelab::pipeline::load_plan(&file).unwrap();
-    let summary = drapelab::pipeline::run_pipeline(
-        &plan,
-        &Default::default(),
-        &drapelab::pipeline::LogProgress::default(),
-    )
-    .unwrap();
-    assert!(summary.failed.is_empty(), "{:?}", summary.failed);
+    crate::support::run_plan(&file);
     let code = r#"
 import sys, polars as pl
 four = pl.read_parquet(sys.argv[1]); two = pl.read_parquet(sys.argv[2])

@@ -106,14 +106,7 @@ set = { "cloth.nx" = 8, "cloth.ny" = 8, "solver.dynamic.max_time_s" = 1.0, "solv
 "cloth.initial_perturbation_m" = [0.0, 0.01]
 "#,
     );
-    let plan = drapelab::pipeline::load_plan(&file).unwrap();
-    let s = drapelab::pipeline::run_pipeline(
-        &plan,
-        &Default::default(),
-        &drapelab::pipeline::LogProgress::default(),
-    )
-    .unwrap();
-    assert!(s.failed.is_empty(), "{:?}", s.failed);
+    crate::support::run_plan(&file);
     let code = r#"
 import sys, polars as pl
 t = pl.read_parquet(sys.argv[1])

@@ -110,3 +110,33 @@ pub fn temp_project(globs: &[&str], name: &str, pipeline: &str) -> (tempfile::Te
     std::fs::write(&file, pipeline).unwrap();
     (tmp, file)
 }
+
+/// Runs the pipeline `file` in this process and asserts that no stage failed.
+pub fn run_plan(file: &Path) -> drapelab::pipeline::RunSummary {
+    let plan = drapelab::pipeline::load_plan(file).unwrap();
+    let s = drapelab::pipeline::run_pipeline(
+        &plan,
+        &Default::default(),
+        &drapelab::pipeline::LogProgress::default(),
+    )
+    .unwrap();
+    assert!(s.failed.is_empty(), "{:?}", s.failed);
+    s
+}
+
+/// Runs drapelab with `args` and asserts bad input: exit code 2 and one line on stderr that names
+/// every string of `names` (the file, the key). Returns that line.
+pub fn assert_bad_input<I, S>(args: I, names: &[&str]) -> String
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let o = drapelab().args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{names:?}: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    for n in names {
+        assert!(err.contains(n), "{n} not named: {err}");
+    }
+    err
+}

@@ -7,6 +7,7 @@ use drapelab::wrinkles::{
     WrinkleConfig, WrinkleResult, boundary_length_m, count_folds, load_config, simpson, solve,
     wrinkle_mesh,
 };
+use std::path::Path;
 
 fn seed_tables() -> WrinkleConfig {
     load_config(&root().join("datasets/wrinkles/seed_tables.toml")).unwrap()
@@ -203,20 +204,8 @@ fn invalid_wrinkle_inputs_exit_2_naming_the_key() {
         let file = tmp.path().join("w.toml");
         std::fs::write(&file, base.replacen(from, to, 1)).unwrap();
         let out = tmp.path().join("out");
-        let o = drapelab()
-            .arg("wrinkles")
-            .arg(&file)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{key}: {err}");
-        assert_eq!(err.trim().lines().count(), 1, "{err}");
-        assert!(
-            err.contains(key) && err.contains("w.toml"),
-            "{key} not named: {err}"
-        );
+        let args = [Path::new("wrinkles"), &file, Path::new("--out"), &out];
+        crate::support::assert_bad_input(args, &[key, "w.toml"]);
         assert!(!out.exists(), "nothing is written for bad input");
     }
 }
