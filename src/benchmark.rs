@@ -26,8 +26,8 @@ pub struct BenchRow {
     pub iterations: usize,
     /// Linear solves (factorizations or CG solves).
     pub linear_solves: usize,
-    /// Largest distance to the finest static solution, at the shared grid points, in m (NaN when the
-    /// grids share no points or the solve did not converge).
+    /// Largest distance to the reference (the finest static solution at the shared grid points, or
+    /// the exact elastica), in m (NaN when the grids share no points or the solve did not converge).
     pub error_m: f64,
     /// Peak resident memory of the process during the point, bytes (Linux; None elsewhere).
     pub peak_rss_bytes: Option<u64>,
@@ -42,6 +42,19 @@ pub struct BenchLimits {
     pub max_explicit_size: usize,
     /// Largest side for implicit Euler.
     pub max_implicit_size: usize,
+    /// Measure errors against the exact heavy elastica (a strip clamped at x-min) instead of the
+    /// finest static solution.
+    pub exact_elastica: bool,
+    /// Wall-clock budget of one dynamic point in s (it ends as max-iterations past it); None: no cap.
+    pub max_wall_time_s: Option<f64>,
+}
+
+/// What a benchmark point's error is measured against.
+enum Reference {
+    /// The static solution at the finest size and a tight tolerance.
+    FinestStatic(Box<crate::simulate::Solution>),
+    /// The exact elastica of a cantilever strip.
+    Elastica(crate::elastica::HeavyElastica),
 }
 
 /// Every solver, cheapest first.
@@ -104,7 +117,8 @@ pub fn bench_scene(scene: &Scene, n: usize, kind: SolverKind, tol: f64) -> Scene
 }
 
 /// Solves `scene` at each size, tolerance and solver (within `limits`), and measures each against the
-/// static solution at the finest size and a tolerance 100 times below the tightest.
+/// static solution at the finest size and a tolerance 100 times below the tightest (or the exact
+/// elastica when `limits.exact_elastica`).
 pub fn bench_rows(
     scene: &Scene,
     sizes: &[usize],
@@ -115,16 +129,29 @@ pub fn bench_rows(
     let finest = *sizes.iter().max().unwrap_or(&11);
     let tightest = tols.iter().copied().fold(1e-6, f64::min);
     let t0 = Instant::now();
-    let reference = solve_scene(
-        &bench_scene(scene, finest, SolverKind::Static, tightest * 1e-2),
-        &mut NoObserver,
-    );
-    log(&format!(
-        "{}: reference {finest} static: {} in {:.3} s",
-        scene.name,
-        reference.report.status.as_str(),
-        t0.elapsed().as_secs_f64()
-    ));
+    let reference = match limits
+        .exact_elastica
+        .then(|| crate::elastica::HeavyElastica::of_cantilever(scene))
+        .flatten()
+    {
+        Some(e) => {
+            log(&format!("{}: reference: the exact elastica", scene.name));
+            Reference::Elastica(e)
+        }
+        None => {
+            let r = solve_scene(
+                &bench_scene(scene, finest, SolverKind::Static, tightest * 1e-2),
+                &mut NoObserver,
+            );
+            log(&format!(
+                "{}: reference {finest} static: {} in {:.3} s",
+                scene.name,
+                r.report.status.as_str(),
+                t0.elapsed().as_secs_f64()
+            ));
+            Reference::FinestStatic(Box::new(r))
+        }
+    };
     let mut rows = Vec::new();
     for &n in sizes {
         for &tol in tols {
@@ -139,13 +166,17 @@ pub fn bench_rows(
                 if skip {
                     continue;
                 }
-                let s = bench_scene(scene, n, kind, tol);
+                let mut s = bench_scene(scene, n, kind, tol);
+                s.solver.dynamic.max_wall_time_s = limits.max_wall_time_s;
                 reset_peak_rss();
                 let t = Instant::now();
                 let sol = solve_scene(&s, &mut NoObserver);
                 let wall = t.elapsed().as_secs_f64();
                 let peak = peak_rss_bytes();
-                let error_m = distance_to(&sol, &reference);
+                let error_m = match &reference {
+                    Reference::FinestStatic(r) => distance_to(&sol, r),
+                    Reference::Elastica(e) => e.distance(&sol),
+                };
                 log(&format!(
                     "{} {n} tol {tol:.0e} {kind:?}: {} {wall:.4} s, error {error_m:.2e} m",
                     scene.name,
@@ -209,6 +240,8 @@ pub fn hang4_rows(
             solvers: ALL_SOLVERS.to_vec(),
             max_explicit_size,
             max_implicit_size,
+            exact_elastica: false,
+            max_wall_time_s: None,
         },
         log,
     )

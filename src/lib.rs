@@ -13,6 +13,7 @@ pub mod cli;
 pub mod cloth;
 pub mod contact;
 pub mod edges;
+pub mod elastica;
 pub mod error;
 pub mod io;
 pub mod material;

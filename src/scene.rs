@@ -453,6 +453,7 @@ impl Scene {
                     pos(&format!("material.continuum.{k}"), v)?;
                 }
                 nonneg("material.continuum.shear", r.shear_N_per_m)?;
+                nonneg("material.continuum.bending_twist", r.bending_twist_N_m)?;
             }
         }
         for (n, p) in self.boundary.pin_particles.iter().enumerate() {
@@ -535,6 +536,9 @@ impl Scene {
         let d = &self.solver.dynamic;
         pos("solver.dynamic.dt_s", d.dt_s)?;
         pos("solver.dynamic.max_time_s", d.max_time_s)?;
+        if let Some(w) = d.max_wall_time_s {
+            pos("solver.dynamic.max_wall_time_s", w)?;
+        }
         pos("solver.dynamic.residual_tol_rel", d.residual_tol_rel)?;
         pos("solver.dynamic.speed_tol_m_per_s", d.speed_tol_m_per_s)?;
         pos("solver.dynamic.strain_bound", d.strain_bound)?;

@@ -3,7 +3,7 @@
 
 use super::{Grid, tributary_lengths};
 use crate::material::Rigidities;
-use crate::physics::{CellShear, EnergyTerm, Gravity, LinearBending, Model, SpringFamily, Springs};
+use crate::physics::{CellShear, CellTwist, EnergyTerm, Gravity, LinearBending, Model, SpringFamily, Springs};
 use crate::scene::Scene;
 use nalgebra::Vector3;
 
@@ -312,8 +312,30 @@ fn symmetry_planes(
     }
 }
 
+/// The grid cells (p₀₀, p₁₀, p₀₁, p₁₁) whose four corners are all present, with their rest sides (h_x, h_y) in m.
+fn present_cells(grid: &Grid, absent: &[bool]) -> (Vec<[usize; 4]>, Vec<(f64, f64)>) {
+    let mut cells = Vec::new();
+    let mut sides = Vec::new();
+    for j in 0..grid.ny - 1 {
+        for i in 0..grid.nx - 1 {
+            let cell = [
+                grid.index(i, j),
+                grid.index(i + 1, j),
+                grid.index(i, j + 1),
+                grid.index(i + 1, j + 1),
+            ];
+            if cell.iter().any(|&p| absent[p]) {
+                continue;
+            }
+            cells.push(cell);
+            sides.push((grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]));
+        }
+    }
+    (cells, sides)
+}
+
 /// The continuum model on the grid: tensile springs along grid lines (k = E·w/h), cell shear (G) and
-/// quadratic bending along grid lines (k = D·w/h̄). A clamped edge pins its particles and adds
+/// quadratic bending along grid lines (k = D·w/h̄) and cell twist (D_t). A clamped edge pins its particles and adds
 /// virtual fixed points mirrored across it, so the bending term sees a zero slope at the edge.
 #[allow(clippy::needless_range_loop, clippy::too_many_arguments)] // grid loops index several parallel arrays
 fn continuum_terms(
@@ -357,24 +379,13 @@ fn continuum_terms(
     )));
     // Shear.
     if r.shear_N_per_m > 0.0 {
-        let mut cells = Vec::new();
-        let mut sides = Vec::new();
-        for j in 0..ny - 1 {
-            for i in 0..nx - 1 {
-                let cell = [
-                    grid.index(i, j),
-                    grid.index(i + 1, j),
-                    grid.index(i, j + 1),
-                    grid.index(i + 1, j + 1),
-                ];
-                if cell.iter().any(|&p| absent[p]) {
-                    continue;
-                }
-                cells.push(cell);
-                sides.push((grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]));
-            }
-        }
+        let (cells, sides) = present_cells(grid, absent);
         terms.push(Box::new(CellShear::new(cells, sides, r.shear_N_per_m)));
+    }
+    // Twist of each cell (plate energy D_t κ_xy²).
+    if r.bending_twist_N_m > 0.0 {
+        let (cells, sides) = present_cells(grid, absent);
+        terms.push(Box::new(CellTwist::cells(cells, &sides, r.bending_twist_N_m)));
     }
     // Bending along x lines (warp) and y lines (weft).
     let mut triples = Vec::new();

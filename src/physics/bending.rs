@@ -8,65 +8,95 @@
 use super::{EnergyTerm, HessianBlocks, Vecs};
 use nalgebra::{Matrix3, Vector3};
 
-/// Quadratic bending on triples of particles.
-pub struct LinearBending {
-    triples: Vec<[u32; 3]>,
-    coef: Vec<[f64; 3]>,
-    stiffness_N_m: Vec<f64>,
+/// An energy ½ k |u|² per stencil, u = Σₘ cₘ x_{pₘ} a fixed linear combination of N particles:
+/// its gradient is linear and its Hessian constant. Bending along grid lines uses three-particle
+/// stencils ([`LinearBending`]) and the twist of a grid cell four ([`CellTwist`]).
+pub struct QuadraticStencil<const N: usize> {
+    name: &'static str,
+    stencils: Vec<[u32; N]>,
+    coef: Vec<[f64; N]>,
+    stiffness: Vec<f64>,
 }
+
+/// Quadratic bending on triples (a, b, c) of consecutive particles of a grid line.
+pub type LinearBending = QuadraticStencil<3>;
+
+/// Quadratic twist of grid cells (p₀₀, p₁₀, p₀₁, p₁₁): w = p₁₁ − p₁₀ − p₀₁ + p₀₀ ≈ h_x h_y ∂²x/∂u∂v,
+/// whose normal part is h_x h_y κ_xy. A plate with Poisson's ratio 0 stores D_t κ_xy² per unit area
+/// (U = ½D[κ_xx² + κ_yy² + 2κ_xy²]), so a cell holds E = D_t |w|²/(h_x h_y) = ½ k |w|²,
+/// k = 2 D_t/(h_x h_y). Without it a sheet bent about a diagonal (κ_xx = κ_yy = κ_xy = κ/2)
+/// would be half as stiff as one bent along a grid line.
+pub type CellTwist = QuadraticStencil<4>;
 
 impl LinearBending {
     /// Triples (a, b, c), coefficients (1/h₁, −1/h₁ − 1/h₂, 1/h₂) and stiffnesses k = D w / h̄ (N·m).
     pub fn new(triples: Vec<[usize; 3]>, coef: Vec<[f64; 3]>, stiffness_N_m: Vec<f64>) -> Self {
-        Self {
-            triples: triples
-                .into_iter()
-                .map(|t| [t[0] as u32, t[1] as u32, t[2] as u32])
-                .collect(),
-            coef,
-            stiffness_N_m,
-        }
-    }
-    fn u(&self, k: usize, x: &Vecs) -> Vector3<f64> {
-        let t = self.triples[k];
-        let c = self.coef[k];
-        x[t[0] as usize] * c[0] + x[t[1] as usize] * c[1] + x[t[2] as usize] * c[2]
+        Self::from_stencils("bending/continuum", triples, coef, stiffness_N_m)
     }
 }
 
-impl EnergyTerm for LinearBending {
+impl CellTwist {
+    /// Cells (p₀₀, p₁₀, p₀₁, p₁₁), their rest sides (h_x, h_y) in m and the twist rigidity D_t in N·m.
+    pub fn cells(cells: Vec<[usize; 4]>, sides_m: &[(f64, f64)], twist_N_m: f64) -> Self {
+        let n = cells.len();
+        let stiffness = sides_m
+            .iter()
+            .map(|(hx, hy)| 2.0 * twist_N_m / (hx * hy))
+            .collect();
+        Self::from_stencils("twist/continuum", cells, vec![[1.0, -1.0, -1.0, 1.0]; n], stiffness)
+    }
+}
+
+impl<const N: usize> QuadraticStencil<N> {
+    /// Stencils of particle indices, their coefficients cₘ and each stencil's k (E = ½ k |u|²).
+    pub fn from_stencils(
+        name: &'static str,
+        stencils: Vec<[usize; N]>,
+        coef: Vec<[f64; N]>,
+        stiffness: Vec<f64>,
+    ) -> Self {
+        Self {
+            name,
+            stencils: stencils.into_iter().map(|t| t.map(|v| v as u32)).collect(),
+            coef,
+            stiffness,
+        }
+    }
+    fn u(&self, k: usize, x: &Vecs) -> Vector3<f64> {
+        let t = self.stencils[k];
+        let c = self.coef[k];
+        (0..N).map(|m| x[t[m] as usize] * c[m]).sum()
+    }
+}
+
+impl<const N: usize> EnergyTerm for QuadraticStencil<N> {
     fn name(&self) -> String {
-        "bending/continuum".into()
+        self.name.into()
     }
     fn energy(&self, x: &Vecs) -> f64 {
-        (0..self.triples.len())
-            .map(|k| 0.5 * self.stiffness_N_m[k] * self.u(k, x).norm_squared())
+        (0..self.stencils.len())
+            .map(|k| 0.5 * self.stiffness[k] * self.u(k, x).norm_squared())
             .sum()
     }
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
-        for k in 0..self.triples.len() {
-            let u = self.u(k, x) * self.stiffness_N_m[k];
-            for m in 0..3 {
-                g[self.triples[k][m] as usize] += u * self.coef[k][m];
+        for k in 0..self.stencils.len() {
+            let u = self.u(k, x) * self.stiffness[k];
+            for m in 0..N {
+                g[self.stencils[k][m] as usize] += u * self.coef[k][m];
             }
         }
     }
     fn stiffness_scale(&self) -> f64 {
         self.coef
             .iter()
-            .zip(&self.stiffness_N_m)
-            .map(|(c, k)| k * c[1] * c[1])
+            .zip(&self.stiffness)
+            .map(|(c, k)| k * c.iter().map(|v| v * v).fold(0.0, f64::max))
             .fold(0.0, f64::max)
     }
     fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _project: bool) {
-        for k in 0..self.triples.len() {
-            let t = self.triples[k];
-            let idx = [t[0] as usize, t[1] as usize, t[2] as usize];
-            h.push_outer(
-                &idx,
-                &self.coef[k],
-                &(Matrix3::identity() * self.stiffness_N_m[k]),
-            );
+        for k in 0..self.stencils.len() {
+            let idx = self.stencils[k].map(|v| v as usize);
+            h.push_outer(&idx, &self.coef[k], &(Matrix3::identity() * self.stiffness[k]));
         }
     }
 }

@@ -9,7 +9,7 @@ mod gravity;
 mod shear;
 mod springs;
 
-pub use bending::{LinearBending, MirrorBending};
+pub use bending::{CellTwist, LinearBending, MirrorBending, QuadraticStencil};
 pub use contact::{BarrierContact, max_penetration_m};
 pub use friction::{FrictionAnchor, LaggedFriction};
 pub use gravity::Gravity;

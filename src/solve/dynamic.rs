@@ -69,6 +69,10 @@ pub struct DynamicOptions {
     /// Whether damping applies (false: conservative dynamics, e.g. for energy checks). Default true.
     #[serde(default = "default_true")]
     pub damping: bool,
+    /// Wall-clock budget in s: past it the solve stops with status max-iterations (benchmarks cap
+    /// their slow points with it). Default none.
+    #[serde(default)]
+    pub max_wall_time_s: Option<f64>,
 }
 
 fn default_dt() -> f64 {
@@ -108,6 +112,7 @@ impl Default for DynamicOptions {
             strain_bound: default_strain(),
             cg_tol_rel: default_cg(),
             damping: true,
+            max_wall_time_s: None,
         }
     }
 }
@@ -345,6 +350,14 @@ pub fn solve_dynamic(
                 report.message = format!(
                     "no equilibrium within {} s (residual {r:.3e} N, speed {vmax:.3e} m/s)",
                     opts.max_time_s
+                );
+                break;
+            }
+            if let Some(budget) = opts.max_wall_time_s
+                && start.elapsed().as_secs_f64() > budget
+            {
+                report.message = format!(
+                    "wall-time budget of {budget} s spent at t = {time:.4} s (residual {r:.3e} N, speed {vmax:.3e} m/s)"
                 );
                 break;
             }

@@ -44,6 +44,14 @@ pub struct BenchmarkParams {
     /// Largest side for implicit Euler. Default 21.
     #[serde(default = "default_explicit")]
     pub max_implicit_size: usize,
+    /// Errors against the exact heavy elastica (scenes that are strips clamped at x-min) instead of
+    /// the finest static solution. Default false.
+    #[serde(default)]
+    pub exact_elastica: bool,
+    /// Wall-clock budget of one dynamic point in s: past it the point ends as max-iterations.
+    /// Default none.
+    #[serde(default)]
+    pub max_wall_time_s: Option<f64>,
 }
 
 fn default_sizes() -> Vec<usize> {
@@ -80,6 +88,8 @@ pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
             .unwrap_or_else(|| crate::benchmark::ALL_SOLVERS.to_vec()),
         max_explicit_size: p.max_explicit_size,
         max_implicit_size: p.max_implicit_size,
+        exact_elastica: p.exact_elastica,
+        max_wall_time_s: p.max_wall_time_s,
     };
     // Serial on purpose: the points are timed, and peak memory is per process.
     let mut rows: Vec<BenchRow> = Vec::new();
@@ -379,10 +389,12 @@ point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
     let svg = plot_panels(
         &panels,
         "log10 wall time (s)",
-        "log10 error vs finest static (m)",
+        "log10 error vs reference (m)",
         Some("scene"),
     )?;
-    md += "## Run time against error\n\n![Pareto fronts](benchmark_pareto.svg)\n\n| scene | Pareto front: (wall time s, error m) |\n|---|---|\n";
+    md += "## Run time against error\n\nThe error is the largest particle distance to the reference: the finest static \
+solution (at the grid points both share), or for the cantilever the exact heavy elastica. Converged points only.\n\n\
+![Pareto fronts](benchmark_pareto.svg)\n\n| scene | Pareto front: (wall time s, error m) |\n|---|---|\n";
     for (s, pts) in &all {
         let front: Vec<String> = pareto_front(pts)
             .iter()
@@ -438,6 +450,30 @@ squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall
             fitted_exponent(pts).map_or("–".into(), |e| format!("{e:.2}"))
         );
     }
+    // How each solver ended on each scene.
+    let mut ends: BTreeMap<(String, String), BTreeMap<String, usize>> = BTreeMap::new();
+    for r in 0..bench.height() {
+        if let (Some(s), Some(sv), Some(st)) = (scene.get(r), solver.get(r), status.get(r)) {
+            *ends
+                .entry((s.into(), sv.into()))
+                .or_default()
+                .entry(st.into())
+                .or_default() += 1;
+        }
+    }
+    md += "\n## How each solver ended\n\nPoints per status (max-iterations includes the wall-time budget of a \
+dynamic point).\n\n| scene | solver | converged | max-iterations | diverged | invalid |\n|---|---|---|---|---|---|\n";
+    for ((s, sv), counts) in &ends {
+        let c = |k: &str| counts.get(k).copied().unwrap_or(0);
+        let _ = writeln!(
+            md,
+            "| {s} | {sv} | {} | {} | {} | {} |",
+            c("converged"),
+            c("max-iterations"),
+            c("diverged"),
+            c("invalid")
+        );
+    }
     md += "\n## Every point\n\n";
     md += &markdown(&bench);
     if let Ok(skips) = ctx.input_named("skips.parquet") {
@@ -470,15 +506,15 @@ equilibrium.\n";
 pub struct SkipsParams {}
 
 /// Runs a skips stage: each skip the engine makes (a quarter model, recording off, the cost cache, an
-/// up-to-date stage; building only the terms a scene needs is not measured: the builder cannot build
-/// the others), measured on and off in the same run, into a Parquet
-/// table (`skip`, `scene`, `time_with_skip_s`, `time_without_skip_s`, `saved_fraction`). Inputs:
-/// `table_wool.toml`, `table_wool_quarter.toml` and `hang4.toml`.
+/// up-to-date stage, a contact term a scene does not need), and the second thread of a calibration
+/// population, measured on and off in the same run, into a Parquet table (`skip`, `scene`,
+/// `time_with_skip_s`, `time_without_skip_s`, `saved_fraction`). Inputs: `table_wool.toml`,
+/// `table_wool_quarter.toml` and `hang4.toml`.
 pub fn run_skips(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
     use std::time::Instant;
     let load =
         |name: &str| -> Result<Scene> { Ok(Scene::load(ctx.input_named(name)?, &[])?.scene) };
-    ctx.progress.stage_started(&ctx.stage.name, 4);
+    ctx.progress.stage_started(&ctx.stage.name, 6);
     let mut rows: Vec<(String, String, f64, f64)> = Vec::new();
     let timed = |f: &mut dyn FnMut()| {
         let t = Instant::now();
@@ -588,6 +624,59 @@ pub fn run_skips(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
         "hang4 41×41".into(),
         t_pipe[1],
         t_pipe[0],
+    ));
+    ctx.progress.item_done(&ctx.stage.name);
+    // 5. Terms a scene does not need: hang4 (no obstacle, so no contact term is built) against the
+    // same scene with a floor 10 m below that it never reaches (the barrier term is built and
+    // evaluated every iteration). 19 a side: both solve from flat (no coarse start).
+    let mut bare = load("hang4.toml")?;
+    bare.cloth.nx = 19;
+    bare.cloth.ny = 19;
+    let mut floored = bare.clone();
+    floored.obstacles.push(crate::contact::Obstacle::Plane {
+        point_m: [0.0, 0.0, -10.0],
+        normal: [0.0, 0.0, 1.0],
+    });
+    let mut t_terms = [0.0; 2];
+    for (k, s) in [&bare, &floored].into_iter().enumerate() {
+        let mut best = f64::INFINITY;
+        for _ in 0..3 {
+            best = best.min(timed(&mut || {
+                solve_scene(s, &mut NoObserver);
+            }));
+        }
+        t_terms[k] = best;
+    }
+    rows.push((
+        "contact term not built (no obstacle within reach)".into(),
+        "hang4 19×19".into(),
+        t_terms[0],
+        t_terms[1],
+    ));
+    ctx.progress.item_done(&ctx.stage.name);
+    // 6. Threads: one ICA population (16 countries of a calibration, the cache off) costed on a
+    // rayon pool of 2 threads against 1.
+    let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(7);
+    let population: Vec<Vec<f64>> = (0..16)
+        .map(|_| (0..5).map(|_| rand::Rng::random::<f64>(&mut rng)).collect())
+        .collect();
+    let mut problem = crate::calibrate::Problem::new(net.clone(), measured.clone(), 50.0);
+    problem.caching = false;
+    let mut t_threads = [0.0; 2];
+    for (k, threads) in [2usize, 1].into_iter().enumerate() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+        t_threads[k] = timed(&mut || {
+            pool.install(|| {
+                use rayon::prelude::*;
+                let _: Vec<f64> = population.par_iter().map(|u| problem.cost(u)).collect();
+            });
+        });
+    }
+    rows.push((
+        "second thread (one calibration population of 16, 2 threads against 1)".into(),
+        format!("{} 11×11", net.name),
+        t_threads[0],
+        t_threads[1],
     ));
     ctx.progress.item_done(&ctx.stage.name);
     let schema = Arc::new(Schema::new(vec![
