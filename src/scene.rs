@@ -66,6 +66,66 @@ pub struct BoundarySpec {
     /// to the edge and the bending across it is mirrored. Continuum model and static solver only.
     #[serde(default)]
     pub symmetry_edges: Vec<Edge>,
+    /// `[[boundary.holds]]`: some coordinates of some particles held where they start (a sheet
+    /// supported vertically round its edge, a corner restrained in the plane: seed 003 §10.5). Static
+    /// solver only. Default none.
+    #[serde(default)]
+    pub holds: Vec<Hold>,
+}
+
+/// Coordinates of particles held at their initial values.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Hold {
+    /// Particles by grid indices [i, j]. Default none.
+    #[serde(default)]
+    pub particles: Vec<[usize; 2]>,
+    /// Every particle of these edges: "xmin", "xmax", "ymin", "ymax". Default none.
+    #[serde(default)]
+    pub edges: Vec<Edge>,
+    /// The coordinates held: any of "x", "y", "z".
+    pub components: Vec<Axis>,
+}
+
+/// A coordinate axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// x.
+    X,
+    /// y.
+    Y,
+    /// z (up).
+    Z,
+}
+
+impl Axis {
+    /// 0, 1 or 2.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}
+
+/// A concentrated force on one particle (seed 003's perturbation forces Q_p, §10.5–10.6, and the
+/// diagonal pull of §10.5), raised with the load factor like gravity. 1 gf = 9.80665e-3 N.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoad {
+    /// The particle by grid indices [i, j]; or give `at_m`.
+    #[serde(default)]
+    pub particle: Option<[usize; 2]>,
+    /// The initial (x, y) in m of the loaded point (origin included); the nearest present particle
+    /// takes the force.
+    #[serde(default)]
+    pub at_m: Option<[f64; 2]>,
+    /// Direction of the force (normalised on use).
+    pub direction: [f64; 3],
+    /// Magnitude in N (0 is allowed: a sweep's unperturbed point).
+    pub magnitude_N: f64,
 }
 
 /// Gravity.
@@ -201,6 +261,9 @@ pub struct Scene {
     /// How contact with the obstacles is treated.
     #[serde(default)]
     pub contact: ContactSpec,
+    /// `[[loads]]`: concentrated forces on particles. Default none.
+    #[serde(default)]
+    pub loads: Vec<PointLoad>,
 }
 
 /// The outline of the sheet.
@@ -293,17 +356,47 @@ pub fn parse_override(s: &str) -> Result<(String, toml::Value), InputError> {
 /// Sets `key` (dotted path) in `table`, creating tables on the way.
 pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
     let parts: Vec<&str> = key.split('.').collect();
-    let mut t = table;
-    for part in &parts[..parts.len() - 1] {
-        let entry = t
-            .entry(part.to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        t = entry
-            .as_table_mut()
-            .ok_or_else(|| format!("`{part}` is not a table"))?;
+    let (last, path) = parts.split_last().ok_or("empty key")?;
+    let mut root = toml::Value::Table(std::mem::take(table));
+    let result = (|| {
+        let mut v = &mut root;
+        for part in path {
+            v = child(v, part)?;
+        }
+        match v {
+            toml::Value::Table(t) => {
+                t.insert(last.to_string(), value);
+                Ok(())
+            }
+            other => {
+                *child(other, last)? = value;
+                Ok(())
+            }
+        }
+    })();
+    if let toml::Value::Table(t) = root {
+        *table = t;
     }
-    t.insert(parts[parts.len() - 1].to_string(), value);
-    Ok(())
+    result
+}
+
+/// The entry `part` of a table (created as a table when missing) or the element of an array at the
+/// index `part` (`loads.0.magnitude_N`).
+fn child<'a>(v: &'a mut toml::Value, part: &str) -> Result<&'a mut toml::Value, String> {
+    match v {
+        toml::Value::Table(t) => Ok(t
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()))),
+        toml::Value::Array(a) => {
+            let n = a.len();
+            let i: usize = part
+                .parse()
+                .map_err(|_| format!("`{part}` is not an index of an array"))?;
+            a.get_mut(i)
+                .ok_or_else(|| format!("index {i} is beyond the array's {n} entries"))
+        }
+        _ => Err(format!("`{part}`: its parent is neither a table nor an array")),
+    }
 }
 
 /// Reads a TOML file into a table, with the file named in errors.
@@ -475,6 +568,49 @@ impl Scene {
                 "symmetry planes need [material.continuum] and solver.kind = \"static\"".into(),
             );
         }
+        if !self.boundary.holds.is_empty() && self.solver.kind != SolverKind::Static {
+            return err(
+                "boundary.holds",
+                "held coordinates need solver.kind = \"static\"".into(),
+            );
+        }
+        for (h, hold) in self.boundary.holds.iter().enumerate() {
+            if hold.components.is_empty() {
+                return err(
+                    &format!("boundary.holds[{h}].components"),
+                    "name at least one of \"x\", \"y\", \"z\"".into(),
+                );
+            }
+            if let Some(p) = hold.particles.iter().find(|p| p[0] >= c.nx || p[1] >= c.ny) {
+                return err(
+                    &format!("boundary.holds[{h}].particles"),
+                    format!("[{}, {}] lies outside the {}×{} grid", p[0], p[1], c.nx, c.ny),
+                );
+            }
+        }
+        for (k, l) in self.loads.iter().enumerate() {
+            let key = |f: &str| format!("loads[{k}].{f}");
+            match (l.particle, l.at_m) {
+                (Some(p), None) if p[0] >= c.nx || p[1] >= c.ny => {
+                    return err(
+                        &key("particle"),
+                        format!("[{}, {}] lies outside the {}×{} grid", p[0], p[1], c.nx, c.ny),
+                    );
+                }
+                (None, Some(a)) if a.iter().any(|v| !v.is_finite()) => {
+                    return err(&key("at_m"), "must be finite".into());
+                }
+                (Some(_), Some(_)) | (None, None) => {
+                    return err(&key("particle"), "give exactly one of `particle` or `at_m`".into());
+                }
+                _ => {}
+            }
+            nonneg(&key("magnitude_N"), l.magnitude_N)?;
+            let d = l.direction;
+            if d.iter().any(|v| !v.is_finite()) || d.iter().all(|v| *v == 0.0) {
+                return err(&key("direction"), "must be finite and not zero".into());
+            }
+        }
         if !self.boundary.clamp_edges.is_empty() && (c.nx < 3 || c.ny < 3) {
             return err(
                 "boundary.clamp_edges",
@@ -484,6 +620,7 @@ impl Scene {
         if self.boundary.pin_corners.is_empty()
             && self.boundary.pin_particles.is_empty()
             && self.boundary.clamp_edges.is_empty()
+            && self.boundary.holds.is_empty()
             && (!self.contact.fix_supported || self.obstacles.is_empty())
         {
             return err(

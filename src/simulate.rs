@@ -186,7 +186,8 @@ fn solve_with_friction(
 
 /// Solves the scene on the grid with every other line and writes the interpolated positions into
 /// the free particles of `x`. Only when both sides have an odd count ≥ 21, the coarse solve converges,
-/// and no absolute natural length ties the springs to the fine spacing.
+/// no absolute natural length ties the springs to the fine spacing, and no hold or point load names
+/// particles of the fine grid.
 fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(SolveReport, ())> {
     let (nx, ny) = (grid.nx, grid.ny);
     let natural = scene
@@ -197,6 +198,8 @@ fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(S
     if !scene.solver.static_.coarse_start
         || natural
         || !scene.obstacles.is_empty()
+        || !scene.boundary.holds.is_empty()
+        || !scene.loads.is_empty()
         || nx < 21
         || ny < 21
         || nx % 2 == 0

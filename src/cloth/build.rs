@@ -189,6 +189,8 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
     if g > 0.0 {
         terms.push(Box::new(Gravity::new(masses.clone(), g)));
     }
+    point_loads(scene, &grid, &absent, &x0, &mut terms);
+    holds(scene, &grid, &mut held);
     contact_terms(scene, &x0, &masses, &mut fixed, &mut terms);
     let model = Model {
         n_grid: grid.len(),
@@ -201,6 +203,59 @@ pub fn build_scene(scene: &Scene) -> BuiltScene {
         elongation_rate: elongation,
     };
     BuiltScene { grid, model, x0 }
+}
+
+/// The scene's `[[loads]]` as one term (only when it has some): a load given by position goes to the
+/// nearest present particle.
+fn point_loads(
+    scene: &Scene,
+    grid: &Grid,
+    absent: &[bool],
+    x0: &[Vector3<f64>],
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    if scene.loads.is_empty() {
+        return;
+    }
+    let loads = scene
+        .loads
+        .iter()
+        .map(|l| {
+            let p = match (l.particle, l.at_m) {
+                (Some([i, j]), _) => grid.index(i, j),
+                (None, Some([x, y])) => (0..grid.len())
+                    .filter(|&p| !absent[p])
+                    .min_by(|&a, &b| {
+                        let d = |p: usize| (x0[p].x - x).powi(2) + (x0[p].y - y).powi(2);
+                        d(a).total_cmp(&d(b))
+                    })
+                    .expect("a sheet has particles"),
+                (None, None) => unreachable!("validated scene"),
+            };
+            let d = Vector3::from(l.direction).normalize();
+            (p, d * l.magnitude_N)
+        })
+        .collect();
+    terms.push(Box::new(crate::physics::PointLoads::new(loads)));
+}
+
+/// The scene's `[[boundary.holds]]` into the per-particle held components.
+fn holds(scene: &Scene, grid: &Grid, held: &mut Vec<[bool; 3]>) {
+    if scene.boundary.holds.is_empty() {
+        return;
+    }
+    held.resize(grid.len(), [false; 3]);
+    for h in &scene.boundary.holds {
+        let mut ps: Vec<usize> = h.particles.iter().map(|&[i, j]| grid.index(i, j)).collect();
+        for e in &h.edges {
+            ps.extend(e.lines(grid).0);
+        }
+        for p in ps {
+            for c in &h.components {
+                held[p][c.index()] = true;
+            }
+        }
+    }
 }
 
 /// Contact with the scene's obstacles (only when it has some): with `contact.fix_supported`, the

@@ -6,6 +6,7 @@ mod bending;
 mod contact;
 mod friction;
 mod gravity;
+mod loads;
 mod shear;
 mod springs;
 
@@ -13,6 +14,7 @@ pub use bending::{CellTwist, LinearBending, MirrorBending, QuadraticStencil};
 pub use contact::{BarrierContact, max_penetration_m};
 pub use friction::{FrictionAnchor, LaggedFriction};
 pub use gravity::Gravity;
+pub use loads::PointLoads;
 pub use shear::CellShear;
 pub use springs::{SpringFamily, Springs};
 

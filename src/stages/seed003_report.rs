@@ -218,42 +218,115 @@ y = 0, the part on the table fixed, a uniform grid where the seed's is graded.\n
                 dist(x, y, z)
             );
         }
-        let mut vg = r.scene.clone();
-        vg.contact.method = ContactMethod::VerticalGap;
-        let mut fr = r.scene.clone();
-        fr.contact.friction_coefficient = 0.3;
-        for (label, sol) in [
-            ("drapelab, barrier (frictionless)", &r.coarse),
-            (
-                "drapelab, vertical gap (sticky)",
-                &solve_scene(&vg, &mut NoObserver),
-            ),
-            (
-                "drapelab, barrier with friction μ = 0.3 (lagged)",
-                &solve_scene(&fr, &mut NoObserver),
-            ),
-        ] {
+        let corner = |sol: &Solution| {
             let n = sol.grid.nx;
             let a = sol.at(n - 1, n - 1) * 100.0;
             let b = sol.at(0, 0) * 100.0;
+            ((a.x, a.y, -a.z), (-b.x, -b.y, -b.z))
+        };
+        let fe_distance = rows
+            .iter()
+            .find(|r| r.get("source").is_some_and(|s| s.starts_with("finite-element")))
+            .map(|r| dist(f(r, "x_cm"), f(r, "y_cm"), f(r, "z_cm")))
+            .unwrap_or(f64::NAN);
+        // The contact treatments, and the twist rigidity the KES data do not give (0, the seed's
+        // model, or an isotropic plate's √(D_warp D_weft)).
+        let twist = |s: &mut Scene| {
+            if let Some(c) = s.material.continuum.as_mut()
+                && let Ok(r) = c.rigidities()
+            {
+                c.bending_twist_N_m = Some((r.bending_warp_N_m * r.bending_weft_N_m).sqrt());
+            }
+        };
+        let variants: Vec<(&str, Scene)> = {
+            let base = r.scene.clone();
+            let mut vg = base.clone();
+            vg.contact.method = ContactMethod::VerticalGap;
+            let mut fr = base.clone();
+            fr.contact.friction_coefficient = 0.3;
+            let (mut vgt, mut frt) = (vg.clone(), fr.clone());
+            twist(&mut vgt);
+            twist(&mut frt);
+            vec![
+                ("vertical gap (sticky)", vg),
+                ("barrier with friction μ = 0.3 (lagged)", fr),
+                ("vertical gap (sticky), twist √(D_warp D_weft)", vgt),
+                ("barrier with friction μ = 0.3, twist √(D_warp D_weft)", frt),
+            ]
+        };
+        let solved_variants: Vec<(&str, Solution)> = variants
+            .par_iter()
+            .map(|(l, s)| (*l, solve_scene(s, &mut NoObserver)))
+            .collect();
+        let ours = std::iter::once(("barrier (frictionless)", &r.coarse))
+            .chain(solved_variants.iter().map(|(l, s)| (*l, s)));
+        let mut best = (f64::INFINITY, String::new());
+        for (label, sol) in ours {
+            let ((ax, ay, az), (bx, by, bz)) = corner(sol);
+            let d = dist(ax, ay, az);
+            if sol.report.is_converged() && d < best.0 {
+                best = (d, label.to_string());
+            }
             let _ = writeln!(
                 md,
-                "| {label} ({}) | {:.2} | {:.2} | {:.2} | {:.2} (corner B: ({:.2}, {:.2}, {:.2})) |",
+                "| drapelab, {label} ({}) | {ax:.2} | {ay:.2} | {az:.2} | {d:.2} (corner B: ({bx:.2}, {by:.2}, {bz:.2})) |",
                 sol.report.status.as_str(),
-                a.x,
-                a.y,
-                -a.z,
-                dist(a.x, a.y, -a.z),
-                -b.x,
-                -b.y,
-                -b.z
             );
         }
-        md += "\nCorner B is shown turned by 180° about the vertical (where it would be if the drape kept the \
-scene's symmetry). With frictionless contact the sheet rolls to one side of the rod (A and B differ): \
-the symmetric drape is not a minimum there; the sticky vertical-gap contact and the lagged friction keep \
-it symmetric but hug the rod. None lands closer to the experiment than the finite elements: the must-show of \
-issue 7 is not met.\n\n";
+        let _ = write!(
+            md,
+            "\nCorner B is shown turned by 180° about the vertical (where it would be if the drape kept the \
+scene's symmetry; frictionless contact lets the sheet roll to one side of the rod). The closest of drapelab's \
+treatments at the seed's 33 × 33 grid is {} at {:.2} cm from the experiment; the finite elements are at \
+{fe_distance:.2} cm: the issue's must-show (closer than the finite elements) is {}.\n\n",
+            best.1,
+            best.0,
+            if best.0 < fe_distance { "met" } else { "not met" }
+        );
+        // Grid convergence of corner A with friction (Table 10.1 style).
+        let sides = [17usize, 25, 33, 41, 49];
+        let mut fr = r.scene.clone();
+        fr.contact.friction_coefficient = 0.3;
+        let tol = fr.solver.static_.residual_tol_rel;
+        let study: Vec<(usize, Solution, f64)> = sides
+            .par_iter()
+            .map(|&n| {
+                let s = crate::benchmark::bench_scene(&fr, n, crate::scene::SolverKind::Static, tol);
+                let t = Instant::now();
+                let sol = solve_scene(&s, &mut NoObserver);
+                (n, sol, t.elapsed().as_secs_f64())
+            })
+            .collect();
+        md += "### Grid convergence of corner A (barrier with friction μ = 0.3)\n\n| grid | status | iterations | time s | x cm | y cm | drop cm | distance to the experiment cm |\n|---|---|---|---|---|---|---|---|\n";
+        for (n, sol, t) in &study {
+            let ((ax, ay, az), _) = corner(sol);
+            let _ = writeln!(
+                md,
+                "| {n}×{n} | {} | {} | {t:.2} | {ax:.2} | {ay:.2} | {az:.2} | {:.2} |",
+                sol.report.status.as_str(),
+                sol.report.iterations,
+                dist(ax, ay, az)
+            );
+        }
+        let off_axis = |sol: &Solution| {
+            let ((ax, ay, _), _) = corner(sol);
+            (ax + ay) / std::f64::consts::SQRT_2
+        };
+        if let (Some(first), Some(last)) = (study.first(), study.last()) {
+            let _ = write!(
+                md,
+                "\nCorner A's horizontal distance from the rod's axis goes from {:.2} cm at {}×{} to {:.2} cm at \
+{}×{} (the experiment: {:.2} cm, the rod's radius 2.5 cm). The fold runs along the cells' diagonals, which \
+a coarse grid's grid-aligned bending and shear resist more than the continuum does.\n\n",
+                off_axis(&first.1),
+                first.0,
+                first.0,
+                off_axis(&last.1),
+                last.0,
+                last.0,
+                (exp.0 + exp.1) / std::f64::consts::SQRT_2
+            );
+        }
     }
     // Load–displacement by incremental loading against the single step (§10.3.3).
     let mut load_svg = String::new();

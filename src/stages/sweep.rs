@@ -184,7 +184,7 @@ struct PointResult {
     linear_solves: u64,
     wall_time_s: f64,
     max_residual_N: f64,
-    /// centre z, min z, corners (x, y, z) × 4, drape coefficient, folds, projected area, penetration
+    /// centre z, min z, max z, corners (x, y, z) × 4, drape coefficient, folds, projected area, penetration
     /// (NaN where not defined); None unless converged.
     measures: Option<Vec<f64>>,
 }
@@ -198,7 +198,11 @@ const CORNERS: [(Corner, &str); 4] = [
 
 /// Names of the measure columns, in order.
 pub fn measure_columns() -> Vec<String> {
-    let mut v = vec!["centre_z_m".to_string(), "min_z_m".to_string()];
+    let mut v = vec![
+        "centre_z_m".to_string(),
+        "min_z_m".to_string(),
+        "max_z_m".to_string(),
+    ];
     for (_, n) in CORNERS {
         for c in ["x", "y", "z"] {
             v.push(format!("corner_{n}_{c}_m"));
@@ -254,12 +258,11 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
             let converged = sol.report.status == Status::Converged;
             let measures = converged.then(|| {
                 let g = &sol.grid;
+                let zs = sol.grid_positions().iter().map(|p| p.z);
                 let mut m = vec![
                     sol.at(g.nx / 2, g.ny / 2).z,
-                    sol.grid_positions()
-                        .iter()
-                        .map(|p| p.z)
-                        .fold(f64::INFINITY, f64::min),
+                    zs.clone().fold(f64::INFINITY, f64::min),
+                    zs.fold(f64::NEG_INFINITY, f64::max),
                 ];
                 for (c, _) in CORNERS {
                     let (ci, cj) = c.ij(g);
