@@ -80,23 +80,17 @@ fn peak_rss_bytes() -> Option<u64> {
 
 /// The scene at side `n` with solver `kind` stopping at force tolerance `tol` (dynamics within 5 s of
 /// simulated time): explicit integrators at 0.8 of their stability limit, implicit Euler at 10 ms
-/// steps; pinned particles scaled with the grid.
+/// steps; particles named by index moved with the grid ([`Scene::regridded`]).
 pub fn bench_scene(scene: &Scene, n: usize, kind: SolverKind, tol: f64) -> Scene {
-    let mut s = scene.clone();
-    let (nx0, ny0) = (s.cloth.nx, s.cloth.ny);
-    if s.cloth.ny == s.cloth.nx {
-        s.cloth.ny = n;
+    let (nx0, ny0) = (scene.cloth.nx, scene.cloth.ny);
+    // Keep the aspect: a strip keeps its particle count across.
+    let ny = if ny0 == nx0 {
+        n
     } else {
-        // Keep the aspect: a strip keeps its particle count across.
-        s.cloth.ny = nx0
-            .min(ny0)
-            .max(((n - 1) * (ny0 - 1)).div_ceil(nx0 - 1) + 1);
-    }
-    s.cloth.nx = n;
-    for p in &mut s.boundary.pin_particles {
-        p[0] = p[0] * (n - 1) / (nx0 - 1);
-        p[1] = p[1] * (s.cloth.ny - 1) / (ny0 - 1).max(1);
-    }
+        nx0.min(ny0)
+            .max(((n - 1) * (ny0 - 1)).div_ceil(nx0 - 1) + 1)
+    };
+    let mut s = scene.regridded(n, ny);
     s.solver.kind = kind;
     s.solver.static_.residual_tol_rel = tol;
     s.solver.dynamic.residual_tol_rel = tol;

@@ -434,6 +434,40 @@ pub fn from_table<T: serde::de::DeserializeOwned>(
 }
 
 impl Scene {
+    /// The scene on an `nx × ny` grid: every particle named by grid indices (pins, holds, point loads)
+    /// moves to the same material point, index i → round(i (nx − 1)/(nx₀ − 1)) (exact when the new
+    /// grid's lines fall on the old one's, as in 2n − 1 refinement).
+    pub fn regridded(&self, nx: usize, ny: usize) -> Scene {
+        let mut s = self.clone();
+        let (nx0, ny0) = (self.cloth.nx, self.cloth.ny);
+        let map = |p: [usize; 2]| {
+            let f = |i: usize, n0: usize, n: usize| {
+                if n0 > 1 {
+                    ((i * (n - 1)) as f64 / (n0 - 1) as f64).round() as usize
+                } else {
+                    i.min(n - 1)
+                }
+            };
+            [f(p[0], nx0, nx), f(p[1], ny0, ny)]
+        };
+        s.cloth.nx = nx;
+        s.cloth.ny = ny;
+        for p in &mut s.boundary.pin_particles {
+            *p = map(*p);
+        }
+        for h in &mut s.boundary.holds {
+            for p in &mut h.particles {
+                *p = map(*p);
+            }
+        }
+        for l in &mut s.loads {
+            if let Some(p) = &mut l.particle {
+                *p = map(*p);
+            }
+        }
+        s
+    }
+
     /// Reads, overrides and validates a scene file.
     pub fn load(
         path: &Path,
@@ -699,5 +733,26 @@ impl Scene {
             return err("record.every", "must be ≥ 1".into());
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn set_dotted_reaches_tables_and_array_elements() {
+        let mut t: toml::Table = "[cloth]\nnx = 3\n[[loads]]\nmagnitude_N = 1.0\n".parse().unwrap();
+        set_dotted(&mut t, "cloth.ny", toml::Value::Integer(5)).unwrap();
+        set_dotted(&mut t, "loads.0.magnitude_N", toml::Value::Float(2.0)).unwrap();
+        set_dotted(&mut t, "solver.static.max_iterations", toml::Value::Integer(9)).unwrap();
+        assert_eq!(t["cloth"]["ny"].as_integer(), Some(5));
+        assert_eq!(t["loads"][0]["magnitude_N"].as_float(), Some(2.0));
+        assert_eq!(t["solver"]["static"]["max_iterations"].as_integer(), Some(9));
+        let e = set_dotted(&mut t, "loads.3.magnitude_N", toml::Value::Float(1.0)).unwrap_err();
+        assert!(e.contains("beyond"), "{e}");
+        assert!(set_dotted(&mut t, "loads.x.magnitude_N", toml::Value::Float(1.0)).is_err());
+        // A failed set leaves the table as it was.
+        assert_eq!(t["cloth"]["nx"].as_integer(), Some(3));
     }
 }

@@ -215,15 +215,7 @@ fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(S
     {
         return None;
     }
-    let mut c = scene.clone();
-    c.cloth.nx = nx.div_ceil(2);
-    c.cloth.ny = ny.div_ceil(2);
-    c.boundary.pin_particles = scene
-        .boundary
-        .pin_particles
-        .iter()
-        .map(|p| [p[0] / 2, p[1] / 2])
-        .collect();
+    let c = scene.regridded(nx.div_ceil(2), ny.div_ceil(2));
     let coarse = solve_scene(&c, &mut crate::solve::NoObserver);
     if !coarse.report.is_converged() {
         return None;

@@ -42,13 +42,7 @@ fn default_steps() -> usize {
 
 /// The scene on a grid twice as fine (2n − 1 lines per side; pinned particles moved with it).
 fn refined(scene: &Scene) -> Scene {
-    let mut s = scene.clone();
-    s.cloth.nx = 2 * s.cloth.nx - 1;
-    s.cloth.ny = 2 * s.cloth.ny - 1;
-    for p in &mut s.boundary.pin_particles {
-        *p = [2 * p[0], 2 * p[1]];
-    }
-    s
+    scene.regridded(2 * scene.cloth.nx - 1, 2 * scene.cloth.ny - 1)
 }
 
 struct Solved {
