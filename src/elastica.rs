@@ -130,7 +130,10 @@ mod tests {
         let e = HeavyElastica::solve(d, q, l);
         let w = -e.tip().1;
         assert!((w - q * l.powi(4) / (8.0 * d)).abs() < 1e-3 * w, "{w}");
-        assert!((e.clamp_curvature_per_m - q * l * l / (2.0 * d)).abs() < 1e-3 * e.clamp_curvature_per_m);
+        assert!(
+            (e.clamp_curvature_per_m - q * l * l / (2.0 * d)).abs()
+                < 1e-3 * e.clamp_curvature_per_m
+        );
     }
 
     #[test]

@@ -395,7 +395,9 @@ fn child<'a>(v: &'a mut toml::Value, part: &str) -> Result<&'a mut toml::Value, 
             a.get_mut(i)
                 .ok_or_else(|| format!("index {i} is beyond the array's {n} entries"))
         }
-        _ => Err(format!("`{part}`: its parent is neither a table nor an array")),
+        _ => Err(format!(
+            "`{part}`: its parent is neither a table nor an array"
+        )),
     }
 }
 
@@ -618,7 +620,10 @@ impl Scene {
             if let Some(p) = hold.particles.iter().find(|p| p[0] >= c.nx || p[1] >= c.ny) {
                 return err(
                     &format!("boundary.holds[{h}].particles"),
-                    format!("[{}, {}] lies outside the {}×{} grid", p[0], p[1], c.nx, c.ny),
+                    format!(
+                        "[{}, {}] lies outside the {}×{} grid",
+                        p[0], p[1], c.nx, c.ny
+                    ),
                 );
             }
         }
@@ -628,14 +633,20 @@ impl Scene {
                 (Some(p), None) if p[0] >= c.nx || p[1] >= c.ny => {
                     return err(
                         &key("particle"),
-                        format!("[{}, {}] lies outside the {}×{} grid", p[0], p[1], c.nx, c.ny),
+                        format!(
+                            "[{}, {}] lies outside the {}×{} grid",
+                            p[0], p[1], c.nx, c.ny
+                        ),
                     );
                 }
                 (None, Some(a)) if a.iter().any(|v| !v.is_finite()) => {
                     return err(&key("at_m"), "must be finite".into());
                 }
                 (Some(_), Some(_)) | (None, None) => {
-                    return err(&key("particle"), "give exactly one of `particle` or `at_m`".into());
+                    return err(
+                        &key("particle"),
+                        "give exactly one of `particle` or `at_m`".into(),
+                    );
                 }
                 _ => {}
             }
@@ -742,13 +753,23 @@ mod tests {
 
     #[test]
     fn set_dotted_reaches_tables_and_array_elements() {
-        let mut t: toml::Table = "[cloth]\nnx = 3\n[[loads]]\nmagnitude_N = 1.0\n".parse().unwrap();
+        let mut t: toml::Table = "[cloth]\nnx = 3\n[[loads]]\nmagnitude_N = 1.0\n"
+            .parse()
+            .unwrap();
         set_dotted(&mut t, "cloth.ny", toml::Value::Integer(5)).unwrap();
         set_dotted(&mut t, "loads.0.magnitude_N", toml::Value::Float(2.0)).unwrap();
-        set_dotted(&mut t, "solver.static.max_iterations", toml::Value::Integer(9)).unwrap();
+        set_dotted(
+            &mut t,
+            "solver.static.max_iterations",
+            toml::Value::Integer(9),
+        )
+        .unwrap();
         assert_eq!(t["cloth"]["ny"].as_integer(), Some(5));
         assert_eq!(t["loads"][0]["magnitude_N"].as_float(), Some(2.0));
-        assert_eq!(t["solver"]["static"]["max_iterations"].as_integer(), Some(9));
+        assert_eq!(
+            t["solver"]["static"]["max_iterations"].as_integer(),
+            Some(9)
+        );
         let e = set_dotted(&mut t, "loads.3.magnitude_N", toml::Value::Float(1.0)).unwrap_err();
         assert!(e.contains("beyond"), "{e}");
         assert!(set_dotted(&mut t, "loads.x.magnitude_N", toml::Value::Float(1.0)).is_err());

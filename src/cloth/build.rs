@@ -3,7 +3,9 @@
 
 use super::{Grid, tributary_lengths};
 use crate::material::Rigidities;
-use crate::physics::{CellShear, CellTwist, EnergyTerm, Gravity, LinearBending, Model, SpringFamily, Springs};
+use crate::physics::{
+    CellShear, CellTwist, EnergyTerm, Gravity, LinearBending, Model, SpringFamily, Springs,
+};
 use crate::scene::Scene;
 use nalgebra::Vector3;
 
@@ -440,7 +442,11 @@ fn continuum_terms(
     // Twist of each cell (plate energy D_t κ_xy²).
     if r.bending_twist_N_m > 0.0 {
         let (cells, sides) = present_cells(grid, absent);
-        terms.push(Box::new(CellTwist::cells(cells, &sides, r.bending_twist_N_m)));
+        terms.push(Box::new(CellTwist::cells(
+            cells,
+            &sides,
+            r.bending_twist_N_m,
+        )));
     }
     // Bending along x lines (warp) and y lines (weft).
     let mut triples = Vec::new();

@@ -15,7 +15,7 @@ mod table;
 pub use from_image::{Calibration, FitImageOptions, ImageFit, fit_image, read_gray};
 pub use from_particles::{ReferenceLine, edges_from_particles};
 pub use poly::{Polynomial, fit_polynomial};
-pub use render::{Camera, RenderOptions, RenderedPhoto, render_drape};
+pub use render::{Camera, RenderOptions, RenderedPhoto, render_drape, render_view};
 pub use table::{read_edges, write_edges};
 
 use serde::{Deserialize, Serialize};

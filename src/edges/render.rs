@@ -107,64 +107,7 @@ pub fn render_drape(
     );
     let shift = |p: (f64, f64, f64)| (p.0 - umin + m, p.1 - vmin + m, p.2);
     let pts: Vec<(f64, f64, f64)> = pts.into_iter().map(shift).collect();
-    // Supersampled coverage and shade with a depth buffer.
-    const SS: usize = 4;
-    let (sw, sh) = (w as usize * SS, h as usize * SS);
-    let mut depth = vec![f64::INFINITY; sw * sh];
-    let mut shade = vec![BACKGROUND; sw * sh];
-    let light = Vector3::new(-0.3, -0.8, 0.5).normalize();
-    for tri in crate::io::grid_triangles(grid) {
-        let [a, b, c] = tri.map(|k| k as usize);
-        let n = (x[b] - x[a]).cross(&(x[c] - x[a]));
-        let lum = if n.norm() > 0.0 {
-            0.35 + 0.65 * n.normalize().dot(&light).abs()
-        } else {
-            1.0
-        };
-        let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
-        let area = (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0);
-        if area.abs() < 1e-12 {
-            continue;
-        }
-        let x0 = ((pa.0.min(pb.0).min(pc.0)) * SS as f64).floor().max(0.0) as usize;
-        let x1 = ((pa.0.max(pb.0).max(pc.0)) * SS as f64)
-            .ceil()
-            .min(sw as f64) as usize;
-        let y0 = ((pa.1.min(pb.1).min(pc.1)) * SS as f64).floor().max(0.0) as usize;
-        let y1 = ((pa.1.max(pb.1).max(pc.1)) * SS as f64)
-            .ceil()
-            .min(sh as f64) as usize;
-        for sy in y0..y1 {
-            for sx in x0..x1 {
-                let (px, py) = ((sx as f64 + 0.5) / SS as f64, (sy as f64 + 0.5) / SS as f64);
-                let w0 = ((pb.0 - px) * (pc.1 - py) - (pb.1 - py) * (pc.0 - px)) / area;
-                let w1 = ((pc.0 - px) * (pa.1 - py) - (pc.1 - py) * (pa.0 - px)) / area;
-                let w2 = 1.0 - w0 - w1;
-                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
-                    continue;
-                }
-                let d = w0 * pa.2 + w1 * pb.2 + w2 * pc.2;
-                let k = sy * sw + sx;
-                if d < depth[k] {
-                    depth[k] = d;
-                    shade[k] = ALBEDO * lum;
-                }
-            }
-        }
-    }
-    let mut img = RgbImage::new(w, h);
-    for v in 0..h as usize {
-        for u in 0..w as usize {
-            let mut acc = 0.0;
-            for dy in 0..SS {
-                for dx in 0..SS {
-                    acc += shade[(v * SS + dy) * sw + u * SS + dx];
-                }
-            }
-            let g = (acc / (SS * SS) as f64).round().clamp(0.0, 255.0) as u8;
-            img.put_pixel(u as u32, v as u32, Rgb([g, g, g]));
-        }
-    }
+    let mut img = rasterize(&pts, x, crate::io::grid_triangles(grid), w, h);
     let corner_px = |(i, j): (usize, usize)| {
         let p = pts[grid.index(i, j)];
         (p.0, p.1)
@@ -220,4 +163,124 @@ pub fn render_drape(
         corners_px,
         px_per_cm: opts.px_per_cm,
     }
+}
+
+/// Draws the triangles (indices into `x`) whose image positions `pts` are (u, v, depth) into a
+/// `w × h` grey image: Lambert shading of each triangle's normal, nearest triangle wins, 4×4
+/// supersampling.
+fn rasterize(
+    pts: &[(f64, f64, f64)],
+    x: &[Vector3<f64>],
+    triangles: impl IntoIterator<Item = [u32; 3]>,
+    w: u32,
+    h: u32,
+) -> RgbImage {
+    // Supersampled coverage and shade with a depth buffer.
+    const SS: usize = 4;
+    let (sw, sh) = (w as usize * SS, h as usize * SS);
+    let mut depth = vec![f64::INFINITY; sw * sh];
+    let mut shade = vec![BACKGROUND; sw * sh];
+    let light = Vector3::new(-0.3, -0.8, 0.5).normalize();
+    for tri in triangles {
+        let [a, b, c] = tri.map(|k| k as usize);
+        let n = (x[b] - x[a]).cross(&(x[c] - x[a]));
+        let lum = if n.norm() > 0.0 {
+            0.35 + 0.65 * n.normalize().dot(&light).abs()
+        } else {
+            1.0
+        };
+        let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
+        let area = (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0);
+        if area.abs() < 1e-12 {
+            continue;
+        }
+        let x0 = ((pa.0.min(pb.0).min(pc.0)) * SS as f64).floor().max(0.0) as usize;
+        let x1 = ((pa.0.max(pb.0).max(pc.0)) * SS as f64)
+            .ceil()
+            .min(sw as f64) as usize;
+        let y0 = ((pa.1.min(pb.1).min(pc.1)) * SS as f64).floor().max(0.0) as usize;
+        let y1 = ((pa.1.max(pb.1).max(pc.1)) * SS as f64)
+            .ceil()
+            .min(sh as f64) as usize;
+        for sy in y0..y1 {
+            for sx in x0..x1 {
+                let (px, py) = ((sx as f64 + 0.5) / SS as f64, (sy as f64 + 0.5) / SS as f64);
+                let w0 = ((pb.0 - px) * (pc.1 - py) - (pb.1 - py) * (pc.0 - px)) / area;
+                let w1 = ((pc.0 - px) * (pa.1 - py) - (pc.1 - py) * (pa.0 - px)) / area;
+                let w2 = 1.0 - w0 - w1;
+                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                    continue;
+                }
+                let d = w0 * pa.2 + w1 * pb.2 + w2 * pc.2;
+                let k = sy * sw + sx;
+                if d < depth[k] {
+                    depth[k] = d;
+                    shade[k] = ALBEDO * lum;
+                }
+            }
+        }
+    }
+    let mut img = RgbImage::new(w, h);
+    for v in 0..h as usize {
+        for u in 0..w as usize {
+            let mut acc = 0.0;
+            for dy in 0..SS {
+                for dx in 0..SS {
+                    acc += shade[(v * SS + dy) * sw + u * SS + dx];
+                }
+            }
+            let g = (acc / (SS * SS) as f64).round().clamp(0.0, 255.0) as u8;
+            img.put_pixel(u as u32, v as u32, Rgb([g, g, g]));
+        }
+    }
+    img
+}
+
+/// A shaded picture of a drape for reports: an orthographic camera `elevation_deg` above the horizon
+/// (90: from above, the vertical projection; 0: from the side along +y), turned `azimuth_deg` about the
+/// vertical, `px_per_cm` pixels per cm, a `margin_px` border; triangles with a particle that is not
+/// `present` (a disc's corners) are left out.
+pub fn render_view(
+    grid: &Grid,
+    x: &[Vector3<f64>],
+    present: &[bool],
+    azimuth_deg: f64,
+    elevation_deg: f64,
+    px_per_cm: f64,
+    margin_px: u32,
+) -> RgbImage {
+    let (sa, ca) = azimuth_deg.to_radians().sin_cos();
+    let (se, ce) = elevation_deg.to_radians().sin_cos();
+    // Camera frame: right r, forward (into the picture) d, up u.
+    let r = Vector3::new(ca, -sa, 0.0);
+    let d = Vector3::new(sa * ce, ca * ce, -se);
+    let u = Vector3::new(sa * se, ca * se, ce);
+    let s = px_per_cm * 100.0;
+    let keep = |k: usize| present.get(k).copied().unwrap_or(true);
+    let pts: Vec<(f64, f64, f64)> = x[..grid.len()]
+        .iter()
+        .map(|p| (p.dot(&r) * s, -p.dot(&u) * s, p.dot(&d)))
+        .collect();
+    let (umin, umax, vmin, vmax) = pts.iter().enumerate().filter(|(k, _)| keep(*k)).fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |a, (_, p)| (a.0.min(p.0), a.1.max(p.0), a.2.min(p.1), a.3.max(p.1)),
+    );
+    let m = margin_px as f64;
+    let (w, h) = (
+        (umax - umin + 2.0 * m).ceil().max(1.0) as u32,
+        (vmax - vmin + 2.0 * m).ceil().max(1.0) as u32,
+    );
+    let pts: Vec<(f64, f64, f64)> = pts
+        .into_iter()
+        .map(|p| (p.0 - umin + m, p.1 - vmin + m, p.2))
+        .collect();
+    let tris = crate::io::grid_triangles(grid)
+        .into_iter()
+        .filter(|t| t.iter().all(|&k| keep(k as usize)));
+    rasterize(&pts, x, tris, w, h)
 }

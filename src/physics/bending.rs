@@ -43,7 +43,12 @@ impl CellTwist {
             .iter()
             .map(|(hx, hy)| 2.0 * twist_N_m / (hx * hy))
             .collect();
-        Self::from_stencils("twist/continuum", cells, vec![[1.0, -1.0, -1.0, 1.0]; n], stiffness)
+        Self::from_stencils(
+            "twist/continuum",
+            cells,
+            vec![[1.0, -1.0, -1.0, 1.0]; n],
+            stiffness,
+        )
     }
 }
 
@@ -96,7 +101,11 @@ impl<const N: usize> EnergyTerm for QuadraticStencil<N> {
     fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _project: bool) {
         for k in 0..self.stencils.len() {
             let idx = self.stencils[k].map(|v| v as usize);
-            h.push_outer(&idx, &self.coef[k], &(Matrix3::identity() * self.stiffness[k]));
+            h.push_outer(
+                &idx,
+                &self.coef[k],
+                &(Matrix3::identity() * self.stiffness[k]),
+            );
         }
     }
 }

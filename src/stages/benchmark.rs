@@ -664,7 +664,9 @@ pub fn run_skips(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
     problem.caching = false;
     let mut t_threads = [0.0; 2];
     for (k, threads) in [2usize, 1].into_iter().enumerate() {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()?;
         t_threads[k] = timed(&mut || {
             pool.install(|| {
                 use rayon::prelude::*;

@@ -38,7 +38,11 @@ fn pin_reactions_balance_gravity_and_a_point_load() {
         -reaction
     );
     // The centre moved along the load's sideways direction (by about a micrometre: stiff springs).
-    assert!(sol.at(5, 5).x > 0.25 + 1e-7, "centre x = {}", sol.at(5, 5).x);
+    assert!(
+        sol.at(5, 5).x > 0.25 + 1e-7,
+        "centre x = {}",
+        sol.at(5, 5).x
+    );
 }
 
 #[test]
@@ -57,7 +61,10 @@ fn a_sheet_pulled_at_diagonal_corners_buckles_only_when_perturbed() {
     // The pulled corner moved out along the diagonal (plane stress).
     let pulled = flat.at(30, 0);
     assert!(pulled.x > 0.15 && pulled.y < 0.0, "{pulled:?}");
-    let s = scene("diagonal_tension_wool.toml", &["loads.1.magnitude_N=7.649e-7"]);
+    let s = scene(
+        "diagonal_tension_wool.toml",
+        &["loads.1.magnitude_N=7.649e-7"],
+    );
     let buckled = solve_scene(&s, &mut NoObserver);
     assert_eq!(buckled.report.status, Status::Converged);
     assert!(zmax(&buckled) > 2e-3, "buckles: {} m", zmax(&buckled));
@@ -140,15 +147,51 @@ fn bad_loads_and_holds_exit_2_naming_the_key() {
     let base =
         std::fs::read_to_string(root().join("datasets/scenes/diagonal_tension_wool.toml")).unwrap();
     for (from, to, key) in [
-        ("particle = [30, 0]", "particle = [31, 0]", "loads[0].particle"),
-        ("magnitude_N = 0.4903325", "magnitude_N = -1.0", "loads[0].magnitude_N"),
-        ("direction = [1.0, -1.0, 0.0]", "direction = [0.0, 0.0, 0.0]", "loads[0].direction"),
-        ("particle = [30, 0]", "particle = [30, 0]\nat_m = [0.1, 0.1]", "loads[0].particle"),
-        ("components = [\"z\"]", "components = []", "boundary.holds[0].components"),
-        ("components = [\"z\"]", "components = [\"w\"]", "boundary.holds"),
-        ("particles = [[0, 30], [30, 30]]", "particles = [[0, 31]]", "boundary.holds[1].particles"),
-        ("kind = \"static\"", "kind = \"implicit-euler\"", "boundary.holds"),
-        ("magnitude_N = 0.4903325", "magnitude_N = nan", "loads[0].magnitude_N"),
+        (
+            "particle = [30, 0]",
+            "particle = [31, 0]",
+            "loads[0].particle",
+        ),
+        (
+            "magnitude_N = 0.4903325",
+            "magnitude_N = -1.0",
+            "loads[0].magnitude_N",
+        ),
+        (
+            "direction = [1.0, -1.0, 0.0]",
+            "direction = [0.0, 0.0, 0.0]",
+            "loads[0].direction",
+        ),
+        (
+            "particle = [30, 0]",
+            "particle = [30, 0]\nat_m = [0.1, 0.1]",
+            "loads[0].particle",
+        ),
+        (
+            "components = [\"z\"]",
+            "components = []",
+            "boundary.holds[0].components",
+        ),
+        (
+            "components = [\"z\"]",
+            "components = [\"w\"]",
+            "boundary.holds",
+        ),
+        (
+            "particles = [[0, 30], [30, 30]]",
+            "particles = [[0, 31]]",
+            "boundary.holds[1].particles",
+        ),
+        (
+            "kind = \"static\"",
+            "kind = \"implicit-euler\"",
+            "boundary.holds",
+        ),
+        (
+            "magnitude_N = 0.4903325",
+            "magnitude_N = nan",
+            "loads[0].magnitude_N",
+        ),
     ] {
         assert!(base.contains(from), "{from}");
         let tmp = tempfile::tempdir().unwrap();
