@@ -543,14 +543,15 @@ fn drapes_png(solved: &[Solved]) -> image::RgbImage {
             .iter()
             .map(|m| *m > 0.0)
             .collect();
-        let extent_cm = x
-            .iter()
-            .zip(&present)
-            .filter(|(_, p)| **p)
-            .map(|(q, _)| q.norm())
-            .fold(0.0f64, f64::max)
-            * 2.0
-            * 100.0;
+        // The diagonal of the drape's bounding box bounds its picture from any direction.
+        let (lo, hi) = x.iter().zip(&present).filter(|(_, p)| **p).fold(
+            (
+                nalgebra::Vector3::repeat(f64::INFINITY),
+                nalgebra::Vector3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), (q, _)| (lo.inf(q), hi.sup(q)),
+        );
+        let extent_cm = (hi - lo).norm() * 100.0;
         let px_per_cm = (TILE_PX as f64 - 20.0) / extent_cm.max(1e-3);
         let view = |el: f64| {
             crate::edges::render_view(
