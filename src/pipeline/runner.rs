@@ -1,7 +1,7 @@
 //! Running a plan make-style: a stage runs when it is stale (or forced), otherwise it is skipped
 //! in milliseconds. Outputs are written atomically by the stages; the manifest is written last.
 
-use super::manifest::{Manifest, hash_file, stage_key};
+use super::manifest::{Manifest, build_id, hash_file, stage_key};
 use super::plan::{Plan, PlannedStage};
 use super::progress::Progress;
 use crate::error::InputError;
@@ -142,6 +142,17 @@ fn check(plan: &Plan, s: &PlannedStage, upstream_stale: &BTreeSet<String>) -> St
     }
     if m.key != stage_key(s.kind.name(), &params, &m.inputs) {
         return StageState::Stale("manifest key mismatch".into());
+    }
+    if m.build != build_id() {
+        return StageState::Stale(format!(
+            "drapelab was rebuilt (build {} → {})",
+            if m.build.is_empty() {
+                "unknown"
+            } else {
+                &m.build
+            },
+            build_id()
+        ));
     }
     StageState::UpToDate
 }
@@ -290,6 +301,7 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
             wall_time_s: wall,
             command_line: std::env::args().collect(),
             drapelab_version: crate::VERSION.into(),
+            build: build_id().into(),
         };
         manifest.write(&manifest_path(plan, &s.name))?;
         progress.stage_finished(&s.name, &status, wall);

@@ -322,3 +322,30 @@ fn lagged_friction_keeps_the_rod_drape_symmetric_and_outside_the_rod() {
     assert!(a.z < -0.08, "the corners hang: {a:?}");
     assert!(max_penetration_m(&s.obstacles, sol.grid_positions()) < 1e-6);
 }
+
+#[test]
+fn the_rendered_view_from_above_covers_the_measured_vertical_projection() {
+    // Two independent computations of the table drape's vertical projection: the drape-coefficient
+    // raster (src/measure.rs) and the shaded rendering seen from straight above (src/edges/render.rs).
+    let s = scene("table_wool.toml", &[]);
+    let sol = solve_scene(&s, &mut NoObserver);
+    assert!(sol.report.is_converged());
+    let d = drapelab::measure::drape_measures(&s, &sol.grid, &sol.x);
+    let present = vec![true; sol.grid.len()];
+    let px_per_cm = 20.0;
+    let img = drapelab::edges::render_view(&sol.grid, &sol.x, &present, 0.0, 90.0, px_per_cm, 5);
+    // Background 232, fabric at most 150 grey: a pixel counts when more than half covered.
+    let background = img.get_pixel(0, 0).0[0] as f64;
+    assert!(background > 200.0);
+    let covered = img
+        .pixels()
+        .filter(|p| (p.0[0] as f64) < (background + 150.0) / 2.0)
+        .count() as f64;
+    let area_m2 = covered / (px_per_cm * 100.0).powi(2);
+    let rel = (area_m2 - d.projected_area_m2).abs() / d.projected_area_m2;
+    assert!(
+        rel < 0.03,
+        "rendered {area_m2} m² against measured {} m²",
+        d.projected_area_m2
+    );
+}

@@ -128,3 +128,34 @@ print(t.group_by("solver.kind", "status").len().sort("solver.kind"))
     let out = crate::support::run_python(code, &[&tmp.path().join("runs/s/sweep/sweep.parquet")]);
     eprintln!("{out}");
 }
+
+#[test]
+fn a_dynamic_solve_past_its_wall_time_budget_ends_as_max_iterations() {
+    // hang2's sway takes explicit Euler minutes to settle; a 0.2 s budget stops it with its status.
+    let s = scene(
+        "hang2.toml",
+        &[
+            "cloth.nx=11",
+            "cloth.ny=11",
+            "solver.kind=\"explicit-euler\"",
+            "solver.dynamic.auto_dt_fraction=0.8",
+            "solver.dynamic.max_time_s=1000.0",
+            "solver.dynamic.max_wall_time_s=0.2",
+        ],
+    );
+    let t = std::time::Instant::now();
+    let sol = solve_scene(&s, &mut NoObserver);
+    assert_eq!(
+        sol.report.status,
+        Status::MaxIterations,
+        "{}",
+        sol.report.message
+    );
+    assert!(
+        sol.report.message.contains("wall-time budget"),
+        "{}",
+        sol.report.message
+    );
+    // It stopped near its budget, not after the 1000 s of simulated time.
+    assert!(t.elapsed().as_secs_f64() < 20.0);
+}
