@@ -267,6 +267,7 @@ pub fn solve_dynamic(
         wall_time_s: 0.0,
         divergence: None,
         message: String::new(),
+        minimum: None,
     };
     if !free.iter().any(|&f| f) || !w_ref.is_finite() || dt.is_nan() || dt <= 0.0 {
         report.status = Status::Invalid;

@@ -134,6 +134,7 @@ pub fn solve_static_loads(
         wall_time_s: 0.0,
         divergence: None,
         message: String::new(),
+        minimum: None,
     };
     if dofs.n == 0 || !w_ref.is_finite() {
         report.status = Status::Invalid;
@@ -330,6 +331,15 @@ pub fn solve_static_loads(
     report.energy_J = model.energy(x, final_load);
     report.wall_time_s = start.elapsed().as_secs_f64();
     if report.status == Status::Converged {
+        // Stability: a Cholesky factorization of the exact Hessian (held components decoupled, a
+        // shift of 1e-10 of the mean diagonal for neutral directions) exists only at a minimum.
+        model.hessian(x, &mut h, false);
+        let scale = mean_free_diagonal(&h, &dofs, model.len());
+        shift.iter_mut().for_each(|s| *s = 1e-10 * scale);
+        for &(d, c) in &held {
+            shift[d + c] += 1e12 * scale.max(1e-300);
+        }
+        report.minimum = Some(spd.factorize(&dofs, &h, &shift));
         report.message = if floor {
             format!(
                 "converged in {iter} iterations to the round-off floor of forces ({:.2e} N)",
@@ -338,6 +348,10 @@ pub fn solve_static_loads(
         } else {
             format!("converged in {iter} iterations")
         };
+        if report.minimum == Some(false) {
+            report.message += "; not a minimum: an unstable equilibrium (a saddle), which a small \
+perturbation (cloth.initial_perturbation_m, [[loads]]) moves off";
+        }
     }
     report
 }

@@ -184,6 +184,8 @@ struct PointResult {
     linear_solves: u64,
     wall_time_s: f64,
     max_residual_N: f64,
+    /// Whether a converged static equilibrium is a minimum (None: not checked).
+    minimum: Option<bool>,
     /// centre z, min z, max z, corners (x, y, z) × 4, drape coefficient, folds, projected area, penetration
     /// (NaN where not defined); None unless converged.
     measures: Option<Vec<f64>>,
@@ -289,6 +291,7 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
                 linear_solves: sol.report.linear_solves as u64,
                 wall_time_s: sol.report.wall_time_s,
                 max_residual_N: sol.report.max_residual_N,
+                minimum: sol.report.minimum,
                 measures,
             };
             (k, row)
@@ -344,6 +347,7 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
         Field::new("linear_solves", DataType::UInt64, false),
         Field::new("wall_time_s", DataType::Float64, false),
         Field::new("max_residual_N", DataType::Float64, true),
+        Field::new("minimum", DataType::Boolean, true),
     ]);
     cols.push(Arc::new(UInt32Array::from_iter_values(
         results.iter().map(|r| r.particles),
@@ -366,6 +370,9 @@ pub fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     cols.push(Arc::new(Float64Array::from_iter(results.iter().map(|r| {
         r.max_residual_N.is_finite().then_some(r.max_residual_N)
     }))));
+    cols.push(Arc::new(arrow::array::BooleanArray::from(
+        results.iter().map(|r| r.minimum).collect::<Vec<_>>(),
+    )));
     for (m, name) in measure_columns().into_iter().enumerate() {
         fields.push(Field::new(name, DataType::Float64, true));
         cols.push(Arc::new(Float64Array::from_iter(results.iter().map(|r| {

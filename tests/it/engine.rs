@@ -280,3 +280,45 @@ fn incremental_loading_reaches_the_same_equilibrium_as_one_step() {
         "five load steps cannot be cheaper than half of one"
     );
 }
+
+#[test]
+fn a_strip_compressed_past_eulers_load_is_reported_as_unstable() {
+    // Euler buckling of a clamped–free strip: the straight state under an axial end load P is a
+    // minimum for P < P_cr = π² D b / (4 L²) and a saddle above it. Gravity off; the load is spread
+    // over the three particles of the free end by their tributary widths (¼, ½, ¼).
+    let base = scene("cantilever_wool_warp.toml", &["gravity.g_m_per_s2=0.0"]);
+    let r = base
+        .material
+        .continuum
+        .as_ref()
+        .unwrap()
+        .rigidities()
+        .unwrap();
+    let (l, b) = (base.cloth.size_x_m, base.cloth.size_y_m);
+    let p_cr = std::f64::consts::PI.powi(2) * r.bending_warp_N_m * b / (4.0 * l * l);
+    let straight = |factor: f64| {
+        let p = factor * p_cr;
+        let loads = format!(
+            "loads=[{{ particle = [40, 0], direction = [-1.0, 0.0, 0.0], magnitude_N = {} }}, \
+             {{ particle = [40, 1], direction = [-1.0, 0.0, 0.0], magnitude_N = {} }}, \
+             {{ particle = [40, 2], direction = [-1.0, 0.0, 0.0], magnitude_N = {} }}]",
+            p / 4.0,
+            p / 2.0,
+            p / 4.0
+        );
+        let s = scene(
+            "cantilever_wool_warp.toml",
+            &["gravity.g_m_per_s2=0.0", &loads],
+        );
+        let sol = solve(&s);
+        let lift = sol
+            .grid_positions()
+            .iter()
+            .map(|q| q.z.abs())
+            .fold(0.0, f64::max);
+        assert!(lift < 1e-12, "the straight strip left its line by {lift} m");
+        sol.report.minimum
+    };
+    assert_eq!(straight(0.9), Some(true), "below Euler's load");
+    assert_eq!(straight(1.1), Some(false), "above Euler's load");
+}

@@ -58,6 +58,8 @@ fn a_sheet_pulled_at_diagonal_corners_buckles_only_when_perturbed() {
             .fold(0.0, f64::max)
     };
     assert_eq!(zmax(&flat), 0.0, "the unperturbed sheet stays plane");
+    // ... and that plane-stress state is a saddle: the solver says it is not a minimum.
+    assert_eq!(flat.report.minimum, Some(false), "{}", flat.report.message);
     // The pulled corner moved out along the diagonal (plane stress).
     let pulled = flat.at(30, 0);
     assert!(pulled.x > 0.15 && pulled.y < 0.0, "{pulled:?}");
@@ -68,6 +70,12 @@ fn a_sheet_pulled_at_diagonal_corners_buckles_only_when_perturbed() {
     let buckled = solve_scene(&s, &mut NoObserver);
     assert_eq!(buckled.report.status, Status::Converged);
     assert!(zmax(&buckled) > 2e-3, "buckles: {} m", zmax(&buckled));
+    assert_eq!(
+        buckled.report.minimum,
+        Some(true),
+        "{}",
+        buckled.report.message
+    );
     // Held coordinates stay: every edge particle keeps z = 0, the restrained corners their x and y.
     let g = &buckled.grid;
     for j in 0..g.ny {
