@@ -349,3 +349,41 @@ fn the_rendered_view_from_above_covers_the_measured_vertical_projection() {
         d.projected_area_m2
     );
 }
+
+#[test]
+fn implicit_euler_with_contact_settles_on_the_static_drape_without_entering_the_pedestal() {
+    // Dynamics with the barrier: each step is cut where a particle would enter the obstacle (CCD),
+    // so implicit Euler falls onto the pedestal and settles where Newton's static solve lands.
+    let sets = ["cloth.nx=11", "cloth.ny=11"];
+    let stat = solve_scene(&scene("pedestal_wool.toml", &sets), &mut NoObserver);
+    assert!(stat.report.is_converged());
+    let dynamic = scene(
+        "pedestal_wool.toml",
+        &[
+            sets[0],
+            sets[1],
+            "solver.kind=\"implicit-euler\"",
+            "solver.dynamic.dt_s=0.01",
+            "solver.dynamic.residual_tol_rel=1e-4",
+            "solver.dynamic.speed_tol_m_per_s=1e-5",
+        ],
+    );
+    let dyn_sol = solve_scene(&dynamic, &mut NoObserver);
+    assert!(dyn_sol.report.is_converged(), "{}", dyn_sol.report.message);
+    assert!(
+        dyn_sol.report.message.contains("cut short by contact"),
+        "{}",
+        dyn_sol.report.message
+    );
+    assert_eq!(
+        max_penetration_m(&dynamic.obstacles, dyn_sol.grid_positions()),
+        0.0
+    );
+    let gap = dyn_sol
+        .grid_positions()
+        .iter()
+        .zip(stat.grid_positions())
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(gap < 1e-4, "implicit Euler and static differ by {gap} m");
+}
