@@ -1,8 +1,9 @@
 //! Seed 003's contact determination (§10.7.1) around the static Newton solver. The load (gravity) is
 //! raised in small increments so that no node can pass an obstacle within one; after each increment,
 //! every free node that went below an obstacle's upper surface is pulled back vertically onto it and
-//! held there, and a held node on which the net force points up (the obstacle no longer pushes) is let
-//! go; the increment is solved again until the set of held nodes settles (releases stop after a few
+//! held there (a node that entered from the side, which the vertical pull would lift over the
+//! obstacle, goes back out along the surface normal instead), and a held node on which the net force
+//! points up (the obstacle no longer pushes) is let go; the increment is solved again until the set of held nodes settles (releases stop after a few
 //! rounds, so it cannot cycle). A held node is fixed in all directions, as the seed fixes the nodes in
 //! contact with a table: the contact is sticky (a node that touched stays where it touched until it is
 //! let go), which suits tables, pedestals and rods; on a sphere the sheet stays where it first touched.
@@ -19,6 +20,9 @@ const MAX_ROUNDS: usize = 100;
 const RELEASE_ROUNDS: usize = 5;
 /// Load increments when the scene asks for a single step.
 const DEFAULT_INCREMENTS: usize = 20;
+/// A node is pulled back vertically only while that lifts it by at most this many times its depth
+/// inside the obstacle; deeper side entries go back out along the surface normal.
+const MAX_LIFT_OVER_DEPTH: f64 = 3.0;
 
 /// The highest upper surface of the obstacles under (x, y), if any.
 fn surface_below(obstacles: &[Obstacle], p: &Vector3<f64>) -> Option<f64> {
@@ -75,13 +79,25 @@ pub fn solve_vertical_gap(
                 if pinned[p] || held[p] {
                     continue;
                 }
-                let inside = obstacles.iter().any(|o| o.signed_distance(&x[p]).0 < 0.0);
-                if inside && let Some(z) = surface_below(obstacles, &x[p]) {
-                    x[p].z = z;
-                    held[p] = true;
-                    model.fixed[p] = true;
-                    changed = true;
+                let deepest = obstacles
+                    .iter()
+                    .map(|o| o.signed_distance(&x[p]))
+                    .filter(|(d, _)| *d < 0.0)
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                let Some((depth, normal)) = deepest else {
+                    continue;
+                };
+                match surface_below(obstacles, &x[p]) {
+                    // The seed's pull-back: vertically onto the upper surface, for a node that came
+                    // from above (the lift is not much more than its depth).
+                    Some(z) if z - x[p].z <= MAX_LIFT_OVER_DEPTH * -depth => x[p].z = z,
+                    // A node that entered from the side or from below would be lifted over the
+                    // obstacle (the sheet would fold over it): put it back out along the normal.
+                    _ => x[p] -= normal * depth,
                 }
+                held[p] = true;
+                model.fixed[p] = true;
+                changed = true;
             }
             // Let go of the held nodes that the obstacle no longer supports.
             if round < RELEASE_ROUNDS {

@@ -143,27 +143,35 @@ fn the_drape_coefficient_is_100_for_a_flat_sheet_and_0_for_one_hanging_straight_
 #[test]
 fn the_rod_drape_hangs_corner_a_near_the_experiment_of_table_10_4() {
     // Table 10.4: corner A from (10, 10, 0) cm to (3.27, 3.27, 12.25) cm in the experiment; the
-    // finite-element prediction (2.70, 2.70, 12.56) is 0.87 cm from it, seed 003's own 0.56 cm.
-    // drapelab (vertical-gap contact) lands within 1.5 cm: the must-show "closer than the finite
-    // elements" is NOT met yet (README, Status), this guards what is.
-    let s = scene("rod_polyester.toml", &["contact.method=\"vertical-gap\""]);
-    let sol = solve_scene(&s, &mut NoObserver);
-    assert!(sol.report.is_converged(), "{}", sol.report.message);
-    let n = s.cloth.nx;
-    let a = sol.at(n - 1, n - 1) * 100.0;
-    let b = sol.at(0, 0) * 100.0;
+    // finite-element prediction (2.70, 2.70, 12.56) is 0.86 cm from it, seed 003's own 0.58 cm.
+    // Two contact treatments, seed 003's sticky vertical gap and the barrier with lagged Coulomb
+    // friction, must agree on where the corner hangs; both land within 2 cm of the experiment (the
+    // must-show "closer than the finite elements" is NOT met: README, Status, and reports/seed003.md).
+    let corner = |method: &[&str]| {
+        let s = scene("rod_polyester.toml", method);
+        let sol = solve_scene(&s, &mut NoObserver);
+        assert!(sol.report.is_converged(), "{}", sol.report.message);
+        assert!(max_penetration_m(&s.obstacles, sol.grid_positions()) < 1e-6);
+        let n = s.cloth.nx;
+        (sol.at(n - 1, n - 1) * 100.0, sol.at(0, 0) * 100.0)
+    };
+    let (friction, _) = corner(&["contact.friction_coefficient=0.3"]);
+    let (a, b) = corner(&["contact.method=\"vertical-gap\""]);
     let dist = ((a.x - 3.27).powi(2) + (a.y - 3.27).powi(2) + (-a.z - 12.25).powi(2)).sqrt();
     eprintln!(
-        "corner A at ({:.2}, {:.2}, {:.2}) cm, {dist:.2} cm from the experiment",
-        a.x, a.y, -a.z
+        "corner A at ({:.2}, {:.2}, {:.2}) cm, {dist:.2} cm from the experiment; with friction ({:.2}, {:.2}, {:.2}) cm",
+        a.x, a.y, -a.z, friction.x, friction.y, -friction.z
     );
-    assert!(dist < 1.5, "{dist} cm");
+    assert!(
+        (a - friction).norm() < 0.3,
+        "the treatments disagree: {a:?} {friction:?} cm"
+    );
+    assert!(dist < 2.0, "{dist} cm");
     // The drape keeps the scene's 180° symmetry about the vertical: B mirrors A.
     assert!(
         (a + b).xy().norm() < 0.01 && (a.z - b.z).abs() < 0.01,
         "{a:?} {b:?}"
     );
-    assert!(max_penetration_m(&s.obstacles, sol.grid_positions()) < 1e-6);
 }
 
 #[test]
