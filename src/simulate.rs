@@ -78,6 +78,15 @@ fn solve_model(
                     grid.ny.div_ceil(2)
                 );
             }
+            // Stability of the final state (once, after every load increment and contact round).
+            if report.is_converged() {
+                let minimum = crate::solve::is_minimum(model, x);
+                report.minimum = Some(minimum);
+                if !minimum {
+                    report.message += "; not a minimum: an unstable equilibrium (a saddle), which a \
+small perturbation (cloth.initial_perturbation_m, [[loads]]) moves off";
+                }
+            }
             report
         }
         Some(integ) => {

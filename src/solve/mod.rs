@@ -13,7 +13,7 @@ pub use dynamic::{
     DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
 };
 pub use linear::{DofMap, SparseSpd};
-pub use newton::{StaticOptions, solve_static, solve_static_loads};
+pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{Divergence, SolveReport, Status};
 pub use vertical_gap::solve_vertical_gap;
 

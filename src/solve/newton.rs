@@ -141,15 +141,7 @@ pub fn solve_static_loads(
         report.message = "no free particle with mass: nothing to solve".into();
         return report;
     }
-    // (first DOF, component) of every held component.
-    let held: Vec<(usize, usize)> = (0..model.len())
-        .filter_map(|p| dofs.dof(p).map(|d| (p, d)))
-        .flat_map(|(p, d)| {
-            (0..3)
-                .filter(move |&c| model.is_held(p, c))
-                .map(move |c| (d, c))
-        })
-        .collect();
+    let held = held_dofs(model, &dofs);
     let mut spd = SparseSpd::new();
     let mut g = Vec::new();
     let mut h = HessianBlocks::default();
@@ -331,15 +323,6 @@ pub fn solve_static_loads(
     report.energy_J = model.energy(x, final_load);
     report.wall_time_s = start.elapsed().as_secs_f64();
     if report.status == Status::Converged {
-        // Stability: a Cholesky factorization of the exact Hessian (held components decoupled, a
-        // shift of 1e-10 of the mean diagonal for neutral directions) exists only at a minimum.
-        model.hessian(x, &mut h, false);
-        let scale = mean_free_diagonal(&h, &dofs, model.len());
-        shift.iter_mut().for_each(|s| *s = 1e-10 * scale);
-        for &(d, c) in &held {
-            shift[d + c] += 1e12 * scale.max(1e-300);
-        }
-        report.minimum = Some(spd.factorize(&dofs, &h, &shift));
         report.message = if floor {
             format!(
                 "converged in {iter} iterations to the round-off floor of forces ({:.2e} N)",
@@ -348,10 +331,37 @@ pub fn solve_static_loads(
         } else {
             format!("converged in {iter} iterations")
         };
-        if report.minimum == Some(false) {
-            report.message += "; not a minimum: an unstable equilibrium (a saddle), which a small \
-perturbation (cloth.initial_perturbation_m, [[loads]]) moves off";
-        }
     }
     report
+}
+
+/// (first DOF, component) of every held component of the free particles.
+fn held_dofs(model: &Model, dofs: &DofMap) -> Vec<(usize, usize)> {
+    (0..model.len())
+        .filter_map(|p| dofs.dof(p).map(|d| (p, d)))
+        .flat_map(|(p, d)| {
+            (0..3)
+                .filter(move |&c| model.is_held(p, c))
+                .map(move |c| (d, c))
+        })
+        .collect()
+}
+
+/// Whether the equilibrium `x` is a minimum of the model's energy: the exact Hessian over the free
+/// coordinates (held components decoupled), shifted by 1e-10 of its mean diagonal for neutral
+/// directions, has a Cholesky factorization. False at a saddle or a maximum (an unstable
+/// equilibrium, e.g. a flat sheet under compression).
+pub fn is_minimum(model: &Model, x: &[Vector3<f64>]) -> bool {
+    let dofs = DofMap::new(&model.fixed);
+    if dofs.n == 0 {
+        return true;
+    }
+    let mut h = HessianBlocks::default();
+    model.hessian(x, &mut h, false);
+    let scale = mean_free_diagonal(&h, &dofs, model.len());
+    let mut shift = vec![1e-10 * scale; dofs.n];
+    for (d, c) in held_dofs(model, &dofs) {
+        shift[d + c] += 1e12 * scale.max(1e-300);
+    }
+    SparseSpd::new().factorize(&dofs, &h, &shift)
 }

@@ -68,10 +68,8 @@ pub struct SolveReport {
     pub divergence: Option<Divergence>,
     /// A human-readable note (why it stopped).
     pub message: String,
-    /// For a converged static solve: whether the equilibrium is a minimum of the energy (the exact
-    /// Hessian over the free coordinates, plus 1e-10 of its mean diagonal, has a Cholesky
-    /// factorization) or not (a saddle or a maximum: an unstable equilibrium, e.g. a flat sheet
-    /// under compression). None when not checked (dynamics, no convergence).
+    /// For a converged static solve of a scene: whether the equilibrium is a minimum of the energy
+    /// ([`super::is_minimum`]). None when not checked (dynamics, no convergence).
     pub minimum: Option<bool>,
 }
 

@@ -344,15 +344,10 @@ pub fn run_report(ctx: &StageContext<'_>, p: &BenchmarkReportParams) -> Result<(
     let mut panels = Panels::new();
     let mut all: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
     let mut md = format!(
-        "# {}\n\nMade by `drapelab run {}` (drapelab {}) from the measured tables: every number and \
+        "# {}\n\n{} from the measured tables: every number and \
 point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
         p.title,
-        ctx.plan
-            .file
-            .strip_prefix(&ctx.plan.root)
-            .unwrap_or(&ctx.plan.file)
-            .display(),
-        crate::VERSION
+        ctx.made_by()
     );
     for r in 0..bench.height() {
         let (Some(s), Some(sv), Some(t), Some(e)) =

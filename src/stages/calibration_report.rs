@@ -229,14 +229,9 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
             .unwrap_or_default()
     };
     let text = format!(
-        "# {}\n\nMade by `drapelab run {}` (drapelab {}). The photos are synthetic (datasets/knitted/README.md): the\ntruth of each sample is seed 000 Table 4, shown in brackets.\n\n## Calibrated parameters, 4-corner hang (Table 4)\n\n{t4}\nBest of the ICA runs, polished by Nelder–Mead over stiffness and natural length (the curve distance of\nICA alone in brackets). ± 2σ: the interval the photos allow, from the curvature of the cost and its\nresidual (nonlinear least squares); a parameter is identifiable when that interval is within 5 % of its\nvalue. Eq. 5 compares the quartics' coefficients in coordinates centred on the edge.\n\n## Validation on the 2-corner hang (Table 6)\n\n{t6}\n## Convergence (Fig. 13)\n\n![best cost per decade]({})\n\n## Taguchi main effects (Fig. 10)\n\n![main effects]({})\n\n## ICA against CMA-ES at the same budget\n\n{}",
+        "# {}\n\n{}. The photos are synthetic (datasets/knitted/README.md): the\ntruth of each sample is seed 000 Table 4, shown in brackets.\n\n## Calibrated parameters, 4-corner hang (Table 4)\n\n{t4}\nBest of the ICA runs, polished by Nelder–Mead over stiffness and natural length (the curve distance of\nICA alone in brackets). ± 2σ: the interval the photos allow, from the curvature of the cost and its\nresidual (nonlinear least squares); a parameter is identifiable when that interval is within 5 % of its\nvalue. Eq. 5 compares the quartics' coefficients in coordinates centred on the edge.\n\n## Validation on the 2-corner hang (Table 6)\n\n{t6}\n## Convergence (Fig. 13)\n\n![best cost per decade]({})\n\n## Taguchi main effects (Fig. 10)\n\n![main effects]({})\n\n## ICA against CMA-ES at the same budget\n\n{}",
         p.title,
-        ctx.plan
-            .file
-            .strip_prefix(&ctx.plan.root)
-            .unwrap_or(&ctx.plan.file)
-            .display(),
-        crate::VERSION,
+        ctx.made_by(),
         rel(conv_svg),
         rel(effects_svg),
         markdown(&cmp)

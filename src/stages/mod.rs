@@ -46,6 +46,15 @@ pub struct StageContext<'a> {
 }
 
 impl StageContext<'_> {
+    /// "Made by `drapelab run PIPELINE` (drapelab VERSION)": the provenance line of every report.
+    pub fn made_by(&self) -> String {
+        let file = &self.plan.file;
+        format!(
+            "Made by `drapelab run {}` (drapelab {})",
+            file.strip_prefix(&self.plan.root).unwrap_or(file).display(),
+            crate::VERSION
+        )
+    }
     /// The input file called `name`.
     pub fn input_named(&self, name: &str) -> Result<&PathBuf> {
         self.inputs

@@ -187,15 +187,7 @@ pub fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
     if !p.notes.is_empty() {
         text += &format!("{}\n\n", p.notes.trim());
     }
-    text += &format!(
-        "Made by `drapelab run {}` (drapelab {}) from:\n\n",
-        ctx.plan
-            .file
-            .strip_prefix(&ctx.plan.root)
-            .unwrap_or(&ctx.plan.file)
-            .display(),
-        crate::VERSION
-    );
+    text += &format!("{} from:\n\n", ctx.made_by());
     for i in &ctx.inputs {
         text += &format!(
             "- `{}`\n",

@@ -91,16 +91,11 @@ pub fn run(ctx: &StageContext<'_>, p: &Seed003ReportParams) -> Result<()> {
         })
         .collect();
     let mut md = format!(
-        "# {}\n\nMade by `drapelab run {}` (drapelab {}). Every scene of `datasets/scenes/` named below is \
+        "# {}\n\n{}. Every scene of `datasets/scenes/` named below is \
 solved at its own grid and at twice its resolution (2n − 1 lines per side); times are this machine's, \
 the seed's are on a Pentium II/266.\n\n## Scenes\n\n",
         p.title,
-        ctx.plan
-            .file
-            .strip_prefix(&ctx.plan.root)
-            .unwrap_or(&ctx.plan.file)
-            .display(),
-        crate::VERSION
+        ctx.made_by()
     );
     md += "| scene | grid | contact | status | iterations | time s | time at 2× s | seed's time s | grid gap mm | DC % | folds | penetration m |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for s in &solved {

@@ -2,12 +2,11 @@
 //! symmetry of the concentric table drape, the limits of the drape coefficient, the rod drape against
 //! Table 10.4, and bad obstacle definitions. A failure means contact or the drape measures broke.
 
-use crate::support::{root, scene};
+use crate::support::scene;
 use drapelab::measure::drape_measures;
 use drapelab::physics::max_penetration_m;
 use drapelab::simulate::solve_scene;
 use drapelab::solve::NoObserver;
-use std::path::Path;
 
 #[test]
 fn no_particle_ends_inside_an_obstacle_with_either_contact_treatment() {
@@ -176,34 +175,28 @@ fn the_rod_drape_hangs_corner_a_near_the_experiment_of_table_10_4() {
 
 #[test]
 fn bad_obstacles_exit_2_naming_the_key() {
-    let base = std::fs::read_to_string(root().join("datasets/scenes/sphere_wool.toml")).unwrap();
-    for (from, to, key) in [
-        (
-            "radius_m = 0.05",
-            "radius_m = -0.05",
-            "obstacles[0].radius_m",
-        ),
-        (
-            "centre_m = [0.0, 0.0, -0.0505]",
-            "centre_m = [0.0, 0.0, -0.02]",
-            "obstacles[0]",
-        ),
-        ("kind = \"sphere\"", "kind = \"cone\"", "obstacles"),
-        (
-            "distance_m = 0.001",
-            "distance_m = -1.0",
-            "contact.distance_m",
-        ),
-    ] {
-        assert!(base.contains(from), "{from}");
-        let tmp = tempfile::tempdir().unwrap();
-        let file = tmp.path().join("s.toml");
-        std::fs::write(&file, base.replace(from, to)).unwrap();
-        let out = tmp.path().join("out");
-        let args = [Path::new("simulate"), &file, Path::new("--out"), &out];
-        crate::support::assert_bad_input(args, &[key, "s.toml"]);
-        assert!(!out.join("particles.parquet").exists());
-    }
+    crate::support::assert_bad_edits(
+        "simulate",
+        "datasets/scenes/sphere_wool.toml",
+        &[
+            (
+                "radius_m = 0.05",
+                "radius_m = -0.05",
+                "obstacles[0].radius_m",
+            ),
+            (
+                "centre_m = [0.0, 0.0, -0.0505]",
+                "centre_m = [0.0, 0.0, -0.02]",
+                "obstacles[0]",
+            ),
+            ("kind = \"sphere\"", "kind = \"cone\"", "obstacles"),
+            (
+                "distance_m = 0.001",
+                "distance_m = -1.0",
+                "contact.distance_m",
+            ),
+        ],
+    );
 }
 
 #[test]
@@ -387,11 +380,6 @@ fn implicit_euler_with_contact_settles_on_the_static_drape_without_entering_the_
         max_penetration_m(&dynamic.obstacles, dyn_sol.grid_positions()),
         0.0
     );
-    let gap = dyn_sol
-        .grid_positions()
-        .iter()
-        .zip(stat.grid_positions())
-        .map(|(a, b)| (a - b).norm())
-        .fold(0.0, f64::max);
+    let gap = drapelab::benchmark::distance_to(&dyn_sol, &stat);
     assert!(gap < 1e-4, "implicit Euler and static differ by {gap} m");
 }

@@ -95,12 +95,7 @@ fn static_and_every_dynamic_integrator_agree_on_hang4() {
             all.extend(sets.iter().map(String::as_str));
             let s = scene("hang4.toml", &all);
             let sol = solve(&s);
-            let d = sol
-                .grid_positions()
-                .iter()
-                .zip(reference.grid_positions())
-                .map(|(a, b)| (a - b).norm())
-                .fold(0.0, f64::max);
+            let d = drapelab::benchmark::distance_to(&sol, &reference);
             assert!(d < 1e-4, "{kind} at {n}×{n} differs from static by {d:e} m");
         }
     }

@@ -150,64 +150,55 @@ fn with_twist_a_plate_bends_alike_about_a_diagonal_and_a_grid_line() {
 
 #[test]
 fn bad_loads_and_holds_exit_2_naming_the_key() {
-    use crate::support::root;
-    use std::path::Path;
-    let base =
-        std::fs::read_to_string(root().join("datasets/scenes/diagonal_tension_wool.toml")).unwrap();
-    for (from, to, key) in [
-        (
-            "particle = [30, 0]",
-            "particle = [31, 0]",
-            "loads[0].particle",
-        ),
-        (
-            "magnitude_N = 0.4903325",
-            "magnitude_N = -1.0",
-            "loads[0].magnitude_N",
-        ),
-        (
-            "direction = [1.0, -1.0, 0.0]",
-            "direction = [0.0, 0.0, 0.0]",
-            "loads[0].direction",
-        ),
-        (
-            "particle = [30, 0]",
-            "particle = [30, 0]\nat_m = [0.1, 0.1]",
-            "loads[0].particle",
-        ),
-        (
-            "components = [\"z\"]",
-            "components = []",
-            "boundary.holds[0].components",
-        ),
-        (
-            "components = [\"z\"]",
-            "components = [\"w\"]",
-            "boundary.holds",
-        ),
-        (
-            "particles = [[0, 30], [30, 30]]",
-            "particles = [[0, 31]]",
-            "boundary.holds[1].particles",
-        ),
-        (
-            "kind = \"static\"",
-            "kind = \"implicit-euler\"",
-            "boundary.holds",
-        ),
-        (
-            "magnitude_N = 0.4903325",
-            "magnitude_N = nan",
-            "loads[0].magnitude_N",
-        ),
-    ] {
-        assert!(base.contains(from), "{from}");
-        let tmp = tempfile::tempdir().unwrap();
-        let file = tmp.path().join("s.toml");
-        std::fs::write(&file, base.replacen(from, to, 1)).unwrap();
-        let out = tmp.path().join("out");
-        let args = [Path::new("simulate"), &file, Path::new("--out"), &out];
-        crate::support::assert_bad_input(args, &[key, "s.toml"]);
-        assert!(!out.exists() || !out.join("particles.parquet").exists());
-    }
+    crate::support::assert_bad_edits(
+        "simulate",
+        "datasets/scenes/diagonal_tension_wool.toml",
+        &[
+            (
+                "particle = [30, 0]",
+                "particle = [31, 0]",
+                "loads[0].particle",
+            ),
+            (
+                "magnitude_N = 0.4903325",
+                "magnitude_N = -1.0",
+                "loads[0].magnitude_N",
+            ),
+            (
+                "direction = [1.0, -1.0, 0.0]",
+                "direction = [0.0, 0.0, 0.0]",
+                "loads[0].direction",
+            ),
+            (
+                "particle = [30, 0]",
+                "particle = [30, 0]\nat_m = [0.1, 0.1]",
+                "loads[0].particle",
+            ),
+            (
+                "components = [\"z\"]",
+                "components = []",
+                "boundary.holds[0].components",
+            ),
+            (
+                "components = [\"z\"]",
+                "components = [\"w\"]",
+                "boundary.holds",
+            ),
+            (
+                "particles = [[0, 30], [30, 30]]",
+                "particles = [[0, 31]]",
+                "boundary.holds[1].particles",
+            ),
+            (
+                "kind = \"static\"",
+                "kind = \"implicit-euler\"",
+                "boundary.holds",
+            ),
+            (
+                "magnitude_N = 0.4903325",
+                "magnitude_N = nan",
+                "loads[0].magnitude_N",
+            ),
+        ],
+    );
 }

@@ -140,3 +140,31 @@ where
     }
     err
 }
+
+/// For each `(from, to, key)`: the bundled file `path` (relative to the repository) with its first
+/// `from` replaced by `to`, given to `drapelab COMMAND FILE --out DIR`, is refused as bad input
+/// naming `key` and the file, and leaves nothing in DIR.
+pub fn assert_bad_edits(command: &str, path: &str, edits: &[(&str, &str, &str)]) {
+    let base = std::fs::read_to_string(root().join(path)).unwrap();
+    let name = Path::new(path)
+        .file_name()
+        .unwrap()
+        .to_string_lossy()
+        .to_string();
+    for (from, to, key) in edits {
+        assert!(base.contains(from), "{from}");
+        let tmp = tempfile::tempdir().unwrap();
+        let file = tmp.path().join(&name);
+        std::fs::write(&file, base.replacen(from, to, 1)).unwrap();
+        let out = tmp.path().join("out");
+        let args = [Path::new(command), &file, Path::new("--out"), &out];
+        assert_bad_input(args, &[key, &name]);
+        let written = std::fs::read_dir(&out).map_or(0, |d| d.count());
+        assert_eq!(
+            written,
+            0,
+            "{key}: bad input left {written} files in {}",
+            out.display()
+        );
+    }
+}

@@ -7,7 +7,6 @@ use drapelab::wrinkles::{
     WrinkleConfig, WrinkleResult, boundary_length_m, count_folds, load_config, simpson, solve,
     wrinkle_mesh,
 };
-use std::path::Path;
 
 fn seed_tables() -> WrinkleConfig {
     load_config(&root().join("datasets/wrinkles/seed_tables.toml")).unwrap()
@@ -171,43 +170,37 @@ assert m.group_by("case").len()["len"].unique().to_list() == [41 * 81]
 
 #[test]
 fn invalid_wrinkle_inputs_exit_2_naming_the_key() {
-    let base = std::fs::read_to_string(root().join("datasets/wrinkles/seed_tables.toml")).unwrap();
-    for (from, to, key) in [
-        (
-            "length_m = 1.40\nheight_m = 0.90",
-            "length_m = 0.0\nheight_m = 0.90",
-            "cases[0].length_m",
-        ),
-        (
-            "thickness_m = 0.25e-3",
-            "thickness_m = -1e-3",
-            "cases[0].thickness_m",
-        ),
-        (
-            "poisson_ratio = 0.3",
-            "poisson_ratio = 0.5",
-            "cases[0].poisson_ratio",
-        ),
-        (
-            "support_displacement_m = 0.10",
-            "support_displacement_m = 0.80",
-            "cases[0].support_displacement_m",
-        ),
-        (
-            "tolerance_rel = 0.05",
-            "tolerance_rel = 0.05\ncolour = 1",
-            "defaults.colour",
-        ),
-    ] {
-        assert!(base.contains(from), "{from}");
-        let tmp = tempfile::tempdir().unwrap();
-        let file = tmp.path().join("w.toml");
-        std::fs::write(&file, base.replacen(from, to, 1)).unwrap();
-        let out = tmp.path().join("out");
-        let args = [Path::new("wrinkles"), &file, Path::new("--out"), &out];
-        crate::support::assert_bad_input(args, &[key, "w.toml"]);
-        assert!(!out.exists(), "nothing is written for bad input");
-    }
+    crate::support::assert_bad_edits(
+        "wrinkles",
+        "datasets/wrinkles/seed_tables.toml",
+        &[
+            (
+                "length_m = 1.40\nheight_m = 0.90",
+                "length_m = 0.0\nheight_m = 0.90",
+                "cases[0].length_m",
+            ),
+            (
+                "thickness_m = 0.25e-3",
+                "thickness_m = -1e-3",
+                "cases[0].thickness_m",
+            ),
+            (
+                "poisson_ratio = 0.3",
+                "poisson_ratio = 0.5",
+                "cases[0].poisson_ratio",
+            ),
+            (
+                "support_displacement_m = 0.10",
+                "support_displacement_m = 0.80",
+                "cases[0].support_displacement_m",
+            ),
+            (
+                "tolerance_rel = 0.05",
+                "tolerance_rel = 0.05\ncolour = 1",
+                "defaults.colour",
+            ),
+        ],
+    );
 }
 
 #[test]
