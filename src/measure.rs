@@ -211,7 +211,7 @@ mod tests {
 
     #[test]
     fn the_projected_area_of_a_flat_square_is_its_area() {
-        let g = Grid::new(11, 11, 0.2, 0.2, crate::cloth::Spacing::Uniform, 0.0);
+        let g = Grid::uniform(11, 11, 0.2, 0.2);
         let x = g.flat_positions();
         let p = vertical_projection(&g, &x, &vec![true; g.len()], 800);
         assert!((p.area_m2() - 0.04).abs() < 0.005 * 0.04, "{}", p.area_m2());

@@ -29,6 +29,14 @@ pub struct ClothSpec {
     /// For graded spacing: 0 = uniform .. <1 = strongly graded. Default 0.5.
     #[serde(default = "default_grading")]
     pub grading: f64,
+    /// For graded spacing: x coordinates in m (the scene's frame, like obstacles) of interior lines
+    /// x = const that become grid lines and towards which the grid is refined, e.g. a table's
+    /// edges (seed 003 Fig. 10.3). Default none: refined towards the sheet's edges only.
+    #[serde(default)]
+    pub refine_x_m: Vec<f64>,
+    /// For graded spacing: y coordinates in m of interior lines y = const, as `refine_x_m`.
+    #[serde(default)]
+    pub refine_y_m: Vec<f64>,
     /// Areal density (mass per area) in kg/m² (45 g/m² = 0.045).
     pub areal_density_kg_per_m2: f64,
     /// "square" (default) or "disc": the circle inscribed in the sheet, the grid particles outside it
@@ -528,6 +536,51 @@ impl Scene {
                 "cloth.grading",
                 format!("must be in [0, 1), got {}", c.grading),
             );
+        }
+        for (key, lines, origin, size, n) in [
+            (
+                "cloth.refine_x_m",
+                &c.refine_x_m,
+                c.origin_m[0],
+                c.size_x_m,
+                c.nx,
+            ),
+            (
+                "cloth.refine_y_m",
+                &c.refine_y_m,
+                c.origin_m[1],
+                c.size_y_m,
+                c.ny,
+            ),
+        ] {
+            if lines.is_empty() {
+                continue;
+            }
+            if c.spacing != Spacing::Graded {
+                return err(key, "needs cloth.spacing = \"graded\"".into());
+            }
+            if let Some(v) = lines
+                .iter()
+                .find(|v| !(v.is_finite() && **v > origin && **v < origin + size))
+            {
+                return err(
+                    key,
+                    format!(
+                        "{v} m is not inside the sheet ({origin} m to {} m): give lines strictly between its edges",
+                        origin + size
+                    ),
+                );
+            }
+            if lines.len() + 1 > n - 1 {
+                return err(
+                    key,
+                    format!(
+                        "{} lines need at least {} particles along the side",
+                        lines.len(),
+                        lines.len() + 2
+                    ),
+                );
+            }
         }
         match (&self.material.mass_spring, &self.material.continuum) {
             (Some(_), Some(_)) => {

@@ -35,6 +35,21 @@ impl Solution {
     pub fn at(&self, i: usize, j: usize) -> Vector3<f64> {
         self.x[self.grid.index(i, j)]
     }
+    /// Where the material point at sheet coordinates (u, v) in m (from particle (0, 0) of the flat
+    /// sheet) ended: bilinear interpolation over its grid cell, exact at grid particles. Lets grids
+    /// of different resolution or grading be compared at the same material points.
+    pub fn at_material(&self, u_m: f64, v_m: f64) -> Vector3<f64> {
+        let cell = |lines: &[f64], s: f64| {
+            let k = lines.partition_point(|&c| c <= s).clamp(1, lines.len() - 1) - 1;
+            let t = ((s - lines[k]) / (lines[k + 1] - lines[k])).clamp(0.0, 1.0);
+            (k, t)
+        };
+        let ((i, a), (j, b)) = (cell(&self.grid.xs, u_m), cell(&self.grid.ys, v_m));
+        self.at(i, j) * ((1.0 - a) * (1.0 - b))
+            + self.at(i + 1, j) * (a * (1.0 - b))
+            + self.at(i, j + 1) * ((1.0 - a) * b)
+            + self.at(i + 1, j + 1) * (a * b)
+    }
 }
 
 /// Solves a validated scene in memory with its configured solver; the observer sees each state.

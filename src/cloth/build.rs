@@ -19,9 +19,14 @@ pub struct BuiltScene {
     pub x0: Vec<Vector3<f64>>,
 }
 
-/// The grid of a scene (uniform or graded).
+/// The grid of a scene (uniform or graded, refined towards `cloth.refine_x_m`/`refine_y_m`).
 fn scene_grid(scene: &Scene) -> Grid {
     let c = &scene.cloth;
+    let local = |lines: &[f64], origin: f64| lines.iter().map(|v| v - origin).collect::<Vec<_>>();
+    let (rx, ry) = (
+        local(&c.refine_x_m, c.origin_m[0]),
+        local(&c.refine_y_m, c.origin_m[1]),
+    );
     Grid::new(
         c.nx,
         c.ny,
@@ -33,6 +38,7 @@ fn scene_grid(scene: &Scene) -> Grid {
         } else {
             0.0
         },
+        [&rx, &ry],
     )
 }
 

@@ -19,20 +19,61 @@ pub enum Spacing {
 }
 
 /// Grid coordinates of `n` lines over `[0, length]`.
-pub fn line_coordinates(n: usize, length: f64, spacing: Spacing, grading: f64) -> Vec<f64> {
-    (0..n)
-        .map(|k| {
-            let s = k as f64 / (n - 1) as f64;
-            match spacing {
-                Spacing::Uniform => s * length,
-                Spacing::Graded => {
-                    // Blend of uniform and cosine spacing; grading in [0, 1): 0 = uniform.
-                    let c = 0.5 * (1.0 - (std::f64::consts::PI * s).cos());
-                    length * ((1.0 - grading) * s + grading * c)
-                }
-            }
-        })
-        .collect()
+///
+/// Graded spacing without `refine_at` clusters lines towards both ends (cosine spacing). With
+/// interior lines `refine_at` (sheet coordinates in m, e.g. a table's edges, seed 003 Figs. 10.3
+/// and 10.7) each becomes a grid line, the segments between them and the edges get intervals in
+/// proportion to their lengths (at least one each), and lines cluster towards the interior lines
+/// only (quarter-cosine spacing in the outer segments). The spacing is a blend of uniform and
+/// clustered, `grading` in [0, 1) (0 = uniform). Uniform spacing ignores `refine_at`.
+pub fn line_coordinates(
+    n: usize,
+    length: f64,
+    spacing: Spacing,
+    grading: f64,
+    refine_at: &[f64],
+) -> Vec<f64> {
+    let intervals = n - 1;
+    if spacing == Spacing::Uniform {
+        return (0..n)
+            .map(|k| k as f64 / intervals as f64 * length)
+            .collect();
+    }
+    let mut breaks = vec![0.0];
+    breaks.extend(refine_at.iter().copied().filter(|&b| b > 0.0 && b < length));
+    breaks.push(length);
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    let segments = breaks.len() - 1;
+    // Interval index of each breakpoint: cumulative rounding, kept strictly increasing.
+    let mut at: Vec<usize> = breaks
+        .iter()
+        .map(|b| (b / length * intervals as f64).round() as usize)
+        .collect();
+    for k in 1..=segments {
+        at[k] = at[k].max(at[k - 1] + 1).min(intervals - (segments - k));
+    }
+    at[segments] = intervals;
+    // With interior lines, the sheet's own edges are not refined towards.
+    let refined = |k: usize| segments == 1 || (k > 0 && k < segments);
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let mut xs = Vec::with_capacity(n);
+    for k in 0..segments {
+        let (a, b) = (breaks[k], breaks[k + 1]);
+        let c = at[k + 1] - at[k];
+        for m in 0..c {
+            let t = m as f64 / c as f64;
+            let clustered = match (refined(k), refined(k + 1)) {
+                (true, true) => 0.5 * (1.0 - (2.0 * half_pi * t).cos()),
+                (true, false) => 1.0 - (half_pi * t).cos(),
+                (false, true) => (half_pi * t).sin(),
+                (false, false) => t,
+            };
+            xs.push(a + (b - a) * ((1.0 - grading) * t + grading * clustered));
+        }
+    }
+    xs.push(length);
+    xs
 }
 
 /// Half-interval ("tributary") lengths of grid lines: the share of the side each line represents.
@@ -69,13 +110,27 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// A grid over `lx × ly` metres.
-    pub fn new(nx: usize, ny: usize, lx: f64, ly: f64, spacing: Spacing, grading: f64) -> Self {
+    /// A grid over `lx × ly` metres with uniform spacing.
+    pub fn uniform(nx: usize, ny: usize, lx: f64, ly: f64) -> Self {
+        Self::new(nx, ny, lx, ly, Spacing::Uniform, 0.0, [&[], &[]])
+    }
+
+    /// A grid over `lx × ly` metres; graded spacing is refined towards `refine_at` = (lines x =
+    /// const, lines y = const) in sheet coordinates (m) as well as the edges ([`line_coordinates`]).
+    pub fn new(
+        nx: usize,
+        ny: usize,
+        lx: f64,
+        ly: f64,
+        spacing: Spacing,
+        grading: f64,
+        refine_at: [&[f64]; 2],
+    ) -> Self {
         Self {
             nx,
             ny,
-            xs: line_coordinates(nx, lx, spacing, grading),
-            ys: line_coordinates(ny, ly, spacing, grading),
+            xs: line_coordinates(nx, lx, spacing, grading, refine_at[0]),
+            ys: line_coordinates(ny, ly, spacing, grading, refine_at[1]),
         }
     }
     /// Number of particles.
@@ -187,10 +242,11 @@ impl Edge {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     #[test]
     fn lumped_masses_follow_seed_000_and_sum_to_sheet_mass() {
-        let g = Grid::new(11, 11, 0.5, 0.5, Spacing::Uniform, 0.0);
+        let g = Grid::new(11, 11, 0.5, 0.5, Spacing::Uniform, 0.0, [&[], &[]]);
         let m = g.lumped_masses(0.045);
         let h: f64 = 0.05;
         let rho_h2 = 0.045 * h * h;
@@ -199,8 +255,35 @@ mod tests {
         assert!((m[g.index(0, 0)] - rho_h2 / 4.0).abs() < 1e-15);
         let total: f64 = m.iter().sum();
         assert!((total - 0.045 * 0.25).abs() < 1e-12);
-        let gg = Grid::new(9, 7, 0.2, 0.1, Spacing::Graded, 0.7);
+        let gg = Grid::new(9, 7, 0.2, 0.1, Spacing::Graded, 0.7, [&[], &[]]);
         let tot: f64 = gg.lumped_masses(2.0).iter().sum();
         assert!((tot - 2.0 * 0.02).abs() < 1e-12);
+    }
+
+    #[test]
+    fn graded_lines_put_a_grid_line_on_each_refined_line_and_cluster_towards_it() {
+        // A 20 cm side refined at 5 and 15 cm (a 10 cm table under a 20 cm sheet).
+        let xs = line_coordinates(41, 0.2, Spacing::Graded, 0.5, &[0.05, 0.15]);
+        assert_eq!(xs.len(), 41);
+        assert!((xs[10] - 0.05).abs() < 1e-15 && (xs[30] - 0.15).abs() < 1e-15);
+        assert!(xs.windows(2).all(|w| w[1] > w[0]));
+        // Mirror symmetric, finest next to the refined lines, coarsest at the free edges.
+        for k in 0..41 {
+            assert!((xs[k] + xs[40 - k] - 0.2).abs() < 1e-14, "{k}");
+        }
+        let h: Vec<f64> = xs.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(h[9] < h[0] && h[10] < h[19] && h[9] < 0.005 && h[0] > 0.005);
+        // Doubling the intervals keeps every line (grid-convergence studies compare material points).
+        let fine = line_coordinates(81, 0.2, Spacing::Graded, 0.5, &[0.05, 0.15]);
+        for k in 0..41 {
+            assert!((fine[2 * k] - xs[k]).abs() < 1e-15, "{k}");
+        }
+        // Without refined lines: cosine towards both edges, as before; uniform ignores them.
+        let both = line_coordinates(5, 1.0, Spacing::Graded, 0.5, &[]);
+        assert!((both[1] - (0.5 * 0.25 + 0.5 * 0.5 * (1.0 - (PI / 4.0).cos()))).abs() < 1e-15);
+        assert_eq!(
+            line_coordinates(3, 1.0, Spacing::Uniform, 0.5, &[0.3]),
+            vec![0.0, 0.5, 1.0]
+        );
     }
 }

@@ -59,7 +59,7 @@ fn solve_pair(scene: &Scene) -> Solved {
         let g = &coarse.grid;
         (0..g.ny)
             .flat_map(|j| (0..g.nx).map(move |i| (i, j)))
-            .map(|(i, j)| (coarse.at(i, j) - fine.at(2 * i, 2 * j)).norm())
+            .map(|(i, j)| (coarse.at(i, j) - fine.at_material(g.xs[i], g.ys[j])).norm())
             .fold(0.0, f64::max)
     } else {
         f64::NAN
@@ -147,8 +147,6 @@ pattern changing with the grid (the folds' number and place are a bifurcation), 
         ctx.input_named("fvm_table_drape_edges.csv"),
     ) {
         md += "## Table 10.2: edge points of the concentric table drape (quarter model)\n\n| point | initial cm | seed 003 cm | drapelab cm | distance cm |\n|---|---|---|---|---|\n";
-        let g = &q.coarse.grid;
-        let size = q.scene.cloth.size_x_m * 100.0;
         for row in super::calibration_report::read_csv(file)? {
             let f = |k: &str| {
                 row.get(k)
@@ -156,9 +154,7 @@ pattern changing with the grid (the folds' number and place are a bifurcation), 
                     .unwrap_or(f64::NAN)
             };
             let (x0, y0) = (f("x0_cm"), f("y0_cm"));
-            let i = ((x0 / size) * (g.nx - 1) as f64).round() as usize;
-            let j = ((y0 / size) * (g.ny - 1) as f64).round() as usize;
-            let pt = q.coarse.at(i, j) * 100.0;
+            let pt = q.coarse.at_material(x0 / 100.0, y0 / 100.0) * 100.0;
             let d = ((pt.x - f("x_cm")).powi(2)
                 + (pt.y - f("y_cm")).powi(2)
                 + (-pt.z - f("z_cm")).powi(2))
