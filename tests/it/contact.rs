@@ -229,6 +229,20 @@ fn bad_obstacles_exit_2_naming_the_key() {
 }
 
 #[test]
+fn bad_refined_lines_exit_2_naming_the_key() {
+    crate::support::assert_bad_edits(
+        "simulate",
+        "datasets/scenes/table_wool_quarter.toml",
+        &[
+            // A line outside the sheet (0 to 10 cm), a non-finite one, and lines on a uniform grid.
+            ("refine_x_m = [0.05]", "refine_x_m = [0.12]", "cloth.refine_x_m"),
+            ("refine_y_m = [0.05]", "refine_y_m = [nan]", "cloth.refine_y_m"),
+            ("spacing = \"graded\"", "spacing = \"uniform\"", "cloth.refine_x_m"),
+        ],
+    );
+}
+
+#[test]
 fn the_quarter_table_model_is_an_equilibrium_of_the_full_model_and_matches_table_10_2() {
     use drapelab::cloth::build_scene;
     let quarter = scene("table_wool_quarter.toml", &[]);
