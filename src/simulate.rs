@@ -126,6 +126,7 @@ fn static_solve(
             model,
             x,
             &scene.obstacles,
+            crate::cloth::scene_grid(scene).min_spacing_m(),
             &scene.solver.static_,
             observer,
         )

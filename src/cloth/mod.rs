@@ -2,7 +2,9 @@
 //! with area-lumped masses and the boundary conditions (pins, clamped edges).
 
 mod build;
-pub use build::{BuiltScene, absent_particles, barrier_contact, build_scene, initial_positions};
+pub use build::{
+    BuiltScene, absent_particles, barrier_contact, build_scene, initial_positions, scene_grid,
+};
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -140,6 +142,14 @@ impl Grid {
     /// Whether the grid is empty (never, for a validated scene).
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+    /// The smallest distance between neighbouring grid lines in m.
+    pub fn min_spacing_m(&self) -> f64 {
+        self.xs
+            .windows(2)
+            .chain(self.ys.windows(2))
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min)
     }
     /// Particle index of grid point `(i, j)`.
     pub fn index(&self, i: usize, j: usize) -> usize {
