@@ -118,7 +118,8 @@ impl Grid {
     }
 
     /// A grid over `lx × ly` metres; graded spacing is refined towards `refine_at` = (lines x =
-    /// const, lines y = const) in sheet coordinates (m) as well as the edges ([`line_coordinates`]).
+    /// const, lines y = const) in sheet coordinates (m), or towards the edges where a side has no
+    /// such lines ([`line_coordinates`]).
     pub fn new(
         nx: usize,
         ny: usize,
