@@ -161,8 +161,8 @@ pub struct Continuum {
     /// Twisting rigidity in gf·cm²/cm: the plate energy density D_t κ_xy² (Poisson's ratio 0). An
     /// isotropic plate has D_t = D, which makes bending about a diagonal as stiff as about a grid line;
     /// without it a diagonal bend is half as stiff. KES does not measure it and seed 003's model bends
-    /// along warp and weft only, so the default is 0 (Table 10.2 is matched within 0.25 cm without it,
-    /// within 1.05 cm with √(D_warp D_weft)).
+    /// along warp and weft only, so the default is 0 (reports/seed003.md shows the rod with and
+    /// without it).
     pub bending_twist_gf_cm2_per_cm: Option<f64>,
     /// Twisting rigidity in N·m (alternative to the gf·cm²/cm key). Default 0.
     pub bending_twist_N_m: Option<f64>,

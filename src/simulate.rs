@@ -82,7 +82,7 @@ fn solve_model(
             // Nested iteration: start Newton from the interpolated solution of the scene on the grid
             // with every other line, when that grid exists; far fewer fine iterations are needed.
             let coarse = coarse_start(scene, grid, x);
-            let mut report = static_solve(scene, model, x, observer);
+            let mut report = static_solve(scene, grid, model, x, observer);
             if let Some((r, _)) = coarse {
                 report.iterations += r.iterations;
                 report.linear_solves += r.linear_solves;
@@ -115,6 +115,7 @@ small perturbation (cloth.initial_perturbation_m, [[loads]]) moves off";
 /// scene asks for that contact treatment.
 fn static_solve(
     scene: &Scene,
+    grid: &Grid,
     model: &mut crate::physics::Model,
     x: &mut [Vector3<f64>],
     observer: &mut dyn Observer,
@@ -126,7 +127,7 @@ fn static_solve(
             model,
             x,
             &scene.obstacles,
-            crate::cloth::scene_grid(scene).min_spacing_m(),
+            grid.min_spacing_m(),
             &scene.solver.static_,
             observer,
         )
@@ -312,11 +313,6 @@ pub fn simulate_to_dir(
         None
     };
     let mut x = x0;
-    let coarse = if scene.solver.kind == crate::scene::SolverKind::Static {
-        coarse_start(scene, &grid, &mut x)
-    } else {
-        None
-    };
     let report = {
         let mut obs: Vec<&mut dyn Observer> = vec![progress];
         if let Some(t) = timeline.as_mut() {
@@ -325,29 +321,7 @@ pub fn simulate_to_dir(
         if let Some(r) = rrd.as_mut() {
             obs.push(r);
         }
-        let mut all = Observers(obs);
-        match scene.solver.kind.integrator() {
-            None => {
-                let mut r = static_solve(scene, &mut model, &mut x, &mut all);
-                if let Some((c, _)) = coarse {
-                    r.iterations += c.iterations;
-                    r.linear_solves += c.linear_solves;
-                    r.wall_time_s += c.wall_time_s;
-                }
-                r
-            }
-            Some(integ) => {
-                let mut v = vec![Vector3::zeros(); x.len()];
-                solve_dynamic(
-                    &model,
-                    integ,
-                    &mut x,
-                    &mut v,
-                    &scene.solver.dynamic,
-                    &mut all,
-                )
-            }
-        }
+        solve_model(scene, &grid, &mut model, &mut x, &mut Observers(obs))
     };
     let final_ev = StateEvent {
         index: report.iterations,

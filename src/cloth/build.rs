@@ -20,7 +20,7 @@ pub struct BuiltScene {
 }
 
 /// The grid of a scene (uniform or graded, refined towards `cloth.refine_x_m`/`refine_y_m`).
-pub fn scene_grid(scene: &Scene) -> Grid {
+fn scene_grid(scene: &Scene) -> Grid {
     let c = &scene.cloth;
     let local = |lines: &[f64], origin: f64| lines.iter().map(|v| v - origin).collect::<Vec<_>>();
     let (rx, ry) = (

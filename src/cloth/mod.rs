@@ -2,9 +2,7 @@
 //! with area-lumped masses and the boundary conditions (pins, clamped edges).
 
 mod build;
-pub use build::{
-    BuiltScene, absent_particles, barrier_contact, build_scene, initial_positions, scene_grid,
-};
+pub use build::{BuiltScene, absent_particles, barrier_contact, build_scene, initial_positions};
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};

@@ -8,6 +8,13 @@ use drapelab::physics::max_penetration_m;
 use drapelab::simulate::solve_scene;
 use drapelab::solve::NoObserver;
 
+/// Solves `scene` and asserts that the solve converged.
+fn converged(scene: &drapelab::scene::Scene) -> drapelab::simulate::Solution {
+    let sol = solve_scene(scene, &mut NoObserver);
+    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    sol
+}
+
 #[test]
 fn no_particle_ends_inside_an_obstacle_with_either_contact_treatment() {
     let cases: [(&str, &[&str]); 4] = [
@@ -73,8 +80,7 @@ fn the_concentric_table_drape_is_symmetric_in_the_full_model() {
     // x → −x and y → −y are symmetries of the scene (warp along x, weft along y): the drape must
     // keep them within 0.1 mm.
     let s = scene("table_wool.toml", &[]);
-    let sol = solve_scene(&s, &mut NoObserver);
-    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let sol = converged(&s);
     let n = s.cloth.nx;
     let (mut ex, mut ey) = (0.0f64, 0.0f64);
     for j in 0..n {
@@ -108,8 +114,7 @@ fn the_drape_coefficient_is_100_for_a_flat_sheet_and_0_for_one_hanging_straight_
             "material.continuum.bending_weft_gf_cm2_per_cm=10000",
         ],
     );
-    let sol = solve_scene(&flat, &mut NoObserver);
-    assert!(sol.report.is_converged());
+    let sol = converged(&flat);
     let m = drape_measures(&flat, &sol.grid, &sol.x);
     let dc = m.drape_coefficient_pct.unwrap();
     assert!((dc - 100.0).abs() < 1.0, "flat: DC {dc} %");
@@ -124,8 +129,7 @@ fn the_drape_coefficient_is_100_for_a_flat_sheet_and_0_for_one_hanging_straight_
             "material.continuum.shear_gf_per_cm=0.01",
         ],
     );
-    let sol = solve_scene(&limp, &mut NoObserver);
-    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let sol = converged(&limp);
     let dc = drape_measures(&limp, &sol.grid, &sol.x)
         .drape_coefficient_pct
         .unwrap();
@@ -154,8 +158,7 @@ fn the_rod_drape_hangs_corner_a_near_the_experiment_of_table_10_4() {
     ];
     let corner = |method: &str| {
         let s = scene("rod_polyester.toml", &[&grid[..], &[method]].concat());
-        let sol = solve_scene(&s, &mut NoObserver);
-        assert!(sol.report.is_converged(), "{}", sol.report.message);
+        let sol = converged(&s);
         assert!(max_penetration_m(&s.obstacles, sol.grid_positions()) < 1e-6);
         let n = s.cloth.nx;
         (sol.at(n - 1, n - 1) * 100.0, sol.at(0, 0) * 100.0)
@@ -194,8 +197,7 @@ fn with_the_finite_elements_material_the_rod_drape_lands_on_their_prediction() {
             "material.continuum.bending_twist_gf_cm2_per_cm=0.322",
         ],
     );
-    let sol = solve_scene(&s, &mut NoObserver);
-    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let sol = converged(&s);
     let n = s.cloth.nx;
     let a = sol.at(n - 1, n - 1) * 100.0;
     let d = ((a.x - 2.70).powi(2) + (a.y - 2.70).powi(2) + (-a.z - 12.56).powi(2)).sqrt();
@@ -264,8 +266,7 @@ fn bad_refined_lines_exit_2_naming_the_key() {
 fn the_quarter_table_model_is_an_equilibrium_of_the_full_model_and_matches_table_10_2() {
     use drapelab::cloth::build_scene;
     let quarter = scene("table_wool_quarter.toml", &[]);
-    let q = solve_scene(&quarter, &mut NoObserver);
-    assert!(q.report.is_converged(), "{}", q.report.message);
+    let q = converged(&quarter);
     // Unfold the quarter (x, y ≥ 0) into the full sheet by the two mirrors (the graded grids match:
     // the full grid's lines mirror the quarter's).
     let full = scene("table_wool.toml", &[]);
@@ -295,8 +296,7 @@ fn the_quarter_table_model_is_an_equilibrium_of_the_full_model_and_matches_table
     eprintln!("full-model residual at the unfolded quarter drape: {r:.2e} of a particle's weight");
     assert!(r < 1e-5, "{r}");
     // The full model, solved from the flat sheet, lands on the same drape.
-    let f = solve_scene(&full, &mut NoObserver);
-    assert!(f.report.is_converged(), "{}", f.report.message);
+    let f = converged(&full);
     let gap = f.x[..built.grid.len()]
         .iter()
         .zip(&x)
@@ -337,8 +337,7 @@ fn the_skirt_drapes_over_the_body_form_without_entering_it() {
     // A disc skirt held at the waist of a body form of revolution (seed 003 §10.7.2.3): it must hang
     // over the hips, below the waist, outside the form everywhere.
     let s = scene("skirt_wool.toml", &["cloth.nx=31", "cloth.ny=31"]);
-    let sol = solve_scene(&s, &mut NoObserver);
-    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let sol = converged(&s);
     let x = sol.grid_positions();
     assert!(max_penetration_m(&s.obstacles, x) < 1e-6);
     let present: Vec<_> = x
@@ -371,8 +370,7 @@ fn lagged_friction_keeps_the_rod_drape_symmetric_and_outside_the_rod() {
             "contact.friction_coefficient=0.3",
         ],
     );
-    let sol = solve_scene(&s, &mut NoObserver);
-    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let sol = converged(&s);
     assert!(
         sol.terms.iter().any(|t| t == "contact/friction"),
         "{:?}",
@@ -394,8 +392,7 @@ fn the_rendered_view_from_above_covers_the_measured_vertical_projection() {
     // Two independent computations of the table drape's vertical projection: the drape-coefficient
     // raster (src/measure.rs) and the shaded rendering seen from straight above (src/edges/render.rs).
     let s = scene("table_wool.toml", &[]);
-    let sol = solve_scene(&s, &mut NoObserver);
-    assert!(sol.report.is_converged());
+    let sol = converged(&s);
     let d = drapelab::measure::drape_measures(&s, &sol.grid, &sol.x);
     let present = vec![true; sol.grid.len()];
     let px_per_cm = 20.0;
@@ -421,8 +418,7 @@ fn implicit_euler_with_contact_settles_on_the_static_drape_without_entering_the_
     // Dynamics with the barrier: each step is cut where a particle would enter the obstacle (CCD),
     // so implicit Euler falls onto the pedestal and settles where Newton's static solve lands.
     let sets = ["cloth.nx=11", "cloth.ny=11"];
-    let stat = solve_scene(&scene("pedestal_wool.toml", &sets), &mut NoObserver);
-    assert!(stat.report.is_converged());
+    let stat = converged(&scene("pedestal_wool.toml", &sets));
     let dynamic = scene(
         "pedestal_wool.toml",
         &[
@@ -434,8 +430,7 @@ fn implicit_euler_with_contact_settles_on_the_static_drape_without_entering_the_
             "solver.dynamic.speed_tol_m_per_s=1e-5",
         ],
     );
-    let dyn_sol = solve_scene(&dynamic, &mut NoObserver);
-    assert!(dyn_sol.report.is_converged(), "{}", dyn_sol.report.message);
+    let dyn_sol = converged(&dynamic);
     assert!(
         dyn_sol.report.message.contains("cut short by contact"),
         "{}",
@@ -466,11 +461,9 @@ fn a_grid_graded_towards_the_table_edge_is_closer_to_the_fine_drape_than_a_unifo
         "table_wool_quarter.toml",
         &[&flat[..], &["cloth.nx=81", "cloth.ny=81"]].concat(),
     );
-    let r = solve_scene(&reference, &mut NoObserver);
-    assert!(r.report.is_converged(), "{}", r.report.message);
+    let r = converged(&reference);
     let error = |s: &drapelab::scene::Scene| {
-        let sol = solve_scene(s, &mut NoObserver);
-        assert!(sol.report.is_converged(), "{}", sol.report.message);
+        let sol = converged(s);
         (0..=20)
             .flat_map(|k| {
                 let u = k as f64 * 0.005;
