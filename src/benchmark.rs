@@ -26,6 +26,10 @@ pub struct BenchRow {
     pub iterations: usize,
     /// Linear solves (factorizations or CG solves).
     pub linear_solves: usize,
+    /// Numeric factorizations attempted (failed ones on an indefinite matrix included).
+    pub factorizations: usize,
+    /// Wall time of the factorizations and triangular solves alone, s.
+    pub factor_time_s: f64,
     /// Largest distance to the reference (the finest static solution at the shared grid points, or
     /// the exact elastica), in m (NaN when the grids share no points or the solve did not converge).
     pub error_m: f64,
@@ -192,6 +196,8 @@ pub fn bench_rows(
                     wall_time_s: wall,
                     iterations: sol.report.iterations,
                     linear_solves: sol.report.linear_solves,
+                    factorizations: sol.report.factorizations,
+                    factor_time_s: sol.report.factor_time_s,
                     error_m,
                     peak_rss_bytes: peak,
                 });
@@ -251,11 +257,11 @@ pub fn hang4_rows(
 /// The rows as a Markdown table.
 pub fn markdown_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| scene | particles | solver | tolerance | status | wall time (ms) | iterations/steps | linear solves | error vs finest static (m) | peak RSS (MB) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| scene | particles | solver | tolerance | status | wall time (ms) | iterations/steps | linear solves | factorizations | factorization time (ms) | error vs finest static (m) | peak RSS (MB) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s += &format!(
-            "| {} | {n}×{n} | {:?} | {:.0e} | {} | {:.3} | {} | {} | {:.2e} | {} |\n",
+            "| {} | {n}×{n} | {:?} | {:.0e} | {} | {:.3} | {} | {} | {} | {:.3} | {:.2e} | {} |\n",
             r.scene,
             r.solver,
             r.tol,
@@ -263,11 +269,123 @@ pub fn markdown_table(rows: &[BenchRow]) -> String {
             r.wall_time_s * 1e3,
             r.iterations,
             r.linear_solves,
+            r.factorizations,
+            r.factor_time_s * 1e3,
             r.error_m,
             r.peak_rss_bytes
                 .map_or("–".into(), |b| format!("{:.1}", b as f64 / 1e6)),
             n = r.n
         );
+    }
+    s
+}
+
+/// One solve of seed 000's slack-net population.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PopulationRow {
+    /// Spring stiffness, N/m.
+    pub stiffness_N_per_m: f64,
+    /// Natural length, m.
+    pub natural_length_m: f64,
+    /// Topology ("a", "b", "c").
+    pub topology: String,
+    /// Areal density, kg/m².
+    pub areal_density_kg_per_m2: f64,
+    /// Solver status.
+    pub status: String,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Numeric factorizations attempted.
+    pub factorizations: usize,
+    /// Wall time of the solve, s.
+    pub wall_time_s: f64,
+    /// Wall time of its factorizations and triangular solves alone, s.
+    pub factor_time_s: f64,
+}
+
+/// Seed 000's calibration population: hang4 on the 14 × 14 net solved statically at `samples`
+/// points of a Latin hypercube over Table 3's stiffness (500–1200 N/m), natural length (40–60 mm),
+/// the three topologies, and Table 2's densities (27.6–58.26 g/m²), seeded by `seed`: what one
+/// calibration asks of the solver thousands of times.
+pub fn slack_net_population(scene: &Scene, samples: usize, seed: u64) -> Vec<PopulationRow> {
+    use rand::{Rng, SeedableRng, seq::SliceRandom};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut strata: Vec<Vec<usize>> = (0..4).map(|_| (0..samples).collect()).collect();
+    for s in &mut strata {
+        s.shuffle(&mut rng);
+    }
+    let lhs = |d: usize, k: usize, r: f64| (strata[d][k] as f64 + r) / samples as f64;
+    (0..samples)
+        .map(|k| {
+            let u: Vec<f64> = (0..4).map(|d| lhs(d, k, rng.random::<f64>())).collect();
+            let mut s = scene.regridded(14, 14);
+            let ms = s.material.mass_spring.get_or_insert_with(Default::default);
+            ms.stiffness_N_per_m = 500.0 + 700.0 * u[0];
+            ms.natural_length_m = Some(0.04 + 0.02 * u[1]);
+            ms.topology = match (u[2] * 3.0) as usize {
+                0 => crate::material::Topology::A,
+                1 => crate::material::Topology::B,
+                _ => crate::material::Topology::C,
+            };
+            s.cloth.areal_density_kg_per_m2 = 0.0276 + (0.05826 - 0.0276) * u[3];
+            s.solver.kind = SolverKind::Static;
+            s.record.timeline = false;
+            s.record.rerun = false;
+            let t = Instant::now();
+            let sol = solve_scene(&s, &mut NoObserver);
+            let ms = s.material.mass_spring.as_ref().expect("set above");
+            PopulationRow {
+                stiffness_N_per_m: ms.stiffness_N_per_m,
+                natural_length_m: ms.natural_length_m.unwrap_or(f64::NAN),
+                topology: format!("{:?}", ms.topology).to_lowercase(),
+                areal_density_kg_per_m2: s.cloth.areal_density_kg_per_m2,
+                status: sol.report.status.as_str().into(),
+                iterations: sol.report.iterations,
+                factorizations: sol.report.factorizations,
+                wall_time_s: t.elapsed().as_secs_f64(),
+                factor_time_s: sol.report.factor_time_s,
+            }
+        })
+        .collect()
+}
+
+/// min / median / max of `v` (NaN for an empty slice).
+pub fn min_median_max(v: &[f64]) -> (f64, f64, f64) {
+    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if s.is_empty() {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    s.sort_by(f64::total_cmp);
+    let m = s.len();
+    let median = if m % 2 == 1 {
+        s[m / 2]
+    } else {
+        0.5 * (s[m / 2 - 1] + s[m / 2])
+    };
+    (s[0], median, s[m - 1])
+}
+
+/// The population as a Markdown summary: converged count, then min / median / max of iterations,
+/// factorizations, wall time and factorization time per solve.
+pub fn population_table(rows: &[PopulationRow]) -> String {
+    let conv: Vec<&PopulationRow> = rows.iter().filter(|r| r.status == "converged").collect();
+    let stat = |f: &dyn Fn(&PopulationRow) -> f64| {
+        min_median_max(&conv.iter().map(|r| f(r)).collect::<Vec<_>>())
+    };
+    let mut s = format!(
+        "{} of {} solves converged; min / median / max over the converged ones:\n\n| per solve | min | median | max |\n|---|---|---|---|\n",
+        conv.len(),
+        rows.len()
+    );
+    let lines: [(&str, &dyn Fn(&PopulationRow) -> f64, f64); 4] = [
+        ("Newton iterations", &|r| r.iterations as f64, 1.0),
+        ("factorizations", &|r| r.factorizations as f64, 1.0),
+        ("wall time (ms)", &|r| r.wall_time_s, 1e3),
+        ("factorization time (ms)", &|r| r.factor_time_s, 1e3),
+    ];
+    for (name, f, k) in lines {
+        let (a, b, c) = stat(f);
+        s += &format!("| {name} | {:.3} | {:.3} | {:.3} |\n", a * k, b * k, c * k);
     }
     s
 }

@@ -69,6 +69,65 @@ pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
     }
 }
 
+/// Solves a validated scene statically or dynamically from the given positions of all particles
+/// (a warm start: no coarse or sagged start is made); the scene's own start when `x0` does not match
+/// the built model's particle count.
+pub fn solve_scene_from(
+    scene: &Scene,
+    x0: &[Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> Solution {
+    let BuiltScene {
+        grid,
+        mut model,
+        x0: mut x,
+    } = build_scene(scene);
+    let report = if x0.len() == x.len() {
+        x.copy_from_slice(x0);
+        let mut report = static_or_dynamic(scene, &grid, &mut model, &mut x, observer);
+        check_minimum(&model, &x, &mut report);
+        report
+    } else {
+        solve_model(scene, &grid, &mut model, &mut x, observer)
+    };
+    Solution {
+        grid,
+        terms: model.term_names(),
+        x,
+        report,
+        model,
+    }
+}
+
+/// The scene's solver from `x` as it is: the static solve, or the dynamic integrator.
+fn static_or_dynamic(
+    scene: &Scene,
+    grid: &Grid,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    match scene.solver.kind.integrator() {
+        None => static_solve(scene, grid, model, x, observer),
+        Some(integ) => {
+            let mut v = vec![Vector3::zeros(); x.len()];
+            solve_dynamic(model, integ, x, &mut v, &scene.solver.dynamic, observer)
+        }
+    }
+}
+
+/// Stability of a converged static state (once, after every load increment and contact round).
+fn check_minimum(model: &crate::physics::Model, x: &[Vector3<f64>], report: &mut SolveReport) {
+    if report.is_converged() && report.solver == "static-newton" {
+        let minimum = crate::solve::is_minimum(model, x);
+        report.minimum = Some(minimum);
+        if !minimum {
+            report.message += "; not a minimum: an unstable equilibrium (a saddle), which a \
+small perturbation (cloth.initial_perturbation_m, [[loads]]) moves off";
+        }
+    }
+}
+
 /// Solves a built scene from `x` (updated in place) with the scene's solver.
 fn solve_model(
     scene: &Scene,
@@ -82,10 +141,15 @@ fn solve_model(
             // Nested iteration: start Newton from the interpolated solution of the scene on the grid
             // with every other line, when that grid exists; far fewer fine iterations are needed.
             let coarse = coarse_start(scene, grid, x);
+            if coarse.is_none() && scene.solver.static_.sag_start && scene.obstacles.is_empty() {
+                crate::solve::sagged_start(model, x);
+            }
             let mut report = static_solve(scene, grid, model, x, observer);
             if let Some((r, _)) = coarse {
                 report.iterations += r.iterations;
                 report.linear_solves += r.linear_solves;
+                report.factorizations += r.factorizations;
+                report.factor_time_s += r.factor_time_s;
                 report.wall_time_s += r.wall_time_s;
                 report.message += &format!(
                     " (from a {}×{} start)",
@@ -93,15 +157,7 @@ fn solve_model(
                     grid.ny.div_ceil(2)
                 );
             }
-            // Stability of the final state (once, after every load increment and contact round).
-            if report.is_converged() {
-                let minimum = crate::solve::is_minimum(model, x);
-                report.minimum = Some(minimum);
-                if !minimum {
-                    report.message += "; not a minimum: an unstable equilibrium (a saddle), which a \
-small perturbation (cloth.initial_perturbation_m, [[loads]]) moves off";
-                }
-            }
+            check_minimum(model, x, &mut report);
             report
         }
         Some(integ) => {
@@ -120,6 +176,7 @@ fn static_solve(
     x: &mut [Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> SolveReport {
+    let opts = scene.solver.static_.resolved(!scene.obstacles.is_empty());
     if scene.contact.method == crate::scene::ContactMethod::VerticalGap
         && !scene.obstacles.is_empty()
     {
@@ -128,13 +185,13 @@ fn static_solve(
             x,
             &scene.obstacles,
             grid.min_spacing_m(),
-            &scene.solver.static_,
+            &opts,
             observer,
         )
     } else if scene.contact.friction_coefficient > 0.0 && !scene.obstacles.is_empty() {
-        solve_with_friction(scene, model, x, observer)
+        solve_with_friction(scene, model, x, &opts, observer)
     } else {
-        solve_static(model, x, &scene.solver.static_, observer)
+        solve_static(model, x, &opts, observer)
     }
 }
 
@@ -145,12 +202,12 @@ fn solve_with_friction(
     scene: &Scene,
     model: &mut crate::physics::Model,
     x: &mut [Vector3<f64>],
+    opts: &crate::solve::StaticOptions,
     observer: &mut dyn Observer,
 ) -> SolveReport {
     use crate::physics::{FrictionAnchor, LaggedFriction};
     let contact = crate::cloth::barrier_contact(scene, &model.masses, &model.fixed);
     let mu = scene.contact.friction_coefficient;
-    let opts = &scene.solver.static_;
     let steps = if opts.load_steps > 1 {
         opts.load_steps
     } else {

@@ -182,6 +182,10 @@ pub enum Command {
         /// Force tolerance of every solver, relative to the lightest particle's weight.
         #[arg(long, default_value_t = 1e-6)]
         tol: f64,
+        /// Static solves of seed 000's slack-net population (14 × 14 over Table 3's box) to run
+        /// after the hang4 table, for its iterations and factorizations per solve (0: none).
+        #[arg(long, default_value_t = 50)]
+        population: usize,
         /// Run the whole benchmark pipeline instead (pipelines/benchmark.toml: every reference scene,
         /// solver, size and tolerance, the scipy/numpy peers, the skips, reports/benchmark.md; only
         /// stale stages run).
@@ -447,6 +451,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             max_explicit_size,
             max_implicit_size,
             tol,
+            population,
             all,
         } => {
             if all {
@@ -455,7 +460,13 @@ pub fn run(cli: Cli) -> Result<i32> {
                     Default::default(),
                 );
             }
-            bench::run_bench(&scene, &sizes, max_explicit_size, max_implicit_size, tol)?;
+            bench::run_bench(
+                &scene,
+                &sizes,
+                (max_explicit_size, max_implicit_size),
+                tol,
+                population,
+            )?;
             Ok(EXIT_OK)
         }
     }

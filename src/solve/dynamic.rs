@@ -258,6 +258,8 @@ pub fn solve_dynamic(
         status: Status::MaxIterations,
         iterations: 0,
         linear_solves: 0,
+        factorizations: 0,
+        factor_time_s: 0.0,
         inner_iterations: 0,
         max_residual_N: f64::NAN,
         max_residual_rel: f64::NAN,

@@ -38,6 +38,49 @@ pub struct StaticOptions {
     /// where that grid exists. Default true.
     #[serde(default = "default_true")]
     pub coarse_start: bool,
+    /// Without a coarse start and without obstacles, start Newton from the sagged sheet
+    /// ([`super::sagged_start`]: the membrane's sag shape at the depth that minimises the energy)
+    /// instead of the flat one. Default true.
+    #[serde(default = "default_true")]
+    pub sag_start: bool,
+    /// How the Levenberg–Marquardt damping moves. Default "auto": "adaptive" without obstacles,
+    /// "cautious" with them.
+    #[serde(default)]
+    pub lm_schedule: LmSchedule,
+}
+
+/// How the static solver's Levenberg–Marquardt damping moves between iterations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LmSchedule {
+    /// "adaptive" for scenes without obstacles, "cautious" for scenes with them (resolved by the
+    /// caller that knows the scene, [`StaticOptions::resolved`]).
+    #[default]
+    Auto,
+    /// Divided by 10 after each full step, raised tenfold from 1e-6 while the exact Hessian is
+    /// indefinite or the line search cuts the step below 1/8, the projected Hessian for three
+    /// iterations once the shift would exceed 1e-3: few iterations where the equilibrium is unique.
+    Adaptive,
+    /// Divided by 4 after each full step, raised tenfold from 1e-8, the projected Hessian only for
+    /// the iteration that needed it (drapelab's schedule before issue 14): small steps, so a drape
+    /// whose equilibrium depends on its path (folds on a pedestal, a sheet rolling off a rod,
+    /// sticky contact) follows a quasi-static path.
+    Cautious,
+}
+
+impl StaticOptions {
+    /// The options with `lm_schedule = "auto"` resolved: cautious when the scene has obstacles.
+    pub fn resolved(&self, has_obstacles: bool) -> Self {
+        let mut o = self.clone();
+        if o.lm_schedule == LmSchedule::Auto {
+            o.lm_schedule = if has_obstacles {
+                LmSchedule::Cautious
+            } else {
+                LmSchedule::Adaptive
+            };
+        }
+        o
+    }
 }
 
 fn default_true() -> bool {
@@ -69,6 +112,8 @@ impl Default for StaticOptions {
             lm_damping_initial: default_lm(),
             strain_bound: default_strain(),
             coarse_start: true,
+            sag_start: true,
+            lm_schedule: LmSchedule::Auto,
         }
     }
 }
@@ -107,6 +152,217 @@ pub fn solve_static(
     solve_static_loads(model, x, opts, &loads, observer)
 }
 
+/// What the Newton loop carries between iterations: the buffers (nothing is allocated per
+/// iteration), the Levenberg–Marquardt damping and which Hessian to use.
+struct Workspace {
+    dofs: DofMap,
+    held: Vec<(usize, usize)>,
+    spd: SparseSpd,
+    g: Vec<Vector3<f64>>,
+    h: HessianBlocks,
+    rhs: Vec<f64>,
+    dx: Vec<Vector3<f64>>,
+    trial: Vec<Vector3<f64>>,
+    g_trial: Vec<Vector3<f64>>,
+    shift: Vec<f64>,
+    /// Levenberg–Marquardt damping relative to the mean free diagonal of the Hessian.
+    mu: f64,
+    /// Whether the next iteration uses the exact Hessian (else the projected one).
+    exact: bool,
+    /// Iterations left before the exact Hessian is tried again after it proved indefinite.
+    cooldown: usize,
+    /// The damping schedule (never `Auto` here).
+    schedule: LmSchedule,
+    /// The damping's initial value (the cautious schedule returns to it on projecting).
+    mu_initial: f64,
+}
+
+/// Smallest damping used once damping is needed (relative to the mean diagonal): a compressed
+/// spring's negative transverse stiffness is its strain times k, rarely below 1e-6 k.
+const MU_MIN: f64 = 1e-6;
+
+impl Workspace {
+    fn new(model: &Model, x: &[Vector3<f64>], opts: &StaticOptions) -> Self {
+        let dofs = DofMap::new(&model.fixed);
+        let held = held_dofs(model, &dofs);
+        let n = dofs.n;
+        Self {
+            dofs,
+            held,
+            spd: SparseSpd::new(),
+            g: Vec::new(),
+            h: HessianBlocks::default(),
+            rhs: vec![0.0; n],
+            dx: vec![Vector3::zeros(); x.len()],
+            trial: x.to_vec(),
+            g_trial: Vec::new(),
+            shift: vec![0.0; n],
+            mu: opts.lm_damping_initial,
+            exact: true,
+            cooldown: 0,
+            schedule: match opts.lm_schedule {
+                LmSchedule::Cautious => LmSchedule::Cautious,
+                _ => LmSchedule::Adaptive,
+            },
+            mu_initial: opts.lm_damping_initial,
+        }
+    }
+
+    /// Factorizes the Hessian at `x`, shifted by the damping: the exact Hessian (quadratic
+    /// convergence; projected Newton stalls on a hanging net whose compressed springs' transverse
+    /// stiffness it drops), its damping raised tenfold while it is indefinite, and the projected
+    /// Hessian (every term's indefinite part clamped) for three iterations once the shift would have
+    /// to exceed 1e-3 of the diagonal. False when no damping helps.
+    fn factorize(
+        &mut self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        projected: &mut bool,
+        scale: f64,
+        report: &mut SolveReport,
+    ) -> bool {
+        let cautious = self.schedule == LmSchedule::Cautious;
+        for _ in 0..40 {
+            self.shift.iter_mut().for_each(|s| *s = self.mu * scale);
+            // Held components (symmetry planes): a diagonal far above the rest decouples them,
+            // and their step is set to zero.
+            for &(d, c) in &self.held {
+                self.shift[d + c] += 1e12 * scale.max(1e-300);
+            }
+            let ok = self.spd.factorize(&self.dofs, &self.h, &self.shift);
+            report.factorizations += 1;
+            if ok {
+                report.linear_solves += 1;
+                return true;
+            }
+            // Indefinite: shift the exact Hessian (Levenberg–Marquardt) first; only when a large
+            // shift would be needed, use the projected Hessian.
+            if !*projected && self.mu >= 1e-3 {
+                *projected = true;
+                model.hessian(x, &mut self.h, true);
+                if cautious {
+                    self.mu = self.mu_initial.min(self.mu);
+                } else {
+                    self.cooldown = 3;
+                }
+            } else {
+                self.mu = (self.mu * 10.0).max(if cautious { 1e-8 } else { MU_MIN });
+            }
+        }
+        false
+    }
+
+    /// The Newton step −(H + μD)⁻¹ g into `dx` (zero on fixed particles and held components), and
+    /// the directional derivative gᵀdx.
+    fn step(&mut self, x_len: usize) -> f64 {
+        for (p, gp) in self.g.iter().enumerate() {
+            if let Some(d) = self.dofs.dof(p) {
+                self.rhs[d] = -gp.x;
+                self.rhs[d + 1] = -gp.y;
+                self.rhs[d + 2] = -gp.z;
+            }
+        }
+        for &(d, c) in &self.held {
+            self.rhs[d + c] = 0.0;
+        }
+        self.spd.solve_in_place(&mut self.rhs);
+        for &(d, c) in &self.held {
+            self.rhs[d + c] = 0.0;
+        }
+        let mut slope = 0.0;
+        for p in 0..x_len {
+            self.dx[p] = match self.dofs.dof(p) {
+                Some(d) => Vector3::new(self.rhs[d], self.rhs[d + 1], self.rhs[d + 2]),
+                None => Vector3::zeros(),
+            };
+            slope += self.g[p].dot(&self.dx[p]);
+        }
+        slope
+    }
+
+    /// Backtracking (Armijo) line search along `dx`, bounded by the terms' largest step (contact).
+    /// Near the solution the energy change falls below round-off: there a step that lowers the
+    /// largest residual force is accepted instead. Returns the accepted step length, if any.
+    fn line_search(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        load: f64,
+        e: &mut f64,
+        r: f64,
+        slope: f64,
+    ) -> Option<f64> {
+        let mut alpha = model.max_step(x, &self.dx).min(1.0);
+        let halvings = if self.schedule == LmSchedule::Cautious { 30 } else { 40 };
+        for _ in 0..halvings {
+            for (p, xp) in x.iter().enumerate() {
+                self.trial[p] = xp + self.dx[p] * alpha;
+            }
+            let et = model.energy(&self.trial, load);
+            let flat = (et - *e).abs() <= 1e-11 * e.abs().max(1e-300);
+            let lowers_residual = flat && {
+                model.gradient(&self.trial, load, &mut self.g_trial);
+                free_max_residual(model, &self.g_trial) < r
+            };
+            if et.is_finite() && (et <= *e + 1e-4 * alpha * slope || lowers_residual) {
+                x.copy_from_slice(&self.trial);
+                *e = et;
+                return Some(alpha);
+            }
+            alpha *= 0.5;
+        }
+        None
+    }
+
+    /// One damped Newton iteration from `x`: factorize, step, line search, then adapt the damping
+    /// (divided by 10 after a full step, multiplied by 10 when the line search had to cut the step
+    /// below 1/8) and re-enable the exact Hessian after a full projected step. False when no step
+    /// lowers the energy.
+    fn iterate(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        load: f64,
+        e: &mut f64,
+        (r, tol): (f64, f64),
+        report: &mut SolveReport,
+    ) -> bool {
+        self.cooldown = self.cooldown.saturating_sub(1);
+        let cautious = self.schedule == LmSchedule::Cautious;
+        let mut projected = !(self.exact && self.cooldown == 0);
+        model.hessian(x, &mut self.h, projected);
+        // The damping's scale: the mean diagonal of this iteration's first Hessian.
+        let scale = mean_free_diagonal(&self.h, &self.dofs, model.len());
+        for _ in 0..20 {
+            if !self.factorize(model, x, &mut projected, scale, report) {
+                return false;
+            }
+            let slope = self.step(x.len());
+            let full = model.max_step(x, &self.dx) >= 1.0;
+            match self.line_search(model, x, load, e, r, slope) {
+                Some(alpha) => {
+                    if cautious {
+                        if alpha == 1.0 && full {
+                            self.mu = if self.mu < 1e-12 { 0.0 } else { self.mu / 4.0 };
+                        }
+                    } else if alpha == 1.0 {
+                        self.mu = if self.mu < 1e-10 { 0.0 } else { self.mu / 10.0 };
+                    } else if alpha < 0.125 {
+                        self.mu = (self.mu * 10.0).max(MU_MIN);
+                    }
+                    return true;
+                }
+                // A step that does not decrease the energy: near the solution, round-off.
+                None if cautious && r <= 10.0 * tol => return false,
+                None => {
+                    self.mu = (self.mu * 10.0).max(if cautious { 1e-8 } else { MU_MIN });
+                }
+            }
+        }
+        false
+    }
+}
+
 /// [`solve_static`] through the given load factors (increasing; the last one is solved to the
 /// tolerance and reported, the others only roughly).
 pub fn solve_static_loads(
@@ -117,7 +373,6 @@ pub fn solve_static_loads(
     observer: &mut dyn Observer,
 ) -> SolveReport {
     let start = Instant::now();
-    let dofs = DofMap::new(&model.fixed);
     let w_ref = model.reference_weight();
     let tol = opts.residual_tol_rel * w_ref;
     let mut report = SolveReport {
@@ -126,6 +381,8 @@ pub fn solve_static_loads(
         iterations: 0,
         linear_solves: 0,
         inner_iterations: 0,
+        factorizations: 0,
+        factor_time_s: 0.0,
         max_residual_N: f64::NAN,
         max_residual_rel: f64::NAN,
         energy_J: f64::NAN,
@@ -136,29 +393,22 @@ pub fn solve_static_loads(
         message: String::new(),
         minimum: None,
     };
-    if dofs.n == 0 || !w_ref.is_finite() {
+    let mut ws = Workspace::new(model, x, opts);
+    if ws.dofs.n == 0 || !w_ref.is_finite() {
         report.status = Status::Invalid;
         report.message = "no free particle with mass: nothing to solve".into();
         return report;
     }
-    let held = held_dofs(model, &dofs);
-    let mut spd = SparseSpd::new();
-    let mut g = Vec::new();
-    let mut h = HessianBlocks::default();
-    let mut rhs = vec![0.0; dofs.n];
-    let mut trial = x.to_vec();
-    let mut g_trial = Vec::new();
-    let mut shift = vec![0.0; dofs.n];
     let steps = loads.len().max(1);
     let mut iter = 0usize;
-    let mut mu = opts.lm_damping_initial;
     let mut floor = false;
     'load: for step in 1..=steps {
         let load = loads.get(step - 1).copied().unwrap_or(1.0);
+        let last = step == steps;
         let mut e = model.energy(x, load);
         loop {
-            model.gradient(x, load, &mut g);
-            let r = free_max_residual(model, &g);
+            model.gradient(x, load, &mut ws.g);
+            let r = free_max_residual(model, &ws.g);
             if !r.is_finite() || !e.is_finite() {
                 report.status = Status::Diverged;
                 report.divergence = Some(Divergence {
@@ -177,18 +427,18 @@ pub fn solve_static_loads(
                     energy_J: e,
                 });
             }
-            if r <= tol && step == steps {
+            if r <= tol && last {
                 report.status = Status::Converged;
                 break 'load;
             }
             // Round-off floor: the residual cannot fall below ~16 ε k |x| (see Model::roundoff_force);
             // reaching it after the tolerance proved unreachable is convergence, said in the message.
-            if step == steps && r <= model.roundoff_force(x) && r <= 1e3 * tol {
+            if last && r <= model.roundoff_force(x) && r <= 1e3 * tol {
                 report.status = Status::Converged;
                 floor = true;
                 break 'load;
             }
-            if r <= tol.max(1e-6 * w_ref) && step < steps {
+            if r <= tol.max(1e-6 * w_ref) && !last {
                 continue 'load;
             }
             if iter >= opts.max_iterations {
@@ -199,103 +449,11 @@ pub fn solve_static_loads(
                 break 'load;
             }
             iter += 1;
-            // The exact Hessian gives quadratic convergence; where it is indefinite (compressed springs)
-            // the projected one keeps the step a descent direction.
-            model.hessian(x, &mut h, false);
-            let scale = mean_free_diagonal(&h, &dofs, model.len());
-            let mut projected = false;
-            let mut accepted = false;
-            for _attempt in 0..40 {
-                shift.iter_mut().for_each(|s| *s = mu * scale);
-                // Held components (symmetry planes): a diagonal far above the rest decouples them,
-                // and their step is set to zero below.
-                for &(d, c) in &held {
-                    shift[d + c] += 1e12 * scale.max(1e-300);
-                }
-                if !spd.factorize(&dofs, &h, &shift) {
-                    // Indefinite: first shift the exact Hessian (Levenberg–Marquardt), and only when a
-                    // large shift is needed fall back to the projected Hessian.
-                    if !projected && mu >= 1e-3 {
-                        projected = true;
-                        model.hessian(x, &mut h, true);
-                        mu = opts.lm_damping_initial.min(mu);
-                    } else {
-                        mu = (mu * 10.0).max(1e-8);
-                    }
-                    continue;
-                }
-                report.linear_solves += 1;
-                for (p, gp) in g.iter().enumerate() {
-                    if let Some(d) = dofs.dof(p) {
-                        rhs[d] = -gp.x;
-                        rhs[d + 1] = -gp.y;
-                        rhs[d + 2] = -gp.z;
-                    }
-                }
-                for &(d, c) in &held {
-                    rhs[d + c] = 0.0;
-                }
-                spd.solve_in_place(&mut rhs);
-                for &(d, c) in &held {
-                    rhs[d + c] = 0.0;
-                }
-                // Backtracking line search on the energy (Armijo condition).
-                let slope: f64 = g
-                    .iter()
-                    .enumerate()
-                    .filter_map(|(p, gp)| {
-                        dofs.dof(p)
-                            .map(|d| gp.x * rhs[d] + gp.y * rhs[d + 1] + gp.z * rhs[d + 2])
-                    })
-                    .sum();
-                // Terms may bound the step (contact: no particle may be carried into an obstacle).
-                let dx: Vec<Vector3<f64>> = (0..x.len())
-                    .map(|p| match dofs.dof(p) {
-                        Some(d) => Vector3::new(rhs[d], rhs[d + 1], rhs[d + 2]),
-                        None => Vector3::zeros(),
-                    })
-                    .collect();
-                let mut alpha = model.max_step(x, &dx).min(1.0);
-                let full_step = alpha == 1.0;
-                for _ in 0..30 {
-                    for (p, xp) in x.iter().enumerate() {
-                        trial[p] = match dofs.dof(p) {
-                            Some(d) => xp + Vector3::new(rhs[d], rhs[d + 1], rhs[d + 2]) * alpha,
-                            None => *xp,
-                        };
-                    }
-                    let et = model.energy(&trial, load);
-                    // Near the solution the energy change falls below round-off: there, accept a step
-                    // that lowers the largest residual force instead (the gradient is accurate).
-                    let flat = (et - e).abs() <= 1e-11 * e.abs().max(1e-300);
-                    let lowers_residual = flat && {
-                        model.gradient(&trial, load, &mut g_trial);
-                        free_max_residual(model, &g_trial) < r
-                    };
-                    if et.is_finite() && (et <= e + 1e-4 * alpha * slope || lowers_residual) {
-                        x.copy_from_slice(&trial);
-                        e = et;
-                        accepted = true;
-                        break;
-                    }
-                    alpha *= 0.5;
-                }
-                if accepted {
-                    if alpha == 1.0 && full_step {
-                        mu = if mu < 1e-12 { 0.0 } else { mu / 4.0 };
-                    }
-                    break;
-                }
-                // A step that does not decrease the energy: near the solution, round-off; otherwise damp more.
-                if r <= 10.0 * tol {
-                    break;
-                }
-                mu = (mu * 10.0).max(1e-8);
-            }
-            if !accepted {
-                model.gradient(x, load, &mut g);
-                let r = free_max_residual(model, &g);
-                if r <= tol && step == steps {
+            if !ws.iterate(model, x, load, &mut e, (r, tol), &mut report) {
+                // A step that does not decrease the energy: near the solution, round-off.
+                model.gradient(x, load, &mut ws.g);
+                let r = free_max_residual(model, &ws.g);
+                if r <= tol && last {
                     report.status = Status::Converged;
                 } else {
                     report.message =
@@ -316,9 +474,10 @@ pub fn solve_static_loads(
         }
     }
     let final_load = loads.last().copied().unwrap_or(1.0);
-    model.gradient(x, final_load, &mut g);
+    model.gradient(x, final_load, &mut ws.g);
     report.iterations = iter;
-    report.max_residual_N = free_max_residual(model, &g);
+    report.factor_time_s = ws.spd.factor_time_s;
+    report.max_residual_N = free_max_residual(model, &ws.g);
     report.max_residual_rel = report.max_residual_N / w_ref;
     report.energy_J = model.energy(x, final_load);
     report.wall_time_s = start.elapsed().as_secs_f64();

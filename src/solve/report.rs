@@ -52,6 +52,12 @@ pub struct SolveReport {
     pub linear_solves: usize,
     /// Inner iterations of the linear solver (CG), 0 for direct solves.
     pub inner_iterations: usize,
+    /// Numeric Cholesky factorizations attempted, those that failed (an indefinite matrix) included.
+    #[serde(default)]
+    pub factorizations: usize,
+    /// Wall time of the factorizations and triangular solves alone, s.
+    #[serde(default)]
+    pub factor_time_s: f64,
     /// Largest residual force on a free particle in N, at the final state.
     pub max_residual_N: f64,
     /// The same relative to the weight of the lightest free particle.
@@ -89,6 +95,8 @@ impl SolveReport {
             Some(mut t) => {
                 t.iterations += latest.iterations;
                 t.linear_solves += latest.linear_solves;
+                t.factorizations += latest.factorizations;
+                t.factor_time_s += latest.factor_time_s;
                 t.wall_time_s += latest.wall_time_s;
                 t.status = latest.status;
                 t.max_residual_N = latest.max_residual_N;

@@ -52,6 +52,11 @@ pub struct BenchmarkParams {
     /// Default none.
     #[serde(default)]
     pub max_wall_time_s: Option<f64>,
+    /// Static solves of seed 000's slack-net population (the first scene on the 14 × 14 net over
+    /// Table 3's box, [`crate::benchmark::slack_net_population`]) written to the output named
+    /// `population.parquet`. Default 0 (none).
+    #[serde(default)]
+    pub slack_net_population: usize,
 }
 
 fn default_sizes() -> Vec<usize> {
@@ -107,6 +112,8 @@ pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
         Field::new("wall_time_s", DataType::Float64, false),
         Field::new("iterations", DataType::UInt64, false),
         Field::new("linear_solves", DataType::UInt64, false),
+        Field::new("factorizations", DataType::UInt64, false),
+        Field::new("factor_time_s", DataType::Float64, false),
         Field::new("error_m", DataType::Float64, true),
         Field::new("peak_rss_bytes", DataType::UInt64, true),
     ]));
@@ -131,6 +138,10 @@ pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
         Arc::new(UInt64Array::from_iter_values(
             rows.iter().map(|r| r.linear_solves as u64),
         )),
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|r| r.factorizations as u64),
+        )),
+        f64s(rows.iter().map(|r| r.factor_time_s).collect()),
         Arc::new(Float64Array::from_iter(
             rows.iter()
                 .map(|r| r.error_m.is_finite().then_some(r.error_m)),
@@ -139,7 +150,50 @@ pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
             rows.iter().map(|r| r.peak_rss_bytes),
         )),
     ];
-    write_parquet(&ctx.outputs[0], &RecordBatch::try_new(schema, cols)?, None)
+    write_parquet(&ctx.outputs[0], &RecordBatch::try_new(schema, cols)?, None)?;
+    if p.slack_net_population > 0 {
+        let out = ctx
+            .outputs
+            .iter()
+            .find(|o| o.file_name().is_some_and(|n| n == "population.parquet"))
+            .context("slack_net_population needs an output named population.parquet")?;
+        let rows = crate::benchmark::slack_net_population(&scenes[0], p.slack_net_population, 8);
+        write_population(out, &rows)?;
+    }
+    Ok(())
+}
+
+/// Writes the slack-net population's solves as a Parquet table.
+fn write_population(out: &std::path::Path, rows: &[crate::benchmark::PopulationRow]) -> Result<()> {
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("stiffness_N_per_m", DataType::Float64, false),
+        Field::new("natural_length_m", DataType::Float64, false),
+        Field::new("topology", DataType::Utf8, false),
+        Field::new("areal_density_kg_per_m2", DataType::Float64, false),
+        Field::new("status", DataType::Utf8, false),
+        Field::new("iterations", DataType::UInt64, false),
+        Field::new("factorizations", DataType::UInt64, false),
+        Field::new("wall_time_s", DataType::Float64, false),
+        Field::new("factor_time_s", DataType::Float64, false),
+    ]));
+    let u64s = |f: &dyn Fn(&crate::benchmark::PopulationRow) -> usize| -> ArrayRef {
+        Arc::new(UInt64Array::from_iter_values(rows.iter().map(|r| f(r) as u64)))
+    };
+    let strs = |f: &dyn Fn(&crate::benchmark::PopulationRow) -> String| -> ArrayRef {
+        Arc::new(StringArray::from_iter_values(rows.iter().map(f)))
+    };
+    let cols: Vec<ArrayRef> = vec![
+        f64s(rows.iter().map(|r| r.stiffness_N_per_m).collect()),
+        f64s(rows.iter().map(|r| r.natural_length_m).collect()),
+        strs(&|r| r.topology.clone()),
+        f64s(rows.iter().map(|r| r.areal_density_kg_per_m2).collect()),
+        strs(&|r| r.status.clone()),
+        u64s(&|r| r.iterations),
+        u64s(&|r| r.factorizations),
+        f64s(rows.iter().map(|r| r.wall_time_s).collect()),
+        f64s(rows.iter().map(|r| r.factor_time_s).collect()),
+    ];
+    write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)
 }
 
 /// Parameters of a peers stage.
@@ -178,10 +232,16 @@ pub fn run_peers(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
         Ok(std::fs::canonicalize(ctx.input_named(name)?)?)
     };
     let (newton, explicit) = (script("scipy_newton.py")?, script("numpy_explicit.py")?);
+    // The CHOLMOD peer (cvxopt) runs when its script is an input.
+    let cholmod = ctx
+        .input_named("cholmod_newton.py")
+        .ok()
+        .map(std::fs::canonicalize)
+        .transpose()?;
     let python = std::path::absolute(ctx.plan.root.join(&p.python))?;
     let has = |py: &std::path::Path| {
         std::process::Command::new(py)
-            .args(["-c", "import numpy, scipy"])
+            .args(["-c", "import numpy, scipy, cvxopt"])
             .output()
             .is_ok_and(|o| o.status.success())
     };
@@ -198,11 +258,11 @@ pub fn run_peers(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
                 .context("python3 -m venv")?;
         }
         let ok = std::process::Command::new(&python)
-            .args(["-m", "pip", "install", "-q", "numpy", "scipy"])
+            .args(["-m", "pip", "install", "-q", "numpy", "scipy", "cvxopt"])
             .status()
-            .context("pip install numpy scipy")?;
+            .context("pip install numpy scipy cvxopt")?;
         if !ok.success() || !has(&python) {
-            bail!("{}: cannot install numpy and scipy", python.display());
+            bail!("{}: cannot install numpy, scipy and cvxopt", python.display());
         }
     }
     let run_py = |script: &std::path::Path, args: &[String]| -> Result<serde_json::Value> {
@@ -239,6 +299,17 @@ pub fn run_peers(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
             peer["centre_z_m"].as_f64().unwrap_or(f64::NAN),
             sol.at(n / 2, n / 2).z,
         ));
+        if let Some(script) = &cholmod {
+            let peer = run_py(script, &[n.to_string(), "1e-6".into()])?;
+            rows.push((
+                "static: CHOLMOD (cvxopt) projected Newton / drapelab",
+                n,
+                peer["wall_time_s"].as_f64().unwrap_or(f64::NAN),
+                sol.report.wall_time_s,
+                peer["centre_z_m"].as_f64().unwrap_or(f64::NAN),
+                sol.at(n / 2, n / 2).z,
+            ));
+        }
         ctx.progress.item_done(&ctx.stage.name);
     }
     for &n in &p.explicit_sizes {
@@ -469,6 +540,10 @@ dynamic point).\n\n| scene | solver | converged | max-iterations | diverged | in
             c("invalid")
         );
     }
+    md += &newton_work_section(&bench)?;
+    if let Ok(pop) = ctx.input_named("population.parquet") {
+        md += &population_section(&read(pop)?)?;
+    }
     md += "\n## Every point\n\n";
     md += &markdown(&bench);
     if let Ok(skips) = ctx.input_named("skips.parquet") {
@@ -493,6 +568,105 @@ equilibrium.\n";
     }
     ctx.progress.item_done(&ctx.stage.name);
     Ok(())
+}
+
+/// The static solves' work per scene and grid at the tightest tolerance: Newton iterations,
+/// factorizations, wall time, the factorizations' own time and what is left (assembly, line
+/// search, energy and gradient evaluations).
+fn newton_work_section(bench: &DataFrame) -> Result<String> {
+    let tols = bench.column("tolerance_rel")?.f64()?.clone();
+    let tightest = (0..tols.len())
+        .filter_map(|i| tols.get(i))
+        .fold(f64::INFINITY, f64::min);
+    let mut md = format!(
+        "\n## Newton iterations and factorizations per solve\n\nStatic solves at tolerance {tightest:.0e}, \
+from the flat sheet (a coarse or sagged start included in the counts). Factorizations count the failed ones \
+too (an indefinite exact Hessian, retried projected); the factorization time is that of the numeric \
+Cholesky factorizations and triangular solves alone, the rest is assembly, line search and the \
+coarse start's own overhead.\n\n| scene | particles | status | iterations | factorizations | wall time (ms) | factorization time (ms) | rest (ms) |\n|---|---|---|---|---|---|---|---|\n"
+    );
+    let col = |c: &str| bench.column(c).map(|c| c.as_materialized_series().clone());
+    let (scene, solver, status, n, tol, wall, it, fact, ft) = (
+        col("scene")?,
+        col("solver")?,
+        col("status")?,
+        col("particles_per_side")?,
+        col("tolerance_rel")?,
+        col("wall_time_s")?,
+        col("iterations")?,
+        col("factorizations")?,
+        col("factor_time_s")?,
+    );
+    for r in 0..bench.height() {
+        if solver.str()?.get(r) != Some("static")
+            || tol.f64()?.get(r).is_none_or(|t| (t / tightest - 1.0).abs() > 1e-9)
+        {
+            continue;
+        }
+        let (w, f) = (
+            wall.f64()?.get(r).unwrap_or(f64::NAN),
+            ft.f64()?.get(r).unwrap_or(f64::NAN),
+        );
+        let k = n.u64()?.get(r).unwrap_or(0);
+        let _ = writeln!(
+            md,
+            "| {} | {k}×{k} | {} | {} | {} | {:.3} | {:.3} | {:.3} |",
+            scene.str()?.get(r).unwrap_or(""),
+            status.str()?.get(r).unwrap_or(""),
+            it.u64()?.get(r).unwrap_or(0),
+            fact.u64()?.get(r).unwrap_or(0),
+            w * 1e3,
+            f * 1e3,
+            (w - f) * 1e3
+        );
+    }
+    Ok(md)
+}
+
+/// The slack-net population's iterations, factorizations and times per solve (min / median / max).
+fn population_section(pop: &DataFrame) -> Result<String> {
+    let f = |c: &str| -> Result<Vec<f64>> {
+        let s = pop.column(c)?.as_materialized_series().cast(&polars::prelude::DataType::Float64)?;
+        let ca = s.f64()?;
+        Ok((0..ca.len()).map(|i| ca.get(i).unwrap_or(f64::NAN)).collect())
+    };
+    let strings = |c: &str| -> Result<Vec<String>> {
+        let ca = pop.column(c)?.str()?.clone();
+        Ok((0..ca.len())
+            .map(|i| ca.get(i).unwrap_or("").to_string())
+            .collect())
+    };
+    let status = strings("status")?;
+    let (k, l, d, it, fa, w, ft) = (
+        f("stiffness_N_per_m")?,
+        f("natural_length_m")?,
+        f("areal_density_kg_per_m2")?,
+        f("iterations")?,
+        f("factorizations")?,
+        f("wall_time_s")?,
+        f("factor_time_s")?,
+    );
+    let topology = strings("topology")?;
+    let rows: Vec<crate::benchmark::PopulationRow> = (0..pop.height())
+        .map(|r| crate::benchmark::PopulationRow {
+            stiffness_N_per_m: k[r],
+            natural_length_m: l[r],
+            topology: topology[r].clone(),
+            areal_density_kg_per_m2: d[r],
+            status: status[r].clone(),
+            iterations: it[r] as usize,
+            factorizations: fa[r] as usize,
+            wall_time_s: w[r],
+            factor_time_s: ft[r],
+        })
+        .collect();
+    Ok(format!(
+        "\n## Seed 000's slack-net population\n\nhang4 on the 14 × 14 net, static, at {} points of a Latin \
+hypercube over Table 3's stiffness and natural length, the three topologies and Table 2's densities (what a \
+calibration asks thousands of times). {}",
+        rows.len(),
+        crate::benchmark::population_table(&rows)
+    ))
 }
 
 /// Parameters of a skips stage.

@@ -235,8 +235,45 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
         rel(conv_svg),
         rel(effects_svg),
         markdown(&cmp)
-    );
+    ) + &run_time_section(ctx, &res, &cmp)?;
     write_text(md, &text)?;
     ctx.progress.item_done(&ctx.stage.name);
     Ok(())
+}
+
+/// The wall time of every other stage of the plan (from its manifest, when it has run) and the
+/// number of hang simulations of the calibration (cache misses: ICA, polish, identifiability and
+/// the CMA-ES baseline's evaluations).
+fn run_time_section(ctx: &StageContext<'_>, res: &DataFrame, cmp: &DataFrame) -> Result<String> {
+    let mut rows = String::new();
+    let mut total = 0.0;
+    for st in &ctx.plan.stages {
+        if st.name == ctx.stage.name {
+            continue;
+        }
+        let path = crate::pipeline::manifest_path(ctx.plan, &st.name);
+        if let Some(m) = crate::pipeline::Manifest::read(&path) {
+            total += m.wall_time_s;
+            rows += &format!("| {} | {} | {:.1} |\n", st.name, m.kind, m.wall_time_s);
+        }
+    }
+    let sims_col = res.column("simulations")?.cast(&DataType::UInt64)?;
+    let sims_ca = sims_col.u64()?;
+    let sims: u64 = (0..sims_ca.len()).filter_map(|i| sims_ca.get(i)).sum();
+    let cmaes: f64 = cmp
+        .clone()
+        .lazy()
+        .filter(col("optimizer").eq(lit("cma-es")))
+        .select([(col("mean_evaluations") * col("runs").cast(DataType::Float64)).sum()])
+        .collect()?
+        .column("mean_evaluations")?
+        .f64()?
+        .get(0)
+        .unwrap_or(0.0);
+    Ok(format!(
+        "\n## Run time\n\nWall time of each stage of this run (the last time it ran; an up-to-date stage keeps \
+its time), on this machine:\n\n| stage | kind | wall time s |\n|---|---|---|\n{rows}| all of the above | | {total:.1} |\n\n\
+Simulations of the 4-corner hang in the calibration: {sims} (ICA, polish and identifiability, distinct \
+parameter vectors) and {cmaes:.0} for the CMA-ES baseline.\n"
+    ))
 }

@@ -6,6 +6,7 @@ mod cli;
 mod contact;
 mod edges;
 mod engine;
+mod equilibria;
 mod loads;
 mod pipeline;
 mod recordings;
