@@ -283,6 +283,8 @@ pub fn markdown_table(rows: &[BenchRow]) -> String {
 /// One solve of seed 000's slack-net population.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PopulationRow {
+    /// Where Newton started: "sagged" (the sagged start) or "lattice" (the calibration's warm start).
+    pub start: String,
     /// Spring stiffness, N/m.
     pub stiffness_N_per_m: f64,
     /// Natural length, m.
@@ -335,6 +337,7 @@ pub fn slack_net_population(scene: &Scene, samples: usize, seed: u64) -> Vec<Pop
             let sol = solve_scene(&s, &mut NoObserver);
             let ms = s.material.mass_spring.as_ref().expect("set above");
             PopulationRow {
+                start: "sagged".into(),
                 stiffness_N_per_m: ms.stiffness_N_per_m,
                 natural_length_m: ms.natural_length_m.unwrap_or(f64::NAN),
                 topology: format!("{:?}", ms.topology).to_lowercase(),
@@ -347,6 +350,55 @@ pub fn slack_net_population(scene: &Scene, samples: usize, seed: u64) -> Vec<Pop
             }
         })
         .collect()
+}
+
+/// What a calibration asks of the solver: the 14 × 14 net of `scene` (its density) at `samples`
+/// Latin-hypercube points of Table 3's stiffness, natural length and topology, each solved from the
+/// drape at the nearest node of the calibration's warm-start lattice
+/// ([`crate::calibrate::StartLattice`]). Returns the rows and the lattice's own solve time in s.
+pub fn warm_start_population(
+    scene: &Scene,
+    samples: usize,
+    seed: u64,
+) -> (Vec<PopulationRow>, f64) {
+    use rand::{Rng, SeedableRng, seq::SliceRandom};
+    let mut net = scene.regridded(14, 14);
+    net.solver.kind = SolverKind::Static;
+    net.record.timeline = false;
+    net.record.rerun = false;
+    let problem = crate::calibrate::Problem::new(net.clone(), vec![], 50.0);
+    let t = Instant::now();
+    problem.drape(&[0.5; 5]);
+    let lattice_s = t.elapsed().as_secs_f64();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut strata: Vec<Vec<usize>> = (0..3).map(|_| (0..samples).collect()).collect();
+    for s in &mut strata {
+        s.shuffle(&mut rng);
+    }
+    let rows = (0..samples)
+        .map(|k| {
+            let mut u = vec![0.5; 5];
+            for (d, &dim) in [0usize, 3, 4].iter().enumerate() {
+                u[dim] = (strata[d][k] as f64 + rng.random::<f64>()) / samples as f64;
+            }
+            let p = problem.bounds.decode(&u);
+            let t = Instant::now();
+            let (sol, _) = problem.drape(&u);
+            PopulationRow {
+                start: "lattice".into(),
+                stiffness_N_per_m: p.stiffness_N_per_m,
+                natural_length_m: p.natural_length_m,
+                topology: format!("{:?}", p.topology).to_lowercase(),
+                areal_density_kg_per_m2: net.cloth.areal_density_kg_per_m2,
+                status: sol.report.status.as_str().into(),
+                iterations: sol.report.iterations,
+                factorizations: sol.report.factorizations,
+                wall_time_s: t.elapsed().as_secs_f64(),
+                factor_time_s: sol.report.factor_time_s,
+            }
+        })
+        .collect();
+    (rows, lattice_s)
 }
 
 /// min / median / max of `v` (NaN for an empty slice).

@@ -101,7 +101,7 @@ pub struct Problem {
     /// the sagged start. Either way the cost stays a pure function of the parameter vector.
     /// Default true.
     pub warm_start: bool,
-    lattice: std::sync::OnceLock<StartLattice>,
+    lattice: std::sync::Arc<std::sync::OnceLock<StartLattice>>,
     cache: Mutex<HashMap<Vec<u64>, Evaluation>>,
     /// Simulations run (cache misses).
     pub simulations: AtomicUsize,
@@ -120,11 +120,23 @@ impl Problem {
             penalty: 100.0,
             caching: true,
             warm_start: true,
-            lattice: std::sync::OnceLock::new(),
+            lattice: Default::default(),
             cache: Mutex::new(HashMap::new()),
             simulations: AtomicUsize::new(0),
             failures: AtomicUsize::new(0),
         }
+    }
+
+    /// A problem over the same scene and measurement with an empty cache and counters, sharing this
+    /// one's warm-start lattice (solved at most once for both): a baseline optimizer's own problem.
+    pub fn fresh(&self) -> Self {
+        let mut p = Self::new(self.scene.clone(), self.measured.clone(), self.side_cm);
+        p.bounds = self.bounds.clone();
+        p.penalty = self.penalty;
+        p.caching = self.caching;
+        p.warm_start = self.warm_start;
+        p.lattice = self.lattice.clone();
+        p
     }
 
     /// The scene with `p` applied.
@@ -237,7 +249,8 @@ impl Problem {
 }
 
 /// Deterministic warm starts for one sample: the static drapes at a fixed lattice of Table 3's box
-/// (every topology × 4 stiffnesses × 11 natural lengths), each solved from the sagged start, so that
+/// (every topology × 4 stiffnesses × 11 natural lengths), solved by continuation in the natural length
+/// from the sagged start along each (topology, stiffness) in a fixed order, so that
 /// an evaluation's start — and with it the equilibrium a slack net lands on — depends on its own
 /// parameters only, never on which evaluations came before or on the thread count.
 pub struct StartLattice {
@@ -262,28 +275,39 @@ impl StartLattice {
         let k = nodes(b.stiffness_N_per_m, Self::STIFFNESSES);
         let l = nodes(b.natural_length_m, Self::LENGTHS);
         let topologies = [Topology::A, Topology::B, Topology::C];
-        let mut points: Vec<(Topology, f64, f64)> = Vec::new();
-        for &t in &topologies {
-            for &kk in &k {
-                for &ll in &l {
-                    points.push((t, kk, ll));
-                }
-            }
-        }
-        let drapes = points
+        let chains: Vec<(Topology, f64)> = topologies
+            .iter()
+            .flat_map(|&t| k.iter().map(move |&kk| (t, kk)))
+            .collect();
+        // One chain per (topology, stiffness), in parallel; along a chain, continuation in the
+        // natural length (each node from the previous node's drape, the first from the sagged start).
+        let drapes: Vec<Vec<Option<Vec<nalgebra::Vector3<f64>>>>> = chains
             .par_iter()
-            .map(|&(topology, kk, ll)| {
-                let scene = problem.scene_for(&Params {
-                    stiffness_N_per_m: kk,
-                    damping_Ns_per_m: b.damping_Ns_per_m.0,
-                    elongation_rate: b.elongation_rate.0,
-                    natural_length_m: ll,
-                    topology,
-                });
-                let sol = solve_scene(&scene, &mut NoObserver);
-                sol.report.is_converged().then_some(sol.x)
+            .map(|&(topology, kk)| {
+                let mut prev: Option<Vec<nalgebra::Vector3<f64>>> = None;
+                l.iter()
+                    .map(|&ll| {
+                        let scene = problem.scene_for(&Params {
+                            stiffness_N_per_m: kk,
+                            damping_Ns_per_m: b.damping_Ns_per_m.0,
+                            elongation_rate: b.elongation_rate.0,
+                            natural_length_m: ll,
+                            topology,
+                        });
+                        let sol = match &prev {
+                            Some(x0) => crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver),
+                            None => solve_scene(&scene, &mut NoObserver),
+                        };
+                        let x = sol.report.is_converged().then_some(sol.x);
+                        if x.is_some() {
+                            prev = x.clone();
+                        }
+                        x
+                    })
+                    .collect()
             })
             .collect();
+        let drapes = drapes.into_iter().flatten().collect();
         Self {
             stiffness_N_per_m: k,
             natural_length_m: l,

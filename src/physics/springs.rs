@@ -106,6 +106,27 @@ impl EnergyTerm for Springs {
             .map(|(&(a, b), &l0)| (((x[b as usize] - x[a as usize]).norm() - l0) / l0).abs())
             .fold(0.0, f64::max)
     }
+    fn limit_stretch(&self, before: &Vecs, x: &mut Vecs, free: &[bool], tol: f64) {
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            let lmax = (before[b] - before[a]).norm().max(self.rest_m[k]) * (1.0 + tol);
+            let d = x[b] - x[a];
+            let l = d.norm();
+            if l <= lmax || l == 0.0 {
+                continue;
+            }
+            let excess = d * ((l - lmax) / l);
+            match (free[a], free[b]) {
+                (true, true) => {
+                    x[a] += excess * 0.5;
+                    x[b] -= excess * 0.5;
+                }
+                (true, false) => x[a] += excess,
+                (false, true) => x[b] -= excess,
+                (false, false) => {}
+            }
+        }
+    }
     fn provot_correct(&self, x: &mut Vecs, free: &[bool], rate: f64) {
         if !matches!(self.family, SpringFamily::Structural | SpringFamily::Shear) {
             return;

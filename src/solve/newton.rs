@@ -177,6 +177,10 @@ struct Workspace {
     mu_initial: f64,
 }
 
+/// The stretch a straight Newton step may add to a spring before the adaptive schedule's line
+/// search pulls it back (relative to the longer of its rest and previous length).
+const STRETCH_TOL: f64 = 1e-3;
+
 /// Smallest damping used once damping is needed (relative to the mean diagonal): a compressed
 /// spring's negative transverse stiffness is its strain times k, rarely below 1e-6 k.
 const MU_MIN: f64 = 1e-6;
@@ -293,10 +297,17 @@ impl Workspace {
         slope: f64,
     ) -> Option<f64> {
         let mut alpha = model.max_step(x, &self.dx).min(1.0);
-        let halvings = if self.schedule == LmSchedule::Cautious { 30 } else { 40 };
+        let cautious = self.schedule == LmSchedule::Cautious;
+        let halvings = if cautious { 30 } else { 40 };
         for _ in 0..halvings {
             for (p, xp) in x.iter().enumerate() {
                 self.trial[p] = xp + self.dx[p] * alpha;
+            }
+            if !cautious {
+                // A straight step rotates stiff springs and stretches them at second order, which
+                // the energy punishes with a tiny step: pull back what the step stretched by more
+                // than 1e-3 (a curvilinear step; near the solution nothing is pulled back).
+                model.limit_stretch(x, &mut self.trial, STRETCH_TOL);
             }
             let et = model.energy(&self.trial, load);
             let flat = (et - *e).abs() <= 1e-11 * e.abs().max(1e-300);

@@ -157,7 +157,9 @@ pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
             .iter()
             .find(|o| o.file_name().is_some_and(|n| n == "population.parquet"))
             .context("slack_net_population needs an output named population.parquet")?;
-        let rows = crate::benchmark::slack_net_population(&scenes[0], p.slack_net_population, 8);
+        let mut rows =
+            crate::benchmark::slack_net_population(&scenes[0], p.slack_net_population, 8);
+        rows.extend(crate::benchmark::warm_start_population(&scenes[0], p.slack_net_population, 9).0);
         write_population(out, &rows)?;
     }
     Ok(())
@@ -166,6 +168,7 @@ pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
 /// Writes the slack-net population's solves as a Parquet table.
 fn write_population(out: &std::path::Path, rows: &[crate::benchmark::PopulationRow]) -> Result<()> {
     let schema = Arc::new(Schema::new(vec![
+        Field::new("start", DataType::Utf8, false),
         Field::new("stiffness_N_per_m", DataType::Float64, false),
         Field::new("natural_length_m", DataType::Float64, false),
         Field::new("topology", DataType::Utf8, false),
@@ -183,6 +186,7 @@ fn write_population(out: &std::path::Path, rows: &[crate::benchmark::PopulationR
         Arc::new(StringArray::from_iter_values(rows.iter().map(f)))
     };
     let cols: Vec<ArrayRef> = vec![
+        strs(&|r| r.start.clone()),
         f64s(rows.iter().map(|r| r.stiffness_N_per_m).collect()),
         f64s(rows.iter().map(|r| r.natural_length_m).collect()),
         strs(&|r| r.topology.clone()),
@@ -647,8 +651,10 @@ fn population_section(pop: &DataFrame) -> Result<String> {
         f("factor_time_s")?,
     );
     let topology = strings("topology")?;
+    let start = strings("start")?;
     let rows: Vec<crate::benchmark::PopulationRow> = (0..pop.height())
         .map(|r| crate::benchmark::PopulationRow {
+            start: start[r].clone(),
             stiffness_N_per_m: k[r],
             natural_length_m: l[r],
             topology: topology[r].clone(),
@@ -660,12 +666,20 @@ fn population_section(pop: &DataFrame) -> Result<String> {
             factor_time_s: ft[r],
         })
         .collect();
+    let of = |which: &str| -> Vec<crate::benchmark::PopulationRow> {
+        rows.iter().filter(|r| r.start == which).cloned().collect()
+    };
+    let (sagged, lattice) = (of("sagged"), of("lattice"));
     Ok(format!(
         "\n## Seed 000's slack-net population\n\nhang4 on the 14 × 14 net, static, at {} points of a Latin \
 hypercube over Table 3's stiffness and natural length, the three topologies and Table 2's densities (what a \
-calibration asks thousands of times). {}",
-        rows.len(),
-        crate::benchmark::population_table(&rows)
+calibration asks thousands of times), from the sagged start: {}\nThe same net as the calibration solves it: \
+{} points over stiffness, natural length and topology at 45 g/m², each from the drape at the nearest node of \
+the calibration's warm-start lattice (`calibrate::StartLattice`): {}",
+        sagged.len(),
+        crate::benchmark::population_table(&sagged),
+        lattice.len(),
+        crate::benchmark::population_table(&lattice)
     ))
 }
 

@@ -247,7 +247,7 @@ pub fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
                 report.best_cost,
             ));
             if p.baseline_cmaes {
-                let fresh = Problem::new(problem.scene.clone(), measured.clone(), p.side_cm);
+                let fresh = problem.fresh();
                 let cm = crate::optim::cmaes(
                     &|u: &[f64]| fresh.cost(u),
                     5,
