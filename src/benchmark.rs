@@ -429,7 +429,8 @@ pub fn population_table(rows: &[PopulationRow]) -> String {
         conv.len(),
         rows.len()
     );
-    let lines: [(&str, &dyn Fn(&PopulationRow) -> f64, f64); 4] = [
+    type Line<'a> = (&'a str, &'a dyn Fn(&PopulationRow) -> f64, f64);
+    let lines: [Line; 4] = [
         ("Newton iterations", &|r| r.iterations as f64, 1.0),
         ("factorizations", &|r| r.factorizations as f64, 1.0),
         ("wall time (ms)", &|r| r.wall_time_s, 1e3),

@@ -249,7 +249,7 @@ impl Problem {
 }
 
 /// Deterministic warm starts for one sample: the static drapes at a fixed lattice of Table 3's box
-/// (every topology × 4 stiffnesses × 11 natural lengths), solved by continuation in the natural length
+/// (every topology × 3 stiffnesses × 41 natural lengths, 0.5 mm apart), solved by continuation in the natural length
 /// from the sagged start along each (topology, stiffness) in a fixed order, so that
 /// an evaluation's start — and with it the equilibrium a slack net lands on — depends on its own
 /// parameters only, never on which evaluations came before or on the thread count.
@@ -261,8 +261,8 @@ pub struct StartLattice {
 }
 
 impl StartLattice {
-    const STIFFNESSES: usize = 4;
-    const LENGTHS: usize = 11;
+    const STIFFNESSES: usize = 3;
+    const LENGTHS: usize = 41;
 
     fn solve(problem: &Problem) -> Self {
         use rayon::prelude::*;
@@ -295,7 +295,9 @@ impl StartLattice {
                             topology,
                         });
                         let sol = match &prev {
-                            Some(x0) => crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver),
+                            Some(x0) => {
+                                crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver)
+                            }
                             None => solve_scene(&scene, &mut NoObserver),
                         };
                         let x = sol.report.is_converged().then_some(sol.x);

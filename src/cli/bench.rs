@@ -30,7 +30,8 @@ pub fn run_bench(
             "\nSeed 000's slack net (14 × 14, Table 3's box), static solves from the sagged start:\n\n{}",
             population_table(&rows)
         );
-        let (rows, lattice_s) = crate::benchmark::warm_start_population(&loaded.scene, population, 9);
+        let (rows, lattice_s) =
+            crate::benchmark::warm_start_population(&loaded.scene, population, 9);
         println!(
             "\nThe same net as a calibration solves it, from its warm-start lattice's nearest drape \
 (the lattice itself: {lattice_s:.2} s):\n\n{}",

@@ -14,6 +14,4 @@ mod runner;
 pub use manifest::{Manifest, hash_file};
 pub use plan::{Plan, PlannedStage, StageSpec, load_plan};
 pub use progress::{LogProgress, MultiBarProgress, Progress, progress_for_terminal};
-pub use runner::{
-    RunOptions, RunSummary, StageState, manifest_path, run_pipeline, stage_states,
-};
+pub use runner::{RunOptions, RunSummary, StageState, manifest_path, run_pipeline, stage_states};

@@ -153,7 +153,8 @@ impl Pattern {
     /// was analysed now).
     fn shared(dofs: &DofMap, h: &HessianBlocks, ordering: Ordering) -> Option<(Arc<Self>, bool)> {
         let key = pattern_key(dofs, h, ordering);
-        let same = |p: &Pattern| p.ordering == ordering && p.pairs == h.pairs && p.first == dofs.first;
+        let same =
+            |p: &Pattern| p.ordering == ordering && p.pairs == h.pairs && p.first == dofs.first;
         {
             let cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
             if let Some((_, p)) = cache.iter().find(|(k, p)| *k == key && same(p)) {

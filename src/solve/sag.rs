@@ -84,13 +84,13 @@ pub fn sagged_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
     let e0 = energy(0.0);
     let mut s = 1e-3 * extent;
     let mut es = energy(s);
-    if !(es < e0) {
+    if es.partial_cmp(&e0) != Some(std::cmp::Ordering::Less) {
         return None;
     }
     loop {
         let t = 2.0 * s;
         let et = energy(t);
-        if !(et < es) || t > 4.0 * extent {
+        if et.partial_cmp(&es) != Some(std::cmp::Ordering::Less) || t > 4.0 * extent {
             break;
         }
         (s, es) = (t, et);
@@ -111,7 +111,7 @@ pub fn sagged_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
         }
     }
     let s = 0.5 * (a + b);
-    if !(energy(s) < e0) {
+    if energy(s).partial_cmp(&e0) != Some(std::cmp::Ordering::Less) {
         return None;
     }
     for p in 0..x.len() {

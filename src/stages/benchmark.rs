@@ -159,7 +159,9 @@ pub fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
             .context("slack_net_population needs an output named population.parquet")?;
         let mut rows =
             crate::benchmark::slack_net_population(&scenes[0], p.slack_net_population, 8);
-        rows.extend(crate::benchmark::warm_start_population(&scenes[0], p.slack_net_population, 9).0);
+        rows.extend(
+            crate::benchmark::warm_start_population(&scenes[0], p.slack_net_population, 9).0,
+        );
         write_population(out, &rows)?;
     }
     Ok(())
@@ -180,7 +182,9 @@ fn write_population(out: &std::path::Path, rows: &[crate::benchmark::PopulationR
         Field::new("factor_time_s", DataType::Float64, false),
     ]));
     let u64s = |f: &dyn Fn(&crate::benchmark::PopulationRow) -> usize| -> ArrayRef {
-        Arc::new(UInt64Array::from_iter_values(rows.iter().map(|r| f(r) as u64)))
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|r| f(r) as u64),
+        ))
     };
     let strs = |f: &dyn Fn(&crate::benchmark::PopulationRow) -> String| -> ArrayRef {
         Arc::new(StringArray::from_iter_values(rows.iter().map(f)))
@@ -266,7 +270,10 @@ pub fn run_peers(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
             .status()
             .context("pip install numpy scipy cvxopt")?;
         if !ok.success() || !has(&python) {
-            bail!("{}: cannot install numpy, scipy and cvxopt", python.display());
+            bail!(
+                "{}: cannot install numpy, scipy and cvxopt",
+                python.display()
+            );
         }
     }
     let run_py = |script: &std::path::Path, args: &[String]| -> Result<serde_json::Value> {
@@ -603,7 +610,10 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
     );
     for r in 0..bench.height() {
         if solver.str()?.get(r) != Some("static")
-            || tol.f64()?.get(r).is_none_or(|t| (t / tightest - 1.0).abs() > 1e-9)
+            || tol
+                .f64()?
+                .get(r)
+                .is_none_or(|t| (t / tightest - 1.0).abs() > 1e-9)
         {
             continue;
         }
@@ -630,9 +640,14 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
 /// The slack-net population's iterations, factorizations and times per solve (min / median / max).
 fn population_section(pop: &DataFrame) -> Result<String> {
     let f = |c: &str| -> Result<Vec<f64>> {
-        let s = pop.column(c)?.as_materialized_series().cast(&polars::prelude::DataType::Float64)?;
+        let s = pop
+            .column(c)?
+            .as_materialized_series()
+            .cast(&polars::prelude::DataType::Float64)?;
         let ca = s.f64()?;
-        Ok((0..ca.len()).map(|i| ca.get(i).unwrap_or(f64::NAN)).collect())
+        Ok((0..ca.len())
+            .map(|i| ca.get(i).unwrap_or(f64::NAN))
+            .collect())
     };
     let strings = |c: &str| -> Result<Vec<String>> {
         let ca = pop.column(c)?.str()?.clone();

@@ -27,8 +27,18 @@ type Case = (
 );
 
 const CASES: [Case; 6] = [
-    ("hang4_21", "hang4.toml", &["cloth.nx=21", "cloth.ny=21"], None),
-    ("hang4_41", "hang4.toml", &["cloth.nx=41", "cloth.ny=41"], None),
+    (
+        "hang4_21",
+        "hang4.toml",
+        &["cloth.nx=21", "cloth.ny=21"],
+        None,
+    ),
+    (
+        "hang4_41",
+        "hang4.toml",
+        &["cloth.nx=41", "cloth.ny=41"],
+        None,
+    ),
     // The 2-corner hang can curl to either side of the vertical plane through its pinned edge.
     (
         "hang2_21",
@@ -42,7 +52,12 @@ const CASES: [Case; 6] = [
         &[],
         None,
     ),
-    ("pedestal_wool_21", "pedestal_wool.toml", &["cloth.nx=21", "cloth.ny=21"], None),
+    (
+        "pedestal_wool_21",
+        "pedestal_wool.toml",
+        &["cloth.nx=21", "cloth.ny=21"],
+        None,
+    ),
     // Without friction the sheet rolls off the rod's crest to one side or the other: the scene is
     // symmetric under a half turn about the vertical (pins, rod axis and warp/weft all map onto
     // themselves), so its equilibria come in pairs.
@@ -64,7 +79,11 @@ fn read_csv(path: &std::path::Path) -> Vec<Vector3<f64>> {
     text.lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("particle"))
         .map(|l| {
-            let v: Vec<f64> = l.split(',').skip(1).map(|s| s.parse().expect("number")).collect();
+            let v: Vec<f64> = l
+                .split(',')
+                .skip(1)
+                .map(|s| s.parse().expect("number"))
+                .collect();
             Vector3::new(v[0], v[1], v[2])
         })
         .collect()
@@ -84,7 +103,10 @@ particle,x_m,y_m,z_m\n",
 }
 
 fn largest_distance(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
-    a.iter().zip(b).map(|(p, q)| (p - q).norm()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).norm())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -95,12 +117,18 @@ fn equilibria_are_the_same_as_before_the_faster_newton() {
         let mut sets = sets.to_vec();
         // The rod (barrier contact, 33² with its pins by index) stalls short of 1e-10 with the old
         // solver; 1e-8 still fixes its positions far below 1e-8 m.
-        sets.push(if name.starts_with("rod") { TOL_ROD } else { TOL });
+        sets.push(if name.starts_with("rod") {
+            TOL_ROD
+        } else {
+            TOL
+        });
         let s = scene(name, &sets);
         let sol = solve_scene(&s, &mut NoObserver);
         assert!(sol.report.is_converged(), "{file}: {}", sol.report.message);
         let x = sol.grid_positions();
-        let path = root().join("datasets/equilibria").join(format!("{file}.csv"));
+        let path = root()
+            .join("datasets/equilibria")
+            .join(format!("{file}.csv"));
         if write {
             write_csv(&path, x);
             continue;
