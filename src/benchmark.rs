@@ -310,16 +310,10 @@ pub struct PopulationRow {
 /// the three topologies, and Table 2's densities (27.6–58.26 g/m²), seeded by `seed`: what one
 /// calibration asks of the solver thousands of times.
 pub fn slack_net_population(scene: &Scene, samples: usize, seed: u64) -> Vec<PopulationRow> {
-    use rand::{Rng, SeedableRng, seq::SliceRandom};
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let mut strata: Vec<Vec<usize>> = (0..4).map(|_| (0..samples).collect()).collect();
-    for s in &mut strata {
-        s.shuffle(&mut rng);
-    }
-    let lhs = |d: usize, k: usize, r: f64| (strata[d][k] as f64 + r) / samples as f64;
+    let design = crate::optim::latin_hypercube(samples, 4, seed);
     (0..samples)
         .map(|k| {
-            let u: Vec<f64> = (0..4).map(|d| lhs(d, k, rng.random::<f64>())).collect();
+            let u: Vec<f64> = design.iter().map(|axis| axis[k]).collect();
             let mut s = scene.regridded(14, 14);
             let ms = s.material.mass_spring.get_or_insert_with(Default::default);
             ms.stiffness_N_per_m = 500.0 + 700.0 * u[0];
@@ -361,7 +355,6 @@ pub fn warm_start_population(
     samples: usize,
     seed: u64,
 ) -> (Vec<PopulationRow>, f64) {
-    use rand::{Rng, SeedableRng, seq::SliceRandom};
     let mut net = scene.regridded(14, 14);
     net.solver.kind = SolverKind::Static;
     net.record.timeline = false;
@@ -370,16 +363,12 @@ pub fn warm_start_population(
     let t = Instant::now();
     problem.drape(&[0.5; 5]);
     let lattice_s = t.elapsed().as_secs_f64();
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let mut strata: Vec<Vec<usize>> = (0..3).map(|_| (0..samples).collect()).collect();
-    for s in &mut strata {
-        s.shuffle(&mut rng);
-    }
+    let design = crate::optim::latin_hypercube(samples, 3, seed);
     let rows = (0..samples)
         .map(|k| {
             let mut u = vec![0.5; 5];
-            for (d, &dim) in [0usize, 3, 4].iter().enumerate() {
-                u[dim] = (strata[d][k] as f64 + rng.random::<f64>()) / samples as f64;
+            for (axis, &dim) in design.iter().zip(&[0usize, 3, 4]) {
+                u[dim] = axis[k];
             }
             let p = problem.bounds.decode(&u);
             let t = Instant::now();

@@ -54,19 +54,7 @@ impl Solution {
 
 /// Solves a validated scene in memory with its configured solver; the observer sees each state.
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
-    let BuiltScene {
-        grid,
-        mut model,
-        x0: mut x,
-    } = build_scene(scene);
-    let report = solve_model(scene, &grid, &mut model, &mut x, observer);
-    Solution {
-        grid,
-        terms: model.term_names(),
-        x,
-        report,
-        model,
-    }
+    solve_built(scene, None, observer)
 }
 
 /// Solves a validated scene statically or dynamically from the given positions of all particles
@@ -77,22 +65,31 @@ pub fn solve_scene_from(
     x0: &[Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> Solution {
+    solve_built(scene, Some(x0), observer)
+}
+
+fn solve_built(
+    scene: &Scene,
+    start: Option<&[Vector3<f64>]>,
+    observer: &mut dyn Observer,
+) -> Solution {
     let BuiltScene {
         grid,
         mut model,
         x0: mut x,
     } = build_scene(scene);
-    let report = if x0.len() == x.len() {
-        x.copy_from_slice(x0);
-        // A warm start is near its equilibrium: Newton starts far less damped.
-        let mut warm = scene.clone();
-        let lm = &mut warm.solver.static_.lm_damping_initial;
-        *lm = lm.min(WARM_LM_DAMPING);
-        let mut report = static_or_dynamic(&warm, &grid, &mut model, &mut x, observer);
-        check_minimum(&model, &x, &mut report);
-        report
-    } else {
-        solve_model(scene, &grid, &mut model, &mut x, observer)
+    let report = match start {
+        Some(x0) if x0.len() == x.len() => {
+            x.copy_from_slice(x0);
+            // A warm start is near its equilibrium: Newton starts far less damped.
+            let mut warm = scene.clone();
+            let lm = &mut warm.solver.static_.lm_damping_initial;
+            *lm = lm.min(WARM_LM_DAMPING);
+            let mut report = static_or_dynamic(&warm, &grid, &mut model, &mut x, observer);
+            check_minimum(&model, &x, &mut report);
+            report
+        }
+        _ => solve_model(scene, &grid, &mut model, &mut x, observer),
     };
     Solution {
         grid,
@@ -184,7 +181,7 @@ fn static_solve(
     x: &mut [Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let opts = scene.solver.static_.resolved(!scene.obstacles.is_empty());
+    let opts = scene.solver.static_.resolved();
     if scene.contact.method == crate::scene::ContactMethod::VerticalGap
         && !scene.obstacles.is_empty()
     {

@@ -41,3 +41,27 @@ def forces(x, pairs, rest, k, mass):
     np.add.at(F, pairs[:, 1], -f)
     F[:, 2] -= mass * G
     return F
+
+
+def energy(x, pairs, rest, k, mass):
+    """Spring energy plus gravity (J)."""
+    l = np.linalg.norm(x[pairs[:, 1]] - x[pairs[:, 0]], axis=1)
+    return 0.5 * np.sum(k * (l - rest) ** 2) + G * np.sum(mass * x[:, 2])
+
+
+def hessian_triplets(x, pairs, rest, k):
+    """(rows, cols, values) of the exact Hessian over all 3n DOFs, both triangles, duplicates to be
+    summed: per spring K = k[uu^T + (1 - L0/l)(I - uu^T)] (negative transverse term when compressed)."""
+    d = x[pairs[:, 1]] - x[pairs[:, 0]]
+    l = np.linalg.norm(d, axis=1)
+    u = d / l[:, None]
+    a = k * (1.0 - rest / l)
+    K = a[:, None, None] * np.eye(3)[None] + (k - a)[:, None, None] * u[:, :, None] * u[:, None, :]
+    rows, cols, vals = [], [], []
+    for (p, q), s in [((0, 0), 1.0), ((1, 1), 1.0), ((0, 1), -1.0), ((1, 0), -1.0)]:
+        for r in range(3):
+            for c in range(3):
+                rows.append(3 * pairs[:, p] + r)
+                cols.append(3 * pairs[:, q] + c)
+                vals.append(s * K[:, r, c])
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)

@@ -10,31 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from model import G, forces, hang4
-
-
-def energy(x, pairs, rest, k, mass):
-    l = np.linalg.norm(x[pairs[:, 1]] - x[pairs[:, 0]], axis=1)
-    return 0.5 * np.sum(k * (l - rest) ** 2) + G * np.sum(mass * x[:, 2])
-
-
-def hessian(x, pairs, rest, k, n3):
-    d = x[pairs[:, 1]] - x[pairs[:, 0]]
-    l = np.linalg.norm(d, axis=1)
-    u = d / l[:, None]
-    # Exact: the transverse term is negative for a compressed spring; the LM shift handles that.
-    a = k * (1.0 - rest / l)
-    K = a[:, None, None] * np.eye(3)[None] + (k - a)[:, None, None] * u[:, :, None] * u[:, None, :]
-    rows, cols, vals = [], [], []
-    for (p, q), s in [((0, 0), 1.0), ((1, 1), 1.0), ((0, 1), -1.0), ((1, 0), -1.0)]:
-        for r in range(3):
-            for c in range(3):
-                rows.append(3 * pairs[:, p] + r)
-                cols.append(3 * pairs[:, q] + c)
-                vals.append(s * K[:, r, c])
-    return sp.csc_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n3, n3)
-    )
+from model import G, energy, forces, hang4, hessian_triplets
 
 
 def main(n, tol):
@@ -50,7 +26,8 @@ def main(n, tol):
         if np.abs(np.linalg.norm(F, axis=1)).max() <= tol * wref:
             break
         it += 1
-        H = hessian(x, pairs, rest, k, 3 * n * n)[free][:, free]
+        r, c, v = hessian_triplets(x, pairs, rest, k)
+        H = sp.csc_matrix((v, (r, c)), shape=(3 * n * n, 3 * n * n))[free][:, free]
         scale = H.diagonal().mean()
         while True:
             A = H + sp.identity(H.shape[0]) * (mu * scale)

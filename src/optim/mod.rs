@@ -4,8 +4,10 @@
 
 mod cmaes;
 mod ica;
+mod lhs;
 mod taguchi;
 
 pub use cmaes::{CmaesReport, cmaes};
 pub use ica::{DecadeEvent, Ica, IcaReport, IcaSettings};
+pub use lhs::latin_hypercube;
 pub use taguchi::{L27, l27, main_effects, sn_smaller_the_better};

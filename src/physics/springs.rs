@@ -1,7 +1,7 @@
 //! Linear springs, seed 000 Eq. 2: F = K (|L| − L0) L/|L|, energy ½K(|L| − L0)².
 
 use super::{EnergyTerm, HessianBlocks, Vecs};
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Which family a set of springs belongs to (seed 000, Fig. 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -115,16 +115,7 @@ impl EnergyTerm for Springs {
             if l <= lmax || l == 0.0 {
                 continue;
             }
-            let excess = d * ((l - lmax) / l);
-            match (free[a], free[b]) {
-                (true, true) => {
-                    x[a] += excess * 0.5;
-                    x[b] -= excess * 0.5;
-                }
-                (true, false) => x[a] += excess,
-                (false, true) => x[b] -= excess,
-                (false, false) => {}
-            }
+            pull_together(x, free, (a, b), d * ((l - lmax) / l));
         }
     }
     fn provot_correct(&self, x: &mut Vecs, free: &[bool], rate: f64) {
@@ -139,16 +130,21 @@ impl EnergyTerm for Springs {
             if l <= lmax || l == 0.0 {
                 continue;
             }
-            let excess = d * ((l - lmax) / l);
-            match (free[a], free[b]) {
-                (true, true) => {
-                    x[a] += excess * 0.5;
-                    x[b] -= excess * 0.5;
-                }
-                (true, false) => x[a] += excess,
-                (false, true) => x[b] -= excess,
-                (false, false) => {}
-            }
+            pull_together(x, free, (a, b), d * ((l - lmax) / l));
         }
+    }
+}
+
+/// Moves the ends of a spring from a to b towards each other by `excess` (shared between two free
+/// ends, taken by the free one alone otherwise): Provot's correction.
+fn pull_together(x: &mut Vecs, free: &[bool], (a, b): (usize, usize), excess: Vector3<f64>) {
+    match (free[a], free[b]) {
+        (true, true) => {
+            x[a] += excess * 0.5;
+            x[b] -= excess * 0.5;
+        }
+        (true, false) => x[a] += excess,
+        (false, true) => x[b] -= excess,
+        (false, false) => {}
     }
 }

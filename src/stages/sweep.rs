@@ -12,8 +12,7 @@ use arrow::array::{
     ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
 };
 use arrow::datatypes::{DataType, Field, Schema};
-use rand::seq::SliceRandom;
-use rand::{Rng, SeedableRng};
+
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -138,28 +137,22 @@ pub fn sweep_points(p: &SweepParams) -> Vec<Vec<toml::Value>> {
         }
         Design::Lhs => {
             let n = p.samples;
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(p.seed);
+            let design = crate::optim::latin_hypercube(n, axes.len(), p.seed);
             let mut cols = Vec::new();
-            for a in axes {
-                let mut strata: Vec<usize> = (0..n).collect();
-                strata.shuffle(&mut rng);
-                let col: Vec<toml::Value> = strata
+            for (a, us) in axes.iter().zip(&design) {
+                let col: Vec<toml::Value> = us
                     .iter()
-                    .map(|&s| {
-                        let u = (s as f64 + rng.random::<f64>()) / n as f64;
-                        match a {
-                            Axis::Values(vals) => {
-                                vals[((u * vals.len() as f64) as usize).min(vals.len() - 1)].clone()
-                            }
-                            Axis::Range { min, max } => {
-                                let (lo, hi) =
-                                    (as_f64(min).unwrap_or(0.0), as_f64(max).unwrap_or(0.0));
-                                let x = lo + u * (hi - lo);
-                                if min.is_integer() && max.is_integer() {
-                                    toml::Value::Integer(x.round() as i64)
-                                } else {
-                                    toml::Value::Float(x)
-                                }
+                    .map(|&u| match a {
+                        Axis::Values(vals) => {
+                            vals[((u * vals.len() as f64) as usize).min(vals.len() - 1)].clone()
+                        }
+                        Axis::Range { min, max } => {
+                            let (lo, hi) = (as_f64(min).unwrap_or(0.0), as_f64(max).unwrap_or(0.0));
+                            let x = lo + u * (hi - lo);
+                            if min.is_integer() && max.is_integer() {
+                                toml::Value::Integer(x.round() as i64)
+                            } else {
+                                toml::Value::Float(x)
                             }
                         }
                     })
