@@ -141,35 +141,31 @@ fn solve_model(
     x: &mut [Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    match scene.solver.kind.integrator() {
-        None => {
-            // Nested iteration: start Newton from the interpolated solution of the scene on the grid
-            // with every other line, when that grid exists; far fewer fine iterations are needed.
-            let coarse = coarse_start(scene, grid, x);
-            if coarse.is_none() && scene.solver.static_.sag_start && scene.obstacles.is_empty() {
-                crate::solve::sagged_start(model, x);
-            }
-            let mut report = static_solve(scene, grid, model, x, observer);
-            if let Some((r, _)) = coarse {
-                report.iterations += r.iterations;
-                report.linear_solves += r.linear_solves;
-                report.factorizations += r.factorizations;
-                report.factor_time_s += r.factor_time_s;
-                report.wall_time_s += r.wall_time_s;
-                report.message += &format!(
-                    " (from a {}×{} start)",
-                    grid.nx.div_ceil(2),
-                    grid.ny.div_ceil(2)
-                );
-            }
-            check_minimum(model, x, &mut report);
-            report
-        }
-        Some(integ) => {
-            let mut v = vec![Vector3::zeros(); x.len()];
-            solve_dynamic(model, integ, x, &mut v, &scene.solver.dynamic, observer)
-        }
+    if scene.solver.kind.integrator().is_some() {
+        return static_or_dynamic(scene, grid, model, x, observer);
     }
+    // Nested iteration: start Newton from the interpolated solution of the scene on the grid with
+    // every other line, when that grid exists; far fewer fine iterations are needed. Otherwise,
+    // without obstacles, from the sagged sheet.
+    let coarse = coarse_start(scene, grid, x);
+    if coarse.is_none() && scene.solver.static_.sag_start && scene.obstacles.is_empty() {
+        crate::solve::sagged_start(model, x);
+    }
+    let mut report = static_solve(scene, grid, model, x, observer);
+    if let Some((r, _)) = coarse {
+        report.iterations += r.iterations;
+        report.linear_solves += r.linear_solves;
+        report.factorizations += r.factorizations;
+        report.factor_time_s += r.factor_time_s;
+        report.wall_time_s += r.wall_time_s;
+        report.message += &format!(
+            " (from a {}×{} start)",
+            grid.nx.div_ceil(2),
+            grid.ny.div_ceil(2)
+        );
+    }
+    check_minimum(model, x, &mut report);
+    report
 }
 
 /// The static solve of a built scene from `x`: Newton, wrapped in the vertical-gap active set when the

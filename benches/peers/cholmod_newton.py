@@ -13,7 +13,7 @@ import time
 import numpy as np
 from cvxopt import cholmod, matrix, spmatrix
 
-from model import G, energy, forces, hang4, hessian_triplets
+from model import G, backtrack, energy, forces, hang4, hessian_triplets
 
 
 def main(n, tol):
@@ -74,17 +74,9 @@ def main(n, tol):
             step = np.zeros(3 * n * n)
             step[free] = dx
             step = step.reshape(-1, 3)
-            alpha, ok = 1.0, False
-            for _ in range(30):
-                xt = x + alpha * step
-                et = energy(xt, pairs, rest, k, mass)
-                # Near the solution the energy change is below round-off: accept a step that lowers
-                # the largest residual force instead (as drapelab does).
-                flat = abs(et - e) <= 1e-11 * abs(e)
-                if et <= e - 1e-4 * alpha * np.dot(rhs, dx) or (flat and residual(xt) < r0):
-                    ok = True
-                    break
-                alpha *= 0.5
+            ok, alpha, xt, et = backtrack(
+                x, step, e, -np.dot(rhs, dx), lambda xt: energy(xt, pairs, rest, k, mass),
+                residual, r0)
             if ok:
                 x, e = xt, et
                 mu = (0.0 if mu < 1e-12 else mu / 10) if alpha == 1.0 else mu

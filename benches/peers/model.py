@@ -65,3 +65,18 @@ def hessian_triplets(x, pairs, rest, k):
                 cols.append(3 * pairs[:, q] + c)
                 vals.append(s * K[:, r, c])
     return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+
+
+def backtrack(x, step, e, slope, energy_at, residual_at=None, r0=None):
+    """Armijo backtracking along `step` (30 halvings): (accepted, alpha, x_new, e_new). With
+    `residual_at`, a step whose energy change is below round-off is accepted when it lowers the largest
+    residual force below r0 (as drapelab does near the solution)."""
+    alpha = 1.0
+    for _ in range(30):
+        xt = x + alpha * step
+        et = energy_at(xt)
+        flat = residual_at is not None and abs(et - e) <= 1e-11 * abs(e)
+        if et <= e + 1e-4 * alpha * slope or (flat and residual_at(xt) < r0):
+            return True, alpha, xt, et
+        alpha *= 0.5
+    return False, alpha, x, e

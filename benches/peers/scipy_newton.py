@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from model import G, energy, forces, hang4, hessian_triplets
+from model import G, backtrack, energy, forces, hang4, hessian_triplets
 
 
 def main(n, tol):
@@ -38,14 +38,9 @@ def main(n, tol):
             step = np.zeros(3 * n * n)
             step[free] = dx
             step = step.reshape(-1, 3)
-            alpha, ok = 1.0, False
-            for _ in range(30):
-                xt = x + alpha * step
-                et = energy(xt, pairs, rest, k, mass)
-                if et <= e - 1e-4 * alpha * np.dot(F.ravel(), step.ravel()):
-                    ok = True
-                    break
-                alpha *= 0.5
+            ok, alpha, xt, et = backtrack(
+                x, step, e, -np.dot(F.ravel(), step.ravel()),
+                lambda xt: energy(xt, pairs, rest, k, mass))
             if ok:
                 x, e = xt, et
                 mu = (0.0 if mu < 1e-12 else mu / 4) if alpha == 1.0 else mu
