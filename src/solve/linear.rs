@@ -53,22 +53,11 @@ impl DofMap {
     }
 }
 
-/// The fill-reducing ordering of the Cholesky factorization.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Ordering {
-    /// Approximate minimum degree (faer's AMD): the default, measured fastest on drapelab's grids.
-    #[default]
-    Amd,
-    /// No reordering (the particles' own order, banded on a grid): for comparison only.
-    Natural,
-}
-
 /// A sparsity pattern analysed once: the lower triangle over the free DOFs, where each Hessian
 /// entry lands in the compressed values, and the symbolic Cholesky factorization.
 struct Pattern {
     pairs: Vec<(u32, u32)>,
     first: Vec<u32>,
-    ordering: Ordering,
     sym: SymbolicSparseColMat<usize>,
     /// The entries ([`SparseSpd::entries`] order, then the diagonal shifts) in the order they are
     /// summed: by column, then by (row, column) as faer's own assembly sorts them, so that the
@@ -84,16 +73,15 @@ static PATTERNS: Mutex<Vec<(u64, Arc<Pattern>)>> = Mutex::new(Vec::new());
 /// Patterns kept at most; the oldest is dropped beyond.
 const MAX_PATTERNS: usize = 64;
 
-fn pattern_key(dofs: &DofMap, h: &HessianBlocks, ordering: Ordering) -> u64 {
+fn pattern_key(dofs: &DofMap, h: &HessianBlocks) -> u64 {
     let mut s = std::collections::hash_map::DefaultHasher::new();
     h.pairs.hash(&mut s);
     dofs.first.hash(&mut s);
-    (ordering as u8).hash(&mut s);
     s.finish()
 }
 
 impl Pattern {
-    fn analyse(dofs: &DofMap, h: &HessianBlocks, ordering: Ordering) -> Option<Self> {
+    fn analyse(dofs: &DofMap, h: &HessianBlocks) -> Option<Self> {
         let n = dofs.n;
         let mut idx: Vec<Pair<usize, usize>> = Vec::new();
         SparseSpd::entries(dofs, h, |r, c, _| idx.push(Pair::new(r, c)));
@@ -132,16 +120,14 @@ impl Pattern {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        let fill_reducing = match ordering {
-            Ordering::Amd => SymmetricOrdering::Amd,
-            Ordering::Natural => SymmetricOrdering::Identity,
-        };
+        // AMD: faer 0.24 offers no nested dissection (AMD, COLAMD, identity or a given permutation),
+        // and its supernodal path panics with the identity ordering on these patterns.
         let symbolic =
-            factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, fill_reducing, params).ok()?;
+            factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, SymmetricOrdering::Amd, params)
+                .ok()?;
         Some(Self {
             pairs: h.pairs.clone(),
             first: dofs.first.clone(),
-            ordering,
             sym,
             order,
             slot,
@@ -151,17 +137,16 @@ impl Pattern {
 
     /// The pattern of `h` over `dofs`, from the process-wide cache or analysed now (with whether it
     /// was analysed now).
-    fn shared(dofs: &DofMap, h: &HessianBlocks, ordering: Ordering) -> Option<(Arc<Self>, bool)> {
-        let key = pattern_key(dofs, h, ordering);
-        let same =
-            |p: &Pattern| p.ordering == ordering && p.pairs == h.pairs && p.first == dofs.first;
+    fn shared(dofs: &DofMap, h: &HessianBlocks) -> Option<(Arc<Self>, bool)> {
+        let key = pattern_key(dofs, h);
+        let same = |p: &Pattern| p.pairs == h.pairs && p.first == dofs.first;
         {
             let cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
             if let Some((_, p)) = cache.iter().find(|(k, p)| *k == key && same(p)) {
                 return Some((p.clone(), false));
             }
         }
-        let p = Arc::new(Self::analyse(dofs, h, ordering)?);
+        let p = Arc::new(Self::analyse(dofs, h)?);
         let mut cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
         if cache.len() >= MAX_PATTERNS {
             cache.remove(0);
@@ -175,7 +160,6 @@ impl Pattern {
 /// with a shared symbolic analysis and numeric buffers kept between calls.
 pub struct SparseSpd {
     pattern: Option<Arc<Pattern>>,
-    ordering: Ordering,
     raw: Vec<f64>,
     values: Vec<f64>,
     l_values: Vec<f64>,
@@ -195,16 +179,10 @@ impl Default for SparseSpd {
 }
 
 impl SparseSpd {
-    /// An empty solver with the AMD ordering; the pattern is looked up at the first factorization.
+    /// An empty solver (AMD ordering); the pattern is looked up at the first factorization.
     pub fn new() -> Self {
-        Self::with_ordering(Ordering::Amd)
-    }
-
-    /// An empty solver with the given ordering.
-    pub fn with_ordering(ordering: Ordering) -> Self {
         Self {
             pattern: None,
-            ordering,
             raw: Vec::new(),
             values: Vec::new(),
             l_values: Vec::new(),
@@ -239,7 +217,7 @@ impl SparseSpd {
             .as_ref()
             .is_none_or(|p| p.pairs != h.pairs || p.first != dofs.first);
         if stale {
-            let Some((pattern, analysed)) = Pattern::shared(dofs, h, self.ordering) else {
+            let Some((pattern, analysed)) = Pattern::shared(dofs, h) else {
                 return false;
             };
             self.analyses += usize::from(analysed);
