@@ -305,6 +305,31 @@ pub struct PopulationRow {
     pub factor_time_s: f64,
 }
 
+impl PopulationRow {
+    /// The row of one solve: where it started, (stiffness N/m, natural length m), topology, areal
+    /// density kg/m², and (its report, its wall time in s).
+    fn of(
+        start: &str,
+        (stiffness_N_per_m, natural_length_m): (f64, f64),
+        topology: crate::material::Topology,
+        areal_density_kg_per_m2: f64,
+        (report, wall_time_s): (&crate::solve::SolveReport, f64),
+    ) -> Self {
+        Self {
+            start: start.into(),
+            stiffness_N_per_m,
+            natural_length_m,
+            topology: format!("{topology:?}").to_lowercase(),
+            areal_density_kg_per_m2,
+            status: report.status.as_str().into(),
+            iterations: report.iterations,
+            factorizations: report.factorizations,
+            wall_time_s,
+            factor_time_s: report.factor_time_s,
+        }
+    }
+}
+
 /// Seed 000's calibration population: hang4 on the 14 × 14 net solved statically at `samples`
 /// points of a Latin hypercube over Table 3's stiffness (500–1200 N/m), natural length (40–60 mm),
 /// the three topologies, and Table 2's densities (27.6–58.26 g/m²), seeded by `seed`: what one
@@ -330,18 +355,16 @@ pub fn slack_net_population(scene: &Scene, samples: usize, seed: u64) -> Vec<Pop
             let t = Instant::now();
             let sol = solve_scene(&s, &mut NoObserver);
             let ms = s.material.mass_spring.as_ref().expect("set above");
-            PopulationRow {
-                start: "sagged".into(),
-                stiffness_N_per_m: ms.stiffness_N_per_m,
-                natural_length_m: ms.natural_length_m.unwrap_or(f64::NAN),
-                topology: format!("{:?}", ms.topology).to_lowercase(),
-                areal_density_kg_per_m2: s.cloth.areal_density_kg_per_m2,
-                status: sol.report.status.as_str().into(),
-                iterations: sol.report.iterations,
-                factorizations: sol.report.factorizations,
-                wall_time_s: t.elapsed().as_secs_f64(),
-                factor_time_s: sol.report.factor_time_s,
-            }
+            PopulationRow::of(
+                "sagged",
+                (
+                    ms.stiffness_N_per_m,
+                    ms.natural_length_m.unwrap_or(f64::NAN),
+                ),
+                ms.topology,
+                s.cloth.areal_density_kg_per_m2,
+                (&sol.report, t.elapsed().as_secs_f64()),
+            )
         })
         .collect()
 }
@@ -373,18 +396,13 @@ pub fn warm_start_population(
             let p = problem.bounds.decode(&u);
             let t = Instant::now();
             let (sol, _) = problem.drape(&u);
-            PopulationRow {
-                start: "lattice".into(),
-                stiffness_N_per_m: p.stiffness_N_per_m,
-                natural_length_m: p.natural_length_m,
-                topology: format!("{:?}", p.topology).to_lowercase(),
-                areal_density_kg_per_m2: net.cloth.areal_density_kg_per_m2,
-                status: sol.report.status.as_str().into(),
-                iterations: sol.report.iterations,
-                factorizations: sol.report.factorizations,
-                wall_time_s: t.elapsed().as_secs_f64(),
-                factor_time_s: sol.report.factor_time_s,
-            }
+            PopulationRow::of(
+                "lattice",
+                (p.stiffness_N_per_m, p.natural_length_m),
+                p.topology,
+                net.cloth.areal_density_kg_per_m2,
+                (&sol.report, t.elapsed().as_secs_f64()),
+            )
         })
         .collect();
     (rows, lattice_s)

@@ -177,7 +177,7 @@ fn static_solve(
     x: &mut [Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let opts = scene.solver.static_.resolved();
+    let opts = &scene.solver.static_;
     if scene.contact.method == crate::scene::ContactMethod::VerticalGap
         && !scene.obstacles.is_empty()
     {
@@ -186,13 +186,13 @@ fn static_solve(
             x,
             &scene.obstacles,
             grid.min_spacing_m(),
-            &opts,
+            opts,
             observer,
         )
     } else if scene.contact.friction_coefficient > 0.0 && !scene.obstacles.is_empty() {
-        solve_with_friction(scene, model, x, &opts, observer)
+        solve_with_friction(scene, model, x, opts, observer)
     } else {
-        solve_static(model, x, &opts, observer)
+        solve_static(model, x, opts, observer)
     }
 }
 

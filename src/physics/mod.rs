@@ -98,10 +98,6 @@ pub trait EnergyTerm: Send + Sync {
     }
     /// Applies Provot's position correction at elongation rate `rate` (only spring terms do).
     fn provot_correct(&self, _x: &mut Vecs, _free: &[bool], _rate: f64) {}
-    /// Shortens every spring that a step from `before` to `x` lengthened by more than `tol` of its
-    /// longer of rest and previous length back to that length (only spring terms do): the curvilinear
-    /// correction of a static Newton step on nearly inextensible springs.
-    fn limit_stretch(&self, _before: &Vecs, _x: &mut Vecs, _free: &[bool], _tol: f64) {}
     /// The largest stiffness (N/m) the term couples particles with: sets the round-off floor of forces.
     fn stiffness_scale(&self) -> f64 {
         0.0
@@ -238,21 +234,6 @@ impl Model {
             .fold(0.0, f64::max);
         let xmax = x.iter().map(|p| p.amax()).fold(0.0, f64::max);
         16.0 * f64::EPSILON * k * xmax
-    }
-    /// [`EnergyTerm::limit_stretch`] of every term, free particles only.
-    pub fn limit_stretch(&self, before: &Vecs, x: &mut Vecs, tol: f64) {
-        let free: Vec<bool> = self.fixed.iter().map(|f| !f).collect();
-        for t in &self.terms {
-            t.limit_stretch(before, x, &free, tol);
-        }
-        // Held components stay where they were.
-        for (p, h) in self.held_components.iter().enumerate() {
-            for c in 0..3 {
-                if h[c] {
-                    x[p][c] = before[p][c];
-                }
-            }
-        }
     }
     /// Largest spring strain over all terms.
     pub fn max_strain(&self, x: &Vecs) -> f64 {

@@ -1,7 +1,7 @@
 //! Linear springs, seed 000 Eq. 2: F = K (|L| − L0) L/|L|, energy ½K(|L| − L0)².
 
 use super::{EnergyTerm, HessianBlocks, Vecs};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Matrix3;
 
 /// Which family a set of springs belongs to (seed 000, Fig. 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -106,18 +106,6 @@ impl EnergyTerm for Springs {
             .map(|(&(a, b), &l0)| (((x[b as usize] - x[a as usize]).norm() - l0) / l0).abs())
             .fold(0.0, f64::max)
     }
-    fn limit_stretch(&self, before: &Vecs, x: &mut Vecs, free: &[bool], tol: f64) {
-        for (k, &(a, b)) in self.pairs.iter().enumerate() {
-            let (a, b) = (a as usize, b as usize);
-            let lmax = (before[b] - before[a]).norm().max(self.rest_m[k]) * (1.0 + tol);
-            let d = x[b] - x[a];
-            let l = d.norm();
-            if l <= lmax || l == 0.0 {
-                continue;
-            }
-            pull_together(x, free, (a, b), d * ((l - lmax) / l));
-        }
-    }
     fn provot_correct(&self, x: &mut Vecs, free: &[bool], rate: f64) {
         if !matches!(self.family, SpringFamily::Structural | SpringFamily::Shear) {
             return;
@@ -130,21 +118,16 @@ impl EnergyTerm for Springs {
             if l <= lmax || l == 0.0 {
                 continue;
             }
-            pull_together(x, free, (a, b), d * ((l - lmax) / l));
+            let excess = d * ((l - lmax) / l);
+            match (free[a], free[b]) {
+                (true, true) => {
+                    x[a] += excess * 0.5;
+                    x[b] -= excess * 0.5;
+                }
+                (true, false) => x[a] += excess,
+                (false, true) => x[b] -= excess,
+                (false, false) => {}
+            }
         }
-    }
-}
-
-/// Moves the ends of a spring from a to b towards each other by `excess` (shared between two free
-/// ends, taken by the free one alone otherwise): Provot's correction.
-fn pull_together(x: &mut Vecs, free: &[bool], (a, b): (usize, usize), excess: Vector3<f64>) {
-    match (free[a], free[b]) {
-        (true, true) => {
-            x[a] += excess * 0.5;
-            x[b] -= excess * 0.5;
-        }
-        (true, false) => x[a] += excess,
-        (false, true) => x[b] -= excess,
-        (false, false) => {}
     }
 }

@@ -14,7 +14,7 @@ pub use dynamic::{
     DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
 };
 pub use linear::{DofMap, SparseSpd};
-pub use newton::{LmSchedule, StaticOptions, is_minimum, solve_static, solve_static_loads};
+pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{Divergence, SolveReport, Status};
 pub use sag::sagged_start;
 pub use vertical_gap::solve_vertical_gap;

@@ -43,41 +43,6 @@ pub struct StaticOptions {
     /// instead of the flat one. Default true.
     #[serde(default = "default_true")]
     pub sag_start: bool,
-    /// How the Levenberg–Marquardt damping moves. Default "auto" (= "cautious", measured the faster
-    /// of the two on hang4 at 81² and as fast on the slack nets).
-    #[serde(default)]
-    pub lm_schedule: LmSchedule,
-}
-
-/// How the static solver's Levenberg–Marquardt damping moves between iterations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LmSchedule {
-    /// "cautious" (resolved by [`StaticOptions::resolved`]). The adaptive schedule was measured
-    /// against it: hang4 at 81² 41 iterations and 50 factorizations (1.56 s) against 40 and 41
-    /// (1.28 s), the slack nets and hang2 alike; it stays as an option.
-    #[default]
-    Auto,
-    /// Divided by 10 after each full step, raised tenfold from 1e-6 while the exact Hessian is
-    /// indefinite or the line search cuts the step below 1/8, the projected Hessian for three
-    /// iterations once the shift would exceed 1e-3: few iterations where the equilibrium is unique.
-    Adaptive,
-    /// Divided by 4 after each full step, raised tenfold from 1e-8, the projected Hessian only for
-    /// the iteration that needed it (drapelab's schedule before issue 14): small steps, so a drape
-    /// whose equilibrium depends on its path (folds on a pedestal, a sheet rolling off a rod,
-    /// sticky contact) follows a quasi-static path.
-    Cautious,
-}
-
-impl StaticOptions {
-    /// The options with `lm_schedule = "auto"` resolved (cautious).
-    pub fn resolved(&self) -> Self {
-        let mut o = self.clone();
-        if o.lm_schedule == LmSchedule::Auto {
-            o.lm_schedule = LmSchedule::Cautious;
-        }
-        o
-    }
 }
 
 fn default_true() -> bool {
@@ -110,7 +75,6 @@ impl Default for StaticOptions {
             strain_bound: default_strain(),
             coarse_start: true,
             sag_start: true,
-            lm_schedule: LmSchedule::Auto,
         }
     }
 }
@@ -150,7 +114,7 @@ pub fn solve_static(
 }
 
 /// What the Newton loop carries between iterations: the buffers (nothing is allocated per
-/// iteration), the Levenberg–Marquardt damping and which Hessian to use.
+/// iteration) and the Levenberg–Marquardt damping.
 struct Workspace {
     dofs: DofMap,
     held: Vec<(usize, usize)>,
@@ -164,23 +128,12 @@ struct Workspace {
     shift: Vec<f64>,
     /// Levenberg–Marquardt damping relative to the mean free diagonal of the Hessian.
     mu: f64,
-    /// Whether the next iteration uses the exact Hessian (else the projected one).
-    exact: bool,
-    /// Iterations left before the exact Hessian is tried again after it proved indefinite.
-    cooldown: usize,
-    /// The damping schedule (never `Auto` here).
-    schedule: LmSchedule,
-    /// The damping's initial value (the cautious schedule returns to it on projecting).
+    /// The damping's initial value (it returns there when the Hessian is projected).
     mu_initial: f64,
 }
 
-/// The stretch a straight Newton step may add to a spring before the adaptive schedule's line
-/// search pulls it back (relative to the longer of its rest and previous length).
-const STRETCH_TOL: f64 = 1e-3;
-
-/// Smallest damping used once damping is needed (relative to the mean diagonal): a compressed
-/// spring's negative transverse stiffness is its strain times k, rarely below 1e-6 k.
-const MU_MIN: f64 = 1e-6;
+/// Smallest damping used once damping is needed (relative to the mean diagonal).
+const MU_MIN: f64 = 1e-8;
 
 impl Workspace {
     fn new(model: &Model, x: &[Vector3<f64>], opts: &StaticOptions) -> Self {
@@ -199,21 +152,15 @@ impl Workspace {
             g_trial: Vec::new(),
             shift: vec![0.0; n],
             mu: opts.lm_damping_initial,
-            exact: true,
-            cooldown: 0,
-            schedule: match opts.lm_schedule {
-                LmSchedule::Adaptive => LmSchedule::Adaptive,
-                _ => LmSchedule::Cautious,
-            },
             mu_initial: opts.lm_damping_initial,
         }
     }
 
-    /// Factorizes the Hessian at `x`, shifted by the damping: the exact Hessian (quadratic
-    /// convergence; projected Newton stalls on a hanging net whose compressed springs' transverse
-    /// stiffness it drops), its damping raised tenfold while it is indefinite, and the projected
-    /// Hessian (every term's indefinite part clamped) for three iterations once the shift would have
-    /// to exceed 1e-3 of the diagonal. False when no damping helps.
+    /// Factorizes the Hessian in `h` (computed at `x`), shifted by the damping: the exact Hessian
+    /// (quadratic convergence; projected Newton stalls on a hanging net whose compressed springs'
+    /// transverse stiffness it drops), its damping raised tenfold while it is indefinite, and the
+    /// projected Hessian (every term's indefinite part clamped), the damping back at its initial
+    /// value, once the shift would have to exceed 1e-3 of the diagonal. False when no damping helps.
     fn factorize(
         &mut self,
         model: &Model,
@@ -222,7 +169,6 @@ impl Workspace {
         scale: f64,
         report: &mut SolveReport,
     ) -> bool {
-        let cautious = self.schedule == LmSchedule::Cautious;
         for _ in 0..40 {
             self.shift.iter_mut().for_each(|s| *s = self.mu * scale);
             // Held components (symmetry planes): a diagonal far above the rest decouples them,
@@ -241,13 +187,9 @@ impl Workspace {
             if !*projected && self.mu >= 1e-3 {
                 *projected = true;
                 model.hessian(x, &mut self.h, true);
-                if cautious {
-                    self.mu = self.mu_initial.min(self.mu);
-                } else {
-                    self.cooldown = 3;
-                }
+                self.mu = self.mu_initial.min(self.mu);
             } else {
-                self.mu = (self.mu * 10.0).max(if cautious { 1e-8 } else { MU_MIN });
+                self.mu = (self.mu * 10.0).max(MU_MIN);
             }
         }
         false
@@ -281,30 +223,21 @@ impl Workspace {
         slope
     }
 
-    /// Backtracking (Armijo) line search along `dx`, bounded by the terms' largest step (contact).
-    /// Near the solution the energy change falls below round-off: there a step that lowers the
-    /// largest residual force is accepted instead. Returns the accepted step length, if any.
+    /// Backtracking (Armijo) line search along `dx` from the step length `alpha` (below 1 where a
+    /// term bounds the step: contact). Near the solution the energy change falls below round-off:
+    /// there a step that lowers the largest residual force is accepted instead. Returns the accepted
+    /// step length, if any.
     fn line_search(
         &mut self,
         model: &Model,
         x: &mut [Vector3<f64>],
         load: f64,
-        e: &mut f64,
-        r: f64,
-        slope: f64,
+        (e, r): (&mut f64, f64),
+        (mut alpha, slope): (f64, f64),
     ) -> Option<f64> {
-        let mut alpha = model.max_step(x, &self.dx).min(1.0);
-        let cautious = self.schedule == LmSchedule::Cautious;
-        let halvings = if cautious { 30 } else { 40 };
-        for _ in 0..halvings {
+        for _ in 0..30 {
             for (p, xp) in x.iter().enumerate() {
                 self.trial[p] = xp + self.dx[p] * alpha;
-            }
-            if !cautious {
-                // A straight step rotates stiff springs and stretches them at second order, which
-                // the energy punishes with a tiny step: pull back what the step stretched by more
-                // than 1e-3 (a curvilinear step; near the solution nothing is pulled back).
-                model.limit_stretch(x, &mut self.trial, STRETCH_TOL);
             }
             let et = model.energy(&self.trial, load);
             let flat = (et - *e).abs() <= 1e-11 * e.abs().max(1e-300);
@@ -323,9 +256,10 @@ impl Workspace {
     }
 
     /// One damped Newton iteration from `x`: factorize, step, line search, then adapt the damping
-    /// (divided by 10 after a full step, multiplied by 10 when the line search had to cut the step
-    /// below 1/8) and re-enable the exact Hessian after a full projected step. False when no step
-    /// lowers the energy.
+    /// (divided by 4 after a full step, raised tenfold from 1e-8 when no step lowers the energy; the
+    /// schedule drapelab has kept since its first static solver: small steps, so that a drape whose equilibrium
+    /// depends on its path — folds on a pedestal, a sheet rolling off a rod, sticky contact —
+    /// follows a quasi-static path). False when no step lowers the energy.
     fn iterate(
         &mut self,
         model: &Model,
@@ -335,36 +269,26 @@ impl Workspace {
         (r, tol): (f64, f64),
         report: &mut SolveReport,
     ) -> bool {
-        self.cooldown = self.cooldown.saturating_sub(1);
-        let cautious = self.schedule == LmSchedule::Cautious;
-        let mut projected = !(self.exact && self.cooldown == 0);
+        let mut projected = false;
         model.hessian(x, &mut self.h, projected);
-        // The damping's scale: the mean diagonal of this iteration's first Hessian.
+        // The damping's scale: the mean diagonal of this iteration's exact Hessian.
         let scale = mean_free_diagonal(&self.h, &self.dofs, model.len());
         for _ in 0..20 {
             if !self.factorize(model, x, &mut projected, scale, report) {
                 return false;
             }
             let slope = self.step(x.len());
-            let full = model.max_step(x, &self.dx) >= 1.0;
-            match self.line_search(model, x, load, e, r, slope) {
+            let bound = model.max_step(x, &self.dx);
+            match self.line_search(model, x, load, (e, r), (bound.min(1.0), slope)) {
                 Some(alpha) => {
-                    if cautious {
-                        if alpha == 1.0 && full {
-                            self.mu = if self.mu < 1e-12 { 0.0 } else { self.mu / 4.0 };
-                        }
-                    } else if alpha == 1.0 {
-                        self.mu = if self.mu < 1e-10 { 0.0 } else { self.mu / 10.0 };
-                    } else if alpha < 0.125 {
-                        self.mu = (self.mu * 10.0).max(MU_MIN);
+                    if alpha == 1.0 && bound >= 1.0 {
+                        self.mu = if self.mu < 1e-12 { 0.0 } else { self.mu / 4.0 };
                     }
                     return true;
                 }
                 // A step that does not decrease the energy: near the solution, round-off.
-                None if cautious && r <= 10.0 * tol => return false,
-                None => {
-                    self.mu = (self.mu * 10.0).max(if cautious { 1e-8 } else { MU_MIN });
-                }
+                None if r <= 10.0 * tol => return false,
+                None => self.mu = (self.mu * 10.0).max(MU_MIN),
             }
         }
         false
