@@ -4,6 +4,7 @@ use clap::Parser;
 
 fn main() {
     let cli = drapelab::cli::Cli::parse();
+    drapelab::cli::init_logging(cli.verbose, cli.quiet);
     let code = match drapelab::cli::run(cli) {
         Ok(code) => code,
         Err(err) => {

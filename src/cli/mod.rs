@@ -7,11 +7,12 @@ mod progress;
 
 pub use progress::SolveProgress;
 
+use crate::config::parse_override;
 use crate::error::{EXIT_FAILED, EXIT_OK, InputError};
-use crate::scene::{Scene, parse_override};
+use crate::scene::{LoadedScene, Scene};
 use anyhow::Result;
-use clap::{Parser, Subcommand};
-use std::path::PathBuf;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::path::{Path, PathBuf};
 
 /// drapelab: simulate how fabric drapes, measure drape, calibrate and validate models, record every run.
 ///
@@ -20,8 +21,32 @@ use std::path::PathBuf;
 #[derive(Debug, Parser)]
 #[command(name = "drapelab", version, about, long_about)]
 pub struct Cli {
+    /// More log lines (-v: debug, -vv: trace); RUST_LOG overrides.
+    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+    /// Only errors.
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
+    pub quiet: bool,
     #[command(subcommand)]
     pub command: Command,
+}
+
+/// Which hang a photo shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ViewArg {
+    /// Four corners pinned: one edge, the lower boundary.
+    Hang4,
+    /// Two corners pinned: top, bottom, left and right edges.
+    Hang2,
+}
+
+impl From<ViewArg> for crate::edges::View {
+    fn from(v: ViewArg) -> Self {
+        match v {
+            ViewArg::Hang4 => crate::edges::View::Hang4,
+            ViewArg::Hang2 => crate::edges::View::Hang2,
+        }
+    }
 }
 
 /// Subcommands.
@@ -66,7 +91,12 @@ pub enum Command {
     Status {
         /// The pipeline file.
         pipeline: PathBuf,
+        /// Exit with 1 when a stage is stale (for scripts and CI).
+        #[arg(long)]
+        check: bool,
     },
+    /// List the stage kinds a pipeline may use, with their input and output slots and parameters' page.
+    Kinds,
     /// Solve a 4- or 2-corner hang and render it as a photo from a camera facing it (along +y): DIR/photo.png
     /// (or .jpg), camera.json (exact scale and corner pixels), particles.parquet, and edges_truth.parquet
     /// (the same edge fit made straight from the particles).
@@ -131,9 +161,9 @@ pub enum Command {
         /// A camera.json written by `render` (scale, corners and view).
         #[arg(long)]
         camera_json: Option<PathBuf>,
-        /// hang4 (one edge, the lower boundary) or hang2 (top, bottom, left, right).
-        #[arg(long, default_value = "hang4")]
-        view: String,
+        /// Which hang the photo shows (ignored with --camera-json, which names it).
+        #[arg(long, value_enum, default_value_t = ViewArg::Hang4)]
+        view: ViewArg,
         /// Polynomial degree.
         #[arg(long, default_value_t = 4)]
         degree: usize,
@@ -195,11 +225,19 @@ pub enum Command {
 }
 
 /// `drapelab run`: runs a pipeline make-style with a progress display; returns the exit code.
-fn run_pipeline_command(
-    pipeline: &std::path::Path,
+fn run_pipeline_command(pipeline: &Path, opts: crate::pipeline::RunOptions) -> Result<i32> {
+    run_pipeline_with(pipeline, opts, &crate::stages::registry())
+}
+
+/// Runs a pipeline with the stage kinds of `registry` (drapelab's own, or those plus a program's
+/// own kinds); 0 when every stage ran or was up to date, 1 when one failed (an error, a panic or a
+/// missing output: the run goes on as far as the graph allows), bad input an error.
+pub fn run_pipeline_with(
+    pipeline: &Path,
     opts: crate::pipeline::RunOptions,
+    registry: &crate::pipeline::Registry,
 ) -> Result<i32> {
-    let plan = crate::pipeline::load_plan(pipeline)?;
+    let plan = crate::pipeline::load_plan(pipeline, registry)?;
     let progress = crate::pipeline::progress_for_terminal();
     let summary = crate::pipeline::run_pipeline(&plan, &opts, progress.as_ref())?;
     for (name, why) in &summary.would_run {
@@ -223,35 +261,33 @@ fn run_pipeline_command(
     })
 }
 
+/// Loads a scene with `--set KEY=VALUE` overrides; an error caused by an override names the flag.
+pub fn load_scene(path: &Path, sets: &[String]) -> Result<LoadedScene, InputError> {
+    let overrides = sets
+        .iter()
+        .map(|s| parse_override(s))
+        .collect::<Result<Vec<_>, InputError>>()?;
+    Scene::load(path, &overrides).map_err(|e| {
+        let culprit = sets.iter().zip(&overrides).find(|(_, (k, _))| {
+            e.key == *k
+                || e.key.starts_with(&format!("{k}."))
+                || k.starts_with(&format!("{}.", e.key))
+        });
+        match culprit {
+            Some((flag, _)) => InputError::new(
+                format!("--set {flag} (over {})", path.display()),
+                e.key,
+                e.message,
+            ),
+            None => e,
+        }
+    })
+}
+
 /// Runs the parsed command line; returns the exit code.
 pub fn run(cli: Cli) -> Result<i32> {
     match cli.command {
-        Command::Simulate { scene, out, set } => {
-            let overrides = set
-                .iter()
-                .map(|s| parse_override(s))
-                .collect::<Result<Vec<_>, InputError>>()?;
-            let loaded = Scene::load(&scene, &overrides)?;
-            let mut progress = SolveProgress::new(&loaded.scene.name);
-            let report = crate::simulate::simulate_to_dir(&loaded, &out, &mut progress)?;
-            progress.finish(&report);
-            eprintln!(
-                "{}: {} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
-                loaded.scene.name,
-                report.status.as_str(),
-                report.solver,
-                report.iterations,
-                report.max_residual_N,
-                report.max_residual_rel,
-                report.wall_time_s,
-                out.display()
-            );
-            Ok(if report.is_converged() {
-                EXIT_OK
-            } else {
-                EXIT_FAILED
-            })
-        }
+        Command::Simulate { scene, out, set } => simulate(&scene, &out, &set),
         Command::Run {
             pipeline,
             until,
@@ -267,14 +303,9 @@ pub fn run(cli: Cli) -> Result<i32> {
                 dry_run,
             },
         ),
-        Command::Status { pipeline } => {
-            let plan = crate::pipeline::load_plan(&pipeline)?;
-            for (name, state) in crate::pipeline::stage_states(&plan) {
-                match state {
-                    crate::pipeline::StageState::UpToDate => println!("{name}: up to date"),
-                    crate::pipeline::StageState::Stale(why) => println!("{name}: stale ({why})"),
-                }
-            }
+        Command::Status { pipeline, check } => status(&pipeline, check),
+        Command::Kinds => {
+            print!("{}", kinds_text());
             Ok(EXIT_OK)
         }
         Command::Render {
@@ -290,50 +321,17 @@ pub fn run(cli: Cli) -> Result<i32> {
             jpeg_quality,
             seed,
         } => {
-            let overrides = set
-                .iter()
-                .map(|s| parse_override(s))
-                .collect::<Result<Vec<_>, InputError>>()?;
-            let loaded = Scene::load(&scene, &overrides)?;
-            let camera = match pinhole_distance_m {
-                Some(d) if d.is_finite() && d > 0.0 => {
-                    crate::edges::Camera::Pinhole { distance_m: d }
-                }
-                Some(d) => {
-                    return Err(InputError::new(
-                        "--pinhole-distance-m",
-                        "",
-                        format!("must be > 0, got {d}"),
-                    )
-                    .into());
-                }
-                None => crate::edges::Camera::Orthographic,
-            };
-            for (k, v) in [
-                ("--px-per-cm", px_per_cm),
-                ("--noise", noise + 1.0),
-                ("--blur-px", blur_px + 1.0),
-            ] {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(InputError::new(
-                        k,
-                        "",
-                        "must be a finite number ≥ 0 (> 0 for the scale)",
-                    )
-                    .into());
-                }
-            }
-            let opts = crate::edges::RenderOptions {
-                camera,
+            let loaded = load_scene(&scene, &set)?;
+            let opts = render_options(
                 px_per_cm,
-                marker_radius_px: if markers { 4.0 } else { 0.0 },
-                noise_sigma: noise,
-                blur_sigma_px: blur_px,
-                rotation_deg: rotate_deg,
+                pinhole_distance_m,
+                markers,
+                noise,
+                blur_px,
+                rotate_deg,
                 seed,
-                ..Default::default()
-            };
-            let path = edges::render_scene(&loaded, &out, &opts, jpeg_quality, 4)?;
+            )?;
+            let path = crate::io::render_scene(&loaded, &out, &opts, jpeg_quality, 4)?;
             eprintln!("rendered {} → {}", loaded.scene.name, path.display());
             Ok(EXIT_OK)
         }
@@ -348,92 +346,18 @@ pub fn run(cli: Cli) -> Result<i32> {
             view,
             degree,
         } => {
-            let mut view = match view.as_str() {
-                "hang4" => crate::edges::View::Hang4,
-                "hang2" => crate::edges::View::Hang2,
-                v => {
-                    return Err(InputError::new(
-                        "--view",
-                        "",
-                        format!("`{v}`: expected hang4 or hang2"),
-                    )
-                    .into());
-                }
+            let calibration = FitCalibration {
+                px_per_cm,
+                corners,
+                markers,
+                side_cm,
+                camera_json,
             };
-            let calibration = if let Some(cj) = camera_json {
-                let cam = edges::read_camera(&cj)?;
-                view = cam.view;
-                crate::edges::Calibration::Given {
-                    px_per_cm: cam.px_per_cm,
-                    corners: cam.corners_px,
-                }
-            } else if markers {
-                let side = side_cm.ok_or_else(|| {
-                    InputError::new(
-                        "--side-cm",
-                        "",
-                        "--markers needs --side-cm (the distance between the corners)",
-                    )
-                })?;
-                crate::edges::Calibration::Markers { side_cm: side }
-            } else {
-                let (Some(s), Some(c)) = (px_per_cm, corners) else {
-                    return Err(InputError::new(&photo, "--corners", "give --px-per-cm and --corners x1,y1,x2,y2, or --markers --side-cm L, or --camera-json").into());
-                };
-                crate::edges::Calibration::Given {
-                    px_per_cm: s,
-                    corners: edges::parse_corners(&c)?,
-                }
-            };
-            if !(1..=8).contains(&degree) {
-                return Err(InputError::new("--degree", "", "must be in 1..=8").into());
-            }
-            let fits = edges::fit_photo(
-                &photo,
-                &out,
-                &crate::edges::FitImageOptions {
-                    view,
-                    degree,
-                    calibration,
-                },
-            )?;
-            for f in &fits {
-                eprintln!(
-                    "{}: {} points, RMS residual {:.4} cm, coefficients {:?}",
-                    f.edge, f.n_points, f.rms_residual_cm, f.coefficients
-                );
-            }
-            Ok(EXIT_OK)
+            fit_edges(&photo, &out, calibration, view, degree)
         }
-        Command::Wrinkles { config, out, mesh } => {
-            let cfg = crate::wrinkles::load_config(&config)?;
-            if mesh.iter().any(|&m| m < 2) {
-                return Err(InputError::new("--mesh", "", "NX and NY must be ≥ 2").into());
-            }
-            std::fs::create_dir_all(&out)?;
-            let outputs: Vec<PathBuf> = [
-                "wrinkles.parquet",
-                "mesh.parquet",
-                "wrinkles.rrd",
-                "wrinkles.md",
-            ]
-            .iter()
-            .map(|n| out.join(n))
-            .collect();
-            let params = crate::stages::WrinklesParams {
-                mesh_nx: mesh[0],
-                mesh_ny: mesh[1],
-            };
-            let solved = crate::stages::write_wrinkles(&cfg, &outputs, &params)?;
-            print!("{}", crate::stages::report_markdown(&cfg, &solved));
-            Ok(if solved.iter().all(|s| s.result.converged) {
-                EXIT_OK
-            } else {
-                EXIT_FAILED
-            })
-        }
+        Command::Wrinkles { config, out, mesh } => wrinkles(&config, &out, &mesh),
         Command::Score { real, sim, side_cm } => {
-            let rows = edges::score_files(&real, &sim, side_cm)?;
+            let rows = crate::io::score_files(&real, &sim, side_cm)?;
             println!(
                 "| edge | objective (Eq. 5) % | Eq. 5 uncentred % | curve distance % of side |\n|---|---|---|---|"
             );
@@ -456,7 +380,7 @@ pub fn run(cli: Cli) -> Result<i32> {
         } => {
             if all {
                 return run_pipeline_command(
-                    std::path::Path::new("pipelines/benchmark.toml"),
+                    Path::new("pipelines/benchmark.toml"),
                     Default::default(),
                 );
             }
@@ -470,4 +394,222 @@ pub fn run(cli: Cli) -> Result<i32> {
             Ok(EXIT_OK)
         }
     }
+}
+
+/// `drapelab simulate`.
+fn simulate(scene: &Path, out: &Path, set: &[String]) -> Result<i32> {
+    let loaded = load_scene(scene, set)?;
+    let mut progress = SolveProgress::new(&loaded.scene.name);
+    let report = crate::io::simulate_to_dir(&loaded, out, &mut progress)?;
+    progress.finish(&report);
+    eprintln!(
+        "{}: {} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
+        loaded.scene.name,
+        report.status.as_str(),
+        report.solver,
+        report.iterations,
+        report.max_residual_N,
+        report.max_residual_rel,
+        report.wall_time_s,
+        out.display()
+    );
+    Ok(if report.is_converged() {
+        EXIT_OK
+    } else {
+        EXIT_FAILED
+    })
+}
+
+/// `drapelab status`: 1 with `--check` when a stage is stale.
+fn status(pipeline: &Path, check: bool) -> Result<i32> {
+    let plan = crate::pipeline::load_plan(pipeline, &crate::stages::registry())?;
+    let mut stale = 0;
+    for (name, state) in crate::pipeline::stage_states(&plan) {
+        match state {
+            crate::pipeline::StageState::UpToDate => println!("{name}: up to date"),
+            crate::pipeline::StageState::Stale(why) => {
+                stale += 1;
+                println!("{name}: stale ({why})")
+            }
+        }
+    }
+    Ok(if check && stale > 0 {
+        EXIT_FAILED
+    } else {
+        EXIT_OK
+    })
+}
+
+/// `drapelab kinds`: every stage kind with its slots.
+pub fn kinds_text() -> String {
+    let mut s = String::new();
+    for k in crate::stages::registry().kinds() {
+        s += &format!("{}: {}\n", k.kind(), k.summary());
+        for (side, slots) in [("inputs", k.inputs()), ("outputs", k.outputs())] {
+            for slot in slots {
+                s += &format!(
+                    "  {side}.{}{}{}: {}\n",
+                    slot.name,
+                    if slot.many { " [list]" } else { "" },
+                    if slot.required { "" } else { " (optional)" },
+                    slot.doc
+                );
+            }
+        }
+    }
+    s
+}
+
+/// The render options of `drapelab render`, checked.
+fn render_options(
+    px_per_cm: f64,
+    pinhole_distance_m: Option<f64>,
+    markers: bool,
+    noise: f64,
+    blur_px: f64,
+    rotate_deg: f64,
+    seed: u64,
+) -> Result<crate::edges::RenderOptions, InputError> {
+    let camera = match pinhole_distance_m {
+        Some(d) if d.is_finite() && d > 0.0 => crate::edges::Camera::Pinhole { distance_m: d },
+        Some(d) => {
+            return Err(InputError::new(
+                "--pinhole-distance-m",
+                "",
+                format!("must be > 0, got {d}"),
+            ));
+        }
+        None => crate::edges::Camera::Orthographic,
+    };
+    for (k, v) in [
+        ("--px-per-cm", px_per_cm),
+        ("--noise", noise + 1.0),
+        ("--blur-px", blur_px + 1.0),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(InputError::new(
+                k,
+                "",
+                "must be a finite number ≥ 0 (> 0 for the scale)",
+            ));
+        }
+    }
+    Ok(crate::edges::RenderOptions {
+        camera,
+        px_per_cm,
+        marker_radius_px: if markers { 4.0 } else { 0.0 },
+        noise_sigma: noise,
+        blur_sigma_px: blur_px,
+        rotation_deg: rotate_deg,
+        seed,
+        ..Default::default()
+    })
+}
+
+/// The calibration flags of `drapelab fit-edges`.
+struct FitCalibration {
+    px_per_cm: Option<f64>,
+    corners: Option<String>,
+    markers: bool,
+    side_cm: Option<f64>,
+    camera_json: Option<PathBuf>,
+}
+
+/// `drapelab fit-edges`.
+fn fit_edges(
+    photo: &Path,
+    out: &Path,
+    c: FitCalibration,
+    view: ViewArg,
+    degree: usize,
+) -> Result<i32> {
+    let mut view: crate::edges::View = view.into();
+    let calibration = if let Some(cj) = c.camera_json {
+        let cam = crate::edges::read_camera(&cj)?;
+        view = cam.view;
+        crate::edges::Calibration::Given {
+            px_per_cm: cam.px_per_cm,
+            corners: cam.corners_px,
+        }
+    } else if c.markers {
+        let side = c.side_cm.ok_or_else(|| {
+            InputError::new(
+                "--side-cm",
+                "",
+                "--markers needs --side-cm (the distance between the corners)",
+            )
+        })?;
+        crate::edges::Calibration::Markers { side_cm: side }
+    } else {
+        let (Some(s), Some(corners)) = (c.px_per_cm, c.corners) else {
+            return Err(InputError::new(photo, "--corners", "give --px-per-cm and --corners x1,y1,x2,y2, or --markers --side-cm L, or --camera-json").into());
+        };
+        crate::edges::Calibration::Given {
+            px_per_cm: s,
+            corners: edges::parse_corners(&corners)?,
+        }
+    };
+    if !(1..=8).contains(&degree) {
+        return Err(InputError::new("--degree", "", "must be in 1..=8").into());
+    }
+    let fits = crate::io::fit_photo(
+        photo,
+        out,
+        &crate::edges::FitImageOptions {
+            view,
+            degree,
+            calibration,
+        },
+    )?;
+    for f in &fits {
+        eprintln!(
+            "{}: {} points, RMS residual {:.4} cm, coefficients {:?}",
+            f.edge, f.n_points, f.rms_residual_cm, f.coefficients
+        );
+    }
+    Ok(EXIT_OK)
+}
+
+/// `drapelab wrinkles`.
+fn wrinkles(config: &Path, out: &Path, mesh: &[usize]) -> Result<i32> {
+    let cfg = crate::wrinkles::load_config(config)?;
+    if mesh.iter().any(|&m| m < 2) {
+        return Err(InputError::new("--mesh", "", "NX and NY must be ≥ 2").into());
+    }
+    std::fs::create_dir_all(out)?;
+    let outputs = crate::stages::WrinkleOutputs {
+        table: Some(out.join("wrinkles.parquet")),
+        mesh: Some(out.join("mesh.parquet")),
+        recording: Some(out.join("wrinkles.rrd")),
+        markdown: Some(out.join("wrinkles.md")),
+    };
+    let params = crate::stages::WrinklesParams {
+        mesh_nx: mesh[0],
+        mesh_ny: mesh[1],
+    };
+    let solved = crate::stages::write_wrinkles(&cfg, &outputs, &params)?;
+    print!("{}", crate::stages::report_markdown(&cfg, &solved));
+    Ok(if solved.iter().all(|s| s.result.converged) {
+        EXIT_OK
+    } else {
+        EXIT_FAILED
+    })
+}
+
+/// Log lines (tracing) on stderr: warnings by default, more with `-v`, errors only with `-q`;
+/// `RUST_LOG` (e.g. `RUST_LOG=drapelab_pipeline=debug`) overrides both.
+pub fn init_logging(verbose: u8, quiet: bool) {
+    let level = match (quiet, verbose) {
+        (true, _) => "error",
+        (false, 0) => "warn",
+        (false, 1) => "debug",
+        (false, _) => "trace",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .try_init();
 }

@@ -3,7 +3,7 @@
 
 use crate::support::{root, scene};
 use drapelab::calibrate::Problem;
-use drapelab::cli::edges::read_camera;
+use drapelab::edges::read_camera;
 use drapelab::edges::{Calibration, FitImageOptions, fit_image, read_gray};
 use drapelab::optim::IcaSettings;
 
@@ -77,8 +77,10 @@ fn bad_calibration_configs_exit_2_naming_the_key() {
 name = "knitted"
 [stages.calibrate]
 kind = "calibrate"
-inputs = ["edges.parquet", "knitted_samples.csv", "hang4.toml"]
-outputs = ["{run}/results.parquet"]
+inputs.edges = "edges.parquet"
+inputs.samples = "knitted_samples.csv"
+inputs.scene = "hang4.toml"
+outputs.results = "{run}/results.parquet"
 [stages.calibrate.params]
 runs = 2
 ica = { decades = 12, countries = 16, imperialists = 3, beta = 2.0, gamma = 0.5, revolution_rate = 0.2, xi = 0.1, seed = 1 }
@@ -134,12 +136,18 @@ fn a_calibration_records_every_decade_for_rerun_and_writes_its_tables() {
 name = "c"
 [stages.fit4]
 kind = "fit-edges"
-inputs = ["datasets/knitted/*/hang4/photo.png", "datasets/knitted/*/hang4/camera.json"]
-outputs = ["{run}/fit4/edges.parquet"]
+inputs.photos = ["datasets/knitted/*/hang4/photo.png"]
+inputs.cameras = ["datasets/knitted/*/hang4/camera.json"]
+outputs.edges = "{run}/fit4/edges.parquet"
 [stages.calibrate]
 kind = "calibrate"
-inputs = ["{run}/fit4/edges.parquet", "datasets/knitted/knitted_samples.csv", "datasets/scenes/hang4.toml"]
-outputs = ["{run}/calibrate/results.parquet", "{run}/calibrate/evaluations.parquet", "{run}/calibrate/calibration.rrd", "{run}/calibrate/comparison.parquet"]
+inputs.edges = "{run}/fit4/edges.parquet"
+inputs.samples = "datasets/knitted/knitted_samples.csv"
+inputs.scene = "datasets/scenes/hang4.toml"
+outputs.results = "{run}/calibrate/results.parquet"
+outputs.evaluations = "{run}/calibrate/evaluations.parquet"
+outputs.recording = "{run}/calibrate/calibration.rrd"
+outputs.comparison = "{run}/calibrate/comparison.parquet"
 [stages.calibrate.params]
 runs = 1
 baseline_cmaes = true
@@ -203,12 +211,15 @@ fn calibration_recovers_the_identifiable_parameters_of_all_nine_samples() {
 name = "r"
 [stages.fit4]
 kind = "fit-edges"
-inputs = ["datasets/knitted/*/hang4/photo.png", "datasets/knitted/*/hang4/camera.json"]
-outputs = ["{run}/fit4/edges.parquet"]
+inputs.photos = ["datasets/knitted/*/hang4/photo.png"]
+inputs.cameras = ["datasets/knitted/*/hang4/camera.json"]
+outputs.edges = "{run}/fit4/edges.parquet"
 [stages.calibrate]
 kind = "calibrate"
-inputs = ["{run}/fit4/edges.parquet", "datasets/knitted/knitted_samples.csv", "datasets/scenes/hang4.toml"]
-outputs = ["{run}/calibrate/results.parquet"]
+inputs.edges = "{run}/fit4/edges.parquet"
+inputs.samples = "datasets/knitted/knitted_samples.csv"
+inputs.scene = "datasets/scenes/hang4.toml"
+outputs.results = "{run}/calibrate/results.parquet"
 [stages.calibrate.params]
 runs = 1
 ica = { decades = 40, countries = 15, imperialists = 5, beta = 2.0, gamma = 0.1, revolution_rate = 0.2, xi = 0.2, seed = 1 }

@@ -155,3 +155,77 @@ fn a_diverged_run_writes_its_status_and_no_particles() {
     assert!(run["report"]["divergence"]["step"].as_u64().is_some());
     assert!(!out.join("particles.parquet").exists());
 }
+
+#[test]
+fn a_bad_set_value_names_the_flag() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = drapelab()
+        .arg("simulate")
+        .arg(root().join("datasets/scenes/hang4.toml"))
+        .arg("--out")
+        .arg(tmp.path().join("out"))
+        .args(["--set", "cloth.nx=1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].contains("--set cloth.nx=1") && lines[0].contains("cloth.nx"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("out").exists());
+}
+
+#[test]
+fn a_grid_override_moves_index_pins_to_the_same_material_points() {
+    // The rod scene pins particles by index on its 33 × 33 grid; on 17 × 17 (and 65 × 65) they must
+    // stay at the same points of the sheet, not at the old indices.
+    let path = root().join("datasets/scenes/rod_polyester.toml");
+    let base = drapelab::scene::Scene::load(&path, &[]).unwrap().scene;
+    let at = |s: &drapelab::scene::Scene, p: [usize; 2]| {
+        (
+            p[0] as f64 / (s.cloth.nx - 1) as f64 * s.cloth.size_x_m,
+            p[1] as f64 / (s.cloth.ny - 1) as f64 * s.cloth.size_y_m,
+        )
+    };
+    for n in [17i64, 65] {
+        let sets = [
+            ("cloth.nx".to_string(), toml::Value::Integer(n)),
+            ("cloth.ny".to_string(), toml::Value::Integer(n)),
+        ];
+        let s = drapelab::scene::Scene::load(&path, &sets).unwrap().scene;
+        assert_eq!(s.cloth.nx, n as usize);
+        assert_eq!(
+            s.boundary.pin_particles.len(),
+            base.boundary.pin_particles.len()
+        );
+        for (a, b) in base
+            .boundary
+            .pin_particles
+            .iter()
+            .zip(&s.boundary.pin_particles)
+        {
+            let (pa, pb) = (at(&base, *a), at(&s, *b));
+            assert!(
+                (pa.0 - pb.0).abs() < 1e-12 && (pa.1 - pb.1).abs() < 1e-12,
+                "n = {n}: pin {a:?} → {b:?}"
+            );
+        }
+    }
+    // Pins given with the grid override are taken as indices of the new grid.
+    let sets = [
+        ("cloth.nx".to_string(), toml::Value::Integer(17)),
+        ("cloth.ny".to_string(), toml::Value::Integer(17)),
+        (
+            "boundary.pin_particles".to_string(),
+            toml::Value::Array(vec![toml::Value::Array(vec![
+                toml::Value::Integer(3),
+                toml::Value::Integer(5),
+            ])]),
+        ),
+    ];
+    let s = drapelab::scene::Scene::load(&path, &sets).unwrap().scene;
+    assert_eq!(s.boundary.pin_particles, vec![[3, 5]]);
+}

@@ -2,12 +2,14 @@
 //! here means measured drape is wrong before any calibration starts.
 
 use crate::support::{drapelab, root};
-use drapelab::cli::edges::{render_scene, score_edges};
+use drapelab::config::parse_override;
+use drapelab::edges::score_edges;
 use drapelab::edges::{
     Calibration, EdgeFit, FitImageOptions, RenderOptions, View, curve_distance_pct,
-    eq5_objective_pct, fit_image, read_edges,
+    eq5_objective_pct, fit_image,
 };
-use drapelab::scene::{Scene, parse_override};
+use drapelab::io::{read_edges, render_scene};
+use drapelab::scene::Scene;
 use image::{Rgb, RgbImage};
 use std::path::Path;
 
@@ -28,7 +30,7 @@ fn rendered(
     let overrides: Vec<_> = sets.iter().map(|s| parse_override(s).unwrap()).collect();
     let loaded = Scene::load(&root().join("datasets/scenes/hang4.toml"), &overrides).unwrap();
     let photo = render_scene(&loaded, dir, opts, jpeg, 4).unwrap();
-    let cam: drapelab::cli::edges::CameraFile =
+    let cam: drapelab::edges::CameraFile =
         serde_json::from_slice(&std::fs::read(dir.join("camera.json")).unwrap()).unwrap();
     let img = image::open(&photo).unwrap().to_rgb8();
     let fit = fit_image(
@@ -293,22 +295,26 @@ fn bundled_knitted_photos_measure_the_simulated_drapes() {
 name = "k"
 [stages.fit2]
 kind = "fit-edges"
-inputs = ["datasets/knitted/*/hang2/photo.png", "datasets/knitted/*/hang2/camera.json"]
-outputs = ["{run}/fit2/edges.parquet"]
+inputs.photos = ["datasets/knitted/*/hang2/photo.png"]
+inputs.cameras = ["datasets/knitted/*/hang2/camera.json"]
+outputs.edges = "{run}/fit2/edges.parquet"
 [stages.err2]
 kind = "score"
-inputs = ["{run}/fit2/edges.parquet", "datasets/knitted/*/hang2/edges_truth.parquet"]
-outputs = ["{run}/err2/score.parquet"]
-params = { measured = "{run}/fit2/edges.parquet", side_cm = 50.0 }
+inputs.measured = "{run}/fit2/edges.parquet"
+inputs.simulated = ["datasets/knitted/*/hang2/edges_truth.parquet"]
+outputs.score = "{run}/err2/score.parquet"
+params = { side_cm = 50.0 }
 [stages.fit4]
 kind = "fit-edges"
-inputs = ["datasets/knitted/*/hang4/photo.png", "datasets/knitted/*/hang4/camera.json"]
-outputs = ["{run}/fit4/edges.parquet"]
+inputs.photos = ["datasets/knitted/*/hang4/photo.png"]
+inputs.cameras = ["datasets/knitted/*/hang4/camera.json"]
+outputs.edges = "{run}/fit4/edges.parquet"
 [stages.err4]
 kind = "score"
-inputs = ["{run}/fit4/edges.parquet", "datasets/knitted/*/hang4/edges_truth.parquet"]
-outputs = ["{run}/err4/score.parquet"]
-params = { measured = "{run}/fit4/edges.parquet", side_cm = 50.0 }
+inputs.measured = "{run}/fit4/edges.parquet"
+inputs.simulated = ["datasets/knitted/*/hang4/edges_truth.parquet"]
+outputs.score = "{run}/err4/score.parquet"
+params = { side_cm = 50.0 }
 "#,
     );
     crate::support::run_plan(&file);

@@ -2,7 +2,7 @@
 //! behaviour of the integrators. A failure here means drapelab's equilibria are wrong.
 
 use crate::support::scene;
-use drapelab::cloth::build_scene;
+use drapelab::build::build_scene;
 use drapelab::scene::Scene;
 use drapelab::simulate::{Solution, solve_scene};
 use drapelab::solve::{

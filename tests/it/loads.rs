@@ -2,7 +2,7 @@
 //! buckles only when perturbed (seed 003 §10.5), and a twisted plate bends alike in every direction.
 
 use crate::support::scene;
-use drapelab::cloth::build_scene;
+use drapelab::build::build_scene;
 use drapelab::simulate::solve_scene;
 use drapelab::solve::{NoObserver, Status};
 use nalgebra::Vector3;

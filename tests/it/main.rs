@@ -7,6 +7,7 @@ mod contact;
 mod edges;
 mod engine;
 mod equilibria;
+mod layering;
 mod loads;
 mod pipeline;
 mod recordings;

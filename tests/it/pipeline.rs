@@ -12,26 +12,29 @@ const PIPELINE: &str = r#"
 name = "t"
 [stages.a4]
 kind = "simulate"
-inputs = ["datasets/scenes/hang4.toml"]
-outputs = ["{run}/a4/particles.parquet", "{run}/a4/run.json"]
+inputs.scene = "datasets/scenes/hang4.toml"
+outputs.particles = "{run}/a4/particles.parquet"
+outputs.run = "{run}/a4/run.json"
 params.set = { "cloth.nx" = 9, "cloth.ny" = 9 }
 
 [stages.a2]
 kind = "simulate"
-inputs = ["datasets/scenes/hang2.toml"]
-outputs = ["{run}/a2/particles.parquet", "{run}/a2/run.json"]
+inputs.scene = "datasets/scenes/hang2.toml"
+outputs.particles = "{run}/a2/particles.parquet"
+outputs.run = "{run}/a2/run.json"
 params.set = { "cloth.nx" = 9, "cloth.ny" = 9 }
 
 [stages.sweep2]
 kind = "sweep"
-inputs = ["datasets/scenes/hang2.toml"]
-outputs = ["{run}/sweep2/sweep.parquet"]
+inputs.scenes = ["datasets/scenes/hang2.toml"]
+outputs.table = "{run}/sweep2/sweep.parquet"
 params.axes = { "material.mass_spring.stiffness_N_per_m" = [600.0, 1100.0], "cloth.nx,cloth.ny" = [7, 9] }
 
 [stages.report]
 kind = "report"
-inputs = ["{run}/sweep2/*.parquet"]
-outputs = ["reports/t.md", "reports/t.svg"]
+inputs.tables = ["{run}/sweep2/*.parquet"]
+outputs.markdown = "reports/t.md"
+outputs.plot = "reports/t.svg"
 params = { title = "t", x = "material.mass_spring.stiffness_N_per_m", group_by = ["scene", "cloth.nx"] }
 "#;
 
@@ -45,7 +48,7 @@ fn project(pipeline: &str) -> (tempfile::TempDir, PathBuf) {
 }
 
 fn run(file: &Path, opts: RunOptions) -> drapelab::pipeline::RunSummary {
-    let plan = load_plan(file).unwrap();
+    let plan = load_plan(file, &drapelab::stages::registry()).unwrap();
     run_pipeline(
         &plan,
         &RunOptions { jobs: 2, ..opts },
@@ -74,7 +77,7 @@ fn second_run_skips_everything_and_a_changed_input_reruns_only_its_dependents() 
         .unwrap()
         .replace("stiffness_N_per_m = 1000.0", "stiffness_N_per_m = 900.0");
     std::fs::write(&h2, text).unwrap();
-    let plan = load_plan(&file).unwrap();
+    let plan = load_plan(&file, &drapelab::stages::registry()).unwrap();
     let states = stage_states(&plan);
     let why = |n: &str| states.iter().find(|(s, _)| s == n).unwrap().1.clone();
     assert_eq!(why("a4"), StageState::UpToDate);
@@ -136,7 +139,7 @@ fn force_reruns_the_stage_and_its_dependents_and_a_changed_parameter_is_reported
         ),
     )
     .unwrap();
-    let plan = load_plan(&file).unwrap();
+    let plan = load_plan(&file, &drapelab::stages::registry()).unwrap();
     let states = stage_states(&plan);
     let a4 = &states.iter().find(|(s, _)| s == "a4").unwrap().1;
     assert!(
@@ -157,20 +160,23 @@ const SLOW_PIPELINE: &str = r#"
 name = "t"
 [stages.a4]
 kind = "simulate"
-inputs = ["datasets/scenes/hang4.toml"]
-outputs = ["{run}/a4/particles.parquet", "{run}/a4/run.json", "{run}/a4/timeline.mcap"]
+inputs.scene = "datasets/scenes/hang4.toml"
+outputs.particles = "{run}/a4/particles.parquet"
+outputs.run = "{run}/a4/run.json"
+outputs.timeline = "{run}/a4/timeline.mcap"
 params.set = { "cloth.nx" = 41, "cloth.ny" = 41, "record.timeline" = true }
 
 [stages.sweep2]
 kind = "sweep"
-inputs = ["datasets/scenes/hang2.toml"]
-outputs = ["{run}/sweep2/sweep.parquet"]
+inputs.scenes = ["datasets/scenes/hang2.toml"]
+outputs.table = "{run}/sweep2/sweep.parquet"
 params.axes = { "material.mass_spring.stiffness_N_per_m" = [600.0, 900.0, 1200.0], "cloth.nx,cloth.ny" = [21, 41] }
 
 [stages.report]
 kind = "report"
-inputs = ["{run}/sweep2/*.parquet"]
-outputs = ["reports/t.md", "reports/t.svg"]
+inputs.tables = ["{run}/sweep2/*.parquet"]
+outputs.markdown = "reports/t.md"
+outputs.plot = "reports/t.svg"
 params = { title = "t", x = "material.mass_spring.stiffness_N_per_m", group_by = ["scene", "cloth.nx"] }
 "#;
 
@@ -199,7 +205,7 @@ fn a_run_killed_mid_stage_completes_to_the_same_artifacts() {
         std::thread::sleep(std::time::Duration::from_millis(delay_ms));
         child.kill().unwrap();
         child.wait().unwrap();
-        let plan = load_plan(&file).unwrap();
+        let plan = load_plan(&file, &drapelab::stages::registry()).unwrap();
         if stage_states(&plan)
             .iter()
             .any(|(_, s)| *s != StageState::UpToDate)
@@ -212,7 +218,7 @@ fn a_run_killed_mid_stage_completes_to_the_same_artifacts() {
                 .path()
                 .join(format!("runs/t/.manifests/{}.json", s.name));
             if m.exists() {
-                for o in &s.outputs {
+                for o in s.outputs.values() {
                     assert!(
                         tmp.path().join(o).exists(),
                         "{} has a manifest but no {}",
@@ -286,13 +292,15 @@ fn bad_pipeline_files_are_refused_naming_file_and_stage() {
 name = "t"
 [stages.x]
 kind = "report"
-inputs = ["{run}/y.parquet"]
-outputs = ["{run}/x.parquet", "reports/x.md", "reports/x.svg"]
+inputs.tables = ["{run}/y.parquet"]
+outputs.plot = "{run}/x.parquet"
+outputs.markdown = "reports/x.md"
 params = { title = "x", x = "a" }
 [stages.y]
 kind = "report"
-inputs = ["{run}/x.parquet"]
-outputs = ["{run}/y.parquet", "reports/y.md", "reports/y.svg"]
+inputs.tables = ["{run}/x.parquet"]
+outputs.plot = "{run}/y.parquet"
+outputs.markdown = "reports/y.md"
 params = { title = "y", x = "a" }
 "#;
     assert_bad_pipeline(cycle, "stages.x", "cycle");
@@ -350,4 +358,90 @@ assert s["centre_z_m"][0] < s["centre_z_m"][1] < 0, s
 print("ok")
 "#;
     run_python(code, &[&tmp.path().join("runs/t/sweep2/sweep.parquet")]);
+}
+
+#[test]
+fn a_missing_or_unknown_slot_is_refused_at_load_naming_stage_and_slot() {
+    // A required output left out.
+    assert_bad_pipeline(
+        &PIPELINE.replace("outputs.run = \"{run}/a4/run.json\"\n", ""),
+        "stages.a4.outputs.run",
+        "missing output slot",
+    );
+    // An output the kind does not have.
+    assert_bad_pipeline(
+        &PIPELINE.replace(
+            "outputs.run = \"{run}/a4/run.json\"\n",
+            "outputs.run = \"{run}/a4/run.json\"\noutputs.extra = \"{run}/a4/extra.json\"\n",
+        ),
+        "stages.a4.outputs.extra",
+        "unknown output slot",
+    );
+    // An input slot the kind does not have, and a required input left out.
+    assert_bad_pipeline(
+        &PIPELINE.replace(
+            "inputs.scene = \"datasets/scenes/hang2.toml\"",
+            "inputs.scenes = \"datasets/scenes/hang2.toml\"",
+        ),
+        "stages.a2.inputs.scenes",
+        "unknown input slot",
+    );
+    // Nothing ran and nothing was written.
+    let (tmp, file) = project(&PIPELINE.replace("outputs.run = \"{run}/a4/run.json\"\n", ""));
+    assert!(load_plan(&file, &drapelab::stages::registry()).is_err());
+    assert!(!tmp.path().join("runs").exists());
+}
+
+/// A stage kind that panics, registered beside drapelab's own (a new kind is one type and one line).
+struct Panics;
+
+impl drapelab::pipeline::StageKind for Panics {
+    type Params = toml::Table;
+    const KIND: &'static str = "panics";
+    const SUMMARY: &'static str = "panics (a test of the runner)";
+    const INPUTS: &'static [drapelab::pipeline::Slot] = &[];
+    const OUTPUTS: &'static [drapelab::pipeline::Slot] =
+        &[drapelab::pipeline::Slot::one("out", "never written")];
+    fn run(_: &drapelab::pipeline::StageContext<'_>, _: &toml::Table) -> anyhow::Result<()> {
+        panic!("index out of bounds in a buggy stage")
+    }
+}
+
+#[test]
+fn a_panicking_stage_fails_alone_and_the_run_exits_1() {
+    let text = PIPELINE.to_string()
+        + "\n[stages.bad]\nkind = \"panics\"\noutputs.out = \"{run}/bad/out.json\"\n\
+           \n[stages.after_bad]\nkind = \"report\"\ninputs.tables = [\"{run}/bad/out.json\"]\n\
+           outputs.markdown = \"reports/ab.md\"\noutputs.plot = \"reports/ab.svg\"\n\
+           params = { title = \"t\", x = \"a\" }\n";
+    let (tmp, file) = project(&text);
+    let registry = drapelab::stages::registry().with::<Panics>();
+    let code = drapelab::cli::run_pipeline_with(
+        &file,
+        RunOptions {
+            jobs: 2,
+            ..Default::default()
+        },
+        &registry,
+    )
+    .unwrap();
+    assert_eq!(code, 1, "a failed stage makes the run exit 1");
+    let manifest: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(tmp.path().join("runs/t/.manifests/bad.json")).unwrap(),
+    )
+    .unwrap();
+    let status = manifest["status"].as_str().unwrap();
+    assert!(
+        status.starts_with("failed") && status.contains("panicked") && status.contains("buggy"),
+        "{status}"
+    );
+    // The stages that do not depend on it ran; its dependent did not.
+    for done in ["a4", "a2", "sweep2", "report"] {
+        let m: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(tmp.path().join(format!("runs/t/.manifests/{done}.json"))).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(m["status"], "ok", "{done}");
+    }
+    assert!(!tmp.path().join("reports/ab.md").exists());
 }

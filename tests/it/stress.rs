@@ -87,8 +87,8 @@ fn a_small_stress_sweep_finds_no_undetected_divergence() {
 name = "s"
 [stages.sweep]
 kind = "sweep"
-inputs = ["datasets/scenes/hang4.toml"]
-outputs = ["{run}/sweep/sweep.parquet"]
+inputs.scenes = ["datasets/scenes/hang4.toml"]
+outputs.table = "{run}/sweep/sweep.parquet"
 [stages.sweep.params]
 design = "lhs"
 samples = 40

@@ -1,6 +1,7 @@
 //! Shared helpers: scene loading with overrides, paths, the binary, the Python of the test venv.
 
-use drapelab::scene::{Scene, parse_override};
+use drapelab::config::parse_override;
+use drapelab::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -113,7 +114,7 @@ pub fn temp_project(globs: &[&str], name: &str, pipeline: &str) -> (tempfile::Te
 
 /// Runs the pipeline `file` in this process and asserts that no stage failed.
 pub fn run_plan(file: &Path) -> drapelab::pipeline::RunSummary {
-    let plan = drapelab::pipeline::load_plan(file).unwrap();
+    let plan = drapelab::pipeline::load_plan(file, &drapelab::stages::registry()).unwrap();
     let s = drapelab::pipeline::run_pipeline(
         &plan,
         &Default::default(),

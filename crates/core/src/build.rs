@@ -1,0 +1,487 @@
+//! From a scene to a [`Model`]: the springs the topology asks for, or the continuum terms, the
+//! lumped masses, pins and clamps. Terms a scene does not need are never built.
+
+use crate::cloth::{Grid, tributary_lengths};
+use crate::material::Rigidities;
+use crate::physics::{
+    CellShear, CellTwist, EnergyTerm, Gravity, LinearBending, Model, SpringFamily, Springs,
+};
+use crate::scene::Scene;
+use nalgebra::Vector3;
+
+/// A scene turned into a model with its grid and initial positions.
+pub struct BuiltScene {
+    /// The grid of real particles.
+    pub grid: Grid,
+    /// The model (possibly with virtual clamp points after the grid particles).
+    pub model: Model,
+    /// Initial positions of all particles in m.
+    pub x0: Vec<Vector3<f64>>,
+}
+
+/// For `cloth.shape = "disc"`, the grid particles outside the circle inscribed in the sheet (plus a
+/// hundredth of the spacing, so that the circle's four extreme points stay); none for a square sheet.
+pub fn absent_particles(scene: &Scene, x0: &[Vector3<f64>]) -> Vec<bool> {
+    let c = &scene.cloth;
+    let n = c.nx * c.ny;
+    if c.shape != crate::scene::SheetShape::Disc {
+        return vec![false; n];
+    }
+    let r = 0.5 * c.size_x_m.min(c.size_y_m);
+    let centre = Vector3::new(
+        c.origin_m[0] + 0.5 * c.size_x_m,
+        c.origin_m[1] + 0.5 * c.size_y_m,
+        0.0,
+    );
+    let tol = 0.01 * c.size_x_m / (c.nx - 1) as f64;
+    x0[..n]
+        .iter()
+        .map(|p| ((p.x - centre.x).powi(2) + (p.y - centre.y).powi(2)).sqrt() > r + tol)
+        .collect()
+}
+
+/// Initial positions of the grid particles ([`Scene::initial_positions`]).
+pub fn initial_positions(scene: &Scene) -> Vec<Vector3<f64>> {
+    scene.initial_positions()
+}
+
+/// Builds the model of a validated scene.
+pub fn build_scene(scene: &Scene) -> BuiltScene {
+    let c = &scene.cloth;
+    let grid = scene.grid();
+    let flat = grid.flat_positions();
+    let mut x0 = initial_positions(scene);
+    let mut masses = grid.lumped_masses(c.areal_density_kg_per_m2);
+    let mut fixed = vec![false; grid.len()];
+    // A disc sheet: the particles outside the inscribed circle are absent (fixed, massless, in no term).
+    let absent = absent_particles(scene, &x0);
+    for (p, &a) in absent.iter().enumerate() {
+        if a {
+            masses[p] = 0.0;
+            fixed[p] = true;
+        }
+    }
+    for corner in &scene.boundary.pin_corners {
+        let (i, j) = corner.ij(&grid);
+        fixed[grid.index(i, j)] = true;
+    }
+    for p in &scene.boundary.pin_particles {
+        fixed[grid.index(p[0], p[1])] = true;
+    }
+    let mut terms: Vec<Box<dyn EnergyTerm>> = Vec::new();
+    let g = scene.gravity.g_m_per_s2;
+    let (damping, elongation) = match &scene.material.mass_spring {
+        Some(ms) => (ms.damping_Ns_per_m, Some(ms.elongation_rate)),
+        None => (0.0, None),
+    };
+    if let Some(ms) = &scene.material.mass_spring {
+        for edge in &scene.boundary.clamp_edges {
+            // A mass-spring net has no rotational degrees of freedom: clamp = pin the edge and the next line.
+            let (on, next) = edge.lines(&grid);
+            for p in on.into_iter().chain(next) {
+                fixed[p] = true;
+            }
+        }
+        let rest = |a: usize, b: usize, factor: f64| match ms.natural_length_m {
+            Some(l0) => l0 * factor,
+            None => (flat[b] - flat[a]).norm(),
+        };
+        let mut family = |fam: SpringFamily, k: f64, offsets: &[(usize, usize)], factor: f64| {
+            let mut pairs = Vec::new();
+            for j in 0..grid.ny {
+                for i in 0..grid.nx {
+                    for &(di, dj) in offsets {
+                        if i + di < grid.nx && j + dj < grid.ny {
+                            let (a, b) = (grid.index(i, j), grid.index(i + di, j + dj));
+                            if !absent[a] && !absent[b] {
+                                pairs.push((a, b));
+                            }
+                        }
+                    }
+                }
+            }
+            // The anti-diagonal of each cell for shear springs.
+            if fam == SpringFamily::Shear {
+                for j in 0..grid.ny - 1 {
+                    for i in 0..grid.nx - 1 {
+                        let (a, b) = (grid.index(i + 1, j), grid.index(i, j + 1));
+                        if !absent[a] && !absent[b] {
+                            pairs.push((a, b));
+                        }
+                    }
+                }
+            }
+            let rests: Vec<f64> = pairs.iter().map(|&(a, b)| rest(a, b, factor)).collect();
+            let n = pairs.len();
+            if n > 0 {
+                terms.push(Box::new(Springs::new(fam, pairs, rests, vec![k; n])));
+            }
+        };
+        family(
+            SpringFamily::Structural,
+            ms.structural(),
+            &[(1, 0), (0, 1)],
+            1.0,
+        );
+        if ms.topology.has_shear() {
+            family(
+                SpringFamily::Shear,
+                ms.shear(),
+                &[(1, 1)],
+                std::f64::consts::SQRT_2,
+            );
+        }
+        if ms.topology.has_bend() {
+            family(SpringFamily::Bend, ms.bend(), &[(2, 0), (0, 2)], 2.0);
+        }
+    }
+    let mut held = Vec::new();
+    if let Some(cont) = &scene.material.continuum {
+        let r = cont.rigidities().expect("validated scene");
+        symmetry_planes(
+            &grid,
+            &r,
+            &scene.boundary.symmetry_edges,
+            &x0,
+            &mut held,
+            &mut terms,
+        );
+        continuum_terms(
+            &grid,
+            &r,
+            &absent,
+            &scene.boundary.clamp_edges,
+            &mut fixed,
+            &mut masses,
+            &mut x0,
+            &mut terms,
+        );
+    }
+    if g > 0.0 {
+        terms.push(Box::new(Gravity::new(masses.clone(), g)));
+    }
+    point_loads(scene, &grid, &absent, &x0, &mut terms);
+    holds(scene, &grid, &mut held);
+    contact_terms(scene, &x0, &masses, &mut fixed, &mut terms);
+    let model = Model {
+        n_grid: grid.len(),
+        masses,
+        fixed,
+        held_components: held,
+        terms,
+        gravity_m_per_s2: g,
+        damping_Ns_per_m: damping,
+        elongation_rate: elongation,
+    };
+    BuiltScene { grid, model, x0 }
+}
+
+/// The scene's `[[loads]]` as one term (only when it has some): a load given by position goes to the
+/// nearest present particle.
+fn point_loads(
+    scene: &Scene,
+    grid: &Grid,
+    absent: &[bool],
+    x0: &[Vector3<f64>],
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    if scene.loads.is_empty() {
+        return;
+    }
+    let loads = scene
+        .loads
+        .iter()
+        .map(|l| {
+            let p = match (l.particle, l.at_m) {
+                (Some([i, j]), _) => grid.index(i, j),
+                (None, Some([x, y])) => (0..grid.len())
+                    .filter(|&p| !absent[p])
+                    .min_by(|&a, &b| {
+                        let d = |p: usize| (x0[p].x - x).powi(2) + (x0[p].y - y).powi(2);
+                        d(a).total_cmp(&d(b))
+                    })
+                    .expect("a sheet has particles"),
+                (None, None) => unreachable!("validated scene"),
+            };
+            let d = Vector3::from(l.direction).normalize();
+            (p, d * l.magnitude_N)
+        })
+        .collect();
+    terms.push(Box::new(crate::physics::PointLoads::new(loads)));
+}
+
+/// The scene's `[[boundary.holds]]` into the per-particle held components.
+fn holds(scene: &Scene, grid: &Grid, held: &mut Vec<[bool; 3]>) {
+    if scene.boundary.holds.is_empty() {
+        return;
+    }
+    held.resize(grid.len(), [false; 3]);
+    for h in &scene.boundary.holds {
+        let mut ps: Vec<usize> = h.particles.iter().map(|&[i, j]| grid.index(i, j)).collect();
+        for e in &h.edges {
+            ps.extend(e.lines(grid).0);
+        }
+        for p in ps {
+            for c in &h.components {
+                held[p][c.index()] = true;
+            }
+        }
+    }
+}
+
+/// Contact with the scene's obstacles (only when it has some): with `contact.fix_supported`, the
+/// particles that start above the top face of a table or pedestal, or above the flat top of a body
+/// form (a skirt's waist), are fixed (seed 003 §10.5, §10.7.2.3); with
+/// the barrier method every other particle gets the barrier term (the vertical-gap method works in the
+/// solver instead, [`crate::simulate`]).
+fn contact_terms(
+    scene: &Scene,
+    x0: &[Vector3<f64>],
+    masses: &[f64],
+    fixed: &mut [bool],
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    use crate::contact::Obstacle;
+    use crate::scene::ContactMethod;
+    if scene.obstacles.is_empty() {
+        return;
+    }
+    if scene.contact.fix_supported {
+        for (p, x) in x0.iter().enumerate().take(fixed.len()) {
+            let on_top = scene.obstacles.iter().any(|o| match o {
+                Obstacle::Box { .. } | Obstacle::Pedestal { .. } => o.top_at(x.x, x.y).is_some(),
+                // A body form: the part over its flat top (the waist of a skirt).
+                Obstacle::Revolution { axis_m, profile_m } => {
+                    let top = profile_m[profile_m.len() - 1];
+                    ((x.x - axis_m[0]).powi(2) + (x.y - axis_m[1]).powi(2)).sqrt() <= top[1]
+                }
+                _ => false,
+            });
+            if on_top {
+                fixed[p] = true;
+            }
+        }
+    }
+    if scene.contact.method == ContactMethod::Barrier {
+        terms.push(Box::new(barrier_contact(scene, masses, fixed)));
+    }
+}
+
+/// The barrier contact term of a scene: every free particle with mass against every obstacle, κ from
+/// its weight ([`BarrierContact::kappa_for_weight`](crate::physics::BarrierContact::kappa_for_weight)).
+pub fn barrier_contact(
+    scene: &Scene,
+    masses: &[f64],
+    fixed: &[bool],
+) -> crate::physics::BarrierContact {
+    let g = if scene.gravity.g_m_per_s2 > 0.0 {
+        scene.gravity.g_m_per_s2
+    } else {
+        crate::STANDARD_GRAVITY_M_PER_S2
+    };
+    let d_hat = scene.contact.distance_m;
+    let kappa = masses
+        .iter()
+        .zip(fixed.iter())
+        .map(|(m, f)| {
+            if *f || *m <= 0.0 {
+                0.0
+            } else {
+                crate::physics::BarrierContact::kappa_for_weight(m * g, d_hat)
+            }
+        })
+        .collect();
+    crate::physics::BarrierContact {
+        obstacles: scene.obstacles.clone(),
+        d_hat_m: d_hat,
+        kappa_J: kappa,
+    }
+}
+
+/// Symmetry planes along grid edges (a quarter or half model, seed 003 §10.4.2): the particles on the
+/// edge keep their coordinate normal to it, and the bending across the plane is kept by
+/// [`MirrorBending`](crate::physics::MirrorBending). Tensile, shear and gravity need nothing: the edge's
+/// tributary widths already halve what lies on the plane.
+fn symmetry_planes(
+    grid: &Grid,
+    r: &Rigidities,
+    edges: &[crate::cloth::Edge],
+    x0: &[Vector3<f64>],
+    held: &mut Vec<[bool; 3]>,
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    if edges.is_empty() {
+        return;
+    }
+    held.resize(grid.len(), [false; 3]);
+    let wx = tributary_lengths(&grid.xs);
+    let wy = tributary_lengths(&grid.ys);
+    for edge in edges {
+        let (on, next) = edge.lines(grid);
+        let (axis, d) = match edge {
+            crate::cloth::Edge::Xmin | crate::cloth::Edge::Xmax => (0, r.bending_warp_N_m),
+            crate::cloth::Edge::Ymin | crate::cloth::Edge::Ymax => (1, r.bending_weft_N_m),
+        };
+        let mut pairs = Vec::new();
+        let (mut hs, mut ks) = (Vec::new(), Vec::new());
+        for (k, (&p, &q)) in on.iter().zip(&next).enumerate() {
+            held[p][axis] = true;
+            let h = (x0[q] - x0[p]).norm();
+            let w = if axis == 0 { wy[k] } else { wx[k] };
+            pairs.push((p, q));
+            hs.push(h);
+            ks.push(d * w / h);
+        }
+        terms.push(Box::new(crate::physics::MirrorBending::new(
+            pairs, axis, &hs, &ks,
+        )));
+    }
+}
+
+/// The grid cells (p₀₀, p₁₀, p₀₁, p₁₁) whose four corners are all present, with their rest sides (h_x, h_y) in m.
+fn present_cells(grid: &Grid, absent: &[bool]) -> (Vec<[usize; 4]>, Vec<(f64, f64)>) {
+    let mut cells = Vec::new();
+    let mut sides = Vec::new();
+    for j in 0..grid.ny - 1 {
+        for i in 0..grid.nx - 1 {
+            let cell = [
+                grid.index(i, j),
+                grid.index(i + 1, j),
+                grid.index(i, j + 1),
+                grid.index(i + 1, j + 1),
+            ];
+            if cell.iter().any(|&p| absent[p]) {
+                continue;
+            }
+            cells.push(cell);
+            sides.push((grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]));
+        }
+    }
+    (cells, sides)
+}
+
+/// The continuum model on the grid: tensile springs along grid lines (k = E·w/h), cell shear (G) and
+/// quadratic bending along grid lines (k = D·w/h̄) and cell twist (D_t). A clamped edge pins its particles and adds
+/// virtual fixed points mirrored across it, so the bending term sees a zero slope at the edge.
+#[allow(clippy::needless_range_loop, clippy::too_many_arguments)] // grid loops index several parallel arrays
+fn continuum_terms(
+    grid: &Grid,
+    r: &Rigidities,
+    absent: &[bool],
+    clamps: &[crate::cloth::Edge],
+    fixed: &mut Vec<bool>,
+    masses: &mut Vec<f64>,
+    x0: &mut Vec<Vector3<f64>>,
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    let (nx, ny) = (grid.nx, grid.ny);
+    let wx = tributary_lengths(&grid.xs);
+    let wy = tributary_lengths(&grid.ys);
+    // Tensile springs.
+    let mut pairs = Vec::new();
+    let mut rest = Vec::new();
+    let mut k = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            if i + 1 < nx && !absent[grid.index(i, j)] && !absent[grid.index(i + 1, j)] {
+                let h = grid.xs[i + 1] - grid.xs[i];
+                pairs.push((grid.index(i, j), grid.index(i + 1, j)));
+                rest.push(h);
+                k.push(r.tensile_warp_N_per_m * wy[j] / h);
+            }
+            if j + 1 < ny && !absent[grid.index(i, j)] && !absent[grid.index(i, j + 1)] {
+                let h = grid.ys[j + 1] - grid.ys[j];
+                pairs.push((grid.index(i, j), grid.index(i, j + 1)));
+                rest.push(h);
+                k.push(r.tensile_weft_N_per_m * wx[i] / h);
+            }
+        }
+    }
+    terms.push(Box::new(Springs::new(
+        SpringFamily::Tensile,
+        pairs,
+        rest,
+        k,
+    )));
+    // Shear.
+    if r.shear_N_per_m > 0.0 {
+        let (cells, sides) = present_cells(grid, absent);
+        terms.push(Box::new(CellShear::new(cells, sides, r.shear_N_per_m)));
+    }
+    // Twist of each cell (plate energy D_t κ_xy²).
+    if r.bending_twist_N_m > 0.0 {
+        let (cells, sides) = present_cells(grid, absent);
+        terms.push(Box::new(CellTwist::cells(
+            cells,
+            &sides,
+            r.bending_twist_N_m,
+        )));
+    }
+    // Bending along x lines (warp) and y lines (weft).
+    let mut triples = Vec::new();
+    let mut coef = Vec::new();
+    let mut stiff = Vec::new();
+    let mut add = |a: usize, b: usize, c: usize, h1: f64, h2: f64, d: f64, w: f64, weight: f64| {
+        if [a, b, c]
+            .iter()
+            .any(|&p| absent.get(p).copied().unwrap_or(false))
+        {
+            return;
+        }
+        triples.push([a, b, c]);
+        coef.push([1.0 / h1, -1.0 / h1 - 1.0 / h2, 1.0 / h2]);
+        stiff.push(weight * d * w / (0.5 * (h1 + h2)));
+    };
+    for j in 0..ny {
+        for i in 1..nx - 1 {
+            let (h1, h2) = (grid.xs[i] - grid.xs[i - 1], grid.xs[i + 1] - grid.xs[i]);
+            add(
+                grid.index(i - 1, j),
+                grid.index(i, j),
+                grid.index(i + 1, j),
+                h1,
+                h2,
+                r.bending_warp_N_m,
+                wy[j],
+                1.0,
+            );
+        }
+    }
+    for i in 0..nx {
+        for j in 1..ny - 1 {
+            let (h1, h2) = (grid.ys[j] - grid.ys[j - 1], grid.ys[j + 1] - grid.ys[j]);
+            add(
+                grid.index(i, j - 1),
+                grid.index(i, j),
+                grid.index(i, j + 1),
+                h1,
+                h2,
+                r.bending_weft_N_m,
+                wx[i],
+                1.0,
+            );
+        }
+    }
+    for edge in clamps {
+        let (on, next) = edge.lines(grid);
+        let (d, along_x) = match edge {
+            crate::cloth::Edge::Xmin | crate::cloth::Edge::Xmax => (r.bending_warp_N_m, true),
+            crate::cloth::Edge::Ymin | crate::cloth::Edge::Ymax => (r.bending_weft_N_m, false),
+        };
+        for (k, (&p, &q)) in on.iter().zip(&next).enumerate() {
+            fixed[p] = true;
+            let ghost = x0.len();
+            x0.push(x0[p] * 2.0 - x0[q]);
+            masses.push(0.0);
+            fixed.push(true);
+            let h = (x0[q] - x0[p]).norm();
+            let w = if along_x { wy[k] } else { wx[k] };
+            // The turning angle at the clamp node happens over h/2 (clamp tangent to the first
+            // segment's midpoint), not h̄ = h: k = D w/(h/2), weight 2.
+            add(ghost, p, q, h, h, d, w, 2.0);
+        }
+    }
+    if !triples.is_empty() {
+        terms.push(Box::new(LinearBending::new(triples, coef, stiff)));
+    }
+}

@@ -1,0 +1,685 @@
+//! Calibration of seed 000's mass-spring parameters against measured edges (issue 5, started): the
+//! search space of Table 3 on the unit box, a cost that simulates a hang and scores its edges against
+//! the measured ones (cached, non-convergence penalised and counted), and one ICA run per call.
+
+mod sample;
+
+pub use sample::{
+    EvaluatedCountry, OptimizerRun, SampleCalibration, SampleSettings, calibrate_sample,
+};
+
+use crate::edges::scene_view;
+use crate::edges::{EdgeFit, curve_distance_pct, edges_from_particles};
+use crate::material::Topology;
+use crate::optim::{Ica, IcaReport, IcaSettings};
+use crate::scene::Scene;
+use crate::simulate::solve_scene;
+use crate::solve::NoObserver;
+use std::collections::HashMap;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Seed 000 Table 3's bounds, SI (elongation rate as a fraction).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bounds {
+    /// Spring stiffness, N/m.
+    pub stiffness_N_per_m: (f64, f64),
+    /// Damping, N·s/m.
+    pub damping_Ns_per_m: (f64, f64),
+    /// Provot's elongation rate.
+    pub elongation_rate: (f64, f64),
+    /// Natural length, m.
+    pub natural_length_m: (f64, f64),
+}
+
+impl Default for Bounds {
+    fn default() -> Self {
+        Self {
+            stiffness_N_per_m: (500.0, 1200.0),
+            damping_Ns_per_m: (10.0, 20.0),
+            elongation_rate: (0.05, 0.20),
+            natural_length_m: (0.04, 0.06),
+        }
+    }
+}
+
+/// A point of the search space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Params {
+    /// Spring stiffness, N/m.
+    pub stiffness_N_per_m: f64,
+    /// Damping, N·s/m.
+    pub damping_Ns_per_m: f64,
+    /// Provot's elongation rate.
+    pub elongation_rate: f64,
+    /// Natural length, m.
+    pub natural_length_m: f64,
+    /// Spring families.
+    pub topology: Topology,
+}
+
+impl Bounds {
+    /// Maps u ∈ [0, 1]^5 to parameters; the fifth coordinate picks the topology by thirds.
+    pub fn decode(&self, u: &[f64]) -> Params {
+        let lerp = |(a, b): (f64, f64), t: f64| a + t.clamp(0.0, 1.0) * (b - a);
+        Params {
+            stiffness_N_per_m: lerp(self.stiffness_N_per_m, u[0]),
+            damping_Ns_per_m: lerp(self.damping_Ns_per_m, u[1]),
+            elongation_rate: lerp(self.elongation_rate, u[2]),
+            natural_length_m: lerp(self.natural_length_m, u[3]),
+            topology: match (u[4] * 3.0) as usize {
+                0 => Topology::A,
+                1 => Topology::B,
+                _ => Topology::C,
+            },
+        }
+    }
+}
+
+/// One simulated candidate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaluation {
+    /// Cost: curve distance in % of the side, or the penalty.
+    pub cost: f64,
+    /// The solver's status.
+    pub status: &'static str,
+    /// Wall time of the simulation, s.
+    pub simulation_time_s: f64,
+}
+
+/// The cost of a sample: simulate its hang with candidate parameters and score the edges.
+pub struct Problem {
+    /// The sample's scene (hang4 or hang2, with its density and grid).
+    pub scene: Scene,
+    /// Measured edges of the sample's photo.
+    pub measured: Vec<EdgeFit>,
+    /// Search bounds.
+    pub bounds: Bounds,
+    /// Side of the sample, cm.
+    pub side_cm: f64,
+    /// Cost given to a simulation that does not converge (counted in `failures`).
+    pub penalty: f64,
+    /// Reuse the evaluation of a parameter vector seen before (default true; off only to measure what
+    /// the cache saves).
+    pub caching: bool,
+    /// Start every evaluation from the drape at the nearest node of a fixed lattice over
+    /// (topology, stiffness, natural length), solved once per problem ([`StartLattice`]); off, from
+    /// the sagged start. Either way the cost stays a pure function of the parameter vector.
+    /// Default true.
+    pub warm_start: bool,
+    lattice: std::sync::Arc<std::sync::OnceLock<StartLattice>>,
+    cache: Mutex<HashMap<Vec<u64>, Evaluation>>,
+    /// Simulations run (cache misses).
+    pub simulations: AtomicUsize,
+    /// Simulations that did not converge.
+    pub failures: AtomicUsize,
+}
+
+impl Problem {
+    /// A problem over `scene` against `measured` edges.
+    pub fn new(scene: Scene, measured: Vec<EdgeFit>, side_cm: f64) -> Self {
+        Self {
+            scene,
+            measured,
+            bounds: Bounds::default(),
+            side_cm,
+            penalty: 100.0,
+            caching: true,
+            warm_start: true,
+            lattice: Default::default(),
+            cache: Mutex::new(HashMap::new()),
+            simulations: AtomicUsize::new(0),
+            failures: AtomicUsize::new(0),
+        }
+    }
+
+    /// A problem over the same scene and measurement with an empty cache and counters, sharing this
+    /// one's warm-start lattice (solved at most once for both): a baseline optimizer's own problem.
+    pub fn fresh(&self) -> Self {
+        let mut p = Self::new(self.scene.clone(), self.measured.clone(), self.side_cm);
+        p.bounds = self.bounds.clone();
+        p.penalty = self.penalty;
+        p.caching = self.caching;
+        p.warm_start = self.warm_start;
+        p.lattice = self.lattice.clone();
+        p
+    }
+
+    /// The scene with `p` applied.
+    pub fn scene_for(&self, p: &Params) -> Scene {
+        let mut s = self.scene.clone();
+        let ms = s.material.mass_spring.get_or_insert_with(Default::default);
+        ms.stiffness_N_per_m = p.stiffness_N_per_m;
+        ms.damping_Ns_per_m = p.damping_Ns_per_m;
+        ms.elongation_rate = p.elongation_rate;
+        ms.natural_length_m = Some(p.natural_length_m);
+        ms.topology = p.topology;
+        s
+    }
+
+    /// The cache key of u: damping and elongation rate do not change a static drape and are left out.
+    fn key(&self, u: &[f64]) -> Vec<u64> {
+        let p = self.bounds.decode(u);
+        vec![
+            p.stiffness_N_per_m.to_bits(),
+            p.natural_length_m.to_bits(),
+            p.topology as u64,
+        ]
+    }
+
+    /// The evaluation of u if it was simulated already.
+    pub fn lookup(&self, u: &[f64]) -> Option<Evaluation> {
+        self.cache.lock().expect("cache").get(&self.key(u)).copied()
+    }
+
+    /// Simulates u (once: results are cached) and scores it: the mean curve distance (% of the side)
+    /// over the measured edges, or the penalty when the drape does not converge.
+    pub fn evaluate(&self, u: &[f64]) -> Evaluation {
+        let key = self.key(u);
+        if self.caching
+            && let Some(e) = self.cache.lock().expect("cache").get(&key)
+        {
+            return *e;
+        }
+        self.simulations.fetch_add(1, Ordering::Relaxed);
+        let (sol, sim) = self.drape(u);
+        let cost = match sim {
+            Some(sim) => {
+                let d: Vec<f64> = self
+                    .measured
+                    .iter()
+                    .filter_map(|m| {
+                        sim.iter().find(|s| s.edge == m.edge).map(|s| {
+                            curve_distance_pct(m, s, m.x_max_cm.max(s.x_max_cm), self.side_cm)
+                        })
+                    })
+                    .collect();
+                if d.is_empty() {
+                    self.penalty
+                } else {
+                    d.iter().sum::<f64>() / d.len() as f64
+                }
+            }
+            None => {
+                self.failures.fetch_add(1, Ordering::Relaxed);
+                self.penalty
+            }
+        };
+        let e = Evaluation {
+            cost,
+            status: sol.report.status.as_str(),
+            simulation_time_s: sol.report.wall_time_s,
+        };
+        self.cache.lock().expect("cache").insert(key, e);
+        e
+    }
+
+    /// The cost of u (see [`Self::evaluate`]).
+    pub fn cost(&self, u: &[f64]) -> f64 {
+        self.evaluate(u).cost
+    }
+
+    /// The static drape at u, with its fitted edges when the solve converged.
+    pub fn drape(&self, u: &[f64]) -> (crate::simulate::Solution, Option<Vec<EdgeFit>>) {
+        let params = self.bounds.decode(u);
+        let scene = self.scene_for(&params);
+        let start = self
+            .warm_start
+            .then(|| self.lattice.get_or_init(|| StartLattice::solve(self)))
+            .and_then(|l| l.nearest(&params));
+        let sol = match start {
+            Some(x0) => crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver),
+            None => solve_scene(&scene, &mut NoObserver),
+        };
+        let edges = match (sol.report.is_converged(), scene_view(&scene)) {
+            (true, Ok((view, corners))) => Some(
+                edges_from_particles(&sol.grid, &sol.x, view, corners)
+                    .into_iter()
+                    .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
+                    .collect(),
+            ),
+            _ => None,
+        };
+        (sol, edges)
+    }
+
+    /// One ICA run over the five-dimensional box.
+    pub fn run_ica(&self, settings: &IcaSettings) -> (Params, IcaReport) {
+        let report = Ica {
+            settings: settings.clone(),
+            dim: 5,
+        }
+        .run(&|u: &[f64]| self.cost(u), |_| {});
+        (self.bounds.decode(&report.best_x), report)
+    }
+}
+
+/// Deterministic warm starts for one sample: the static drapes at a fixed lattice of Table 3's box
+/// (every topology × 3 stiffnesses × 41 natural lengths, 0.5 mm apart), solved by continuation in the natural length
+/// from the sagged start along each (topology, stiffness) in a fixed order, so that
+/// an evaluation's start — and with it the equilibrium a slack net lands on — depends on its own
+/// parameters only, never on which evaluations came before or on the thread count.
+pub struct StartLattice {
+    stiffness_N_per_m: Vec<f64>,
+    natural_length_m: Vec<f64>,
+    /// Per topology (A, B, C), per stiffness, per natural length: the converged drape, if it converged.
+    drapes: Vec<Option<Vec<nalgebra::Vector3<f64>>>>,
+}
+
+impl StartLattice {
+    const STIFFNESSES: usize = 3;
+    const LENGTHS: usize = 41;
+
+    fn solve(problem: &Problem) -> Self {
+        use rayon::prelude::*;
+        let b = &problem.bounds;
+        let nodes = |(lo, hi): (f64, f64), n: usize| -> Vec<f64> {
+            (0..n)
+                .map(|k| lo + (hi - lo) * k as f64 / (n - 1) as f64)
+                .collect()
+        };
+        let k = nodes(b.stiffness_N_per_m, Self::STIFFNESSES);
+        let l = nodes(b.natural_length_m, Self::LENGTHS);
+        let topologies = [Topology::A, Topology::B, Topology::C];
+        let chains: Vec<(Topology, f64)> = topologies
+            .iter()
+            .flat_map(|&t| k.iter().map(move |&kk| (t, kk)))
+            .collect();
+        // One chain per (topology, stiffness), in parallel; along a chain, continuation in the
+        // natural length (each node from the previous node's drape, the first from the sagged start).
+        let drapes: Vec<Vec<Option<Vec<nalgebra::Vector3<f64>>>>> = chains
+            .par_iter()
+            .map(|&(topology, kk)| {
+                let mut prev: Option<Vec<nalgebra::Vector3<f64>>> = None;
+                l.iter()
+                    .map(|&ll| {
+                        let scene = problem.scene_for(&Params {
+                            stiffness_N_per_m: kk,
+                            damping_Ns_per_m: b.damping_Ns_per_m.0,
+                            elongation_rate: b.elongation_rate.0,
+                            natural_length_m: ll,
+                            topology,
+                        });
+                        let sol = match &prev {
+                            Some(x0) => {
+                                crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver)
+                            }
+                            None => solve_scene(&scene, &mut NoObserver),
+                        };
+                        let x = sol.report.is_converged().then_some(sol.x);
+                        if x.is_some() {
+                            prev = x.clone();
+                        }
+                        x
+                    })
+                    .collect()
+            })
+            .collect();
+        let drapes = drapes.into_iter().flatten().collect();
+        Self {
+            stiffness_N_per_m: k,
+            natural_length_m: l,
+            drapes,
+        }
+    }
+
+    /// The drape at the lattice node nearest to `p` (in the box's unit coordinates), if it converged.
+    fn nearest(&self, p: &Params) -> Option<&[nalgebra::Vector3<f64>]> {
+        let index = |nodes: &[f64], v: f64| {
+            let (lo, hi) = (nodes[0], nodes[nodes.len() - 1]);
+            let t = ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
+            (t * (nodes.len() - 1) as f64).round() as usize
+        };
+        let t = match p.topology {
+            Topology::A => 0,
+            Topology::B => 1,
+            Topology::C => 2,
+        };
+        let (nk, nl) = (self.stiffness_N_per_m.len(), self.natural_length_m.len());
+        let i = (t * nk + index(&self.stiffness_N_per_m, p.stiffness_N_per_m)) * nl
+            + index(&self.natural_length_m, p.natural_length_m);
+        self.drapes.get(i)?.as_deref()
+    }
+}
+
+/// The cost restricted to the parameters a static drape depends on (stiffness and natural length, unit
+/// box), the others held at a base point: what the Nelder–Mead polish minimises.
+struct StaticSubspace<'a> {
+    problem: &'a Problem,
+    base: Vec<f64>,
+}
+
+/// The coordinates of the unit box that a static drape can see: stiffness and natural length.
+const STATIC_DIMS: [usize; 2] = [0, 3];
+
+impl StaticSubspace<'_> {
+    fn full(&self, v: &[f64]) -> Vec<f64> {
+        let mut u = self.base.clone();
+        for (&d, &x) in STATIC_DIMS.iter().zip(v) {
+            u[d] = x.clamp(0.0, 1.0);
+        }
+        u
+    }
+}
+
+impl argmin::core::CostFunction for StaticSubspace<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, v: &Self::Param) -> Result<f64, argmin::core::Error> {
+        Ok(self.problem.cost(&self.full(v)))
+    }
+}
+
+impl Problem {
+    /// Polishes an optimum: Nelder–Mead (argmin) over stiffness and natural length from `u` (topology,
+    /// damping and elongation rate held), with at most `max_iters` iterations (a few evaluations each).
+    /// ICA finds the valley of the cost; the valley is long and narrow (stiffness and natural length
+    /// trade off), and a local simplex walks along it far more cheaply than more decades would.
+    /// Returns the better of `u` and the polished point, with its cost.
+    pub fn polish(&self, u: &[f64], max_iters: u64) -> (Vec<f64>, f64) {
+        use argmin::core::{Executor, State};
+        let start = self.cost(u);
+        if max_iters == 0 {
+            return (u.to_vec(), start);
+        }
+        let sub = StaticSubspace {
+            problem: self,
+            base: u.to_vec(),
+        };
+        let v0: Vec<f64> = STATIC_DIMS.iter().map(|&d| u[d]).collect();
+        let step = 0.02;
+        let mut simplex = vec![v0.clone()];
+        for k in 0..v0.len() {
+            let mut v = v0.clone();
+            v[k] += if v[k] + step <= 1.0 { step } else { -step };
+            simplex.push(v);
+        }
+        let solver = argmin::solver::neldermead::NelderMead::new(simplex)
+            .with_sd_tolerance(1e-7)
+            .expect("a valid tolerance");
+        let run = Executor::new(sub, solver)
+            .configure(|s| s.max_iters(max_iters))
+            .run();
+        match run {
+            Ok(res) => {
+                let best = res.state().get_best_param().cloned();
+                match best {
+                    Some(v) if res.state().get_best_cost() < start => {
+                        let sub = StaticSubspace {
+                            problem: self,
+                            base: u.to_vec(),
+                        };
+                        (sub.full(&v), res.state().get_best_cost())
+                    }
+                    _ => (u.to_vec(), start),
+                }
+            }
+            Err(_) => (u.to_vec(), start),
+        }
+    }
+}
+
+/// Areal density (kg/m²) of each sample of seed 000 Table 2, read from `knitted_samples.csv`
+/// (`sample` and `weight_g_per_m2` columns; `#` lines are comments).
+pub fn read_sample_densities(path: &std::path::Path) -> anyhow::Result<HashMap<u32, f64>> {
+    let text = std::fs::read_to_string(path)?;
+    let mut lines = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty());
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| anyhow::anyhow!("{}: no column {name}", path.display()))
+    };
+    let (cs, cw) = (col("sample")?, col("weight_g_per_m2")?);
+    let mut out = HashMap::new();
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        out.insert(f[cs].trim().parse()?, f[cw].trim().parse::<f64>()? / 1000.0);
+    }
+    Ok(out)
+}
+
+/// The sample number in a path such as `datasets/knitted/sample_08/hang4`.
+pub fn sample_number(path: &str) -> Option<u32> {
+    path.split('/')
+        .find_map(|p| p.strip_prefix("sample_"))
+        .and_then(|n| n.parse().ok())
+}
+
+/// What the drape tells of one parameter near the optimum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Identifiability {
+    /// Parameter name with its unit (`stiffness_N_per_m`, ...; `topology` has none).
+    pub name: &'static str,
+    /// Half-width of the interval around the optimum over which the cost rises by less than the
+    /// measurement noise, in the parameter's unit; infinite when the cost does not rise at all.
+    pub uncertainty: f64,
+    /// Whether that half-width is below the required fraction of the value (for `topology`: whether
+    /// every other topology costs more than the optimum plus the noise).
+    pub identifiable: bool,
+}
+
+/// What "a cost indistinguishable from the optimum" means in [`identifiability`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Noise {
+    /// A given measurement error of the photos, in the cost's unit (% of the side): a worst-case
+    /// bound, since all of it may lie along the model's directions.
+    Given(f64),
+    /// Nonlinear least squares: σ̂² from the residual at the optimum over the degrees of freedom left
+    /// (5 coefficients per measured edge, minus the 2 fitted parameters), and a 2σ (about 95 %) interval.
+    FromResidual,
+}
+
+/// Identifiability of each parameter at the optimum `best_u` (seed 000's five: stiffness, damping,
+/// elongation rate, natural length, topology). The squared cost, quadratic in the parameters near a
+/// minimum (cost² ≈ c² + ½ δᵀHδ), is fitted by least squares to costs sampled around the optimum:
+/// jointly on a `steps` × `steps` grid for stiffness and natural length, which trade off against each
+/// other (each axis scaled to where the cost rises by a few noise levels), and along a line over
+/// ±`window` of the range (unit box) for damping and the elongation rate. A parameter's uncertainty is
+/// the half-width, projected on its axis, of the region where cost² exceeds its minimum by less than
+/// Δ: √(2Δ (H⁻¹)ᵢᵢ), so a correlated pair shows its whole valley. Δ is `noise`² for a given noise,
+/// or 4c²/(N − 2) from the residual c with N = 5 × edges (a 2σ interval). A parameter is identifiable when its
+/// uncertainty is below `rel_tol` × its value; a static drape cannot see damping or the elongation
+/// rate, so their cost is flat and their uncertainty infinite. The topology is identifiable when
+/// every other topology raises cost² by more than Δ.
+pub fn identifiability(
+    problem: &Problem,
+    best_u: &[f64],
+    window: f64,
+    steps: usize,
+    noise: Noise,
+    rel_tol: f64,
+) -> Vec<Identifiability> {
+    const NAMES: [&str; 4] = [
+        "stiffness_N_per_m",
+        "damping_Ns_per_m",
+        "elongation_rate",
+        "natural_length_m",
+    ];
+    let b = &problem.bounds;
+    let ranges = [
+        b.stiffness_N_per_m,
+        b.damping_Ns_per_m,
+        b.elongation_rate,
+        b.natural_length_m,
+    ];
+    let best = b.decode(best_u);
+    let values = [
+        best.stiffness_N_per_m,
+        best.damping_Ns_per_m,
+        best.elongation_rate,
+        best.natural_length_m,
+    ];
+    let steps = steps.max(3);
+    let offsets: Vec<f64> = (0..steps)
+        .map(|k| -window + 2.0 * window * k as f64 / (steps - 1) as f64)
+        .collect();
+    // Squared costs at best_u moved by `t` along `dims` (clamped to the box); failed drapes left out.
+    let sample = |dims: &[usize], grid: Vec<Vec<f64>>| -> Vec<(Vec<f64>, f64)> {
+        grid.into_iter()
+            .filter_map(|t| {
+                let mut u = best_u.to_vec();
+                let mut moved = Vec::with_capacity(dims.len());
+                for (&d, &td) in dims.iter().zip(&t) {
+                    u[d] = (best_u[d] + td).clamp(0.0, 1.0);
+                    moved.push(u[d] - best_u[d]);
+                }
+                let c = problem.cost(&u);
+                (c < problem.penalty).then_some((moved, c * c))
+            })
+            .collect()
+    };
+    let mut half_widths = [f64::INFINITY; 4];
+    let joint = [0usize, 3];
+    // Per axis, a step over which the cost rises by a few times the noise: the quadratic model holds
+    // there, and the fit sees curvature rather than round-off.
+    let c0 = problem.cost(best_u);
+    let dof = (5 * problem.measured.len()).saturating_sub(2).max(1) as f64;
+    let delta = match noise {
+        Noise::Given(n) => n * n,
+        Noise::FromResidual => 4.0 * c0 * c0 / dof,
+    };
+    let noise_pct = 0.5 * delta.sqrt();
+    let reach: Vec<f64> = joint
+        .iter()
+        .map(|&d| {
+            let rise = |h: f64| {
+                [-h, h]
+                    .iter()
+                    .map(|&t| {
+                        let mut u = best_u.to_vec();
+                        u[d] = (best_u[d] + t).clamp(0.0, 1.0);
+                        problem.cost(&u) - c0
+                    })
+                    .fold(f64::NEG_INFINITY, f64::max)
+            };
+            let mut h = window / 8.0;
+            for _ in 0..12 {
+                let r = rise(h);
+                if r < 3.0 * noise_pct && h < window {
+                    h = (2.0 * h).min(window);
+                } else if r > 30.0 * noise_pct {
+                    h *= 0.5;
+                } else {
+                    break;
+                }
+            }
+            h / window
+        })
+        .collect();
+    let grid2: Vec<Vec<f64>> = offsets
+        .iter()
+        .flat_map(|&a| {
+            let reach = &reach;
+            offsets
+                .iter()
+                .map(move |&c| vec![a * reach[0], c * reach[1]])
+        })
+        .collect();
+    let w = quadratic_half_widths(&sample(&joint, grid2), delta);
+    for (k, &d) in joint.iter().enumerate() {
+        half_widths[d] = w[k];
+    }
+    for d in [1usize, 2] {
+        let line = offsets.iter().map(|&t| vec![t]).collect();
+        half_widths[d] = quadratic_half_widths(&sample(&[d], line), delta)[0];
+    }
+    let mut out: Vec<Identifiability> = (0..4)
+        .map(|d| {
+            let uncertainty = half_widths[d] * (ranges[d].1 - ranges[d].0);
+            Identifiability {
+                name: NAMES[d],
+                uncertainty,
+                identifiable: uncertainty < rel_tol * values[d].abs(),
+            }
+        })
+        .collect();
+    let others_cost_more = (0..3).all(|k| {
+        let mut u = best_u.to_vec();
+        u[4] = (k as f64 + 0.5) / 3.0;
+        b.decode(&u).topology == best.topology || problem.cost(&u).powi(2) > c0 * c0 + delta
+    });
+    out.push(Identifiability {
+        name: "topology",
+        uncertainty: if others_cost_more { 0.0 } else { f64::INFINITY },
+        identifiable: others_cost_more,
+    });
+    out
+}
+
+/// Fits y ≈ a + gᵀt + ½ tᵀHt to `pts` (t ∈ ℝⁿ, squared cost y) and returns, per coordinate, the
+/// half-width of the region y ≤ y_min + `delta` projected on that axis: √(2Δ (H⁻¹)ᵢᵢ). Infinite where
+/// H is not positive definite (a flat or one-sided cost) or there are too few points.
+pub fn quadratic_half_widths(pts: &[(Vec<f64>, f64)], delta: f64) -> Vec<f64> {
+    let n = pts.first().map_or(0, |p| p.0.len());
+    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
+    let cols = 1 + n + pairs.len();
+    let flat = vec![f64::INFINITY; n];
+    if n == 0 || pts.len() < cols {
+        return flat;
+    }
+    let m = nalgebra::DMatrix::from_fn(pts.len(), cols, |r, k| {
+        let t = &pts[r].0;
+        match k {
+            0 => 1.0,
+            k if k <= n => t[k - 1],
+            k => {
+                let (i, j) = pairs[k - 1 - n];
+                t[i] * t[j]
+            }
+        }
+    });
+    let y = nalgebra::DVector::from_iterator(pts.len(), pts.iter().map(|p| p.1));
+    let Ok(coef) = m.svd(true, true).solve(&y, 1e-14) else {
+        return flat;
+    };
+    let mut h = nalgebra::DMatrix::zeros(n, n);
+    for (k, &(i, j)) in pairs.iter().enumerate() {
+        let c = coef[1 + n + k];
+        if i == j {
+            h[(i, i)] = 2.0 * c;
+        } else {
+            h[(i, j)] = c;
+            h[(j, i)] = c;
+        }
+    }
+    let scale = y.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
+    let eig = h.clone().symmetric_eigen();
+    if eig.eigenvalues.iter().any(|&e| e <= 1e-9 * scale) {
+        return flat;
+    }
+    let Some(h_inv) = h.try_inverse() else {
+        return flat;
+    };
+    (0..n)
+        .map(|i| (2.0 * delta * h_inv[(i, i)]).sqrt())
+        .collect()
+}
+
+/// The scene of a knitted sample: `scene_file` on a `grid` × `grid` net with the sample's Table 2
+/// density (`sample` is a path holding `sample_NN`).
+pub fn sample_scene(
+    scene_file: &std::path::Path,
+    densities: &HashMap<u32, f64>,
+    sample: &str,
+    grid: usize,
+) -> anyhow::Result<Scene> {
+    use anyhow::Context;
+    let n =
+        sample_number(sample).with_context(|| format!("`{sample}`: no sample_NN in the path"))?;
+    let rho = *densities
+        .get(&n)
+        .with_context(|| format!("sample {n} is not in knitted_samples.csv"))?;
+    let sets = [
+        format!("cloth.nx={grid}"),
+        format!("cloth.ny={grid}"),
+        format!("cloth.areal_density_kg_per_m2={rho}"),
+    ]
+    .iter()
+    .map(|s| crate::config::parse_override(s))
+    .collect::<Result<Vec<_>, _>>()?;
+    Ok(Scene::load(scene_file, &sets)?.scene)
+}

@@ -1,0 +1,456 @@
+//! Edges from a photo: segment the fabric from the background (Otsu's threshold, imageproc), trace
+//! the boundary column by column (or row by row for side edges) with sub-pixel positions from the
+//! grey levels of the boundary pixels, convert to cm relative to the reference line through the two
+//! fixed corners, and fit polynomials. Bad images are [`InputError`]s naming the file.
+
+use super::{EdgeFit, View};
+use crate::error::InputError;
+use image::{GrayImage, Rgb, RgbImage};
+use std::path::Path;
+
+/// How pixels become centimetres.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Calibration {
+    /// A known scale and the pixel positions (u right, v down) of the left and right fixed corners.
+    Given {
+        /// Pixels per cm in the plane of the corners.
+        px_per_cm: f64,
+        /// Left and right corner positions, px.
+        corners: [(f64, f64); 2],
+    },
+    /// Two red markers at the fixed corners, `side_cm` apart.
+    Markers {
+        /// Distance between the markers, cm.
+        side_cm: f64,
+    },
+}
+
+/// Options of [`fit_image`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitImageOptions {
+    /// Which hang the photo shows.
+    pub view: View,
+    /// Polynomial degree (4 in seed 000).
+    pub degree: usize,
+    /// Scale and corners.
+    pub calibration: Calibration,
+}
+
+/// The result of fitting a photo.
+pub struct ImageFit {
+    /// One fit per edge of the view.
+    pub edges: Vec<EdgeFit>,
+    /// The photo with the reference line (blue) and the fitted curves (red).
+    pub overlay: RgbImage,
+    /// Corners used, px.
+    pub corners: [(f64, f64); 2],
+    /// Scale used, px per cm.
+    pub px_per_cm: f64,
+}
+
+/// Reads an image file; an unreadable or undecodable file is an input error naming it.
+pub fn read_gray(path: &Path) -> Result<RgbImage, InputError> {
+    let bytes =
+        std::fs::read(path).map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
+    if bytes.is_empty() {
+        return Err(InputError::new(path, "", "empty file: not an image"));
+    }
+    image::load_from_memory(&bytes)
+        .map(|i| i.to_rgb8())
+        .map_err(|e| InputError::new(path, "", format!("cannot decode image: {e}")))
+}
+
+fn is_marker(p: &Rgb<u8>) -> bool {
+    let [r, g, b] = p.0;
+    r > 150 && g < 100 && b < 100
+}
+
+/// Centroids of the two largest red blobs, sorted left to right, and their mean radius.
+fn find_markers(img: &RgbImage) -> Option<([(f64, f64); 2], f64)> {
+    let (w, h) = img.dimensions();
+    let mut seen = vec![false; (w * h) as usize];
+    let mut blobs: Vec<(usize, f64, f64)> = Vec::new();
+    for v in 0..h {
+        for u in 0..w {
+            let k = (v * w + u) as usize;
+            if seen[k] || !is_marker(img.get_pixel(u, v)) {
+                continue;
+            }
+            let (mut n, mut su, mut sv) = (0usize, 0.0, 0.0);
+            let mut stack = vec![(u, v)];
+            seen[k] = true;
+            while let Some((a, b)) = stack.pop() {
+                n += 1;
+                su += a as f64 + 0.5;
+                sv += b as f64 + 0.5;
+                for (da, db) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+                    let (na, nb) = (a as i64 + da, b as i64 + db);
+                    if na < 0 || nb < 0 || na >= w as i64 || nb >= h as i64 {
+                        continue;
+                    }
+                    let kk = (nb as u32 * w + na as u32) as usize;
+                    if !seen[kk] && is_marker(img.get_pixel(na as u32, nb as u32)) {
+                        seen[kk] = true;
+                        stack.push((na as u32, nb as u32));
+                    }
+                }
+            }
+            blobs.push((n, su / n as f64, sv / n as f64));
+        }
+    }
+    blobs.sort_by_key(|b| std::cmp::Reverse(b.0));
+    if blobs.len() < 2 || blobs[1].0 < 5 {
+        return None;
+    }
+    let mut c = [(blobs[0].1, blobs[0].2), (blobs[1].1, blobs[1].2)];
+    if c[0].0 > c[1].0 {
+        c.swap(0, 1);
+    }
+    let r = ((blobs[0].0 + blobs[1].0) as f64 / 2.0 / std::f64::consts::PI).sqrt();
+    Some((c, r))
+}
+
+/// The two fixed corners in the image (px), the scale (px per cm) and the guard band around the
+/// corners (px), from the calibration the options give.
+fn calibrate(
+    img: &RgbImage,
+    opts: &FitImageOptions,
+    file: &Path,
+) -> Result<([(f64, f64); 2], f64, f64), InputError> {
+    let (w, h) = img.dimensions();
+    let (corners, s, guard) = match &opts.calibration {
+        Calibration::Given { px_per_cm, corners } => {
+            if !(px_per_cm.is_finite() && *px_per_cm > 0.0) {
+                return Err(InputError::new(
+                    file,
+                    "--px-per-cm",
+                    format!("must be a finite number > 0, got {px_per_cm}"),
+                ));
+            }
+            for c in corners {
+                if !(c.0.is_finite()
+                    && c.1.is_finite()
+                    && c.0 >= 0.0
+                    && c.1 >= 0.0
+                    && c.0 <= w as f64
+                    && c.1 <= h as f64)
+                {
+                    return Err(InputError::new(
+                        file,
+                        "--corners",
+                        format!("corner ({}, {}) lies outside the {w}×{h} image", c.0, c.1),
+                    ));
+                }
+            }
+            let mut c = *corners;
+            if c[0].0 > c[1].0 {
+                c.swap(0, 1);
+            }
+            (c, *px_per_cm, 4.0)
+        }
+        Calibration::Markers { side_cm } => {
+            let Some((c, r)) = find_markers(img) else {
+                return Err(InputError::new(
+                    file,
+                    "--markers",
+                    "two red corner markers not found: give --px-per-cm and --corners instead",
+                ));
+            };
+            let d = ((c[1].0 - c[0].0).powi(2) + (c[1].1 - c[0].1).powi(2)).sqrt();
+            (c, d / side_cm, r + 3.0)
+        }
+    };
+    if ((corners[1].0 - corners[0].0).powi(2) + (corners[1].1 - corners[0].1).powi(2)).sqrt() < 10.0
+    {
+        return Err(InputError::new(
+            file,
+            "--corners",
+            "the two corners are less than 10 px apart",
+        ));
+    }
+    Ok((corners, s, guard))
+}
+
+/// The photo in grey levels split into fabric and background (Otsu's threshold; the border is
+/// mostly background), with the mean grey level of each.
+struct Segmented {
+    gray: GrayImage,
+    threshold: f64,
+    fabric_dark: bool,
+    fabric: f64,
+    background: f64,
+}
+
+impl Segmented {
+    fn at(&self, u: u32, v: u32) -> f64 {
+        self.gray.get_pixel(u, v).0[0] as f64
+    }
+    fn is_fabric(&self, g: f64) -> bool {
+        if self.fabric_dark {
+            g <= self.threshold
+        } else {
+            g > self.threshold
+        }
+    }
+}
+
+/// Segments a photo; an image with no fabric (or no contrast) is refused.
+fn segment(img: &RgbImage, file: &Path) -> Result<Segmented, InputError> {
+    let (w, h) = img.dimensions();
+    // Grey levels; marker pixels count as background.
+    let mut gray = GrayImage::new(w, h);
+    for (u, v, p) in img.enumerate_pixels() {
+        let [r, g, b] = p.0;
+        let l = if is_marker(p) {
+            255.0
+        } else {
+            0.299 * r as f64 + 0.587 * g as f64 + 0.114 * b as f64
+        };
+        gray.put_pixel(u, v, image::Luma([l.round() as u8]));
+    }
+    let t = imageproc::contrast::otsu_level(&gray);
+    let at = |u: u32, v: u32| gray.get_pixel(u, v).0[0] as f64;
+    // Polarity: the border is mostly background.
+    let mut border_above = 0usize;
+    let mut border = 0usize;
+    for u in 0..w {
+        for v in [0, h - 1] {
+            border += 1;
+            border_above += (at(u, v) > t as f64) as usize;
+        }
+    }
+    let fabric_dark = border_above * 2 >= border;
+    let is_fabric = |g: f64| {
+        if fabric_dark {
+            g <= t as f64
+        } else {
+            g > t as f64
+        }
+    };
+    let (mut nf, mut sf, mut nb, mut sb) = (0usize, 0.0, 0usize, 0.0);
+    for p in gray.pixels() {
+        let g = p.0[0] as f64;
+        if is_fabric(g) {
+            nf += 1;
+            sf += g;
+        } else {
+            nb += 1;
+            sb += g;
+        }
+    }
+    let (fabric, background) = (
+        if nf > 0 { sf / nf as f64 } else { 0.0 },
+        if nb > 0 { sb / nb as f64 } else { 0.0 },
+    );
+    if nf < (w * h) as usize / 200 || nb == 0 || (fabric - background).abs() < 15.0 {
+        return Err(InputError::new(
+            file,
+            "",
+            "no fabric found: the image is all background (or has no contrast)",
+        ));
+    }
+    Ok(Segmented {
+        gray,
+        threshold: t as f64,
+        fabric_dark,
+        fabric,
+        background,
+    })
+}
+
+/// Fits the edges of a photo.
+pub fn fit_image(
+    img: &RgbImage,
+    opts: &FitImageOptions,
+    file: &Path,
+) -> Result<ImageFit, InputError> {
+    let (w, h) = img.dimensions();
+    let (corners, s, guard) = calibrate(img, opts, file)?;
+    let seg = segment(img, file)?;
+    let at = |u: u32, v: u32| seg.at(u, v);
+    let is_fabric = |g: f64| seg.is_fabric(g);
+    let (fabric, background) = (seg.fabric, seg.background);
+    let mask = |u: i64, v: i64| {
+        u >= 0 && v >= 0 && u < w as i64 && v < h as i64 && is_fabric(at(u as u32, v as u32))
+    };
+    for c in &corners {
+        let r = guard as i64 + 3;
+        let (cu, cv) = (c.0 as i64, c.1 as i64);
+        let touches = (-r..=r).any(|dv| (-r..=r).any(|du| mask(cu + du, cv + dv)));
+        if !touches {
+            return Err(InputError::new(
+                file,
+                "--corners",
+                format!(
+                    "the fabric touches no corner at ({:.1}, {:.1}): check the corner positions or markers",
+                    c.0, c.1
+                ),
+            ));
+        }
+    }
+    let cov = |g: f64, f: f64| ((g - background) / (f - background)).clamp(0.0, 1.0);
+    let [c0, c1] = corners;
+    let len = ((c1.0 - c0.0).powi(2) + (c1.1 - c0.1).powi(2)).sqrt();
+    let tdir = ((c1.0 - c0.0) / len, (c1.1 - c0.1) / len);
+    let up = (tdir.1, -tdir.0);
+    let to_cm = |pu: f64, pv: f64| {
+        let d = (pu - c0.0, pv - c0.1);
+        (
+            (d.0 * tdir.0 + d.1 * tdir.1) / s,
+            (d.0 * up.0 + d.1 * up.1) / s,
+        )
+    };
+    let span_cm = len / s;
+    let (u_lo, u_hi) = ((c0.0 + guard).ceil() as i64, (c1.0 - guard).floor() as i64);
+    // Sub-pixel boundary in a line of pixels `g(k)`, k in [a, b], fabric before the boundary (`forward`)
+    // or after it: the covered length is the sum of coverages.
+    let edge_pos = |vals: &[(i64, f64)], f: f64, fabric_first: bool| -> f64 {
+        let sum: f64 = vals.iter().map(|&(_, g)| cov(g, f)).sum();
+        if fabric_first {
+            vals[0].0 as f64 + sum
+        } else {
+            vals[vals.len() - 1].0 as f64 + 1.0 - sum
+        }
+    };
+    let local_fabric = |vals: Vec<f64>| {
+        if vals.is_empty() {
+            fabric
+        } else {
+            vals.iter().sum::<f64>() / vals.len() as f64
+        }
+    };
+    let grey = |u: i64, v: i64| {
+        if u >= 0 && v >= 0 && u < w as i64 && v < h as i64 {
+            at(u as u32, v as u32)
+        } else {
+            background
+        }
+    };
+    // The boundary along one line of pixels `px(k)`, k in 0..len: the last (or first) fabric pixel
+    // that has a fabric neighbour on the line, refined to sub-pixel by summing coverages over a window
+    // that starts one pixel inside the fabric; the fabric's grey level is taken from the pixels just
+    // inside it (shading varies across the sheet).
+    let trace = |len: i64, px: &dyn Fn(i64) -> (i64, i64), last: bool| -> Option<f64> {
+        let fab = |k: i64| {
+            let (u, v) = px(k);
+            mask(u, v)
+        };
+        let mut hits = (0..len).filter(|&k| fab(k) && (fab(k + 1) || fab(k - 1)));
+        let kb = if last { hits.next_back() } else { hits.next() }?;
+        let (a, b) = if last {
+            (kb - 1, kb + 3)
+        } else {
+            (kb - 3, kb + 1)
+        };
+        let vals: Vec<(i64, f64)> = (a..=b).map(|k| (k, grey(px(k).0, px(k).1))).collect();
+        let inside_range = if last { kb - 3..kb } else { kb + 1..kb + 4 };
+        let inside: Vec<f64> = inside_range
+            .filter(|&k| fab(k))
+            .map(|k| grey(px(k).0, px(k).1))
+            .collect();
+        Some(edge_pos(&vals, local_fabric(inside), last))
+    };
+    let mut edges = Vec::new();
+    for &name in opts.view.edges() {
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        match name {
+            "bottom" | "top" => {
+                for u in u_lo..=u_hi {
+                    if let Some(ve) = trace(h as i64, &|v| (u, v), name == "bottom") {
+                        pts.push(to_cm(u as f64 + 0.5, ve));
+                    }
+                }
+            }
+            _ => {
+                // Side edges of a 2-corner hang: rows below the reference line.
+                let v_lo = (c0.1.max(c1.1) + guard + 2.0).ceil() as i64;
+                let offset = if name == "right" { span_cm } else { 0.0 };
+                for v in v_lo..h as i64 {
+                    if let Some(ue) = trace(w as i64, &|u| (u, v), name == "right") {
+                        let (along, upc) = to_cm(ue, v as f64 + 0.5);
+                        pts.push((-upc, along - offset));
+                    }
+                }
+            }
+        }
+        // The bottom edge's depth at each side bounds the side edges.
+        let bottom_depth = |x: f64| {
+            edges
+                .iter()
+                .find(|e: &&EdgeFit| e.edge == "bottom")
+                .map(|e| -e.eval(x))
+                .unwrap_or(f64::INFINITY)
+        };
+        let side_depth = if name == "right" {
+            bottom_depth(span_cm)
+        } else {
+            bottom_depth(0.0)
+        };
+        let pts = super::trim_edge(name, pts, span_cm, side_depth);
+        let Some(fit) = EdgeFit::from_points(name, &pts, opts.degree) else {
+            return Err(InputError::new(
+                file,
+                "",
+                format!(
+                    "too few points on the {name} edge ({}) to fit degree {}",
+                    pts.len(),
+                    opts.degree
+                ),
+            ));
+        };
+        edges.push(fit);
+    }
+    let overlay = draw_overlay(img, &edges, corners, s);
+    Ok(ImageFit {
+        edges,
+        overlay,
+        corners,
+        px_per_cm: s,
+    })
+}
+
+/// The photo with the reference line in blue and the fitted curves in red.
+fn draw_overlay(img: &RgbImage, edges: &[EdgeFit], corners: [(f64, f64); 2], s: f64) -> RgbImage {
+    let [c0, c1] = corners;
+    let len = ((c1.0 - c0.0).powi(2) + (c1.1 - c0.1).powi(2)).sqrt();
+    let tdir = ((c1.0 - c0.0) / len, (c1.1 - c0.1) / len);
+    let up = (tdir.1, -tdir.0);
+    let span_cm = len / s;
+    // Overlay: reference line in blue, fitted curves in red.
+    let mut overlay = img.clone();
+    let to_px = |along: f64, upc: f64| {
+        (
+            c0.0 + (along * tdir.0 + upc * up.0) * s,
+            c0.1 + (along * tdir.1 + upc * up.1) * s,
+        )
+    };
+    imageproc::drawing::draw_line_segment_mut(
+        &mut overlay,
+        (c0.0 as f32, c0.1 as f32),
+        (c1.0 as f32, c1.1 as f32),
+        Rgb([30, 60, 230]),
+    );
+    for e in edges {
+        let n = 200;
+        let mut prev: Option<(f64, f64)> = None;
+        for k in 0..=n {
+            let x = e.x_min_cm + (e.x_max_cm - e.x_min_cm) * k as f64 / n as f64;
+            let y = e.eval(x);
+            let p = match e.edge.as_str() {
+                "left" => to_px(y, -x),
+                "right" => to_px(y + span_cm, -x),
+                _ => to_px(x, y),
+            };
+            if let Some(q) = prev {
+                imageproc::drawing::draw_line_segment_mut(
+                    &mut overlay,
+                    (q.0 as f32, q.1 as f32),
+                    (p.0 as f32, p.1 as f32),
+                    Rgb([230, 20, 20]),
+                );
+            }
+            prev = Some(p);
+        }
+    }
+    overlay
+}

@@ -1,0 +1,286 @@
+//! Photo-like renders of a simulated drape: an orthographic or pinhole camera looking along +y, the
+//! sheet as shaded triangles (Lambert, 4×4 supersampling) on a plain light background, optional red
+//! markers at the fixed corners, Gaussian noise, blur and a small rotation. This is how drapelab makes
+//! synthetic measurements; real photos enter [`super::fit_image`] the same way.
+
+use crate::cloth::Grid;
+use image::{Rgb, RgbImage};
+use nalgebra::Vector3;
+use rand::{Rng, SeedableRng};
+use serde::{Deserialize, Serialize};
+
+/// The camera model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", tag = "kind")]
+pub enum Camera {
+    /// Parallel projection along +y.
+    Orthographic,
+    /// A pinhole at distance `distance_m` in front of the plane y = 0, looking along +y; closer parts
+    /// look larger (the scale at y = 0 is `px_per_cm`).
+    Pinhole {
+        /// Distance from the pinhole to the plane y = 0, m.
+        distance_m: f64,
+    },
+}
+
+/// What to render.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RenderOptions {
+    /// Camera model.
+    pub camera: Camera,
+    /// Scale in the plane y = 0, pixels per cm.
+    pub px_per_cm: f64,
+    /// Empty border around the sheet, px.
+    pub margin_px: u32,
+    /// Draw red discs of this radius (px) at the fixed corners; 0 = none.
+    pub marker_radius_px: f64,
+    /// Standard deviation of additive Gaussian noise, grey levels (0..255).
+    pub noise_sigma: f64,
+    /// Standard deviation of a Gaussian blur, px; 0 = none.
+    pub blur_sigma_px: f64,
+    /// Rotation of the camera about its axis, degrees (the image is rotated about its centre).
+    pub rotation_deg: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            camera: Camera::Orthographic,
+            px_per_cm: 8.0,
+            margin_px: 30,
+            marker_radius_px: 0.0,
+            noise_sigma: 0.0,
+            blur_sigma_px: 0.0,
+            rotation_deg: 0.0,
+            seed: 1,
+        }
+    }
+}
+
+/// A rendered photo with its exact calibration.
+pub struct RenderedPhoto {
+    /// The image.
+    pub image: RgbImage,
+    /// Image positions (u right, v down; pixel (u, v) spans [u, u+1) × [v, v+1)) of the left and right fixed corners.
+    pub corners_px: [(f64, f64); 2],
+    /// Scale in the plane of the fixed corners, px per cm.
+    pub px_per_cm: f64,
+}
+
+/// Background and fabric grey levels.
+const BACKGROUND: f64 = 232.0;
+const ALBEDO: f64 = 150.0;
+
+/// Renders the grid particles `x` (m); `corners` are the left and right fixed corners as grid indices.
+pub fn render_drape(
+    grid: &Grid,
+    x: &[Vector3<f64>],
+    corners: [(usize, usize); 2],
+    opts: &RenderOptions,
+) -> RenderedPhoto {
+    let s = opts.px_per_cm * 100.0; // px per m in the plane y = 0
+    let project = |p: &Vector3<f64>| -> (f64, f64, f64) {
+        match opts.camera {
+            Camera::Orthographic => (p.x * s, -p.z * s, p.y),
+            Camera::Pinhole { distance_m } => {
+                let k = distance_m / (distance_m + p.y);
+                (p.x * s * k, -p.z * s * k, p.y)
+            }
+        }
+    };
+    let pts: Vec<(f64, f64, f64)> = x[..grid.len()].iter().map(project).collect();
+    let (umin, umax, vmin, vmax) = pts.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |a, p| (a.0.min(p.0), a.1.max(p.0), a.2.min(p.1), a.3.max(p.1)),
+    );
+    let m = opts.margin_px as f64;
+    let (w, h) = (
+        (umax - umin + 2.0 * m).ceil() as u32,
+        (vmax - vmin + 2.0 * m).ceil() as u32,
+    );
+    let shift = |p: (f64, f64, f64)| (p.0 - umin + m, p.1 - vmin + m, p.2);
+    let pts: Vec<(f64, f64, f64)> = pts.into_iter().map(shift).collect();
+    let mut img = rasterize(&pts, x, crate::cloth::grid_triangles(grid), w, h);
+    let corner_px = |(i, j): (usize, usize)| {
+        let p = pts[grid.index(i, j)];
+        (p.0, p.1)
+    };
+    let mut corners_px = [corner_px(corners[0]), corner_px(corners[1])];
+    if opts.marker_radius_px > 0.0 {
+        let r = opts.marker_radius_px;
+        for &(cu, cv) in &corners_px {
+            for v in (cv - r - 1.0).floor().max(0.0) as u32..((cv + r + 1.0).ceil() as u32).min(h) {
+                for u in
+                    (cu - r - 1.0).floor().max(0.0) as u32..((cu + r + 1.0).ceil() as u32).min(w)
+                {
+                    if ((u as f64 + 0.5 - cu).powi(2) + (v as f64 + 0.5 - cv).powi(2)).sqrt() <= r {
+                        img.put_pixel(u, v, Rgb([220, 30, 30]));
+                    }
+                }
+            }
+        }
+    }
+    if opts.rotation_deg != 0.0 {
+        let theta = opts.rotation_deg.to_radians();
+        img = imageproc::geometric_transformations::rotate_about_center(
+            &img,
+            theta as f32,
+            imageproc::geometric_transformations::Interpolation::Bilinear,
+            imageproc::geometric_transformations::Border::Constant(Rgb([BACKGROUND as u8; 3])),
+        );
+        // imageproc maps p to c + R(θ)(p − c) with c = (w/2, h/2) in pixel-index coordinates (pixel
+        // centres at integers), i.e. c + 0.5 in ours.
+        let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
+        let (sn, cs) = theta.sin_cos();
+        for c in corners_px.iter_mut() {
+            let (du, dv) = (c.0 - 0.5 - cx, c.1 - 0.5 - cy);
+            *c = (cx + cs * du - sn * dv + 0.5, cy + sn * du + cs * dv + 0.5);
+        }
+    }
+    if opts.blur_sigma_px > 0.0 {
+        img = imageproc::filter::gaussian_blur_f32(&img, opts.blur_sigma_px as f32);
+    }
+    if opts.noise_sigma > 0.0 {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
+        for p in img.pixels_mut() {
+            // Box–Muller.
+            let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+            let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos() * opts.noise_sigma;
+            for ch in p.0.iter_mut() {
+                *ch = (*ch as f64 + z).round().clamp(0.0, 255.0) as u8;
+            }
+        }
+    }
+    RenderedPhoto {
+        image: img,
+        corners_px,
+        px_per_cm: opts.px_per_cm,
+    }
+}
+
+/// Draws the triangles (indices into `x`) whose image positions `pts` are (u, v, depth) into a
+/// `w × h` grey image: Lambert shading of each triangle's normal, nearest triangle wins, 4×4
+/// supersampling.
+fn rasterize(
+    pts: &[(f64, f64, f64)],
+    x: &[Vector3<f64>],
+    triangles: impl IntoIterator<Item = [u32; 3]>,
+    w: u32,
+    h: u32,
+) -> RgbImage {
+    // Supersampled coverage and shade with a depth buffer.
+    const SS: usize = 4;
+    let (sw, sh) = (w as usize * SS, h as usize * SS);
+    let mut depth = vec![f64::INFINITY; sw * sh];
+    let mut shade = vec![BACKGROUND; sw * sh];
+    let light = Vector3::new(-0.3, -0.8, 0.5).normalize();
+    for tri in triangles {
+        let [a, b, c] = tri.map(|k| k as usize);
+        let n = (x[b] - x[a]).cross(&(x[c] - x[a]));
+        let lum = if n.norm() > 0.0 {
+            0.35 + 0.65 * n.normalize().dot(&light).abs()
+        } else {
+            1.0
+        };
+        let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
+        let area = (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0);
+        if area.abs() < 1e-12 {
+            continue;
+        }
+        let x0 = ((pa.0.min(pb.0).min(pc.0)) * SS as f64).floor().max(0.0) as usize;
+        let x1 = ((pa.0.max(pb.0).max(pc.0)) * SS as f64)
+            .ceil()
+            .min(sw as f64) as usize;
+        let y0 = ((pa.1.min(pb.1).min(pc.1)) * SS as f64).floor().max(0.0) as usize;
+        let y1 = ((pa.1.max(pb.1).max(pc.1)) * SS as f64)
+            .ceil()
+            .min(sh as f64) as usize;
+        for sy in y0..y1 {
+            for sx in x0..x1 {
+                let (px, py) = ((sx as f64 + 0.5) / SS as f64, (sy as f64 + 0.5) / SS as f64);
+                let w0 = ((pb.0 - px) * (pc.1 - py) - (pb.1 - py) * (pc.0 - px)) / area;
+                let w1 = ((pc.0 - px) * (pa.1 - py) - (pc.1 - py) * (pa.0 - px)) / area;
+                let w2 = 1.0 - w0 - w1;
+                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                    continue;
+                }
+                let d = w0 * pa.2 + w1 * pb.2 + w2 * pc.2;
+                let k = sy * sw + sx;
+                if d < depth[k] {
+                    depth[k] = d;
+                    shade[k] = ALBEDO * lum;
+                }
+            }
+        }
+    }
+    let mut img = RgbImage::new(w, h);
+    for v in 0..h as usize {
+        for u in 0..w as usize {
+            let mut acc = 0.0;
+            for dy in 0..SS {
+                for dx in 0..SS {
+                    acc += shade[(v * SS + dy) * sw + u * SS + dx];
+                }
+            }
+            let g = (acc / (SS * SS) as f64).round().clamp(0.0, 255.0) as u8;
+            img.put_pixel(u as u32, v as u32, Rgb([g, g, g]));
+        }
+    }
+    img
+}
+
+/// A shaded picture of a drape for reports: an orthographic camera `elevation_deg` above the horizon
+/// (90: from above, the vertical projection; 0: from the side along +y), turned `azimuth_deg` about the
+/// vertical, `px_per_cm` pixels per cm, a `margin_px` border; triangles with a particle that is not
+/// `present` (a disc's corners) are left out.
+pub fn render_view(
+    grid: &Grid,
+    x: &[Vector3<f64>],
+    present: &[bool],
+    azimuth_deg: f64,
+    elevation_deg: f64,
+    px_per_cm: f64,
+    margin_px: u32,
+) -> RgbImage {
+    let (sa, ca) = azimuth_deg.to_radians().sin_cos();
+    let (se, ce) = elevation_deg.to_radians().sin_cos();
+    // Camera frame: right r, forward (into the picture) d, up u.
+    let r = Vector3::new(ca, -sa, 0.0);
+    let d = Vector3::new(sa * ce, ca * ce, -se);
+    let u = Vector3::new(sa * se, ca * se, ce);
+    let s = px_per_cm * 100.0;
+    let keep = |k: usize| present.get(k).copied().unwrap_or(true);
+    let pts: Vec<(f64, f64, f64)> = x[..grid.len()]
+        .iter()
+        .map(|p| (p.dot(&r) * s, -p.dot(&u) * s, p.dot(&d)))
+        .collect();
+    let (umin, umax, vmin, vmax) = pts.iter().enumerate().filter(|(k, _)| keep(*k)).fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |a, (_, p)| (a.0.min(p.0), a.1.max(p.0), a.2.min(p.1), a.3.max(p.1)),
+    );
+    let m = margin_px as f64;
+    let (w, h) = (
+        (umax - umin + 2.0 * m).ceil().max(1.0) as u32,
+        (vmax - vmin + 2.0 * m).ceil().max(1.0) as u32,
+    );
+    let pts: Vec<(f64, f64, f64)> = pts
+        .into_iter()
+        .map(|p| (p.0 - umin + m, p.1 - vmin + m, p.2))
+        .collect();
+    let tris = crate::cloth::grid_triangles(grid)
+        .into_iter()
+        .filter(|t| t.iter().all(|&k| keep(k as usize)));
+    rasterize(&pts, x, tris, w, h)
+}

@@ -1,0 +1,314 @@
+//! Running one scene: build the model and solve it with the scene's solver (static Newton, with a
+//! coarse or sagged start, friction increments and contact rounds as the scene asks, or dynamics).
+//! Writing the outputs of a run is `drapelab_record::simulate_to_dir`'s.
+
+use crate::build::{BuiltScene, build_scene};
+use crate::cloth::Grid;
+use crate::scene::Scene;
+use crate::solve::{Observer, SolveReport, solve_dynamic, solve_static};
+use nalgebra::Vector3;
+
+/// A solved scene.
+pub struct Solution {
+    /// The grid of real particles.
+    pub grid: Grid,
+    /// Final positions of all particles (virtual points after the grid ones) in m.
+    pub x: Vec<Vector3<f64>>,
+    /// How the solve went.
+    pub report: SolveReport,
+    /// The energy terms that were built.
+    pub terms: Vec<String>,
+    /// The model, for evaluating residuals or energies afterwards.
+    pub model: crate::physics::Model,
+}
+
+impl Solution {
+    /// Positions of the grid particles only.
+    pub fn grid_positions(&self) -> &[Vector3<f64>] {
+        &self.x[..self.grid.len()]
+    }
+    /// Position of grid particle (i, j).
+    pub fn at(&self, i: usize, j: usize) -> Vector3<f64> {
+        self.x[self.grid.index(i, j)]
+    }
+    /// Where the material point at sheet coordinates (u, v) in m (from particle (0, 0) of the flat
+    /// sheet) ended: bilinear interpolation over its grid cell, exact at grid particles. Lets grids
+    /// of different resolution or grading be compared at the same material points.
+    pub fn at_material(&self, u_m: f64, v_m: f64) -> Vector3<f64> {
+        let cell = |lines: &[f64], s: f64| {
+            let k = lines.partition_point(|&c| c <= s).clamp(1, lines.len() - 1) - 1;
+            let t = ((s - lines[k]) / (lines[k + 1] - lines[k])).clamp(0.0, 1.0);
+            (k, t)
+        };
+        let ((i, a), (j, b)) = (cell(&self.grid.xs, u_m), cell(&self.grid.ys, v_m));
+        self.at(i, j) * ((1.0 - a) * (1.0 - b))
+            + self.at(i + 1, j) * (a * (1.0 - b))
+            + self.at(i, j + 1) * ((1.0 - a) * b)
+            + self.at(i + 1, j + 1) * (a * b)
+    }
+}
+
+/// Solves a validated scene in memory with its configured solver; the observer sees each state.
+pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
+    solve_built(scene, None, observer)
+}
+
+/// Solves a validated scene statically or dynamically from the given positions of all particles
+/// (a warm start: no coarse or sagged start is made); the scene's own start when `x0` does not match
+/// the built model's particle count.
+pub fn solve_scene_from(
+    scene: &Scene,
+    x0: &[Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> Solution {
+    solve_built(scene, Some(x0), observer)
+}
+
+fn solve_built(
+    scene: &Scene,
+    start: Option<&[Vector3<f64>]>,
+    observer: &mut dyn Observer,
+) -> Solution {
+    let BuiltScene {
+        grid,
+        mut model,
+        x0: mut x,
+    } = build_scene(scene);
+    let report = match start {
+        Some(x0) if x0.len() == x.len() => {
+            x.copy_from_slice(x0);
+            // A warm start is near its equilibrium: Newton starts far less damped.
+            let mut warm = scene.clone();
+            let lm = &mut warm.solver.static_.lm_damping_initial;
+            *lm = lm.min(WARM_LM_DAMPING);
+            let mut report = static_or_dynamic(&warm, &grid, &mut model, &mut x, observer);
+            check_minimum(&model, &x, &mut report);
+            report
+        }
+        _ => solve_model(scene, &grid, &mut model, &mut x, observer),
+    };
+    Solution {
+        grid,
+        terms: model.term_names(),
+        x,
+        report,
+        model,
+    }
+}
+
+/// The initial Levenberg–Marquardt damping of a solve from a warm start (relative to the mean
+/// diagonal; the flat or sagged start's default is 1e-3).
+const WARM_LM_DAMPING: f64 = 1e-5;
+
+/// The scene's solver from `x` as it is: the static solve, or the dynamic integrator.
+fn static_or_dynamic(
+    scene: &Scene,
+    grid: &Grid,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    match scene.solver.kind.integrator() {
+        None => static_solve(scene, grid, model, x, observer),
+        Some(integ) => {
+            let mut v = vec![Vector3::zeros(); x.len()];
+            solve_dynamic(model, integ, x, &mut v, &scene.solver.dynamic, observer)
+        }
+    }
+}
+
+/// Stability of a converged static state (once, after every load increment and contact round).
+fn check_minimum(model: &crate::physics::Model, x: &[Vector3<f64>], report: &mut SolveReport) {
+    if report.is_converged() && report.solver == "static-newton" {
+        let minimum = crate::solve::is_minimum(model, x);
+        report.minimum = Some(minimum);
+        if !minimum {
+            report.message += "; not a minimum: an unstable equilibrium (a saddle), which a \
+small perturbation (cloth.initial_perturbation_m, [[loads]]) moves off";
+        }
+    }
+}
+
+/// Solves a built scene from `x` (updated in place) with the scene's solver.
+pub fn solve_model(
+    scene: &Scene,
+    grid: &Grid,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    if scene.solver.kind.integrator().is_some() {
+        return static_or_dynamic(scene, grid, model, x, observer);
+    }
+    // Nested iteration: start Newton from the interpolated solution of the scene on the grid with
+    // every other line, when that grid exists; far fewer fine iterations are needed. Otherwise,
+    // without obstacles, from the sagged sheet.
+    let coarse = coarse_start(scene, grid, x);
+    if coarse.is_none() && scene.solver.static_.sag_start && scene.obstacles.is_empty() {
+        crate::solve::sagged_start(model, x);
+    }
+    let mut report = static_solve(scene, grid, model, x, observer);
+    if let Some((r, _)) = coarse {
+        report.iterations += r.iterations;
+        report.linear_solves += r.linear_solves;
+        report.factorizations += r.factorizations;
+        report.factor_time_s += r.factor_time_s;
+        report.wall_time_s += r.wall_time_s;
+        report.message += &format!(
+            " (from a {}×{} start)",
+            grid.nx.div_ceil(2),
+            grid.ny.div_ceil(2)
+        );
+    }
+    check_minimum(model, x, &mut report);
+    report
+}
+
+/// The static solve of a built scene from `x`: Newton, wrapped in the vertical-gap active set when the
+/// scene asks for that contact treatment.
+fn static_solve(
+    scene: &Scene,
+    grid: &Grid,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let opts = &scene.solver.static_;
+    if scene.contact.method == crate::scene::ContactMethod::VerticalGap
+        && !scene.obstacles.is_empty()
+    {
+        crate::solve::solve_vertical_gap(
+            model,
+            x,
+            &scene.obstacles,
+            grid.min_spacing_m(),
+            opts,
+            observer,
+        )
+    } else if scene.contact.friction_coefficient > 0.0 && !scene.obstacles.is_empty() {
+        solve_with_friction(scene, model, x, opts, observer)
+    } else {
+        solve_static(model, x, opts, observer)
+    }
+}
+
+/// The static solve with lagged friction: the load raised in increments (20 when the scene asks for
+/// one step), the friction anchors refreshed before each, then up to 10 more refreshes at full load
+/// until no particle moves by more than 1e-7 m.
+fn solve_with_friction(
+    scene: &Scene,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    opts: &crate::solve::StaticOptions,
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    use crate::physics::{FrictionAnchor, LaggedFriction};
+    let contact = crate::build::barrier_contact(scene, &model.masses, &model.fixed);
+    let mu = scene.contact.friction_coefficient;
+    let steps = if opts.load_steps > 1 {
+        opts.load_steps
+    } else {
+        20
+    };
+    let mut loads: Vec<f64> = (1..=steps).map(|k| k as f64 / steps as f64).collect();
+    loads.extend([1.0; 10]);
+    model.terms.push(Box::new(LaggedFriction {
+        anchors: vec![],
+        eps_m: 1e-5,
+    }));
+    let mut total: Option<SolveReport> = None;
+    for (k, &load) in loads.iter().enumerate() {
+        let anchors = contact
+            .contacts(x)
+            .into_iter()
+            .map(|(p, n, force)| FrictionAnchor {
+                particle: p,
+                anchor_m: x[p],
+                normal: n,
+                limit_N: mu * force,
+            })
+            .collect();
+        if let Some(t) = model.terms.last_mut() {
+            *t = Box::new(LaggedFriction {
+                anchors,
+                eps_m: 1e-5,
+            });
+        }
+        let before = x.to_vec();
+        let obs: &mut dyn Observer = if k == 0 {
+            &mut *observer
+        } else {
+            &mut crate::solve::NoObserver
+        };
+        let r = crate::solve::solve_static_loads(model, x, opts, &[load], obs);
+        let moved = x
+            .iter()
+            .zip(&before)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        let mut t = SolveReport::accumulate(total.take(), r);
+        if !t.is_converged() {
+            return t;
+        }
+        if k >= steps && moved < 1e-7 {
+            t.message = format!("{} (friction μ = {mu}, {} lag updates)", t.message, k + 1);
+            return t;
+        }
+        total = Some(t);
+    }
+    let mut t = total.expect("at least one solve");
+    t.message = format!(
+        "{} (friction μ = {mu}: lag updates still moving the sheet)",
+        t.message
+    );
+    t
+}
+
+/// Solves the scene on the grid with every other line and writes the interpolated positions into
+/// the free particles of `x`. Only when both sides have an odd count ≥ 21, the coarse solve converges,
+/// no absolute natural length ties the springs to the fine spacing, and no hold or point load names
+/// particles of the fine grid.
+fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(SolveReport, ())> {
+    let (nx, ny) = (grid.nx, grid.ny);
+    let natural = scene
+        .material
+        .mass_spring
+        .as_ref()
+        .is_some_and(|m| m.natural_length_m.is_some());
+    if !scene.solver.static_.coarse_start
+        || natural
+        || !scene.obstacles.is_empty()
+        || !scene.boundary.holds.is_empty()
+        || !scene.loads.is_empty()
+        || nx < 21
+        || ny < 21
+        || nx % 2 == 0
+        || ny % 2 == 0
+    {
+        return None;
+    }
+    if scene
+        .boundary
+        .pin_particles
+        .iter()
+        .any(|p| p[0] % 2 == 1 || p[1] % 2 == 1)
+    {
+        return None;
+    }
+    let c = scene.regridded(nx.div_ceil(2), ny.div_ceil(2));
+    let coarse = solve_scene(&c, &mut crate::solve::NoObserver);
+    if !coarse.report.is_converged() {
+        return None;
+    }
+    let cg = &coarse.grid;
+    let at = |i: usize, j: usize| coarse.x[cg.index(i, j)];
+    for j in 0..ny {
+        for i in 0..nx {
+            let p = grid.index(i, j);
+            let (i0, j0) = (i / 2, j / 2);
+            let (i1, j1) = (i0 + i % 2, j0 + j % 2);
+            x[p] = (at(i0, j0) + at(i1, j0) + at(i0, j1) + at(i1, j1)) * 0.25;
+        }
+    }
+    Some((coarse.report, ()))
+}

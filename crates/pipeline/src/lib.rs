@@ -1,0 +1,19 @@
+//! Declarative make-style pipelines (n2's habit): stages read from `pipelines/*.toml`, a graph from
+//! declared inputs and outputs, and a stage is up to date when the hash of its input files' content,
+//! its resolved parameters and the drapelab version matches the one in its manifest.
+//!
+//! Paths in a pipeline are relative to the project root (the folder above `pipelines/`); `{run}`
+//! stands for `runs/<pipeline>`. An input equal to (or a glob matching) another stage's output makes
+//! that stage a dependency.
+
+mod manifest;
+mod plan;
+mod progress;
+mod runner;
+mod stage;
+
+pub use manifest::{Manifest, hash_file};
+pub use plan::{Paths, Plan, PlannedStage, StageSpec, load_plan};
+pub use progress::{LogProgress, MultiBarProgress, Progress, progress_for_terminal};
+pub use runner::{RunOptions, RunSummary, StageState, manifest_path, run_pipeline, stage_states};
+pub use stage::{ParamError, Registry, Slot, Stage, StageContext, StageKind, typed_params};

@@ -1,0 +1,273 @@
+//! One shape for every stage (n2's habit: the engine knows a stage only through one small interface).
+//!
+//! A kind is a [`StageKind`]: its typed parameters (checked when the plan loads), its named input and
+//! output slots (checked when the plan loads, looked up by name when it runs) and `run`. The engine
+//! sees kinds as `dyn` [`Stage`] through a [`Registry`]; adding a kind is one file and one line in the
+//! registry that the binary builds.
+
+use crate::plan::{Plan, PlannedStage};
+use crate::progress::Progress;
+use anyhow::Result;
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use std::collections::BTreeMap;
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A named input or output of a stage kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Slot {
+    /// The slot's name, the key under `inputs.` or `outputs.` in a pipeline file.
+    pub name: &'static str,
+    /// Whether a pipeline must give it.
+    pub required: bool,
+    /// Whether it takes a list of paths or globs (otherwise exactly one path).
+    pub many: bool,
+    /// What goes there, for `--help` and errors.
+    pub doc: &'static str,
+}
+
+impl Slot {
+    /// A required slot of one path.
+    pub const fn one(name: &'static str, doc: &'static str) -> Self {
+        Self {
+            name,
+            required: true,
+            many: false,
+            doc,
+        }
+    }
+    /// An optional slot of one path.
+    pub const fn optional(name: &'static str, doc: &'static str) -> Self {
+        Self {
+            name,
+            required: false,
+            many: false,
+            doc,
+        }
+    }
+    /// A required slot of one or more paths or globs.
+    pub const fn many(name: &'static str, doc: &'static str) -> Self {
+        Self {
+            name,
+            required: true,
+            many: true,
+            doc,
+        }
+    }
+    /// An optional slot of paths or globs.
+    pub const fn optional_many(name: &'static str, doc: &'static str) -> Self {
+        Self {
+            name,
+            required: false,
+            many: true,
+            doc,
+        }
+    }
+}
+
+/// A bad parameter: the key under `params.` (empty for the whole table) and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamError {
+    /// Dotted key under `params.`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl ParamError {
+    /// A new parameter error.
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// The interface the engine knows a stage kind by (object safe).
+pub trait Stage: Send + Sync {
+    /// The kind's name in pipeline files (`simulate`, `fit-edges`, …).
+    fn kind(&self) -> &'static str;
+    /// One line on what the kind does.
+    fn summary(&self) -> &'static str;
+    /// The input slots.
+    fn inputs(&self) -> &'static [Slot];
+    /// The output slots.
+    fn outputs(&self) -> &'static [Slot];
+    /// Checks a params table; the resolved parameters (defaults filled in) as JSON, part of the
+    /// up-to-date key.
+    fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError>;
+    /// Runs the stage.
+    fn run(&self, ctx: &StageContext<'_>) -> Result<()>;
+}
+
+/// A stage kind with typed parameters: implement this, register it with [`Registry::with`].
+pub trait StageKind: Send + Sync + 'static {
+    /// The parameters (`params.*` in a pipeline file); unknown keys should be refused.
+    type Params: DeserializeOwned + Serialize;
+    /// The kind's name.
+    const KIND: &'static str;
+    /// One line on what it does.
+    const SUMMARY: &'static str;
+    /// Input slots.
+    const INPUTS: &'static [Slot];
+    /// Output slots.
+    const OUTPUTS: &'static [Slot];
+    /// Checks beyond the types (ranges, consistency).
+    fn check(_params: &Self::Params) -> Result<(), ParamError> {
+        Ok(())
+    }
+    /// Runs the stage with its parameters.
+    fn run(ctx: &StageContext<'_>, params: &Self::Params) -> Result<()>;
+}
+
+/// Deserializes a params table into `T`, naming the bad key.
+pub fn typed_params<T: DeserializeOwned>(params: &toml::Table) -> Result<T, ParamError> {
+    serde_path_to_error::deserialize(toml::Value::Table(params.clone())).map_err(|e| {
+        let path = e.path().to_string();
+        ParamError::new(
+            if path == "." { String::new() } else { path },
+            e.into_inner()
+                .to_string()
+                .lines()
+                .next()
+                .unwrap_or("invalid")
+                .to_string(),
+        )
+    })
+}
+
+struct Typed<K>(PhantomData<K>);
+
+impl<K: StageKind> Stage for Typed<K> {
+    fn kind(&self) -> &'static str {
+        K::KIND
+    }
+    fn summary(&self) -> &'static str {
+        K::SUMMARY
+    }
+    fn inputs(&self) -> &'static [Slot] {
+        K::INPUTS
+    }
+    fn outputs(&self) -> &'static [Slot] {
+        K::OUTPUTS
+    }
+    fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError> {
+        let p: K::Params = typed_params(params)?;
+        K::check(&p)?;
+        serde_json::to_value(&p).map_err(|e| ParamError::new("", e.to_string()))
+    }
+    fn run(&self, ctx: &StageContext<'_>) -> Result<()> {
+        let p: K::Params = typed_params(&ctx.stage.spec.params)
+            .map_err(|e| anyhow::anyhow!("params.{}: {}", e.key, e.message))?;
+        K::run(ctx, &p)
+    }
+}
+
+/// The stage kinds a plan may use, by name.
+#[derive(Default)]
+pub struct Registry {
+    kinds: BTreeMap<&'static str, Arc<dyn Stage>>,
+}
+
+impl Registry {
+    /// An empty registry.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Adds a typed kind.
+    pub fn with<K: StageKind>(mut self) -> Self {
+        self.kinds
+            .insert(K::KIND, Arc::new(Typed::<K>(PhantomData)));
+        self
+    }
+    /// Adds a kind given as a trait object.
+    pub fn with_stage(mut self, stage: Arc<dyn Stage>) -> Self {
+        self.kinds.insert(stage.kind(), stage);
+        self
+    }
+    /// The kind called `name`, shared.
+    pub fn shared(&self, name: &str) -> Option<Arc<dyn Stage>> {
+        self.kinds.get(name).cloned()
+    }
+    /// The kind called `name`.
+    pub fn get(&self, name: &str) -> Option<&dyn Stage> {
+        self.kinds.get(name).map(|b| b.as_ref())
+    }
+    /// Every kind, by name.
+    pub fn kinds(&self) -> impl Iterator<Item = &dyn Stage> {
+        self.kinds.values().map(|b| b.as_ref())
+    }
+    /// The kinds' names, comma separated.
+    pub fn names(&self) -> String {
+        self.kinds.keys().copied().collect::<Vec<_>>().join(", ")
+    }
+}
+
+/// What a stage gets to run: its files by slot, absolute.
+pub struct StageContext<'a> {
+    /// The plan (for the root and run folder).
+    pub plan: &'a Plan,
+    /// The stage.
+    pub stage: &'a PlannedStage,
+    /// Input files of each given slot, absolute, sorted within a slot (globs expanded).
+    pub inputs: BTreeMap<String, Vec<PathBuf>>,
+    /// Output files of each given slot, absolute.
+    pub outputs: BTreeMap<String, PathBuf>,
+    /// Where to report items.
+    pub progress: &'a dyn Progress,
+}
+
+impl StageContext<'_> {
+    /// "Made by `drapelab run PIPELINE` (drapelab VERSION)": the provenance line of every report.
+    pub fn made_by(&self) -> String {
+        let file = &self.plan.file;
+        format!(
+            "Made by `drapelab run {}` (drapelab {})",
+            file.strip_prefix(&self.plan.root).unwrap_or(file).display(),
+            drapelab_core::VERSION
+        )
+    }
+    /// The one file of input slot `slot` (a required slot is always there once the plan loaded).
+    pub fn input(&self, slot: &str) -> Result<&Path> {
+        match self.inputs.get(slot).map(Vec::as_slice) {
+            Some([one]) => Ok(one),
+            Some(many) => anyhow::bail!(
+                "input `{slot}` of stage `{}` matched {} files; it takes one",
+                self.stage.name,
+                many.len()
+            ),
+            None => anyhow::bail!(
+                "stage `{}` needs input `{slot}`: add `inputs.{slot} = \"PATH\"`",
+                self.stage.name
+            ),
+        }
+    }
+    /// The file of an optional input slot, if given.
+    pub fn optional_input(&self, slot: &str) -> Result<Option<&Path>> {
+        if self.inputs.contains_key(slot) {
+            self.input(slot).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+    /// The files of input slot `slot` (empty when an optional slot is not given).
+    pub fn input_files(&self, slot: &str) -> &[PathBuf] {
+        self.inputs.get(slot).map_or(&[], Vec::as_slice)
+    }
+    /// The path of output slot `slot` (a required slot is always there once the plan loaded).
+    pub fn output(&self, slot: &str) -> Result<&Path> {
+        self.optional_output(slot).ok_or_else(|| {
+            anyhow::anyhow!(
+                "stage `{}` needs output `{slot}`: add `outputs.{slot} = \"PATH\"`",
+                self.stage.name
+            )
+        })
+    }
+    /// The path of an optional output slot, if given.
+    pub fn optional_output(&self, slot: &str) -> Option<&Path> {
+        self.outputs.get(slot).map(PathBuf::as_path)
+    }
+}

@@ -1,0 +1,25 @@
+//! drapelab-record: every file a solve leaves behind. Parquet tables (particles, edges, any record
+//! batch), MCAP timelines in Foxglove's schema, rerun recordings, and the whole output folder of one
+//! solved scene. Every file is written to a temporary name in its folder and renamed when complete
+//! ([`drapelab_core::atomic`]), so a killed run never leaves an artifact that looks finished.
+
+#![allow(non_snake_case)]
+
+mod calibration_rrd;
+mod edges_table;
+mod particles;
+mod photo;
+mod rrd;
+mod run_dir;
+mod table;
+mod timeline;
+
+pub use calibration_rrd::CalibrationRecorder;
+pub use drapelab_core::atomic::{Staged, write_atomic, write_text};
+pub use edges_table::{read_edges, write_edges};
+pub use particles::{read_particles, write_particles};
+pub use photo::{fit_photo, render_scene, score_files};
+pub use rrd::RerunRecorder;
+pub use run_dir::simulate_to_dir;
+pub use table::write_parquet;
+pub use timeline::TimelineRecorder;

@@ -1,0 +1,116 @@
+//! `drape.rrd`: a rerun recording with the cloth as a mesh over an `iteration` (Newton) or `sim_time`
+//! (dynamics) timeline, the pinned points, and the residual and energy as scalars.
+
+use crate::Staged;
+use anyhow::Result;
+use drapelab_core::cloth::Grid;
+use drapelab_core::solve::{Observer, StateEvent};
+use std::path::Path;
+
+/// An observer writing a rerun recording.
+pub struct RerunRecorder {
+    rec: Option<rerun::RecordingStream>,
+    staged: Option<Staged>,
+    every: usize,
+    n_grid: usize,
+    tris: Vec<[u32; 3]>,
+    last_index: Option<usize>,
+    error: Option<String>,
+}
+
+impl RerunRecorder {
+    /// Starts a recording at `path`; `pins` are the fixed grid particles.
+    pub fn new(
+        path: &Path,
+        app: &str,
+        grid: &Grid,
+        x0: &[nalgebra::Vector3<f64>],
+        pins: &[usize],
+        every: usize,
+    ) -> Result<Self> {
+        let staged = Staged::new(path)?;
+        let rec = rerun::RecordingStreamBuilder::new(rerun::ApplicationId::new_or_unknown(
+            format!("drapelab_{app}"),
+        ))
+        .save(staged.path())?;
+        let tris = drapelab_core::cloth::grid_triangles(grid);
+        // The mesh topology is static; positions change over time.
+        rec.log_static(
+            "cloth/rest",
+            &rerun::Mesh3D::new(
+                x0[..grid.len()]
+                    .iter()
+                    .map(|p| [p.x as f32, p.y as f32, p.z as f32]),
+            )
+            .with_triangle_indices(tris.iter().copied()),
+        )?;
+        rec.log_static(
+            "cloth/pins",
+            &rerun::Points3D::new(
+                pins.iter()
+                    .map(|&p| [x0[p].x as f32, x0[p].y as f32, x0[p].z as f32]),
+            )
+            .with_radii([0.004f32]),
+        )?;
+        Ok(Self {
+            rec: Some(rec),
+            staged: Some(staged),
+            every,
+            n_grid: grid.len(),
+            tris,
+            last_index: None,
+            error: None,
+        })
+    }
+
+    fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+        let rec = self.rec.as_ref().expect("open recording");
+        match ev.time_s {
+            Some(t) => rec.set_duration_secs("sim_time", t),
+            None => rec.set_time_sequence("iteration", ev.index as i64),
+        }
+        let verts: Vec<[f32; 3]> = ev.x[..self.n_grid]
+            .iter()
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+            .collect();
+        rec.log(
+            "cloth/mesh",
+            &rerun::Mesh3D::new(verts).with_triangle_indices(self.tris.iter().copied()),
+        )?;
+        rec.log(
+            "stats/max_residual_N",
+            &rerun::Scalars::single(ev.max_residual_N),
+        )?;
+        rec.log("stats/energy_J", &rerun::Scalars::single(ev.energy_J))?;
+        self.last_index = Some(ev.index);
+        Ok(())
+    }
+
+    /// Records the final state and renames the recording into place.
+    pub fn finish(mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
+        if let Some(ev) = final_state
+            && self.last_index != Some(ev.index)
+        {
+            self.write(ev)?;
+        }
+        if let Some(e) = self.error.take() {
+            anyhow::bail!("writing the rerun recording failed: {e}");
+        }
+        let rec = self.rec.take().expect("open recording");
+        rec.flush_blocking()?;
+        drop(rec);
+        self.staged.take().expect("staged").commit()?;
+        Ok(())
+    }
+}
+
+impl Observer for RerunRecorder {
+    fn wants(&self, index: usize) -> bool {
+        self.error.is_none() && index.is_multiple_of(self.every)
+    }
+    fn observe(&mut self, ev: &StateEvent<'_>) {
+        if let Err(e) = self.write(ev) {
+            self.error = Some(e.to_string());
+        }
+    }
+}

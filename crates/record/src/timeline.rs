@@ -1,0 +1,143 @@
+//! `timeline.mcap`: particle states over Newton iterations or time, as Foxglove's well-known
+//! `foxglove.SceneUpdate` schema in JSON encoding (topic `/drapelab/cloth`, a triangle mesh), and a
+//! `drapelab.Stats` channel with residual and energy (topic `/drapelab/stats`). Foxglove's 3D panel
+//! replays the first; any MCAP reader decodes both as JSON.
+
+use crate::Staged;
+use anyhow::Result;
+use drapelab_core::cloth::Grid;
+use drapelab_core::solve::{Observer, StateEvent};
+use mcap::records::MessageHeader;
+use serde_json::json;
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::Path;
+
+/// JSON schema of the subset of `foxglove.SceneUpdate` that drapelab writes.
+const SCENE_UPDATE_SCHEMA: &str = r#"{"title":"foxglove.SceneUpdate","type":"object","properties":{"deletions":{"type":"array","items":{"type":"object"}},"entities":{"type":"array","items":{"type":"object","properties":{"timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_id":{"type":"string"},"id":{"type":"string"},"lifetime":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},"frame_locked":{"type":"boolean"},"metadata":{"type":"array"},"arrows":{"type":"array"},"cubes":{"type":"array"},"spheres":{"type":"array"},"cylinders":{"type":"array"},"lines":{"type":"array"},"triangles":{"type":"array","items":{"type":"object","properties":{"pose":{"type":"object"},"points":{"type":"array","items":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}}},"color":{"type":"object"},"colors":{"type":"array"},"indices":{"type":"array","items":{"type":"integer"}}}}},"texts":{"type":"array"},"models":{"type":"array"}}}}}}"#;
+
+const STATS_SCHEMA: &str = r#"{"title":"drapelab.Stats","type":"object","properties":{"index":{"type":"integer"},"time_s":{"type":["number","null"]},"max_residual_N":{"type":"number"},"energy_J":{"type":"number"}}}"#;
+
+/// An observer writing `timeline.mcap`.
+pub struct TimelineRecorder {
+    writer: Option<mcap::Writer<BufWriter<std::fs::File>>>,
+    staged: Option<Staged>,
+    cloth: u16,
+    stats: u16,
+    seq: u32,
+    every: usize,
+    n_grid: usize,
+    indices: Vec<u32>,
+    last_index: Option<usize>,
+    /// The first write error, reported at finish.
+    error: Option<String>,
+}
+
+impl TimelineRecorder {
+    /// Starts recording to `path`, keeping every `every`-th state.
+    pub fn new(path: &Path, grid: &Grid, every: usize) -> Result<Self> {
+        let staged = Staged::new(path)?;
+        let file = staged.path().to_path_buf();
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .truncate(true)
+            .open(&file)?;
+        let opts = mcap::WriteOptions::new()
+            .compression(None)
+            .profile("drapelab");
+        let mut writer = opts.create(BufWriter::new(f))?;
+        let s1 = writer.add_schema(
+            "foxglove.SceneUpdate",
+            "jsonschema",
+            SCENE_UPDATE_SCHEMA.as_bytes(),
+        )?;
+        let cloth = writer.add_channel(s1, "/drapelab/cloth", "json", &BTreeMap::new())?;
+        let s2 = writer.add_schema("drapelab.Stats", "jsonschema", STATS_SCHEMA.as_bytes())?;
+        let stats = writer.add_channel(s2, "/drapelab/stats", "json", &BTreeMap::new())?;
+        Ok(Self {
+            writer: Some(writer),
+            staged: Some(staged),
+            cloth,
+            stats,
+            seq: 0,
+            every,
+            n_grid: grid.len(),
+            indices: drapelab_core::cloth::grid_triangles(grid)
+                .into_iter()
+                .flatten()
+                .collect(),
+            last_index: None,
+            error: None,
+        })
+    }
+
+    fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+        // Log time: simulated time for dynamics, the iteration as milliseconds for Newton.
+        let t_ns = match ev.time_s {
+            Some(t) => (t * 1e9).round() as u64,
+            None => ev.index as u64 * 1_000_000,
+        };
+        let stamp = json!({"sec": t_ns / 1_000_000_000, "nsec": t_ns % 1_000_000_000});
+        let points: Vec<_> = ev.x[..self.n_grid]
+            .iter()
+            .map(|p| json!({"x": p.x, "y": p.y, "z": p.z}))
+            .collect();
+        let msg = json!({
+            "deletions": [],
+            "entities": [{
+                "timestamp": stamp, "frame_id": "world", "id": "cloth",
+                "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": false, "metadata": [],
+                "arrows": [], "cubes": [], "spheres": [], "cylinders": [], "lines": [], "texts": [], "models": [],
+                "triangles": [{
+                    "pose": {"position": {"x": 0.0, "y": 0.0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}},
+                    "points": points,
+                    "color": {"r": 0.85, "g": 0.35, "b": 0.2, "a": 1.0},
+                    "colors": [],
+                    "indices": self.indices,
+                }]
+            }]
+        });
+        let stats = json!({"index": ev.index, "time_s": ev.time_s, "max_residual_N": ev.max_residual_N, "energy_J": ev.energy_J});
+        let w = self.writer.as_mut().expect("open writer");
+        for (ch, body) in [(self.cloth, msg), (self.stats, stats)] {
+            self.seq += 1;
+            let header = MessageHeader {
+                channel_id: ch,
+                sequence: self.seq,
+                log_time: t_ns,
+                publish_time: t_ns,
+            };
+            w.write_to_known_channel(&header, serde_json::to_string(&body)?.as_bytes())?;
+        }
+        self.last_index = Some(ev.index);
+        Ok(())
+    }
+
+    /// Records the final state (if it was not the last one recorded) and renames the file into place.
+    pub fn finish(mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
+        if let Some(ev) = final_state
+            && self.last_index != Some(ev.index)
+        {
+            self.write(ev)?;
+        }
+        if let Some(e) = self.error.take() {
+            anyhow::bail!("writing the timeline failed: {e}");
+        }
+        let mut w = self.writer.take().expect("open writer");
+        w.finish()?;
+        drop(w);
+        self.staged.take().expect("staged").commit()?;
+        Ok(())
+    }
+}
+
+impl Observer for TimelineRecorder {
+    fn wants(&self, index: usize) -> bool {
+        self.error.is_none() && index.is_multiple_of(self.every)
+    }
+    fn observe(&mut self, ev: &StateEvent<'_>) {
+        if let Err(e) = self.write(ev) {
+            self.error = Some(e.to_string());
+        }
+    }
+}

@@ -1,0 +1,347 @@
+//! `benchmark-report`: Pareto fronts of time against error per scene, the fitted scaling exponents,
+//! Newton's work, seed 000's slack-net population, the skips and the peer ratios: all from the
+//! measured tables.
+
+use crate::report::{Panels, markdown, plot_panels};
+use anyhow::{Context, Result};
+use drapelab_core::benchmark::{fitted_exponent, pareto_front};
+use drapelab_pipeline::{Slot, StageContext, StageKind};
+use drapelab_record::write_text;
+use polars::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// Parameters of a benchmark-report stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BenchmarkReportParams {
+    /// Title of the report.
+    pub title: String,
+    /// The tolerance whose rows make the scaling fits. Default 1e-6.
+    #[serde(default = "default_scaling_tol")]
+    pub scaling_tolerance: f64,
+}
+
+fn default_scaling_tol() -> f64 {
+    1e-6
+}
+
+fn read(path: &std::path::Path) -> Result<DataFrame> {
+    Ok(LazyFrame::scan_parquet(
+        PlRefPath::from(path.to_string_lossy().as_ref()),
+        ScanArgsParquet::default(),
+    )?
+    .collect()?)
+}
+
+/// The `benchmark-report` stage kind.
+pub struct BenchmarkReport;
+
+impl StageKind for BenchmarkReport {
+    type Params = BenchmarkReportParams;
+    const KIND: &'static str = "benchmark-report";
+    const SUMMARY: &'static str =
+        "Pareto fronts, scaling exponents, skips and peer ratios from the benchmark tables";
+    const INPUTS: &'static [Slot] = &[
+        Slot::many("bench", "bench.parquet tables of benchmark stages"),
+        Slot::optional("population", "population.parquet of a benchmark stage"),
+        Slot::optional("peers", "peers.parquet"),
+        Slot::optional("skips", "skips.parquet"),
+    ];
+    const OUTPUTS: &'static [Slot] = &[
+        Slot::one("markdown", "the report, .md"),
+        Slot::one("plot", "the Pareto fronts, .svg"),
+    ];
+    fn run(ctx: &StageContext<'_>, p: &BenchmarkReportParams) -> Result<()> {
+        run(ctx, p)
+    }
+}
+
+fn run(ctx: &StageContext<'_>, p: &BenchmarkReportParams) -> Result<()> {
+    ctx.progress.stage_started(&ctx.stage.name, 1);
+    let mut bench: Option<DataFrame> = None;
+    for f in ctx.input_files("bench") {
+        let df = read(f)?;
+        bench = Some(match bench {
+            None => df,
+            Some(b) => b.vstack(&df)?,
+        });
+    }
+    let bench = bench.context("a benchmark report needs bench.parquet inputs")?;
+    let scene = bench.column("scene")?.str()?.clone();
+    let solver = bench.column("solver")?.str()?.clone();
+    let status = bench.column("status")?.str()?.clone();
+    let n = bench.column("particles_per_side")?.u64()?.clone();
+    let tol = bench.column("tolerance_rel")?.f64()?.clone();
+    let wall = bench.column("wall_time_s")?.f64()?.clone();
+    let iters = bench.column("iterations")?.u64()?.clone();
+    let err = bench.column("error_m")?.f64()?.clone();
+    let mut panels = Panels::new();
+    let mut all: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut md = format!(
+        "# {}\n\n{} from the measured tables: every number and \
+point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
+        p.title,
+        ctx.made_by()
+    );
+    for r in 0..bench.height() {
+        let (Some(s), Some(sv), Some(t), Some(e)) =
+            (scene.get(r), solver.get(r), wall.get(r), err.get(r))
+        else {
+            continue;
+        };
+        if status.get(r) != Some("converged") || e <= 0.0 {
+            continue;
+        }
+        let pt = (t.log10(), e.log10());
+        panels
+            .entry(s.to_string())
+            .or_default()
+            .entry(sv.to_string())
+            .or_default()
+            .push(pt);
+        all.entry(s.to_string()).or_default().push((t, e));
+    }
+    for (s, pts) in &all {
+        panels.entry(s.clone()).or_default().insert(
+            "Pareto front".into(),
+            pareto_front(pts)
+                .iter()
+                .map(|(t, e)| (t.log10(), e.log10()))
+                .collect(),
+        );
+    }
+    for lines in panels.values_mut() {
+        for pts in lines.values_mut() {
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+    }
+    let svg = plot_panels(
+        &panels,
+        "log10 wall time (s)",
+        "log10 error vs reference (m)",
+        Some("scene"),
+    )?;
+    md += "## Run time against error\n\nThe error is the largest particle distance to the reference: the finest static \
+solution (at the grid points both share), or for the cantilever the exact heavy elastica. Converged points only.\n\n\
+![Pareto fronts](benchmark_pareto.svg)\n\n| scene | Pareto front: (wall time s, error m) |\n|---|---|\n";
+    for (s, pts) in &all {
+        let front: Vec<String> = pareto_front(pts)
+            .iter()
+            .map(|(t, e)| format!("({t:.3e}, {e:.2e})"))
+            .collect();
+        let _ = writeln!(md, "| {s} | {} |", front.join(" "));
+    }
+    // Scaling: static wall time against particle count, and explicit time per step, per scene at the
+    // tightest tolerance.
+    let _ = write!(
+        md,
+        "\n## Scaling\n\nConverged runs at tolerance {:.0e}; the exponent p of wall time ∝ (particles)^p by least \
+squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall time against particle count |\n|---|---|---|---|\n",
+        p.scaling_tolerance
+    );
+    let mut series: BTreeMap<(String, String), Vec<(f64, f64)>> = BTreeMap::new();
+    for r in 0..bench.height() {
+        let (Some(s), Some(sv), Some(k), Some(t), Some(tl), Some(it)) = (
+            scene.get(r),
+            solver.get(r),
+            n.get(r),
+            wall.get(r),
+            tol.get(r),
+            iters.get(r),
+        ) else {
+            continue;
+        };
+        if status.get(r) != Some("converged") || (tl / p.scaling_tolerance - 1.0).abs() > 1e-9 {
+            continue;
+        }
+        let particles = (k * k) as f64;
+        if sv == "static" {
+            series
+                .entry((s.into(), "static (whole solve)".into()))
+                .or_default()
+                .push((particles, t));
+        } else if sv == "explicit-euler" && it > 0 {
+            series
+                .entry((s.into(), "explicit Euler (one step)".into()))
+                .or_default()
+                .push((particles, t / it as f64));
+        }
+    }
+    for ((s, sv), pts) in &series {
+        let sides: Vec<String> = pts
+            .iter()
+            .map(|(p, _)| format!("{}", p.sqrt().round()))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {s} | {sv} | {} | {} |",
+            sides.join(", "),
+            fitted_exponent(pts).map_or("–".into(), |e| format!("{e:.2}"))
+        );
+    }
+    // How each solver ended on each scene.
+    let mut ends: BTreeMap<(String, String), BTreeMap<String, usize>> = BTreeMap::new();
+    for r in 0..bench.height() {
+        if let (Some(s), Some(sv), Some(st)) = (scene.get(r), solver.get(r), status.get(r)) {
+            *ends
+                .entry((s.into(), sv.into()))
+                .or_default()
+                .entry(st.into())
+                .or_default() += 1;
+        }
+    }
+    md += "\n## How each solver ended\n\nPoints per status (max-iterations includes the wall-time budget of a \
+dynamic point).\n\n| scene | solver | converged | max-iterations | diverged | invalid |\n|---|---|---|---|---|---|\n";
+    for ((s, sv), counts) in &ends {
+        let c = |k: &str| counts.get(k).copied().unwrap_or(0);
+        let _ = writeln!(
+            md,
+            "| {s} | {sv} | {} | {} | {} | {} |",
+            c("converged"),
+            c("max-iterations"),
+            c("diverged"),
+            c("invalid")
+        );
+    }
+    md += &newton_work_section(&bench)?;
+    if let Some(pop) = ctx.optional_input("population")? {
+        md += &population_section(&read(pop)?)?;
+    }
+    md += "\n## Every point\n\n";
+    md += &markdown(&bench);
+    if let Some(skips) = ctx.optional_input("skips")? {
+        md += "\n## What skipping saves, measured on and off in the same run\n\n";
+        md += &markdown(&read(skips)?);
+        md += "\nsaved_fraction = 1 − time with the skip / time without it.\n";
+    }
+    if let Some(peers) = ctx.optional_input("peers")? {
+        md += "\n## Peers, run beside drapelab in the same stage\n\n";
+        md += &markdown(&read(peers)?);
+        md += "\nratio = peer time / drapelab time (> 1: drapelab is faster). The scipy script solves the same \
+hang4 model by sparse Newton to the same force tolerance; the centre heights show both reach the same \
+equilibrium.\n";
+    }
+    write_text(ctx.output("markdown")?, &md)?;
+    write_text(ctx.output("plot")?, &svg)?;
+    ctx.progress.item_done(&ctx.stage.name);
+    Ok(())
+}
+
+/// The static solves' work per scene and grid at the tightest tolerance: Newton iterations,
+/// factorizations, wall time, the factorizations' own time and what is left (assembly, line
+/// search, energy and gradient evaluations).
+fn newton_work_section(bench: &DataFrame) -> Result<String> {
+    let tols = bench.column("tolerance_rel")?.f64()?.clone();
+    let tightest = (0..tols.len())
+        .filter_map(|i| tols.get(i))
+        .fold(f64::INFINITY, f64::min);
+    let mut md = format!(
+        "\n## Newton iterations and factorizations per solve\n\nStatic solves at tolerance {tightest:.0e}, \
+from the flat sheet (a coarse or sagged start included in the counts). Factorizations count the failed ones \
+too (an indefinite exact Hessian, retried projected); the factorization time is that of the numeric \
+Cholesky factorizations and triangular solves alone, the rest is assembly, line search and the \
+coarse start's own overhead.\n\n| scene | particles | status | iterations | factorizations | wall time (ms) | factorization time (ms) | rest (ms) |\n|---|---|---|---|---|---|---|---|\n"
+    );
+    let col = |c: &str| bench.column(c).map(|c| c.as_materialized_series().clone());
+    let (scene, solver, status, n, tol, wall, it, fact, ft) = (
+        col("scene")?,
+        col("solver")?,
+        col("status")?,
+        col("particles_per_side")?,
+        col("tolerance_rel")?,
+        col("wall_time_s")?,
+        col("iterations")?,
+        col("factorizations")?,
+        col("factor_time_s")?,
+    );
+    for r in 0..bench.height() {
+        if solver.str()?.get(r) != Some("static")
+            || tol
+                .f64()?
+                .get(r)
+                .is_none_or(|t| (t / tightest - 1.0).abs() > 1e-9)
+        {
+            continue;
+        }
+        let (w, f) = (
+            wall.f64()?.get(r).unwrap_or(f64::NAN),
+            ft.f64()?.get(r).unwrap_or(f64::NAN),
+        );
+        let k = n.u64()?.get(r).unwrap_or(0);
+        let _ = writeln!(
+            md,
+            "| {} | {k}×{k} | {} | {} | {} | {:.3} | {:.3} | {:.3} |",
+            scene.str()?.get(r).unwrap_or(""),
+            status.str()?.get(r).unwrap_or(""),
+            it.u64()?.get(r).unwrap_or(0),
+            fact.u64()?.get(r).unwrap_or(0),
+            w * 1e3,
+            f * 1e3,
+            (w - f) * 1e3
+        );
+    }
+    Ok(md)
+}
+
+/// The slack-net population's iterations, factorizations and times per solve (min / median / max).
+fn population_section(pop: &DataFrame) -> Result<String> {
+    let f = |c: &str| -> Result<Vec<f64>> {
+        let s = pop
+            .column(c)?
+            .as_materialized_series()
+            .cast(&polars::prelude::DataType::Float64)?;
+        let ca = s.f64()?;
+        Ok((0..ca.len())
+            .map(|i| ca.get(i).unwrap_or(f64::NAN))
+            .collect())
+    };
+    let strings = |c: &str| -> Result<Vec<String>> {
+        let ca = pop.column(c)?.str()?.clone();
+        Ok((0..ca.len())
+            .map(|i| ca.get(i).unwrap_or("").to_string())
+            .collect())
+    };
+    let status = strings("status")?;
+    let (k, l, d, it, fa, w, ft) = (
+        f("stiffness_N_per_m")?,
+        f("natural_length_m")?,
+        f("areal_density_kg_per_m2")?,
+        f("iterations")?,
+        f("factorizations")?,
+        f("wall_time_s")?,
+        f("factor_time_s")?,
+    );
+    let topology = strings("topology")?;
+    let start = strings("start")?;
+    let rows: Vec<drapelab_core::benchmark::PopulationRow> = (0..pop.height())
+        .map(|r| drapelab_core::benchmark::PopulationRow {
+            start: start[r].clone(),
+            stiffness_N_per_m: k[r],
+            natural_length_m: l[r],
+            topology: topology[r].clone(),
+            areal_density_kg_per_m2: d[r],
+            status: status[r].clone(),
+            iterations: it[r] as usize,
+            factorizations: fa[r] as usize,
+            wall_time_s: w[r],
+            factor_time_s: ft[r],
+        })
+        .collect();
+    let of = |which: &str| -> Vec<drapelab_core::benchmark::PopulationRow> {
+        rows.iter().filter(|r| r.start == which).cloned().collect()
+    };
+    let (sagged, lattice) = (of("sagged"), of("lattice"));
+    Ok(format!(
+        "\n## Seed 000's slack-net population\n\nhang4 on the 14 × 14 net, static, at {} points of a Latin \
+hypercube over Table 3's stiffness and natural length, the three topologies and Table 2's densities (what a \
+calibration asks thousands of times), from the sagged start: {}\nThe same net as the calibration solves it: \
+{} points over stiffness, natural length and topology at 45 g/m², each from the drape at the nearest node of \
+the calibration's warm-start lattice (`calibrate::StartLattice`): {}",
+        sagged.len(),
+        drapelab_core::benchmark::population_table(&sagged),
+        lattice.len(),
+        drapelab_core::benchmark::population_table(&lattice)
+    ))
+}

@@ -1,0 +1,440 @@
+//! `calibrate`: for each sample of a fit-edges table, ICA runs over Table 3's box against the sample's
+//! measured 4-corner edges (the scene input with the sample's Table 2 density); the best run is kept.
+//! Writes `results.parquet` (one row per sample, with the runs' spread and each parameter's
+//! identifiability) and `evaluations.parquet` (every country of every decade of every run).
+
+use anyhow::{Context, Result, bail};
+use arrow::array::{
+    ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
+};
+use arrow::datatypes::{DataType, Field, Schema};
+use drapelab_core::calibrate::{
+    EvaluatedCountry, Noise, OptimizerRun, Problem, SampleCalibration, SampleSettings,
+    calibrate_sample, read_sample_densities, sample_scene,
+};
+use drapelab_core::edges::EdgeFit;
+use drapelab_core::optim::{DecadeEvent, IcaSettings};
+use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
+use drapelab_record::{CalibrationRecorder, read_edges, write_parquet};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+
+/// Parameters of a calibrate stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrateParams {
+    /// Independent ICA runs per sample (seeds seed, seed+1, ...). Default 10 (seed 000).
+    #[serde(default = "default_runs")]
+    pub runs: usize,
+    /// ICA settings (seed is the first run's); or set `ica_from_input`.
+    #[serde(default)]
+    pub ica: Option<IcaSettings>,
+    /// Read ICA's settings from the `ica` input (a tune stage's `best_ica.json`) instead of `ica`.
+    #[serde(default)]
+    pub ica_from_input: bool,
+    /// Particles per side of the simulated net. Default 14.
+    #[serde(default = "default_grid")]
+    pub grid: usize,
+    /// Side of the samples, cm. Default 50.
+    #[serde(default = "default_side")]
+    pub side_cm: f64,
+    /// Measurement error of the photos in the cost's unit (curve distance, % of the side), for the
+    /// identifiability analysis: a worst-case bound (0.03 is the photo-to-particle gap of the bundled
+    /// dataset, README "Edges from photos"). Default: none, the standard error of least squares
+    /// estimated from the residual at the optimum ([`drapelab_core::calibrate::Noise`]).
+    #[serde(default)]
+    pub measurement_noise_pct: Option<f64>,
+    /// A parameter is identifiable when the photos pin it to within this fraction of its value (the
+    /// half-width over which the cost stays within the noise). Default 0.05.
+    #[serde(default = "default_ident")]
+    pub identifiable_rel: f64,
+    /// Half-width of the window swept around the optimum for each parameter, as a fraction of its
+    /// Table 3 range. Default 0.1.
+    #[serde(default = "default_window")]
+    pub identifiability_window: f64,
+    /// Nelder–Mead iterations that polish the best ICA optimum over stiffness and natural length
+    /// ([`drapelab_core::calibrate::Problem::polish`]); 0 keeps seed 000's ICA alone. Default 60.
+    #[serde(default = "default_polish")]
+    pub polish_iterations: u64,
+    /// Also run CMA-ES with the same number of cost evaluations as each ICA run (the baseline), into
+    /// the `comparison.parquet` output. Default false.
+    #[serde(default)]
+    pub baseline_cmaes: bool,
+}
+
+fn default_runs() -> usize {
+    10
+}
+fn default_grid() -> usize {
+    14
+}
+fn default_side() -> f64 {
+    50.0
+}
+fn default_ident() -> f64 {
+    0.05
+}
+fn default_polish() -> u64 {
+    60
+}
+fn default_window() -> f64 {
+    0.1
+}
+
+impl CalibrateParams {
+    /// Checks the parameters: Err((key, message)).
+    pub fn check(&self) -> Result<(), (String, String)> {
+        match (&self.ica, self.ica_from_input) {
+            (Some(ica), false) => ica.check().map_err(|(k, m)| (format!("ica.{k}"), m))?,
+            (None, true) => {}
+            _ => {
+                return Err((
+                    "ica".into(),
+                    "give exactly one of `ica` (settings) and `ica_from_input = true` (the `ica` input)"
+                        .into(),
+                ));
+            }
+        }
+        if self.runs == 0 {
+            return Err(("runs".into(), "must be ≥ 1".into()));
+        }
+        if self.grid < 3 {
+            return Err(("grid".into(), "must be ≥ 3".into()));
+        }
+        for (key, v, lo, hi) in [
+            (
+                "measurement_noise_pct",
+                self.measurement_noise_pct.unwrap_or(1.0),
+                0.0,
+                100.0,
+            ),
+            ("identifiable_rel", self.identifiable_rel, 0.0, 1.0),
+            (
+                "identifiability_window",
+                self.identifiability_window,
+                0.0,
+                1.0,
+            ),
+        ] {
+            if !(v.is_finite() && v > lo && v <= hi) {
+                return Err((key.into(), format!("must be in ({lo}, {hi}], got {v}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The `calibrate` stage kind.
+pub struct Calibrate;
+
+impl StageKind for Calibrate {
+    type Params = CalibrateParams;
+    const KIND: &'static str = "calibrate";
+    const SUMMARY: &'static str =
+        "ICA calibration of mass-spring parameters against measured edges";
+    const INPUTS: &'static [Slot] = &[
+        Slot::one(
+            "edges",
+            "measured edges of every sample (a fit-edges table)",
+        ),
+        Slot::one("samples", "Table 2's densities (knitted_samples.csv)"),
+        Slot::one("scene", "the hang scene each sample is simulated in"),
+        Slot::optional(
+            "ica",
+            "ICA settings as JSON (a tune stage's best_ica.json), with params.ica_from",
+        ),
+    ];
+    const OUTPUTS: &'static [Slot] = &[
+        Slot::one("results", "results.parquet: one row per sample"),
+        Slot::optional(
+            "evaluations",
+            "evaluations.parquet: every country of every decade",
+        ),
+        Slot::optional(
+            "recording",
+            "calibration.rrd: the empires and best drapes, decade by decade",
+        ),
+        Slot::optional(
+            "comparison",
+            "comparison.parquet: ICA against the CMA-ES baseline per run",
+        ),
+    ];
+    fn check(p: &CalibrateParams) -> Result<(), ParamError> {
+        p.check().map_err(|(k, m)| ParamError::new(k, m))
+    }
+    fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
+        run(ctx, p)
+    }
+}
+
+/// The ICA settings: given, or read from the `ica` input.
+fn ica_settings(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<IcaSettings> {
+    if let Some(ica) = &p.ica {
+        return Ok(ica.clone());
+    }
+    let path = ctx.input("ica")?;
+    let ica: IcaSettings = serde_json::from_slice(
+        &std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?,
+    )?;
+    ica.check()
+        .map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", path.display()))?;
+    Ok(ica)
+}
+
+fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
+    let densities = read_sample_densities(ctx.input("samples")?)?;
+    let scene_file = ctx.input("scene")?;
+    let edges_file = ctx.input("edges")?;
+    let mut by_sample: BTreeMap<String, Vec<EdgeFit>> = BTreeMap::new();
+    for (s, e) in read_edges(edges_file)? {
+        by_sample.entry(s).or_default().push(e);
+    }
+    if by_sample.is_empty() {
+        bail!("{}: no edges", edges_file.display());
+    }
+    ctx.progress
+        .stage_started(&ctx.stage.name, (by_sample.len() * p.runs) as u64);
+    let settings = SampleSettings {
+        runs: p.runs,
+        ica: ica_settings(ctx, p)?,
+        side_cm: p.side_cm,
+        polish_iterations: p.polish_iterations,
+        noise: p
+            .measurement_noise_pct
+            .map_or(Noise::FromResidual, Noise::Given),
+        identifiable_rel: p.identifiable_rel,
+        identifiability_window: p.identifiability_window,
+        baseline_cmaes: p.baseline_cmaes,
+    };
+    let recorder = match ctx.optional_output("recording") {
+        Some(path) => Some(CalibrationRecorder::new(path)?),
+        None => None,
+    };
+    let mut results = Vec::new();
+    for (sample, measured) in &by_sample {
+        let scene = sample_scene(scene_file, &densities, sample, p.grid)?;
+        let problem = Problem::new(scene, measured.clone(), p.side_cm);
+        let mut observe = |r: usize, ev: &DecadeEvent<'_>| -> Result<()> {
+            match &recorder {
+                Some(rec) => record_decade(rec, &problem, sample, r, ev, measured, p.side_cm)
+                    .context("writing the calibration recording"),
+                None => Ok(()),
+            }
+        };
+        let done = || ctx.progress.item_done(&ctx.stage.name);
+        let found = calibrate_sample(&problem, measured, &settings, &mut observe, &done)?;
+        results.push((sample.clone(), found));
+    }
+    write_results(ctx.output("results")?, &results, p.runs)?;
+    if let Some(rec) = recorder {
+        rec.finish()?;
+    }
+    if let Some(out) = ctx.optional_output("comparison") {
+        write_comparison(out, &results)?;
+    }
+    if let Some(out) = ctx.optional_output("evaluations") {
+        write_evaluations(out, &results)?;
+    }
+    Ok(())
+}
+
+/// Logs a decade: the empires and the drape of the best imperialist.
+fn record_decade(
+    rec: &CalibrationRecorder,
+    problem: &Problem,
+    sample: &str,
+    run: usize,
+    ev: &DecadeEvent<'_>,
+    measured: &[EdgeFit],
+    side_cm: f64,
+) -> Result<()> {
+    let best = ev
+        .empires
+        .iter()
+        .map(|e| &e.imperialist)
+        .min_by(|a, b| a.cost.total_cmp(&b.cost));
+    let drape = best
+        .map(|b| problem.drape(&b.x))
+        .and_then(|(s, e)| Some((s, e?)));
+    let origin = drape.as_ref().map(|(s, _)| s.x[0]).unwrap_or_default();
+    rec.decade(
+        sample,
+        run,
+        ev,
+        |x| [x[0] as f32, x[3] as f32, x[4] as f32],
+        drape
+            .as_ref()
+            .map(|(s, e)| (&s.grid, s.x.as_slice(), e.as_slice())),
+        measured,
+        origin,
+        side_cm,
+    )
+}
+
+fn f64s(v: Vec<f64>) -> ArrayRef {
+    Arc::new(Float64Array::from(v))
+}
+
+/// `results.parquet`: one row per sample.
+fn write_results(out: &Path, results: &[(String, SampleCalibration)], runs: usize) -> Result<()> {
+    let mut fields = vec![
+        Field::new("sample", DataType::Utf8, false),
+        Field::new("objective_pct", DataType::Float64, false),
+        Field::new("curve_distance_pct", DataType::Float64, false),
+        Field::new("ica_curve_distance_pct", DataType::Float64, false),
+        Field::new("stiffness_N_per_m", DataType::Float64, false),
+        Field::new("damping_Ns_per_m", DataType::Float64, false),
+        Field::new("elongation_rate", DataType::Float64, false),
+        Field::new("natural_length_m", DataType::Float64, false),
+        Field::new("topology", DataType::Utf8, false),
+        Field::new("runs", DataType::UInt32, false),
+        Field::new("spread_curve_distance_pct", DataType::Float64, false),
+        Field::new("simulations", DataType::UInt64, false),
+        Field::new("failed_simulations", DataType::UInt64, false),
+    ];
+    let r = |f: fn(&SampleCalibration) -> f64| f64s(results.iter().map(|(_, c)| f(c)).collect());
+    let mut cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(
+            results.iter().map(|(s, _)| s.clone()),
+        )),
+        r(|c| c.eq5_pct),
+        r(|c| c.curve_pct),
+        r(|c| c.ica_curve_pct),
+        r(|c| c.best.stiffness_N_per_m),
+        r(|c| c.best.damping_Ns_per_m),
+        r(|c| c.best.elongation_rate),
+        r(|c| c.best.natural_length_m),
+        Arc::new(StringArray::from_iter_values(
+            results.iter().map(|(_, c)| c.best.topology.letter()),
+        )),
+        Arc::new(UInt32Array::from_iter_values(
+            results.iter().map(|_| runs as u32),
+        )),
+        r(|c| c.spread_pct),
+        Arc::new(UInt64Array::from_iter_values(
+            results.iter().map(|(_, c)| c.simulations as u64),
+        )),
+        Arc::new(UInt64Array::from_iter_values(
+            results.iter().map(|(_, c)| c.failures as u64),
+        )),
+    ];
+    for (k, name) in [
+        "stiffness",
+        "damping",
+        "elongation_rate",
+        "natural_length",
+        "topology",
+    ]
+    .iter()
+    .enumerate()
+    {
+        fields.push(Field::new(
+            format!("identifiable_{name}"),
+            DataType::Boolean,
+            false,
+        ));
+        cols.push(Arc::new(BooleanArray::from(
+            results
+                .iter()
+                .map(|(_, c)| c.identifiability[k].identifiable)
+                .collect::<Vec<_>>(),
+        )));
+    }
+    // Half-widths of the intervals the photos allow (null where the cost is flat).
+    for (k, name) in [
+        "stiffness_uncertainty_N_per_m",
+        "damping_uncertainty_Ns_per_m",
+        "elongation_rate_uncertainty",
+        "natural_length_uncertainty_m",
+    ]
+    .iter()
+    .enumerate()
+    {
+        fields.push(Field::new(*name, DataType::Float64, true));
+        cols.push(Arc::new(Float64Array::from_iter(results.iter().map(
+            |(_, c)| {
+                let u = c.identifiability[k].uncertainty;
+                u.is_finite().then_some(u)
+            },
+        ))));
+    }
+    write_parquet(
+        out,
+        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
+        None,
+    )
+}
+
+/// `comparison.parquet`: every optimiser run's best cost.
+fn write_comparison(out: &Path, results: &[(String, SampleCalibration)]) -> Result<()> {
+    let rows: Vec<(&str, &OptimizerRun)> = results
+        .iter()
+        .flat_map(|(s, c)| c.runs.iter().map(move |r| (s.as_str(), r)))
+        .collect();
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("sample", DataType::Utf8, false),
+        Field::new("optimizer", DataType::Utf8, false),
+        Field::new("run", DataType::UInt32, false),
+        Field::new("evaluations", DataType::UInt64, false),
+        Field::new("best_cost_pct", DataType::Float64, false),
+    ]));
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(rows.iter().map(|c| c.0))),
+        Arc::new(StringArray::from_iter_values(
+            rows.iter().map(|c| c.1.optimizer),
+        )),
+        Arc::new(UInt32Array::from_iter_values(rows.iter().map(|c| c.1.run))),
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|c| c.1.evaluations),
+        )),
+        f64s(rows.iter().map(|c| c.1.best_cost_pct).collect()),
+    ];
+    write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)
+}
+
+/// `evaluations.parquet`: every country of every decade of every run.
+fn write_evaluations(out: &Path, results: &[(String, SampleCalibration)]) -> Result<()> {
+    let evals: Vec<(&str, &EvaluatedCountry)> = results
+        .iter()
+        .flat_map(|(s, c)| c.evaluations.iter().map(move |e| (s.as_str(), e)))
+        .collect();
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("sample", DataType::Utf8, false),
+        Field::new("run", DataType::UInt32, false),
+        Field::new("decade", DataType::UInt32, false),
+        Field::new("empire", DataType::UInt32, false),
+        Field::new("cost_pct", DataType::Float64, false),
+        Field::new("stiffness_N_per_m", DataType::Float64, false),
+        Field::new("natural_length_m", DataType::Float64, false),
+        Field::new("topology", DataType::Utf8, false),
+        Field::new("solver_status", DataType::Utf8, true),
+        Field::new("simulation_time_s", DataType::Float64, true),
+    ]));
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(evals.iter().map(|e| e.0))),
+        Arc::new(UInt32Array::from_iter_values(evals.iter().map(|e| e.1.run))),
+        Arc::new(UInt32Array::from_iter_values(
+            evals.iter().map(|e| e.1.decade),
+        )),
+        Arc::new(UInt32Array::from_iter_values(
+            evals.iter().map(|e| e.1.empire),
+        )),
+        f64s(evals.iter().map(|e| e.1.cost_pct).collect()),
+        f64s(evals.iter().map(|e| e.1.params.stiffness_N_per_m).collect()),
+        f64s(evals.iter().map(|e| e.1.params.natural_length_m).collect()),
+        Arc::new(StringArray::from_iter_values(
+            evals.iter().map(|e| e.1.params.topology.letter()),
+        )),
+        Arc::new(StringArray::from_iter(
+            evals.iter().map(|e| e.1.evaluation.map(|v| v.status)),
+        )),
+        Arc::new(Float64Array::from_iter(
+            evals
+                .iter()
+                .map(|e| e.1.evaluation.map(|v| v.simulation_time_s)),
+        )),
+    ];
+    write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)
+}

@@ -1,0 +1,93 @@
+//! `fit-edges`: every input photo (PNG or JPEG) fitted with edge polynomials, calibrated by the
+//! `camera.json` in its folder (as `drapelab render` writes it); one `edges.parquet` for all photos,
+//! each row's `sample` being the photo's folder relative to the project root.
+
+use anyhow::{Result, bail};
+use drapelab_core::edges::{
+    Calibration, EdgeFit, FitImageOptions, fit_image, read_camera, read_gray,
+};
+use drapelab_pipeline::{Slot, StageContext, StageKind};
+use drapelab_record::write_edges;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Parameters of a fit-edges stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitEdgesParams {
+    /// Polynomial degree. Default 4 (seed 000).
+    #[serde(default = "default_degree")]
+    pub degree: usize,
+}
+
+fn default_degree() -> usize {
+    4
+}
+
+/// The `fit-edges` stage kind.
+pub struct FitEdges;
+
+impl StageKind for FitEdges {
+    type Params = FitEdgesParams;
+    const KIND: &'static str = "fit-edges";
+    const SUMMARY: &'static str = "Fit edge polynomials to photos (seed 000 Figs 11-12)";
+    const INPUTS: &'static [Slot] = &[
+        Slot::many(
+            "photos",
+            "photos (.png, .jpg), each with its camera.json beside it",
+        ),
+        Slot::optional_many(
+            "cameras",
+            "the camera.json files beside the photos (listed so that a changed calibration reruns)",
+        ),
+    ];
+    const OUTPUTS: &'static [Slot] = &[Slot::one("edges", "edges.parquet of every photo")];
+    fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
+        run(ctx, p)
+    }
+}
+
+fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
+    let photos: Vec<_> = ctx
+        .input_files("photos")
+        .iter()
+        .filter(|f| {
+            f.extension()
+                .is_some_and(|e| e == "png" || e == "jpg" || e == "jpeg")
+        })
+        .collect();
+    if photos.is_empty() {
+        bail!("no photo (.png, .jpg) in input `photos`");
+    }
+    ctx.progress
+        .stage_started(&ctx.stage.name, photos.len() as u64);
+    let fits: Vec<Result<Vec<(String, EdgeFit)>>> = photos
+        .par_iter()
+        .map(|photo| {
+            let dir = photo.parent().unwrap_or(std::path::Path::new("."));
+            let cam = read_camera(&dir.join("camera.json"))?;
+            let img = read_gray(photo)?;
+            let opts = FitImageOptions {
+                view: cam.view,
+                degree: p.degree,
+                calibration: Calibration::Given {
+                    px_per_cm: cam.px_per_cm,
+                    corners: cam.corners_px,
+                },
+            };
+            let fit = fit_image(&img, &opts, photo)?;
+            let sample = dir
+                .strip_prefix(&ctx.plan.root)
+                .unwrap_or(dir)
+                .to_string_lossy()
+                .replace('\\', "/");
+            ctx.progress.item_done(&ctx.stage.name);
+            Ok(fit.edges.into_iter().map(|e| (sample.clone(), e)).collect())
+        })
+        .collect();
+    let mut rows = Vec::new();
+    for f in fits {
+        rows.extend(f?);
+    }
+    write_edges(ctx.output("edges")?, &rows)
+}

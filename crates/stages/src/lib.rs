@@ -1,0 +1,62 @@
+//! drapelab-stages: the stage kinds of drapelab's pipelines, one file each, glue over the library
+//! (`drapelab-core` for the science, `drapelab-record` for the files), and the report helpers
+//! (Markdown tables from polars, plots with plotters). [`registry`] lists every kind: adding one is
+//! a file here and a line there.
+
+#![allow(non_snake_case)]
+
+mod benchmark;
+mod benchmark_report;
+mod calibrate;
+mod calibration_report;
+mod fit_edges;
+mod peers;
+pub mod report;
+mod score;
+mod seed003_report;
+mod simulate;
+mod skips;
+mod sweep;
+mod tune;
+mod validate;
+mod wrinkles;
+
+pub use benchmark::{Benchmark, BenchmarkParams};
+pub use benchmark_report::{BenchmarkReport, BenchmarkReportParams};
+pub use calibrate::{Calibrate, CalibrateParams};
+pub use calibration_report::{CalibrationReport, CalibrationReportParams};
+pub use fit_edges::{FitEdges, FitEdgesParams};
+pub use peers::{Peers, PeersParams};
+pub use report::{Report, ReportParams};
+pub use score::{Score, ScoreParams};
+pub use seed003_report::{Seed003Report, Seed003ReportParams};
+pub use simulate::{Simulate, SimulateParams};
+pub use skips::{Skips, SkipsParams};
+pub use sweep::{Axis, Design, Sweep, SweepParams, sweep_points};
+pub use tune::{Levels, Tune, TuneParams};
+pub use validate::{Validate, ValidateParams};
+pub use wrinkles::{
+    SolvedCase, WrinkleOutputs, Wrinkles, WrinklesParams, report_markdown, write_wrinkles,
+};
+
+use drapelab_pipeline::Registry;
+
+/// Every stage kind drapelab knows.
+pub fn registry() -> Registry {
+    Registry::new()
+        .with::<Simulate>()
+        .with::<Sweep>()
+        .with::<Report>()
+        .with::<FitEdges>()
+        .with::<Score>()
+        .with::<Calibrate>()
+        .with::<Validate>()
+        .with::<Tune>()
+        .with::<CalibrationReport>()
+        .with::<Wrinkles>()
+        .with::<Seed003Report>()
+        .with::<Benchmark>()
+        .with::<Peers>()
+        .with::<BenchmarkReport>()
+        .with::<Skips>()
+}

@@ -1,0 +1,217 @@
+//! `peers`: a scipy sparse-Newton script, a CHOLMOD (cvxopt) Newton and a numpy explicit-Euler script
+//! from `benches/peers/`, run beside drapelab in the same stage so that the ratios hold on a noisy
+//! machine.
+
+use anyhow::{Context, Result, bail};
+use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
+use arrow::datatypes::{DataType, Field, Schema};
+use drapelab_core::benchmark::bench_scene;
+use drapelab_core::scene::{Scene, SolverKind};
+use drapelab_core::simulate::solve_scene;
+use drapelab_core::solve::NoObserver;
+use drapelab_pipeline::{Slot, StageContext, StageKind};
+use drapelab_record::write_parquet;
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+fn default_sizes() -> Vec<usize> {
+    vec![11, 21, 41]
+}
+
+fn f64s(v: Vec<f64>) -> ArrayRef {
+    Arc::new(Float64Array::from(v))
+}
+
+/// Parameters of a peers stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeersParams {
+    /// The Python interpreter (of a virtual environment; numpy and scipy are installed into it when
+    /// missing). Default ".venv/bin/python".
+    #[serde(default = "default_python")]
+    pub python: String,
+    /// Sides of the hang4 grid for the static comparison. Default [11, 21, 41].
+    #[serde(default = "default_sizes")]
+    pub static_sizes: Vec<usize>,
+    /// Sides for the per-step explicit Euler comparison. Default [21, 41].
+    #[serde(default = "default_step_sizes")]
+    pub explicit_sizes: Vec<usize>,
+    /// Explicit steps timed. Default 2000.
+    #[serde(default = "default_steps")]
+    pub explicit_steps: usize,
+}
+
+fn default_python() -> String {
+    ".venv/bin/python".into()
+}
+fn default_step_sizes() -> Vec<usize> {
+    vec![21, 41]
+}
+fn default_steps() -> usize {
+    2000
+}
+
+/// The `peers` stage kind.
+pub struct Peers;
+
+impl StageKind for Peers {
+    type Params = PeersParams;
+    const KIND: &'static str = "peers";
+    const SUMMARY: &'static str = "scipy, CHOLMOD and numpy peers run beside drapelab";
+    const INPUTS: &'static [Slot] = &[
+        Slot::one("scene", "the hang4 scene"),
+        Slot::one("scipy_newton", "benches/peers/scipy_newton.py"),
+        Slot::one("numpy_explicit", "benches/peers/numpy_explicit.py"),
+        Slot::optional(
+            "cholmod_newton",
+            "benches/peers/cholmod_newton.py (runs when given)",
+        ),
+        Slot::optional_many("support", "modules the scripts import (model.py)"),
+    ];
+    const OUTPUTS: &'static [Slot] = &[Slot::one("table", "peers.parquet")];
+    fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
+        run(ctx, p)
+    }
+}
+
+fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
+    let scene = Scene::load(ctx.input("scene")?, &[])?.scene;
+    let script =
+        |slot: &str| -> Result<std::path::PathBuf> { Ok(std::fs::canonicalize(ctx.input(slot)?)?) };
+    let (newton, explicit) = (script("scipy_newton")?, script("numpy_explicit")?);
+    let cholmod = ctx
+        .optional_input("cholmod_newton")?
+        .map(std::fs::canonicalize)
+        .transpose()?;
+    let python = std::path::absolute(ctx.plan.root.join(&p.python))?;
+    let has = |py: &std::path::Path| {
+        std::process::Command::new(py)
+            .args(["-c", "import numpy, scipy, cvxopt"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !has(&python) {
+        let venv = python
+            .parent()
+            .and_then(|b| b.parent())
+            .context("python is not inside a virtual environment")?;
+        if !python.exists() {
+            std::process::Command::new("python3")
+                .args(["-m", "venv"])
+                .arg(venv)
+                .status()
+                .context("python3 -m venv")?;
+        }
+        let ok = std::process::Command::new(&python)
+            .args(["-m", "pip", "install", "-q", "numpy", "scipy", "cvxopt"])
+            .status()
+            .context("pip install numpy scipy cvxopt")?;
+        if !ok.success() || !has(&python) {
+            bail!(
+                "{}: cannot install numpy, scipy and cvxopt",
+                python.display()
+            );
+        }
+    }
+    let run_py = |script: &std::path::Path, args: &[String]| -> Result<serde_json::Value> {
+        let o = std::process::Command::new(&python)
+            .arg(script)
+            .args(args)
+            .current_dir(script.parent().unwrap_or(std::path::Path::new(".")))
+            .output()?;
+        if !o.status.success() {
+            bail!(
+                "{}: {}",
+                script.display(),
+                String::from_utf8_lossy(&o.stderr)
+                    .lines()
+                    .last()
+                    .unwrap_or("failed")
+            );
+        }
+        Ok(serde_json::from_slice(&o.stdout)?)
+    };
+    let total = p.static_sizes.len() + p.explicit_sizes.len();
+    ctx.progress.stage_started(&ctx.stage.name, total as u64);
+    // (comparison, n, peer time, drapelab time, peer centre z, drapelab centre z)
+    let mut rows: Vec<(&str, usize, f64, f64, f64, f64)> = Vec::new();
+    for &n in &p.static_sizes {
+        let peer = run_py(&newton, &[n.to_string(), "1e-6".into()])?;
+        let s = bench_scene(&scene, n, SolverKind::Static, 1e-6);
+        let sol = solve_scene(&s, &mut NoObserver);
+        rows.push((
+            "static: scipy sparse Newton / drapelab",
+            n,
+            peer["wall_time_s"].as_f64().unwrap_or(f64::NAN),
+            sol.report.wall_time_s,
+            peer["centre_z_m"].as_f64().unwrap_or(f64::NAN),
+            sol.at(n / 2, n / 2).z,
+        ));
+        if let Some(script) = &cholmod {
+            let peer = run_py(script, &[n.to_string(), "1e-6".into()])?;
+            rows.push((
+                "static: CHOLMOD (cvxopt) Newton / drapelab",
+                n,
+                peer["wall_time_s"].as_f64().unwrap_or(f64::NAN),
+                sol.report.wall_time_s,
+                peer["centre_z_m"].as_f64().unwrap_or(f64::NAN),
+                sol.at(n / 2, n / 2).z,
+            ));
+        }
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    for &n in &p.explicit_sizes {
+        let peer = run_py(&explicit, &[n.to_string(), p.explicit_steps.to_string()])?;
+        let mut s = bench_scene(&scene, n, SolverKind::ExplicitEuler, 1e-30);
+        // A fixed number of steps at half the stability limit: stop by time, not by convergence.
+        let built = drapelab_core::build::build_scene(&s);
+        let dt = 0.5
+            * drapelab_core::solve::stability_limit_dt(
+                &built.model,
+                &built.x0,
+                drapelab_core::solve::Integrator::ExplicitEuler,
+                built.model.damping_Ns_per_m,
+            )
+            .unwrap_or(1e-4);
+        s.solver.dynamic.auto_dt_fraction = 0.0;
+        s.solver.dynamic.dt_s = dt;
+        s.solver.dynamic.max_time_s = dt * p.explicit_steps as f64;
+        let sol = solve_scene(&s, &mut NoObserver);
+        let steps = sol.report.iterations.max(1) as f64;
+        rows.push((
+            "explicit Euler per step: numpy / drapelab",
+            n,
+            peer["per_step_s"].as_f64().unwrap_or(f64::NAN),
+            sol.report.wall_time_s / steps,
+            f64::NAN,
+            f64::NAN,
+        ));
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("comparison", DataType::Utf8, false),
+        Field::new("particles_per_side", DataType::UInt64, false),
+        Field::new("peer_time_s", DataType::Float64, false),
+        Field::new("drapelab_time_s", DataType::Float64, false),
+        Field::new("ratio", DataType::Float64, false),
+        Field::new("peer_centre_z_m", DataType::Float64, true),
+        Field::new("drapelab_centre_z_m", DataType::Float64, true),
+    ]));
+    let opt = |v: f64| v.is_finite().then_some(v);
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.0))),
+        Arc::new(UInt64Array::from_iter_values(
+            rows.iter().map(|r| r.1 as u64),
+        )),
+        f64s(rows.iter().map(|r| r.2).collect()),
+        f64s(rows.iter().map(|r| r.3).collect()),
+        f64s(rows.iter().map(|r| r.2 / r.3).collect()),
+        Arc::new(Float64Array::from_iter(rows.iter().map(|r| opt(r.4)))),
+        Arc::new(Float64Array::from_iter(rows.iter().map(|r| opt(r.5)))),
+    ];
+    write_parquet(
+        ctx.output("table")?,
+        &RecordBatch::try_new(schema, cols)?,
+        None,
+    )
+}

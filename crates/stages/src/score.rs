@@ -1,0 +1,106 @@
+//! `score`: measured edges (a fit-edges table) against simulated ones (`edges_truth.parquet` files, one
+//! per sample folder), per sample and edge: seed 000 Eq. 5 and the curve distance, into `score.parquet`.
+
+use anyhow::{Context, Result, bail};
+use arrow::array::{Float64Array, RecordBatch, StringArray};
+use arrow::datatypes::{DataType, Field, Schema};
+use drapelab_core::edges::score_edges;
+use drapelab_pipeline::{Slot, StageContext, StageKind};
+use drapelab_record::{read_edges, write_parquet};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// Parameters of a score stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScoreParams {
+    /// Side of the samples, cm (normalises Eq. 5). Default 50.
+    #[serde(default = "default_side")]
+    pub side_cm: f64,
+}
+
+fn default_side() -> f64 {
+    50.0
+}
+
+/// The `score` stage kind.
+pub struct Score;
+
+impl StageKind for Score {
+    type Params = ScoreParams;
+    const KIND: &'static str = "score";
+    const SUMMARY: &'static str =
+        "Seed 000 Eq. 5 and curve distance of measured against simulated edges";
+    const INPUTS: &'static [Slot] = &[
+        Slot::one("measured", "the measured edges (a fit-edges table)"),
+        Slot::many(
+            "simulated",
+            "edges_truth.parquet files, one per sample folder (the folder names the sample)",
+        ),
+    ];
+    const OUTPUTS: &'static [Slot] = &[Slot::one("score", "score.parquet")];
+    fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
+        run(ctx, p)
+    }
+}
+
+fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
+    let measured_path = ctx.input("measured")?;
+    let measured = read_edges(measured_path)
+        .with_context(|| format!("measured edges {}", measured_path.display()))?;
+    let truths = ctx.input_files("simulated");
+    if truths.is_empty() {
+        bail!("input `simulated` matched no file");
+    }
+    ctx.progress
+        .stage_started(&ctx.stage.name, truths.len() as u64);
+    let mut rows = Vec::new();
+    for t in truths {
+        let dir = t.parent().unwrap_or(std::path::Path::new("."));
+        let sample = dir
+            .strip_prefix(&ctx.plan.root)
+            .unwrap_or(dir)
+            .to_string_lossy()
+            .replace('\\', "/");
+        let sim: Vec<_> = read_edges(t)?
+            .into_iter()
+            .map(|(_, e)| (sample.clone(), e))
+            .collect();
+        let real: Vec<_> = measured
+            .iter()
+            .filter(|(s, _)| *s == sample)
+            .cloned()
+            .collect();
+        rows.extend(score_edges(&real, &sim, p.side_cm));
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("sample", DataType::Utf8, false),
+        Field::new("edge", DataType::Utf8, false),
+        Field::new("objective_pct", DataType::Float64, false),
+        Field::new("objective_uncentred_pct", DataType::Float64, false),
+        Field::new("curve_distance_pct", DataType::Float64, false),
+    ]));
+    let batch = RecordBatch::try_new(
+        schema.clone(),
+        vec![
+            Arc::new(StringArray::from_iter_values(
+                rows.iter().map(|r| r.sample.clone()),
+            )),
+            Arc::new(StringArray::from_iter_values(
+                rows.iter().map(|r| r.edge.clone()),
+            )),
+            Arc::new(Float64Array::from_iter_values(
+                rows.iter().map(|r| r.objective_pct),
+            )),
+            Arc::new(Float64Array::from_iter_values(
+                rows.iter().map(|r| r.objective_uncentred_pct),
+            )),
+            Arc::new(Float64Array::from_iter_values(
+                rows.iter().map(|r| r.curve_distance_pct),
+            )),
+        ],
+    )?;
+    write_parquet(ctx.output("score")?, &batch, None)?;
+    Ok(())
+}

@@ -1,0 +1,268 @@
+//! `tune`: the Taguchi L27 design over ICA's seven control factors at three levels (seed 000 Table 1),
+//! each row an ICA calibration of one sample (`repeats` seeds), scored by the smaller-the-better S/N of
+//! its final costs; the mean S/N of every factor level (Fig. 10) and the best level of each factor.
+//! Outputs: `tune.parquet` (one row per design row), `main_effects.parquet`, `best_ica.json` (the best
+//! combination, which `calibrate` reads from its `ica` input) and `main_effects.svg`.
+
+use crate::report::plot_panels;
+use anyhow::Result;
+use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt32Array};
+use arrow::datatypes::{DataType, Field, Schema};
+use drapelab_core::calibrate::{Problem, read_sample_densities, sample_scene};
+use drapelab_core::edges::EdgeFit;
+use drapelab_core::optim::{Ica, IcaSettings, l27, main_effects, sn_smaller_the_better};
+use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
+use drapelab_record::{read_edges, write_atomic, write_parquet};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// The seven factors of Table 1 and their three levels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Levels {
+    /// A: decades.
+    pub decades: [usize; 3],
+    /// B: imperialists (Table 1 prints 15..25 for B and 2..10 for C; the rows look swapped and are read so).
+    pub imperialists: [usize; 3],
+    /// C: countries.
+    pub countries: [usize; 3],
+    /// D: assimilation coefficient β.
+    pub beta: [f64; 3],
+    /// E: assimilation angle γ, rad.
+    pub gamma: [f64; 3],
+    /// F: revolution rate.
+    pub revolution_rate: [f64; 3],
+    /// G: colonies' share ξ.
+    pub xi: [f64; 3],
+}
+
+impl Default for Levels {
+    fn default() -> Self {
+        Self {
+            decades: [10, 20, 40],
+            imperialists: [2, 5, 10],
+            countries: [15, 20, 25],
+            beta: [0.5, 1.0, 2.0],
+            gamma: [0.1, 0.3, 0.5],
+            revolution_rate: [0.2, 0.3, 0.4],
+            xi: [0.1, 0.15, 0.2],
+        }
+    }
+}
+
+/// Parameters of a tune stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TuneParams {
+    /// The sample to tune on, as its folder in the fit-edges table, e.g. "datasets/knitted/sample_03/hang4".
+    pub sample: String,
+    /// ICA runs (seeds) per design row. Default 1.
+    #[serde(default = "one")]
+    pub repeats: usize,
+    /// Seed of the first run.
+    #[serde(default)]
+    pub seed: u64,
+    /// Factor levels. Default: Table 1.
+    #[serde(default)]
+    pub levels: Levels,
+    /// Particles per side. Default 14.
+    #[serde(default = "default_grid")]
+    pub grid: usize,
+    /// Side of the samples, cm. Default 50.
+    #[serde(default = "default_side")]
+    pub side_cm: f64,
+}
+
+fn one() -> usize {
+    1
+}
+fn default_grid() -> usize {
+    14
+}
+fn default_side() -> f64 {
+    50.0
+}
+
+/// L27 columns used for the factors A..G (any seven columns of L27 are pairwise orthogonal).
+const COLUMNS: [usize; 7] = [0, 1, 4, 2, 5, 7, 8];
+const FACTORS: [&str; 7] = [
+    "A decades",
+    "B imperialists",
+    "C countries",
+    "D beta",
+    "E gamma",
+    "F revolution_rate",
+    "G xi",
+];
+
+fn settings(levels: &Levels, l: &[u8], seed: u64) -> IcaSettings {
+    let k = |f: usize| l[f] as usize;
+    let countries = levels.countries[k(2)];
+    IcaSettings {
+        decades: levels.decades[k(0)],
+        imperialists: levels.imperialists[k(1)].min(countries),
+        countries,
+        beta: levels.beta[k(3)],
+        gamma: levels.gamma[k(4)],
+        revolution_rate: levels.revolution_rate[k(5)],
+        xi: levels.xi[k(6)],
+        seed,
+    }
+}
+
+/// The `tune` stage kind.
+pub struct Tune;
+
+impl StageKind for Tune {
+    type Params = TuneParams;
+    const KIND: &'static str = "tune";
+    const SUMMARY: &'static str =
+        "Taguchi L27 tuning of ICA's seven settings (seed 000 Table 1, Fig. 10)";
+    const INPUTS: &'static [Slot] = &[
+        Slot::one(
+            "edges",
+            "measured edges of every sample (a fit-edges table)",
+        ),
+        Slot::one("samples", "Table 2's densities (knitted_samples.csv)"),
+        Slot::one("scene", "the hang scene each sample is simulated in"),
+    ];
+    const OUTPUTS: &'static [Slot] = &[
+        Slot::one("table", "tune.parquet: one row per design row"),
+        Slot::one(
+            "main_effects",
+            "main_effects.parquet: mean S/N of every factor level",
+        ),
+        Slot::one("best_ica", "best_ica.json: the best level of each factor"),
+        Slot::optional("plot", "main_effects.svg"),
+    ];
+    fn check(p: &TuneParams) -> Result<(), ParamError> {
+        if p.repeats == 0 {
+            Err(ParamError::new("repeats", "must be ≥ 1"))
+        } else {
+            Ok(())
+        }
+    }
+    fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
+        run(ctx, p)
+    }
+}
+
+fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
+    let densities = read_sample_densities(ctx.input("samples")?)?;
+    let scene_file = ctx.input("scene")?;
+    let measured: Vec<EdgeFit> = read_edges(ctx.input("edges")?)?
+        .into_iter()
+        .filter(|(s, _)| *s == p.sample)
+        .map(|(_, e)| e)
+        .collect();
+    anyhow::ensure!(
+        !measured.is_empty(),
+        "sample `{}` is not in the edges table",
+        p.sample
+    );
+    let scene = sample_scene(scene_file, &densities, &p.sample, p.grid)?;
+    let problem = Problem::new(scene, measured, p.side_cm);
+    let table = l27();
+    let rows: Vec<Vec<u8>> = table
+        .iter()
+        .map(|r| COLUMNS.iter().map(|&c| r[c]).collect())
+        .collect();
+    ctx.progress
+        .stage_started(&ctx.stage.name, rows.len() as u64);
+    let mut sn = Vec::new();
+    let mut costs = Vec::new();
+    for l in &rows {
+        let finals: Vec<f64> = (0..p.repeats)
+            .map(|r| {
+                Ica {
+                    settings: settings(&p.levels, l, p.seed + r as u64),
+                    dim: 5,
+                }
+                .run(&|u: &[f64]| problem.cost(u), |_| {})
+                .best_cost
+            })
+            .collect();
+        sn.push(sn_smaller_the_better(&finals));
+        costs.push(finals.iter().sum::<f64>() / finals.len() as f64);
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    let effects = main_effects(&rows, &sn);
+    let best_levels: Vec<u8> = effects
+        .iter()
+        .map(|e| (0..3).max_by(|&a, &b| e[a].total_cmp(&e[b])).unwrap_or(0) as u8)
+        .collect();
+    let best = settings(&p.levels, &best_levels, p.seed);
+    // tune.parquet
+    let mut fields = vec![Field::new("row", DataType::UInt32, false)];
+    let mut cols: Vec<ArrayRef> = vec![Arc::new(UInt32Array::from_iter_values(
+        1..=rows.len() as u32,
+    ))];
+    for (f, name) in FACTORS.iter().enumerate() {
+        fields.push(Field::new(
+            format!("level_{}", &name[..1]),
+            DataType::UInt32,
+            false,
+        ));
+        cols.push(Arc::new(UInt32Array::from_iter_values(
+            rows.iter().map(|l| l[f] as u32 + 1),
+        )));
+    }
+    fields.push(Field::new("mean_cost_pct", DataType::Float64, false));
+    cols.push(Arc::new(Float64Array::from(costs)));
+    fields.push(Field::new("sn_db", DataType::Float64, false));
+    cols.push(Arc::new(Float64Array::from(sn.clone())));
+    write_parquet(
+        ctx.output("table")?,
+        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
+        None,
+    )?;
+    // main_effects.parquet
+    let (mut fac, mut lev, mut val) = (Vec::new(), Vec::new(), Vec::new());
+    let mut panels: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>> = BTreeMap::new();
+    for (f, e) in effects.iter().enumerate() {
+        for (k, v) in e.iter().enumerate() {
+            fac.push(FACTORS[f].to_string());
+            lev.push(k as u32 + 1);
+            val.push(*v);
+        }
+        panels.entry("main effects".into()).or_default().insert(
+            FACTORS[f].to_string(),
+            e.iter()
+                .enumerate()
+                .map(|(k, v)| (k as f64 + 1.0, *v))
+                .collect(),
+        );
+    }
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("factor", DataType::Utf8, false),
+        Field::new("level", DataType::UInt32, false),
+        Field::new("mean_sn_db", DataType::Float64, false),
+    ]));
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from(fac)),
+        Arc::new(UInt32Array::from(lev)),
+        Arc::new(Float64Array::from(val)),
+    ];
+    write_parquet(
+        ctx.output("main_effects")?,
+        &RecordBatch::try_new(schema, cols)?,
+        None,
+    )?;
+    let json = serde_json::to_vec_pretty(&best)?;
+    write_atomic(ctx.output("best_ica")?, |f| {
+        use std::io::Write;
+        f.write_all(&json)?;
+        Ok(())
+    })?;
+    if let Some(svg) = ctx.optional_output("plot") {
+        let text = plot_panels(
+            &panels,
+            "factor level (1..3)",
+            "mean S/N (dB, smaller-the-better)",
+            None,
+        )?;
+        drapelab_record::write_text(svg, &text)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,181 @@
+//! `validate`: the calibrated parameters of each sample (a calibrate `results.parquet`) on the 2-corner
+//! hang, scored against the sample's measured 2-corner edges (a fit-edges table): `validation.parquet`
+//! with `sample`, `objective_pct` (Eq. 5, mean over the edges) and `curve_distance_pct` (seed 000 Table 6).
+
+use anyhow::{Context, Result};
+use arrow::array::{Array, ArrayRef, Float64Array, RecordBatch, StringArray};
+use arrow::datatypes::{DataType, Field, Schema};
+use drapelab_core::calibrate::{
+    Params, Problem, read_sample_densities, sample_number, sample_scene,
+};
+use drapelab_core::edges::{EdgeFit, edges_from_particles, scene_view, score_edges};
+use drapelab_core::material::Topology;
+use drapelab_core::simulate::solve_scene;
+use drapelab_core::solve::NoObserver;
+use drapelab_pipeline::{Slot, StageContext, StageKind};
+use drapelab_record::{read_edges, write_parquet};
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Parameters of a validate stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ValidateParams {
+    /// Particles per side of the simulated net. Default 14.
+    #[serde(default = "default_grid")]
+    pub grid: usize,
+    /// Side of the samples, cm. Default 50.
+    #[serde(default = "default_side")]
+    pub side_cm: f64,
+}
+
+fn default_grid() -> usize {
+    14
+}
+fn default_side() -> f64 {
+    50.0
+}
+
+/// Calibrated parameters by sample number from a results table.
+fn read_results(path: &std::path::Path) -> Result<BTreeMap<u32, Params>> {
+    let f = std::fs::File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let mut out = BTreeMap::new();
+    for batch in ParquetRecordBatchReaderBuilder::try_new(f)?.build()? {
+        let b = batch?;
+        let s = |n: &str| {
+            b.column_by_name(n)
+                .and_then(|c| c.as_any().downcast_ref::<StringArray>().cloned())
+                .with_context(|| format!("{n}: missing"))
+        };
+        let x = |n: &str| {
+            b.column_by_name(n)
+                .and_then(|c| c.as_any().downcast_ref::<Float64Array>().cloned())
+                .with_context(|| format!("{n}: missing"))
+        };
+        let (sample, topo) = (s("sample")?, s("topology")?);
+        let (k, c, e, l) = (
+            x("stiffness_N_per_m")?,
+            x("damping_Ns_per_m")?,
+            x("elongation_rate")?,
+            x("natural_length_m")?,
+        );
+        for r in 0..b.num_rows() {
+            let n = sample_number(sample.value(r))
+                .with_context(|| format!("`{}`: no sample number", sample.value(r)))?;
+            let topology = match topo.value(r) {
+                "b" => Topology::B,
+                "c" => Topology::C,
+                _ => Topology::A,
+            };
+            out.insert(
+                n,
+                Params {
+                    stiffness_N_per_m: k.value(r),
+                    damping_Ns_per_m: c.value(r),
+                    elongation_rate: e.value(r),
+                    natural_length_m: l.value(r),
+                    topology,
+                },
+            );
+        }
+    }
+    Ok(out)
+}
+
+/// The `validate` stage kind.
+pub struct Validate;
+
+impl StageKind for Validate {
+    type Params = ValidateParams;
+    const KIND: &'static str = "validate";
+    const SUMMARY: &'static str =
+        "Calibrated parameters on the 2-corner hang against its measured edges (seed 000 Table 6)";
+    const INPUTS: &'static [Slot] = &[
+        Slot::one("calibration", "a calibrate stage's results.parquet"),
+        Slot::one(
+            "edges",
+            "measured 2-corner edges of every sample (a fit-edges table)",
+        ),
+        Slot::one("samples", "Table 2's densities (knitted_samples.csv)"),
+        Slot::one("scene", "the 2-corner hang scene"),
+    ];
+    const OUTPUTS: &'static [Slot] = &[Slot::one(
+        "validation",
+        "validation.parquet: one row per sample",
+    )];
+    fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
+        run(ctx, p)
+    }
+}
+
+fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
+    let densities = read_sample_densities(ctx.input("samples")?)?;
+    let scene_file = ctx.input("scene")?;
+    let results = read_results(ctx.input("calibration")?)?;
+    let edges_file = ctx.input("edges")?;
+    let mut by_sample: BTreeMap<String, Vec<(String, EdgeFit)>> = BTreeMap::new();
+    for (s, e) in read_edges(edges_file)? {
+        by_sample.entry(s.clone()).or_default().push((s, e));
+    }
+    ctx.progress
+        .stage_started(&ctx.stage.name, by_sample.len() as u64);
+    let (mut names, mut eq5, mut dist) = (Vec::new(), Vec::new(), Vec::new());
+    for (sample, measured) in &by_sample {
+        let n = sample_number(sample)
+            .with_context(|| format!("`{sample}`: no sample_NN in the path"))?;
+        let params = results
+            .get(&n)
+            .with_context(|| format!("sample {n} has no calibrated parameters"))?;
+        let problem = Problem::new(
+            sample_scene(scene_file, &densities, sample, p.grid)?,
+            Vec::new(),
+            p.side_cm,
+        );
+        let scene = problem.scene_for(params);
+        let sol = solve_scene(&scene, &mut NoObserver);
+        let (view, corners) = scene_view(&scene)?;
+        let sim: Vec<(String, EdgeFit)> = edges_from_particles(&sol.grid, &sol.x, view, corners)
+            .into_iter()
+            .filter_map(|(name, pts)| EdgeFit::from_points(&name, &pts, 4))
+            .map(|e| (sample.clone(), e))
+            .collect();
+        let rows = if sol.report.is_converged() {
+            score_edges(measured, &sim, p.side_cm)
+        } else {
+            Vec::new()
+        };
+        let mean = |v: Vec<f64>| {
+            if v.is_empty() {
+                f64::NAN
+            } else {
+                v.iter().sum::<f64>() / v.len() as f64
+            }
+        };
+        names.push(sample.clone());
+        eq5.push(mean(rows.iter().map(|r| r.objective_pct).collect()));
+        dist.push(mean(rows.iter().map(|r| r.curve_distance_pct).collect()));
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    let schema = Arc::new(Schema::new(vec![
+        Field::new("sample", DataType::Utf8, false),
+        Field::new("objective_pct", DataType::Float64, true),
+        Field::new("curve_distance_pct", DataType::Float64, true),
+    ]));
+    let opt = |v: Vec<f64>| -> ArrayRef {
+        Arc::new(Float64Array::from_iter(
+            v.into_iter().map(|x| x.is_finite().then_some(x)),
+        ))
+    };
+    let cols: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(names)),
+        opt(eq5),
+        opt(dist),
+    ];
+    write_parquet(
+        ctx.output("validation")?,
+        &RecordBatch::try_new(schema, cols)?,
+        None,
+    )
+}

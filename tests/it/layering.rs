@@ -1,0 +1,315 @@
+//! The layering written down in the README's module map, checked: crates depend only on crates
+//! below them, the core crate pulls in no I/O stack (not even transitively), no module of the core
+//! imports a module above it, and no function outside tests runs over 150 lines.
+
+use crate::support::root;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Each workspace crate and the workspace crates it may depend on.
+const CRATES: [(&str, &[&str]); 5] = [
+    ("drapelab-core", &[]),
+    ("drapelab-record", &["drapelab-core"]),
+    ("drapelab-pipeline", &["drapelab-core"]),
+    (
+        "drapelab-stages",
+        &["drapelab-core", "drapelab-record", "drapelab-pipeline"],
+    ),
+    (
+        "drapelab",
+        &[
+            "drapelab-core",
+            "drapelab-record",
+            "drapelab-pipeline",
+            "drapelab-stages",
+        ],
+    ),
+];
+
+/// Crates the core must not reach, directly or through another crate.
+const NOT_IN_CORE: [&str; 8] = [
+    "rerun",
+    "polars",
+    "arrow",
+    "parquet",
+    "mcap",
+    "clap",
+    "plotters",
+    "indicatif",
+];
+
+/// The modules of the core, lowest first: a module may import only modules of a lower rank.
+const CORE_RANKS: [(&str, u8); 19] = [
+    ("error", 0),
+    ("atomic", 0),
+    ("material", 0),
+    ("contact", 0),
+    ("optim", 0),
+    ("config", 1),
+    ("cloth", 1),
+    ("physics", 1),
+    ("solve", 2),
+    ("scene", 3),
+    ("build", 4),
+    ("simulate", 5),
+    ("measure", 5),
+    ("elastica", 6),
+    ("edges", 6),
+    ("wrinkles", 6),
+    ("calibrate", 7),
+    ("benchmark", 8),
+    ("lib", 9),
+];
+
+fn cargo() -> std::process::Command {
+    let mut c =
+        std::process::Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(root());
+    c
+}
+
+#[test]
+fn crates_depend_only_downwards() {
+    let out = cargo()
+        .args([
+            "metadata",
+            "--format-version",
+            "1",
+            "--no-deps",
+            "--offline",
+        ])
+        .output()
+        .expect("cargo metadata runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let meta: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let packages = meta["packages"].as_array().unwrap();
+    assert_eq!(
+        packages.len(),
+        CRATES.len(),
+        "every workspace crate is in the table"
+    );
+    for p in packages {
+        let name = p["name"].as_str().unwrap();
+        let allowed = CRATES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .unwrap_or_else(|| panic!("{name} is not in the layering table"))
+            .1;
+        for d in p["dependencies"].as_array().unwrap() {
+            let dep = d["name"].as_str().unwrap();
+            if dep.starts_with("drapelab") {
+                assert!(allowed.contains(&dep), "{name} must not depend on {dep}");
+            }
+            if name == "drapelab-core" {
+                assert!(
+                    !NOT_IN_CORE.contains(&dep),
+                    "drapelab-core depends on {dep}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_core_crate_pulls_in_no_io_stack() {
+    let out = cargo()
+        .args([
+            "tree",
+            "-p",
+            "drapelab-core",
+            "-e",
+            "normal",
+            "--prefix",
+            "none",
+            "--offline",
+        ])
+        .output()
+        .expect("cargo tree runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let tree = String::from_utf8_lossy(&out.stdout);
+    let names: Vec<&str> = tree
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert!(
+        names.contains(&"faer") && names.contains(&"nalgebra"),
+        "{tree}"
+    );
+    for bad in NOT_IN_CORE {
+        assert!(
+            !names
+                .iter()
+                .any(|n| *n == bad || n.starts_with(&format!("{bad}-"))),
+            "drapelab-core reaches {bad}:\n{tree}"
+        );
+    }
+}
+
+/// The `crate::MODULE` paths a source file names (comments left out).
+fn crate_refs(text: &str) -> Vec<String> {
+    let mut refs = Vec::new();
+    for line in text.lines() {
+        let code = line.split("//").next().unwrap_or("");
+        let mut rest = code;
+        while let Some(i) = rest.find("crate::") {
+            let tail = &rest[i + 7..];
+            let name: String = tail
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if !name.is_empty() {
+                refs.push(name);
+            }
+            rest = &tail[1..];
+        }
+    }
+    refs
+}
+
+/// The top module of a file under a crate's `src/`.
+fn module_of(rel: &Path) -> String {
+    let first = rel
+        .components()
+        .next()
+        .unwrap()
+        .as_os_str()
+        .to_string_lossy();
+    first.trim_end_matches(".rs").to_string()
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn no_core_module_imports_one_above_it() {
+    let rank: BTreeMap<&str, u8> = CORE_RANKS.into_iter().collect();
+    let src = root().join("crates/core/src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut seen = std::collections::BTreeSet::new();
+    for f in &files {
+        let m = module_of(f.strip_prefix(&src).unwrap());
+        seen.insert(m.clone());
+        let r = *rank
+            .get(m.as_str())
+            .unwrap_or_else(|| panic!("core module `{m}` is not in the layering table"));
+        let text = std::fs::read_to_string(f).unwrap();
+        for dep in crate_refs(&text) {
+            if dep == m || dep == "VERSION" || dep == "STANDARD_GRAVITY_M_PER_S2" {
+                continue;
+            }
+            let d = *rank
+                .get(dep.as_str())
+                .unwrap_or_else(|| panic!("{}: unknown module crate::{dep}", f.display()));
+            assert!(
+                d < r,
+                "{}: module `{m}` (rank {r}) imports `{dep}` (rank {d}), which is not below it",
+                f.display()
+            );
+        }
+    }
+    assert_eq!(seen.len(), CORE_RANKS.len(), "modules: {seen:?}");
+}
+
+/// Lengths of the functions of a Rust file outside `#[cfg(test)]` modules, by brace matching
+/// (string literals with braces are rare enough here; raw strings are skipped).
+fn long_functions(text: &str, limit: usize) -> Vec<(String, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let test_start = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with("#[cfg(test)]"))
+        .unwrap_or(lines.len());
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < test_start {
+        let t = lines[i].trim_start();
+        let is_fn = [
+            "fn ",
+            "pub fn ",
+            "pub(crate) fn ",
+            "const fn ",
+            "pub const fn ",
+        ]
+        .iter()
+        .any(|p| t.starts_with(p));
+        if !is_fn {
+            i += 1;
+            continue;
+        }
+        // Find the opening brace of the body, then its match.
+        let mut depth = 0i64;
+        let mut opened = false;
+        let mut j = i;
+        'scan: while j < lines.len() {
+            for c in lines[j].chars() {
+                match c {
+                    '{' => {
+                        depth += 1;
+                        opened = true;
+                    }
+                    '}' => depth -= 1,
+                    ';' if !opened => break 'scan,
+                    _ => {}
+                }
+                if opened && depth == 0 {
+                    break 'scan;
+                }
+            }
+            j += 1;
+        }
+        let len = j.saturating_sub(i) + 1;
+        if opened && len > limit {
+            out.push((t.chars().take(60).collect(), len));
+        }
+        i = if opened { j + 1 } else { i + 1 };
+    }
+    out
+}
+
+#[test]
+fn no_function_is_over_150_lines() {
+    let mut files = Vec::new();
+    for dir in ["crates", "src"] {
+        rust_files(&root().join(dir), &mut files);
+    }
+    let mut long = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (name, len) in long_functions(&text, 150) {
+            long.push(format!(
+                "{}: {name} ({len} lines)",
+                f.strip_prefix(root()).unwrap().display()
+            ));
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "functions over 150 lines:\n{}",
+        long.join("\n")
+    );
+}
+
+#[test]
+fn the_function_length_check_sees_a_long_function() {
+    let body = "    let x = 1;\n".repeat(160);
+    let text = format!("fn long() {{\n{body}}}\nfn short() {{\n    1;\n}}\n");
+    let found = long_functions(&text, 150);
+    assert_eq!(found.len(), 1);
+    assert_eq!(found[0].1, 162);
+}
