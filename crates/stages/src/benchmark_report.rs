@@ -69,23 +69,84 @@ fn run(ctx: &StageContext<'_>, p: &BenchmarkReportParams) -> Result<()> {
         });
     }
     let bench = bench.context("a benchmark report needs bench.parquet inputs")?;
-    let scene = bench.column("scene")?.str()?.clone();
-    let solver = bench.column("solver")?.str()?.clone();
-    let status = bench.column("status")?.str()?.clone();
-    let n = bench.column("particles_per_side")?.u64()?.clone();
-    let tol = bench.column("tolerance_rel")?.f64()?.clone();
-    let wall = bench.column("wall_time_s")?.f64()?.clone();
-    let iters = bench.column("iterations")?.u64()?.clone();
-    let err = bench.column("error_m")?.f64()?.clone();
-    let mut panels = Panels::new();
-    let mut all: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let c = BenchCols::of(&bench)?;
     let mut md = format!(
         "# {}\n\n{} from the measured tables: every number and \
 point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
         p.title,
         ctx.made_by()
     );
-    for r in 0..bench.height() {
+    let (pareto, svg) = pareto_section(&c)?;
+    md += &pareto;
+    md += &scaling_section(&c, p.scaling_tolerance);
+    md += &endings_section(&c);
+    md += &newton_work_section(&bench)?;
+    if let Some(pop) = ctx.optional_input("population")? {
+        md += &population_section(&read(pop)?)?;
+    }
+    md += "\n## Every point\n\n";
+    md += &markdown(&bench);
+    if let Some(skips) = ctx.optional_input("skips")? {
+        md += "\n## What skipping saves, measured on and off in the same run\n\n";
+        md += &markdown(&read(skips)?);
+        md += "\nsaved_fraction = 1 − time with the skip / time without it.\n";
+    }
+    if let Some(peers) = ctx.optional_input("peers")? {
+        md += "\n## Peers, run beside drapelab in the same stage\n\n";
+        md += &markdown(&read(peers)?);
+        md += "\nratio = peer time / drapelab time (> 1: drapelab is faster). The scipy script solves the same \
+hang4 model by sparse Newton to the same force tolerance; the centre heights show both reach the same \
+equilibrium.\n";
+    }
+    write_text(ctx.output("markdown")?, &md)?;
+    write_text(ctx.output("plot")?, &svg)?;
+    ctx.progress.item_done(&ctx.stage.name);
+    Ok(())
+}
+
+/// The columns of the benchmark tables the report reads.
+struct BenchCols {
+    rows: usize,
+    scene: StringChunked,
+    solver: StringChunked,
+    status: StringChunked,
+    n: UInt64Chunked,
+    tol: Float64Chunked,
+    wall: Float64Chunked,
+    iters: UInt64Chunked,
+    err: Float64Chunked,
+}
+
+impl BenchCols {
+    fn of(bench: &DataFrame) -> Result<Self> {
+        Ok(Self {
+            rows: bench.height(),
+            scene: bench.column("scene")?.str()?.clone(),
+            solver: bench.column("solver")?.str()?.clone(),
+            status: bench.column("status")?.str()?.clone(),
+            n: bench.column("particles_per_side")?.u64()?.clone(),
+            tol: bench.column("tolerance_rel")?.f64()?.clone(),
+            wall: bench.column("wall_time_s")?.f64()?.clone(),
+            iters: bench.column("iterations")?.u64()?.clone(),
+            err: bench.column("error_m")?.f64()?.clone(),
+        })
+    }
+}
+
+/// Run time against error: the Pareto front of each scene, as a Markdown section and an SVG.
+fn pareto_section(c: &BenchCols) -> Result<(String, String)> {
+    let BenchCols {
+        scene,
+        solver,
+        status,
+        wall,
+        err,
+        ..
+    } = c;
+    let mut panels = Panels::new();
+    let mut all: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut md = String::new();
+    for r in 0..c.rows {
         let (Some(s), Some(sv), Some(t), Some(e)) =
             (scene.get(r), solver.get(r), wall.get(r), err.get(r))
         else {
@@ -133,16 +194,31 @@ solution (at the grid points both share), or for the cantilever the exact heavy 
             .collect();
         let _ = writeln!(md, "| {s} | {} |", front.join(" "));
     }
-    // Scaling: static wall time against particle count, and explicit time per step, per scene at the
-    // tightest tolerance.
+    Ok((md, svg))
+}
+
+/// Scaling: static wall time against particle count, and explicit time per step, per scene at the
+/// tolerance `scaling_tolerance`.
+fn scaling_section(c: &BenchCols, scaling_tolerance: f64) -> String {
+    let BenchCols {
+        scene,
+        solver,
+        status,
+        n,
+        tol,
+        wall,
+        iters,
+        ..
+    } = c;
+    let mut md = String::new();
     let _ = write!(
         md,
         "\n## Scaling\n\nConverged runs at tolerance {:.0e}; the exponent p of wall time ∝ (particles)^p by least \
 squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall time against particle count |\n|---|---|---|---|\n",
-        p.scaling_tolerance
+        scaling_tolerance
     );
     let mut series: BTreeMap<(String, String), Vec<(f64, f64)>> = BTreeMap::new();
-    for r in 0..bench.height() {
+    for r in 0..c.rows {
         let (Some(s), Some(sv), Some(k), Some(t), Some(tl), Some(it)) = (
             scene.get(r),
             solver.get(r),
@@ -153,7 +229,7 @@ squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall
         ) else {
             continue;
         };
-        if status.get(r) != Some("converged") || (tl / p.scaling_tolerance - 1.0).abs() > 1e-9 {
+        if status.get(r) != Some("converged") || (tl / scaling_tolerance - 1.0).abs() > 1e-9 {
             continue;
         }
         let particles = (k * k) as f64;
@@ -181,9 +257,20 @@ squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall
             fitted_exponent(pts).map_or("–".into(), |e| format!("{e:.2}"))
         );
     }
-    // How each solver ended on each scene.
+    md
+}
+
+/// How each solver ended on each scene.
+fn endings_section(c: &BenchCols) -> String {
+    let BenchCols {
+        scene,
+        solver,
+        status,
+        ..
+    } = c;
+    let mut md = String::new();
     let mut ends: BTreeMap<(String, String), BTreeMap<String, usize>> = BTreeMap::new();
-    for r in 0..bench.height() {
+    for r in 0..c.rows {
         if let (Some(s), Some(sv), Some(st)) = (scene.get(r), solver.get(r), status.get(r)) {
             *ends
                 .entry((s.into(), sv.into()))
@@ -205,28 +292,7 @@ dynamic point).\n\n| scene | solver | converged | max-iterations | diverged | in
             c("invalid")
         );
     }
-    md += &newton_work_section(&bench)?;
-    if let Some(pop) = ctx.optional_input("population")? {
-        md += &population_section(&read(pop)?)?;
-    }
-    md += "\n## Every point\n\n";
-    md += &markdown(&bench);
-    if let Some(skips) = ctx.optional_input("skips")? {
-        md += "\n## What skipping saves, measured on and off in the same run\n\n";
-        md += &markdown(&read(skips)?);
-        md += "\nsaved_fraction = 1 − time with the skip / time without it.\n";
-    }
-    if let Some(peers) = ctx.optional_input("peers")? {
-        md += "\n## Peers, run beside drapelab in the same stage\n\n";
-        md += &markdown(&read(peers)?);
-        md += "\nratio = peer time / drapelab time (> 1: drapelab is faster). The scipy script solves the same \
-hang4 model by sparse Newton to the same force tolerance; the centre heights show both reach the same \
-equilibrium.\n";
-    }
-    write_text(ctx.output("markdown")?, &md)?;
-    write_text(ctx.output("plot")?, &svg)?;
-    ctx.progress.item_done(&ctx.stage.name);
-    Ok(())
+    md
 }
 
 /// The static solves' work per scene and grid at the tightest tolerance: Newton iterations,

@@ -99,8 +99,48 @@ fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
         .into_iter()
         .filter_map(|r| Some((r.get("sample")?.parse().ok()?, r.get("error_pct")?.clone())))
         .collect();
-    // Table 4: calibrated against ground truth (the dataset was made from Table 4).
     let res = scan(find("results")?)?.collect()?;
+    let t4 = table_4(&res, &truth4)?;
+    let t6 = table_6(&scan(find("validation")?)?.collect()?, &seed6)?;
+    let convergence = fig_13(find("evaluations")?)?;
+    if let Some(svg) = conv_svg {
+        write_text(svg, &convergence)?;
+    }
+    let effects = fig_10(&scan(find("main_effects")?)?.collect()?)?;
+    if let Some(svg) = effects_svg {
+        write_text(svg, &effects)?;
+    }
+    // ICA against CMA-ES at the same budget.
+    let cmp = scan(find("comparison")?)?
+        .group_by([col("optimizer")])
+        .agg([
+            len().alias("runs"),
+            col("evaluations").mean().alias("mean_evaluations"),
+            col("best_cost_pct").mean().alias("mean_best_pct"),
+            col("best_cost_pct").median().alias("median_best_pct"),
+        ])
+        .sort(["optimizer"], SortMultipleOptions::default())
+        .collect()?;
+    let rel = |o: Option<&Path>| {
+        o.and_then(|o| o.strip_prefix(md.parent().unwrap_or(Path::new(""))).ok())
+            .map(|p| p.to_string_lossy().to_string())
+            .unwrap_or_default()
+    };
+    let text = format!(
+        "# {}\n\n{}. The photos are synthetic (datasets/knitted/README.md): the\ntruth of each sample is seed 000 Table 4, shown in brackets.\n\n## Calibrated parameters, 4-corner hang (Table 4)\n\n{t4}\nBest of the ICA runs, polished by Nelder–Mead over stiffness and natural length (the curve distance of\nICA alone in brackets). ± 2σ: the interval the photos allow, from the curvature of the cost and its\nresidual (nonlinear least squares); a parameter is identifiable when that interval is within 5 % of its\nvalue. Eq. 5 compares the quartics' coefficients in coordinates centred on the edge.\n\n## Validation on the 2-corner hang (Table 6)\n\n{t6}\n## Convergence (Fig. 13)\n\n![best cost per decade]({})\n\n## Taguchi main effects (Fig. 10)\n\n![main effects]({})\n\n## ICA against CMA-ES at the same budget\n\n{}",
+        p.title,
+        ctx.made_by(),
+        rel(conv_svg),
+        rel(effects_svg),
+        markdown(&cmp)
+    ) + &run_time_section(ctx, &res, &cmp)?;
+    write_text(md, &text)?;
+    ctx.progress.item_done(&ctx.stage.name);
+    Ok(())
+}
+
+/// Table 4: calibrated against ground truth (the dataset was made from Table 4).
+fn table_4(res: &DataFrame, truth4: &BTreeMap<u32, BTreeMap<String, String>>) -> Result<String> {
     let mut t4 = String::from(
         "| sample | stiffness N/m ± 2σ (truth) | natural length mm ± 2σ (truth) | topology (truth) | objective Eq. 5 % (seed) | curve distance % (ICA alone) | spread of runs % | identifiable to 5 %: stiffness, natural length, damping, elongation |\n|---|---|---|---|---|---|---|---|\n",
     );
@@ -157,8 +197,11 @@ fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
             yes(ie.get(r)),
         );
     }
-    // Table 6: validation on the 2-corner hang.
-    let val = scan(find("validation")?)?.collect()?;
+    Ok(t4)
+}
+
+/// Table 6: validation on the 2-corner hang.
+fn table_6(val: &DataFrame, seed6: &BTreeMap<u32, String>) -> Result<String> {
     let mut t6 = String::from(
         "| sample | objective Eq. 5 % | seed 000 Table 6 % | curve distance % |\n|---|---|---|---|\n",
     );
@@ -176,8 +219,13 @@ fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
             vc.get(r).unwrap_or(f64::NAN)
         );
     }
-    // Fig. 13: best cost per decade of each sample's first run (a lazy group-by over every evaluation).
-    let conv = scan(find("evaluations")?)?
+    Ok(t6)
+}
+
+/// Fig. 13: best cost per decade of each sample's first run (a lazy group-by over every evaluation),
+/// as SVG.
+fn fig_13(evaluations: &Path) -> Result<String> {
+    let conv = scan(evaluations)?
         .filter(col("run").eq(lit(0u32)))
         .group_by([col("sample"), col("decade")])
         .agg([
@@ -207,19 +255,16 @@ fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
             .or_default()
             .push((cdk.get(r).unwrap_or(0) as f64, *best));
     }
-    if let Some(svg) = conv_svg {
-        write_text(
-            svg,
-            &plot_panels(
-                &panels,
-                "decade",
-                "best curve distance so far (% of side)",
-                None,
-            )?,
-        )?;
-    }
-    // Fig. 10: main effects.
-    let me = scan(find("main_effects")?)?.collect()?;
+    plot_panels(
+        &panels,
+        "decade",
+        "best curve distance so far (% of side)",
+        None,
+    )
+}
+
+/// Fig. 10: the main effects of the tuning, as SVG.
+fn fig_10(me: &DataFrame) -> Result<String> {
     let mut fx: Panels = BTreeMap::new();
     let (mf, ml, mv) = (
         me.column("factor")?.str()?.clone(),
@@ -233,44 +278,12 @@ fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
             .or_default()
             .push((ml.get(r).unwrap_or(0) as f64, mv.get(r).unwrap_or(f64::NAN)));
     }
-    if let Some(svg) = effects_svg {
-        write_text(
-            svg,
-            &plot_panels(
-                &fx,
-                "factor level (1..3)",
-                "mean S/N (dB, smaller-the-better)",
-                None,
-            )?,
-        )?;
-    }
-    // ICA against CMA-ES at the same budget.
-    let cmp = scan(find("comparison")?)?
-        .group_by([col("optimizer")])
-        .agg([
-            len().alias("runs"),
-            col("evaluations").mean().alias("mean_evaluations"),
-            col("best_cost_pct").mean().alias("mean_best_pct"),
-            col("best_cost_pct").median().alias("median_best_pct"),
-        ])
-        .sort(["optimizer"], SortMultipleOptions::default())
-        .collect()?;
-    let rel = |o: Option<&Path>| {
-        o.and_then(|o| o.strip_prefix(md.parent().unwrap_or(Path::new(""))).ok())
-            .map(|p| p.to_string_lossy().to_string())
-            .unwrap_or_default()
-    };
-    let text = format!(
-        "# {}\n\n{}. The photos are synthetic (datasets/knitted/README.md): the\ntruth of each sample is seed 000 Table 4, shown in brackets.\n\n## Calibrated parameters, 4-corner hang (Table 4)\n\n{t4}\nBest of the ICA runs, polished by Nelder–Mead over stiffness and natural length (the curve distance of\nICA alone in brackets). ± 2σ: the interval the photos allow, from the curvature of the cost and its\nresidual (nonlinear least squares); a parameter is identifiable when that interval is within 5 % of its\nvalue. Eq. 5 compares the quartics' coefficients in coordinates centred on the edge.\n\n## Validation on the 2-corner hang (Table 6)\n\n{t6}\n## Convergence (Fig. 13)\n\n![best cost per decade]({})\n\n## Taguchi main effects (Fig. 10)\n\n![main effects]({})\n\n## ICA against CMA-ES at the same budget\n\n{}",
-        p.title,
-        ctx.made_by(),
-        rel(conv_svg),
-        rel(effects_svg),
-        markdown(&cmp)
-    ) + &run_time_section(ctx, &res, &cmp)?;
-    write_text(md, &text)?;
-    ctx.progress.item_done(&ctx.stage.name);
-    Ok(())
+    plot_panels(
+        &fx,
+        "factor level (1..3)",
+        "mean S/N (dB, smaller-the-better)",
+        None,
+    )
 }
 
 /// The wall time of every other stage of the plan (from its manifest, when it has run) and the

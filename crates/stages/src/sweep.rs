@@ -223,7 +223,34 @@ fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     }
     let points = sweep_points(p);
     let keys: Vec<&String> = p.axes.keys().collect();
-    // Load every scene at every point first: bad values are refused before any work.
+    let jobs = load_jobs(files, p, &points, &keys)?;
+    let name = &ctx.stage.name;
+    ctx.progress.stage_started(name, jobs.len() as u64);
+    // Largest grids first, so that the last items to finish are small (balanced threads); the rows
+    // are put back in design order afterwards.
+    let mut order: Vec<usize> = (0..jobs.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(jobs[k].1.cloth.nx * jobs[k].1.cloth.ny));
+    let mut unordered: Vec<(usize, PointResult)> = order
+        .par_iter()
+        .map(|&k| {
+            let (i, scene) = &jobs[k];
+            let row = solve_point(scene, *i);
+            ctx.progress.item_done(name);
+            (k, row)
+        })
+        .collect();
+    unordered.sort_by_key(|(k, _)| *k);
+    let results: Vec<PointResult> = unordered.into_iter().map(|(_, r)| r).collect();
+    write_table(ctx.output("table")?, &results, &points, &keys)
+}
+
+/// Every scene at every point, loaded first: bad values are refused before any work.
+fn load_jobs(
+    files: &[std::path::PathBuf],
+    p: &SweepParams,
+    points: &[Vec<toml::Value>],
+    keys: &[&String],
+) -> Result<Vec<(u32, Scene)>> {
     let mut jobs = Vec::new();
     for file in files {
         for (i, pt) in points.iter().enumerate() {
@@ -240,59 +267,57 @@ fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
             jobs.push((i as u32, scene));
         }
     }
-    let name = &ctx.stage.name;
-    ctx.progress.stage_started(name, jobs.len() as u64);
-    // Largest grids first, so that the last items to finish are small (balanced threads); the rows
-    // are put back in design order afterwards.
-    let mut order: Vec<usize> = (0..jobs.len()).collect();
-    order.sort_by_key(|&k| std::cmp::Reverse(jobs[k].1.cloth.nx * jobs[k].1.cloth.ny));
-    let mut unordered: Vec<(usize, PointResult)> = order
-        .par_iter()
-        .map(|&k| {
-            let (i, scene) = &jobs[k];
-            let sol = solve_scene(scene, &mut NoObserver);
-            let converged = sol.report.status == Status::Converged;
-            let measures = converged.then(|| {
-                let g = &sol.grid;
-                let zs = sol.grid_positions().iter().map(|p| p.z);
-                let mut m = vec![
-                    sol.at(g.nx / 2, g.ny / 2).z,
-                    zs.clone().fold(f64::INFINITY, f64::min),
-                    zs.fold(f64::NEG_INFINITY, f64::max),
-                ];
-                for (c, _) in CORNERS {
-                    let (ci, cj) = c.ij(g);
-                    let q = sol.at(ci, cj);
-                    m.extend([q.x, q.y, q.z]);
-                }
-                let d = drapelab_core::measure::drape_measures(scene, g, &sol.x);
-                m.extend([
-                    d.drape_coefficient_pct.unwrap_or(f64::NAN),
-                    d.folds.map_or(f64::NAN, |f| f as f64),
-                    d.projected_area_m2,
-                    d.max_penetration_m,
-                ]);
-                m
-            });
-            ctx.progress.item_done(name);
-            let row = PointResult {
-                scene: scene.name.clone(),
-                point: *i,
-                particles: sol.grid.len() as u32,
-                solver: sol.report.solver.clone(),
-                status: sol.report.status,
-                iterations: sol.report.iterations as u64,
-                linear_solves: sol.report.linear_solves as u64,
-                wall_time_s: sol.report.wall_time_s,
-                max_residual_N: sol.report.max_residual_N,
-                minimum: sol.report.minimum,
-                measures,
-            };
-            (k, row)
-        })
-        .collect();
-    unordered.sort_by_key(|(k, _)| *k);
-    let results: Vec<PointResult> = unordered.into_iter().map(|(_, r)| r).collect();
+    Ok(jobs)
+}
+
+/// Solves one point and measures its drape (when it converged).
+fn solve_point(scene: &Scene, i: u32) -> PointResult {
+    let sol = solve_scene(scene, &mut NoObserver);
+    let converged = sol.report.status == Status::Converged;
+    let measures = converged.then(|| {
+        let g = &sol.grid;
+        let zs = sol.grid_positions().iter().map(|p| p.z);
+        let mut m = vec![
+            sol.at(g.nx / 2, g.ny / 2).z,
+            zs.clone().fold(f64::INFINITY, f64::min),
+            zs.fold(f64::NEG_INFINITY, f64::max),
+        ];
+        for (c, _) in CORNERS {
+            let (ci, cj) = c.ij(g);
+            let q = sol.at(ci, cj);
+            m.extend([q.x, q.y, q.z]);
+        }
+        let d = drapelab_core::measure::drape_measures(scene, g, &sol.x);
+        m.extend([
+            d.drape_coefficient_pct.unwrap_or(f64::NAN),
+            d.folds.map_or(f64::NAN, |f| f as f64),
+            d.projected_area_m2,
+            d.max_penetration_m,
+        ]);
+        m
+    });
+    PointResult {
+        scene: scene.name.clone(),
+        point: i,
+        particles: sol.grid.len() as u32,
+        solver: sol.report.solver.clone(),
+        status: sol.report.status,
+        iterations: sol.report.iterations as u64,
+        linear_solves: sol.report.linear_solves as u64,
+        wall_time_s: sol.report.wall_time_s,
+        max_residual_N: sol.report.max_residual_N,
+        minimum: sol.report.minimum,
+        measures,
+    }
+}
+
+/// `sweep.parquet`: one row per scene and point, the axes' values as columns.
+fn write_table(
+    out: &std::path::Path,
+    results: &[PointResult],
+    points: &[Vec<toml::Value>],
+    keys: &[&String],
+) -> Result<()> {
     // Columns.
     let mut fields = vec![
         Field::new("scene", DataType::Utf8, false),
@@ -376,9 +401,8 @@ fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
         }))));
     }
     let schema = Arc::new(Schema::new(fields));
-    let batch = RecordBatch::try_new(schema.clone(), cols)?;
-    write_parquet(ctx.output("table")?, &batch, None)?;
-    Ok(())
+    let batch = RecordBatch::try_new(schema, cols)?;
+    write_parquet(out, &batch, None)
 }
 
 /// The `sweep` stage kind.

@@ -111,12 +111,15 @@ fn find_markers(img: &RgbImage) -> Option<([(f64, f64); 2], f64)> {
 }
 
 /// The two fixed corners in the image (px), the scale (px per cm) and the guard band around the
-/// corners (px), from the calibration the options give.
+/// corners (px).
+type Calibrated = ([(f64, f64); 2], f64, f64);
+
+/// The calibration the options give, checked against the image.
 fn calibrate(
     img: &RgbImage,
     opts: &FitImageOptions,
     file: &Path,
-) -> Result<([(f64, f64); 2], f64, f64), InputError> {
+) -> Result<Calibrated, InputError> {
     let (w, h) = img.dimensions();
     let (corners, s, guard) = match &opts.calibration {
         Calibration::Given { px_per_cm, corners } => {

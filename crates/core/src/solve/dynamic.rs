@@ -7,7 +7,7 @@
 //!   conjugate gradients with a block-Jacobi preconditioner.
 
 use super::linear::DofMap;
-use super::{Divergence, Observer, SolveReport, StateEvent, Status};
+use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -256,6 +256,7 @@ pub fn solve_dynamic(
     let mut report = SolveReport {
         solver: integrator.as_str().into(),
         status: Status::MaxIterations,
+        stop: StopReason::SimulatedTime,
         iterations: 0,
         linear_solves: 0,
         factorizations: 0,
@@ -272,115 +273,243 @@ pub fn solve_dynamic(
         minimum: None,
     };
     if !free.iter().any(|&f| f) || !w_ref.is_finite() || dt.is_nan() || dt <= 0.0 {
-        report.status = Status::Invalid;
+        report.stop_for(StopReason::Invalid);
         report.message = "nothing free to integrate, or a non-positive time step".into();
         return report;
     }
-    let total_weight: f64 = model.masses.iter().sum::<f64>() * model.gravity_m_per_s2.max(1.0);
-    let extent = {
-        let (lo, hi) = x.iter().fold(
-            (
-                Vector3::repeat(f64::INFINITY),
-                Vector3::repeat(f64::NEG_INFINITY),
-            ),
-            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-        );
-        (hi - lo).norm().max(1e-3)
-    };
-    let e0 = model.energy(x, 1.0) + kinetic_energy(model, v);
-    let blowup = 100.0 * total_weight * extent + 100.0 * e0.abs();
-    let max_steps = (opts.max_time_s / dt).ceil() as usize;
-    let inv_m: Vec<f64> = model
-        .masses
-        .iter()
-        .zip(&free)
-        .map(|(m, f)| if *f && *m > 0.0 { 1.0 / m } else { 0.0 })
-        .collect();
+    let limits = Limits::new(model, x, v, opts, dt, start);
     for (vi, f) in v.iter_mut().zip(&free) {
         if !f {
             *vi = Vector3::zeros();
         }
     }
+    let mut stepper = Stepper::new(model, integrator, x, c, dt, free);
     let mut g = Vec::with_capacity(n);
-    let mut implicit = ImplicitState::new(model);
-    // Terms that bound a step (contact): each step is then cut so that no particle enters an
-    // obstacle (continuous collision detection, as the static solver's line search does), and the
-    // velocities are cut with it (the approach is stopped, not reflected).
-    let bounded = model
-        .max_step(x, &vec![Vector3::new(0.0, 0.0, -1.0); n])
-        .is_finite();
-    let mut x_old: Vec<Vector3<f64>> = Vec::new();
-    let mut dx: Vec<Vector3<f64>> = Vec::new();
-    let mut cut_steps = 0usize;
     let check = opts.check_every.max(1);
     let mut step = 0usize;
     loop {
         let want = observer.wants(step);
-        if step.is_multiple_of(check) || want || step == max_steps {
-            model.gradient(x, 1.0, &mut g);
-            let r = model.max_residual(&g);
-            let vmax = v.iter().map(|vi| vi.norm()).fold(0.0, f64::max);
-            let epot = model.energy(x, 1.0);
-            let etot = epot + kinetic_energy(model, v);
-            let time = step as f64 * dt;
-            if want {
-                observer.observe(&StateEvent {
-                    index: step,
-                    time_s: Some(time),
-                    x,
-                    max_residual_N: r,
-                    energy_J: etot,
-                });
+        model.gradient(x, 1.0, &mut g);
+        if (step.is_multiple_of(check) || want || step == limits.max_steps)
+            && let Some((reason, message)) =
+                limits.check(model, x, v, &g, step, want.then_some(&mut *observer))
+        {
+            match reason {
+                Stop::Diverged(d) => report.diverge(step, Some(dt), d),
+                Stop::Reason(r) => report.stop_for(r),
             }
-            let reason = if !etot.is_finite() || !r.is_finite() {
-                Some("non-finite".to_string())
-            } else if etot - e0 > blowup {
-                Some(format!("energy blow-up: {etot:.3e} J from {e0:.3e} J"))
-            } else {
-                let s = model.max_strain(x);
-                (s > opts.strain_bound)
-                    .then(|| format!("strain {s:.3e} beyond bound {}", opts.strain_bound))
-            };
-            if let Some(reason) = reason {
-                report.status = Status::Diverged;
-                report.divergence = Some(Divergence {
-                    step,
-                    dt_s: Some(dt),
-                    reason: reason.clone(),
-                });
-                report.message = format!("diverged at step {step} (dt = {dt:e} s): {reason}");
-                break;
-            }
-            if r <= (opts.residual_tol_rel * w_ref).max(model.roundoff_force(x))
-                && vmax <= opts.speed_tol_m_per_s
-            {
-                report.status = Status::Converged;
-                report.message = format!("equilibrium at t = {time:.4} s after {step} steps");
-                break;
-            }
-            if step >= max_steps {
-                report.message = format!(
-                    "no equilibrium within {} s (residual {r:.3e} N, speed {vmax:.3e} m/s)",
-                    opts.max_time_s
-                );
-                break;
-            }
-            if let Some(budget) = opts.max_wall_time_s
-                && start.elapsed().as_secs_f64() > budget
-            {
-                report.message = format!(
-                    "wall-time budget of {budget} s spent at t = {time:.4} s (residual {r:.3e} N, speed {vmax:.3e} m/s)"
-                );
-                break;
-            }
+            report.message = message;
+            break;
+        }
+        stepper.step(model, x, v, &g, opts.cg_tol_rel, &mut report);
+        step += 1;
+    }
+    model.gradient(x, 1.0, &mut g);
+    report.iterations = step;
+    report.sim_time_s = Some(step as f64 * dt);
+    report.max_residual_N = model.max_residual(&g);
+    report.max_residual_rel = report.max_residual_N / w_ref;
+    report.energy_J = model.energy(x, 1.0);
+    report.wall_time_s = start.elapsed().as_secs_f64();
+    if stepper.cut_steps > 0 {
+        report.message = format!(
+            "{} ({} steps cut short by contact)",
+            report.message, stepper.cut_steps
+        );
+    }
+    report
+}
+
+/// Why the time loop stops.
+enum Stop {
+    Reason(StopReason),
+    Diverged(DivergenceReason),
+}
+
+/// The budgets and divergence thresholds of one integration.
+struct Limits {
+    dt: f64,
+    max_steps: usize,
+    w_ref: f64,
+    e0: f64,
+    blowup: f64,
+    start: Instant,
+    residual_tol_rel: f64,
+    speed_tol: f64,
+    strain_bound: f64,
+    max_time_s: f64,
+    max_wall_time_s: Option<f64>,
+}
+
+impl Limits {
+    fn new(
+        model: &Model,
+        x: &[Vector3<f64>],
+        v: &[Vector3<f64>],
+        opts: &DynamicOptions,
+        dt: f64,
+        start: Instant,
+    ) -> Self {
+        let total_weight: f64 = model.masses.iter().sum::<f64>() * model.gravity_m_per_s2.max(1.0);
+        let extent = {
+            let (lo, hi) = x.iter().fold(
+                (
+                    Vector3::repeat(f64::INFINITY),
+                    Vector3::repeat(f64::NEG_INFINITY),
+                ),
+                |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+            );
+            (hi - lo).norm().max(1e-3)
+        };
+        let e0 = model.energy(x, 1.0) + kinetic_energy(model, v);
+        Self {
+            dt,
+            max_steps: (opts.max_time_s / dt).ceil() as usize,
+            w_ref: model.reference_weight(),
+            e0,
+            blowup: 100.0 * total_weight * extent + 100.0 * e0.abs(),
+            start,
+            residual_tol_rel: opts.residual_tol_rel,
+            speed_tol: opts.speed_tol_m_per_s,
+            strain_bound: opts.strain_bound,
+            max_time_s: opts.max_time_s,
+            max_wall_time_s: opts.max_wall_time_s,
+        }
+    }
+
+    /// Whether to stop at `step` (the gradient `g` is current), and why, in words too; the observer,
+    /// when given, sees the state first.
+    fn check(
+        &self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        v: &[Vector3<f64>],
+        g: &[Vector3<f64>],
+        step: usize,
+        observer: Option<&mut dyn Observer>,
+    ) -> Option<(Stop, String)> {
+        let dt = self.dt;
+        let r = model.max_residual(g);
+        let vmax = v.iter().map(|vi| vi.norm()).fold(0.0, f64::max);
+        let etot = model.energy(x, 1.0) + kinetic_energy(model, v);
+        let time = step as f64 * dt;
+        if let Some(obs) = observer {
+            obs.observe(&StateEvent {
+                index: step,
+                time_s: Some(time),
+                x,
+                max_residual_N: r,
+                energy_J: etot,
+            });
+        }
+        let divergence = if !etot.is_finite() || !r.is_finite() {
+            Some(DivergenceReason::NonFinite)
+        } else if etot - self.e0 > self.blowup {
+            Some(DivergenceReason::EnergyBlowUp {
+                energy_J: etot,
+                initial_J: self.e0,
+            })
         } else {
-            model.gradient(x, 1.0, &mut g);
+            let s = model.max_strain(x);
+            (s > self.strain_bound).then_some(DivergenceReason::StrainBeyondBound {
+                strain: s,
+                bound: self.strain_bound,
+            })
+        };
+        if let Some(d) = divergence {
+            let msg = format!("diverged at step {step} (dt = {dt:e} s): {d}");
+            return Some((Stop::Diverged(d), msg));
         }
-        if bounded {
-            x_old.clear();
-            x_old.extend_from_slice(x);
+        if r <= (self.residual_tol_rel * self.w_ref).max(model.roundoff_force(x))
+            && vmax <= self.speed_tol
+        {
+            let msg = format!("equilibrium at t = {time:.4} s after {step} steps");
+            return Some((Stop::Reason(StopReason::Converged), msg));
         }
-        match integrator {
+        if step >= self.max_steps {
+            let msg = format!(
+                "no equilibrium within {} s (residual {r:.3e} N, speed {vmax:.3e} m/s)",
+                self.max_time_s
+            );
+            return Some((Stop::Reason(StopReason::SimulatedTime), msg));
+        }
+        if let Some(budget) = self.max_wall_time_s
+            && self.start.elapsed().as_secs_f64() > budget
+        {
+            let msg = format!(
+                "wall-time budget of {budget} s spent at t = {time:.4} s (residual {r:.3e} N, speed {vmax:.3e} m/s)"
+            );
+            return Some((Stop::Reason(StopReason::WallTime), msg));
+        }
+        None
+    }
+}
+
+/// One integrator's steps, cut short where a step would enter an obstacle.
+struct Stepper {
+    integrator: Integrator,
+    c: f64,
+    dt: f64,
+    free: Vec<bool>,
+    inv_m: Vec<f64>,
+    implicit: ImplicitState,
+    /// Terms bound a step (contact): each step is cut so that no particle enters an obstacle
+    /// (continuous collision detection, as the static solver's line search does), and the
+    /// velocities with it (the approach is stopped, not reflected).
+    bounded: bool,
+    x_old: Vec<Vector3<f64>>,
+    dx: Vec<Vector3<f64>>,
+    cut_steps: usize,
+}
+
+impl Stepper {
+    fn new(
+        model: &Model,
+        integrator: Integrator,
+        x: &[Vector3<f64>],
+        c: f64,
+        dt: f64,
+        free: Vec<bool>,
+    ) -> Self {
+        let inv_m = model
+            .masses
+            .iter()
+            .zip(&free)
+            .map(|(m, f)| if *f && *m > 0.0 { 1.0 / m } else { 0.0 })
+            .collect();
+        Self {
+            integrator,
+            c,
+            dt,
+            free,
+            inv_m,
+            implicit: ImplicitState::new(model),
+            bounded: model
+                .max_step(x, &vec![Vector3::new(0.0, 0.0, -1.0); model.len()])
+                .is_finite(),
+            x_old: Vec::new(),
+            dx: Vec::new(),
+            cut_steps: 0,
+        }
+    }
+
+    /// Advances `x`, `v` by one step from the gradient `g` at `x`.
+    fn step(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        v: &mut [Vector3<f64>],
+        g: &[Vector3<f64>],
+        cg_tol_rel: f64,
+        report: &mut SolveReport,
+    ) {
+        let (n, c, dt) = (model.len(), self.c, self.dt);
+        let (free, inv_m) = (&self.free, &self.inv_m);
+        if self.bounded {
+            self.x_old.clear();
+            self.x_old.extend_from_slice(x);
+        }
+        match self.integrator {
             Integrator::ExplicitEuler => {
                 for p in 0..n {
                     if free[p] {
@@ -391,7 +520,7 @@ pub fn solve_dynamic(
                 }
                 if let Some(rate) = model.elongation_rate {
                     for t in &model.terms {
-                        t.provot_correct(x, &free, rate);
+                        t.provot_correct(x, free, rate);
                     }
                 }
             }
@@ -404,39 +533,25 @@ pub fn solve_dynamic(
                 }
             }
             Integrator::ImplicitEuler => {
-                let iters = implicit.step(model, x, v, &g, c, dt, opts.cg_tol_rel);
+                let iters = self.implicit.step(model, x, v, g, c, dt, cg_tol_rel);
                 report.linear_solves += 1;
                 report.inner_iterations += iters;
             }
         }
-        if bounded {
-            dx.clear();
-            dx.extend(x.iter().zip(&x_old).map(|(a, b)| a - b));
-            let alpha = model.max_step(&x_old, &dx);
+        if self.bounded {
+            self.dx.clear();
+            self.dx
+                .extend(x.iter().zip(&self.x_old).map(|(a, b)| a - b));
+            let alpha = model.max_step(&self.x_old, &self.dx);
             if alpha < 1.0 {
-                cut_steps += 1;
+                self.cut_steps += 1;
                 for p in 0..n {
-                    x[p] = x_old[p] + dx[p] * alpha;
+                    x[p] = self.x_old[p] + self.dx[p] * alpha;
                     v[p] *= alpha;
                 }
             }
         }
-        step += 1;
     }
-    model.gradient(x, 1.0, &mut g);
-    report.iterations = step;
-    report.sim_time_s = Some(step as f64 * dt);
-    report.max_residual_N = model.max_residual(&g);
-    report.max_residual_rel = report.max_residual_N / w_ref;
-    report.energy_J = model.energy(x, 1.0);
-    report.wall_time_s = start.elapsed().as_secs_f64();
-    if cut_steps > 0 {
-        report.message = format!(
-            "{} ({cut_steps} steps cut short by contact)",
-            report.message
-        );
-    }
-    report
 }
 
 /// Work arrays of implicit Euler.

@@ -8,7 +8,7 @@
 //! last iterations are plain Newton with quadratic convergence.
 
 use super::linear::{DofMap, SparseSpd};
-use super::{Divergence, Observer, SolveReport, StateEvent, Status};
+use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -310,6 +310,7 @@ pub fn solve_static_loads(
     let mut report = SolveReport {
         solver: "static-newton".into(),
         status: Status::MaxIterations,
+        stop: StopReason::Iterations,
         iterations: 0,
         linear_solves: 0,
         inner_iterations: 0,
@@ -327,7 +328,7 @@ pub fn solve_static_loads(
     };
     let mut ws = Workspace::new(model, x, opts);
     if ws.dofs.n == 0 || !w_ref.is_finite() {
-        report.status = Status::Invalid;
+        report.stop_for(StopReason::Invalid);
         report.message = "no free particle with mass: nothing to solve".into();
         return report;
     }
@@ -342,12 +343,7 @@ pub fn solve_static_loads(
             model.gradient(x, load, &mut ws.g);
             let r = free_max_residual(model, &ws.g);
             if !r.is_finite() || !e.is_finite() {
-                report.status = Status::Diverged;
-                report.divergence = Some(Divergence {
-                    step: iter,
-                    dt_s: None,
-                    reason: "non-finite".into(),
-                });
+                report.diverge(iter, None, DivergenceReason::NonFinite);
                 break 'load;
             }
             if observer.wants(iter) {
@@ -360,13 +356,13 @@ pub fn solve_static_loads(
                 });
             }
             if r <= tol && last {
-                report.status = Status::Converged;
+                report.stop_for(StopReason::Converged);
                 break 'load;
             }
             // Round-off floor: the residual cannot fall below ~16 ε k |x| (see Model::roundoff_force);
             // reaching it after the tolerance proved unreachable is convergence, said in the message.
             if last && r <= model.roundoff_force(x) && r <= 1e3 * tol {
-                report.status = Status::Converged;
+                report.stop_for(StopReason::RoundoffFloor);
                 floor = true;
                 break 'load;
             }
@@ -386,8 +382,9 @@ pub fn solve_static_loads(
                 model.gradient(x, load, &mut ws.g);
                 let r = free_max_residual(model, &ws.g);
                 if r <= tol && last {
-                    report.status = Status::Converged;
+                    report.stop_for(StopReason::Converged);
                 } else {
+                    report.stop_for(StopReason::LineSearch);
                     report.message =
                         format!("line search failed at iteration {iter} with residual {r:.3e} N");
                 }
@@ -395,12 +392,12 @@ pub fn solve_static_loads(
             }
             let strain = model.max_strain(x);
             if strain > opts.strain_bound {
-                report.status = Status::Diverged;
-                report.divergence = Some(Divergence {
-                    step: iter,
-                    dt_s: None,
-                    reason: format!("strain {strain:.3e} beyond bound"),
-                });
+                let bound = opts.strain_bound;
+                report.diverge(
+                    iter,
+                    None,
+                    DivergenceReason::StrainBeyondBound { strain, bound },
+                );
                 break 'load;
             }
         }

@@ -28,6 +28,84 @@ impl Status {
     }
 }
 
+/// Why a solve stopped (argmin's habit: the reason is data; [`SolveReport::message`] says it in words).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StopReason {
+    /// The residual force (and in dynamics the speed) fell below tolerance.
+    Converged,
+    /// The residual reached the round-off floor of the forces after the tolerance proved unreachable.
+    RoundoffFloor,
+    /// The Newton iteration budget (`max_iterations`) ran out.
+    #[default]
+    Iterations,
+    /// The simulated-time budget (`max_time_s`) ran out.
+    SimulatedTime,
+    /// The wall-clock budget (`max_wall_time_s`) ran out.
+    WallTime,
+    /// The line search found no step that lowers the energy away from the solution.
+    LineSearch,
+    /// The vertical-gap contact rounds did not settle.
+    ContactRounds,
+    /// A divergence was detected ([`SolveReport::divergence`] says which).
+    Diverged,
+    /// The problem cannot be solved as posed (nothing free, a non-positive step).
+    Invalid,
+}
+
+impl StopReason {
+    /// The status a solve that stopped for this reason has.
+    pub fn status(self) -> Status {
+        match self {
+            StopReason::Converged | StopReason::RoundoffFloor => Status::Converged,
+            StopReason::Iterations
+            | StopReason::SimulatedTime
+            | StopReason::WallTime
+            | StopReason::LineSearch
+            | StopReason::ContactRounds => Status::MaxIterations,
+            StopReason::Diverged => Status::Diverged,
+            StopReason::Invalid => Status::Invalid,
+        }
+    }
+}
+
+/// What a divergence check detected.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum DivergenceReason {
+    /// A NaN or infinite energy or force.
+    NonFinite,
+    /// The total energy rose far above its start (dynamics).
+    EnergyBlowUp {
+        /// Total energy when detected, J.
+        energy_J: f64,
+        /// Total energy at the start, J.
+        initial_J: f64,
+    },
+    /// A spring or membrane strain beyond the solver's `strain_bound`.
+    StrainBeyondBound {
+        /// The largest strain.
+        strain: f64,
+        /// The bound.
+        bound: f64,
+    },
+}
+
+impl std::fmt::Display for DivergenceReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DivergenceReason::NonFinite => write!(f, "non-finite"),
+            DivergenceReason::EnergyBlowUp {
+                energy_J,
+                initial_J,
+            } => write!(f, "energy blow-up: {energy_J:.3e} J from {initial_J:.3e} J"),
+            DivergenceReason::StrainBeyondBound { strain, bound } => {
+                write!(f, "strain {strain:.3e} beyond bound {bound}")
+            }
+        }
+    }
+}
+
 /// Where and why a solve diverged.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Divergence {
@@ -35,8 +113,8 @@ pub struct Divergence {
     pub step: usize,
     /// Time step in s (dynamics) at divergence.
     pub dt_s: Option<f64>,
-    /// What was detected: "non-finite", "energy blow-up", "strain beyond bound".
-    pub reason: String,
+    /// What was detected.
+    pub reason: DivergenceReason,
 }
 
 /// The outcome of a solve.
@@ -46,6 +124,9 @@ pub struct SolveReport {
     pub solver: String,
     /// How the solve ended.
     pub status: Status,
+    /// Why it stopped.
+    #[serde(default)]
+    pub stop: StopReason,
     /// Newton iterations or time steps taken.
     pub iterations: usize,
     /// Linear solves (Cholesky factorizations or CG solves).
@@ -84,6 +165,16 @@ impl SolveReport {
     pub fn is_converged(&self) -> bool {
         self.status == Status::Converged
     }
+    /// Records why the solve stopped, and so its status.
+    pub fn stop_for(&mut self, reason: StopReason) {
+        self.stop = reason;
+        self.status = reason.status();
+    }
+    /// Records a divergence detected at `step`.
+    pub fn diverge(&mut self, step: usize, dt_s: Option<f64>, reason: DivergenceReason) {
+        self.stop_for(StopReason::Diverged);
+        self.divergence = Some(Divergence { step, dt_s, reason });
+    }
 }
 
 impl SolveReport {
@@ -99,6 +190,7 @@ impl SolveReport {
                 t.factor_time_s += latest.factor_time_s;
                 t.wall_time_s += latest.wall_time_s;
                 t.status = latest.status;
+                t.stop = latest.stop;
                 t.max_residual_N = latest.max_residual_N;
                 t.max_residual_rel = latest.max_residual_rel;
                 t.energy_J = latest.energy_J;

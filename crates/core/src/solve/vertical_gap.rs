@@ -9,7 +9,9 @@
 //! let go), which suits tables, pedestals and rods; on a sphere the sheet stays where it first touched.
 //! The barrier method is the frictionless one.
 
-use super::{NoObserver, Observer, SolveReport, StaticOptions, Status, solve_static_loads};
+use super::{
+    NoObserver, Observer, SolveReport, StaticOptions, Status, StopReason, solve_static_loads,
+};
 use crate::contact::Obstacle;
 use crate::physics::Model;
 use nalgebra::Vector3;
@@ -155,7 +157,7 @@ pub fn solve_vertical_gap(
         }
         if !settled {
             let mut report = total.expect("at least one round");
-            report.status = Status::MaxIterations;
+            report.stop_for(StopReason::ContactRounds);
             report.message = format!(
                 "vertical-gap contact did not settle in {MAX_ROUNDS} rounds at load {target:.3}"
             );

@@ -2,6 +2,10 @@
 //! solver, each result's wall time, work (iterations or steps, linear solves), peak memory, and its
 //! error: the largest distance to the finest static solution at the grid points both share.
 
+mod skips;
+
+pub use skips::{SkipRow, skip_cost_cache, skip_second_thread, skip_symmetry, skip_unneeded_terms};
+
 use crate::scene::{Scene, SolverKind};
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
