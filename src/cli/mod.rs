@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Parser)]
 #[command(name = "drapelab", version, about, long_about)]
 pub struct Cli {
-    /// More log lines (-v: debug, -vv: trace); RUST_LOG overrides.
+    /// More log lines (-v: debug, e.g. why each stage is stale; -vv: trace); RUST_LOG overrides.
     #[arg(short, long, global = true, action = clap::ArgAction::Count)]
     pub verbose: u8,
     /// Only errors.
@@ -52,8 +52,10 @@ impl From<ViewArg> for crate::edges::View {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Solve one scene (TOML) and write particles.parquet, run.json and, when the scene's [record]
-    /// asks, timeline.mcap (Foxglove) and drape.rrd (rerun) into DIR.
+    /// Solve one scene and record it.
+    ///
+    /// Writes particles.parquet, run.json and, when the scene's [record] asks, timeline.mcap
+    /// (Foxglove) and drape.rrd (rerun) into DIR.
     ///
     /// Example: drapelab simulate datasets/scenes/hang4.toml --out runs/hang4 --set cloth.nx=41 --set cloth.ny=41
     Simulate {
@@ -67,8 +69,11 @@ pub enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
-    /// Run a pipeline make-style: only stale stages run (inputs' content, parameters or the drapelab
-    /// version changed since the stage's manifest), items in parallel, artifacts under runs/<pipeline>/.
+    /// Run a pipeline make-style (only stale stages).
+    ///
+    /// A stage runs when its inputs' content, parameters or the drapelab build changed since its
+    /// manifest; items run in parallel; artifacts go under runs/<pipeline>/. A failing (or panicking)
+    /// stage fails alone: the run goes on as far as the graph allows and exits 1.
     ///
     /// Example: drapelab run pipelines/main.toml --jobs 2
     Run {
@@ -87,7 +92,9 @@ pub enum Command {
         #[arg(long)]
         dry_run: bool,
     },
-    /// List each stage of a pipeline as up to date or stale, and why (which input or parameter changed).
+    /// Say which stages of a pipeline are stale, and why.
+    ///
+    /// Each stage is up to date, or stale with the reason (which input or parameter changed).
     Status {
         /// The pipeline file.
         pipeline: PathBuf,
@@ -95,11 +102,13 @@ pub enum Command {
         #[arg(long)]
         check: bool,
     },
-    /// List the stage kinds a pipeline may use, with their input and output slots and parameters' page.
+    /// List the stage kinds a pipeline may use, with their input and output slots.
     Kinds,
-    /// Solve a 4- or 2-corner hang and render it as a photo from a camera facing it (along +y): DIR/photo.png
-    /// (or .jpg), camera.json (exact scale and corner pixels), particles.parquet, and edges_truth.parquet
-    /// (the same edge fit made straight from the particles).
+    /// Solve a 4- or 2-corner hang and render it as a photo.
+    ///
+    /// The camera faces the sheet (along +y). Writes DIR/photo.png (or .jpg), camera.json (exact
+    /// scale and corner pixels), particles.parquet, and edges_truth.parquet (the same edge fit made
+    /// straight from the particles).
     ///
     /// Example: drapelab render datasets/scenes/hang4.toml --out runs/photo --px-per-cm 8 --markers --noise 4
     Render {
@@ -136,10 +145,11 @@ pub enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
-    /// Fit the edges of a photo of a hanging sheet with polynomials (seed 000, Figs 3, 11, 12): writes
-    /// DIR/edges.parquet (edge, power, coefficient of x^power in cm, RMS residual, points) and DIR/overlay.png
-    /// (fitted curves red, reference line blue). Calibrate with --px-per-cm and --corners, or --markers
-    /// and --side-cm, or --camera-json from `render`.
+    /// Fit the edges of a photo of a hanging sheet with polynomials (seed 000).
+    ///
+    /// Seed 000 Figs 3, 11, 12. Writes DIR/edges.parquet (edge, power, coefficient of x^power in cm,
+    /// RMS residual, points) and DIR/overlay.png (fitted curves red, reference line blue). Calibrate
+    /// with --px-per-cm and --corners, or --markers and --side-cm, or --camera-json from `render`.
     FitEdges {
         /// The photo (PNG or JPEG).
         photo: PathBuf,
@@ -168,8 +178,10 @@ pub enum Command {
         #[arg(long, default_value_t = 4)]
         degree: usize,
     },
-    /// Score simulated edges against measured ones: seed 000 Eq. 5 (coefficients in coordinates centred
-    /// on the edge, in %) and the RMS distance between the curves (% of the side), per edge.
+    /// Score simulated edges against measured ones (seed 000 Eq. 5).
+    ///
+    /// Per edge: Eq. 5 (coefficients in coordinates centred on the edge, in %) and the RMS distance
+    /// between the curves (% of the side).
     Score {
         /// Measured edges.parquet.
         real: PathBuf,
@@ -179,9 +191,11 @@ pub enum Command {
         #[arg(long, default_value_t = 50.0)]
         side_cm: f64,
     },
-    /// Tension-field wrinkles of vertically hung fabric (seed 002): number n, ratio Q and depth z_max of
-    /// the wrinkles for every case of CONFIG, with the deformed grids. Writes DIR/wrinkles.parquet,
-    /// DIR/mesh.parquet, DIR/wrinkles.rrd and DIR/wrinkles.md (the seed's results beside ours).
+    /// Tension-field wrinkles of vertically hung fabric (seed 002).
+    ///
+    /// Number n, ratio Q and depth z_max of the wrinkles for every case of CONFIG, with the deformed
+    /// grids. Writes DIR/wrinkles.parquet, DIR/mesh.parquet, DIR/wrinkles.rrd and DIR/wrinkles.md
+    /// (the seed's results beside ours).
     ///
     /// Example: drapelab wrinkles datasets/wrinkles/seed_tables.toml --out runs/wrinkles
     Wrinkles {
@@ -194,8 +208,10 @@ pub enum Command {
         #[arg(long, num_args = 2, value_names = ["NX", "NY"], default_values_t = [41, 81])]
         mesh: Vec<usize>,
     },
-    /// Benchmark: time to equilibrium of hang4 at several resolutions with every solver, and each
-    /// result's distance to the finest static solution. Prints a Markdown table.
+    /// Time to equilibrium of hang4 against error, every solver.
+    ///
+    /// Each resolution with every solver, and each result's distance to the finest static solution;
+    /// prints a Markdown table.
     Bench {
         /// The hang4 scene to benchmark.
         #[arg(long, default_value = "datasets/scenes/hang4.toml")]
@@ -596,12 +612,12 @@ fn wrinkles(config: &Path, out: &Path, mesh: &[usize]) -> Result<i32> {
     })
 }
 
-/// Log lines (tracing) on stderr: warnings by default, more with `-v`, errors only with `-q`;
-/// `RUST_LOG` (e.g. `RUST_LOG=drapelab_pipeline=debug`) overrides both.
+/// Log lines (tracing) on stderr: stage progress (info) by default, more with `-v`, errors only
+/// with `-q`; `RUST_LOG` (e.g. `RUST_LOG=drapelab_pipeline=debug`) overrides both.
 pub fn init_logging(verbose: u8, quiet: bool) {
     let level = match (quiet, verbose) {
         (true, _) => "error",
-        (false, 0) => "warn",
+        (false, 0) => "info",
         (false, 1) => "debug",
         (false, _) => "trace",
     };
@@ -611,5 +627,6 @@ pub fn init_logging(verbose: u8, quiet: bool) {
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
         .with_target(false)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .try_init();
 }

@@ -1,5 +1,6 @@
 //! Progress of a pipeline run: the runner talks to the [`Progress`] trait, never to the terminal.
-//! On a terminal, an indicatif MultiProgress with one bar per running stage; otherwise log lines.
+//! On a terminal, an indicatif MultiProgress with one bar per running stage; otherwise log lines
+//! through `tracing` (level info; `-q` or `RUST_LOG=warn` silences them).
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::HashMap;
@@ -34,7 +35,7 @@ impl Default for LogProgress {
 
 impl Progress for LogProgress {
     fn stage_started(&self, stage: &str, items: u64) {
-        eprintln!("[{stage}] started: {items} item(s)");
+        tracing::info!("[{stage}] started: {items} item(s)");
         self.counts
             .lock()
             .expect("lock")
@@ -53,15 +54,19 @@ impl Progress for LogProgress {
                 } else {
                     0.0
                 };
-                eprintln!("[{stage}] {done}/{total} done, {el:.1} s elapsed, ETA {eta:.1} s");
+                tracing::info!("[{stage}] {done}/{total} done, {el:.1} s elapsed, ETA {eta:.1} s");
             }
         }
     }
     fn stage_finished(&self, stage: &str, outcome: &str, wall_s: f64) {
-        eprintln!("[{stage}] {outcome} in {wall_s:.2} s");
+        if outcome == "ok" {
+            tracing::info!("[{stage}] {outcome} in {wall_s:.2} s");
+        } else {
+            tracing::error!("[{stage}] {outcome} in {wall_s:.2} s");
+        }
     }
     fn stage_skipped(&self, stage: &str, why: &str) {
-        eprintln!("[{stage}] skipped: {why}");
+        tracing::info!("[{stage}] skipped: {why}");
     }
 }
 

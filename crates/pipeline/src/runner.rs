@@ -252,6 +252,7 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
         } else {
             check(plan, s, &upstream)
         };
+        tracing::debug!(stage = %s.name, kind = s.kind.kind(), state = ?state, "checked");
         let StageState::Stale(why) = state else {
             progress.stage_skipped(&s.name, "up to date");
             summary.skipped.push(s.name.clone());

@@ -62,6 +62,7 @@ impl CalibrationRecorder {
             "drapelab_calibration",
         ))
         .save(staged.path())?;
+        rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
         Ok(Self { rec, staged })
     }
 

@@ -7,7 +7,6 @@ use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::cloth::Grid;
 use nalgebra::Vector3;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-use parquet::file::properties::WriterProperties;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -43,7 +42,7 @@ pub fn write_particles(
         .iter()
         .map(|(k, v)| parquet::file::metadata::KeyValue::new(k.to_string(), v.clone()))
         .collect();
-    let props = WriterProperties::builder()
+    let props = crate::table::writer_properties()
         .set_key_value_metadata(Some(kv))
         .build();
     write_parquet(path, &batch, Some(props))?;

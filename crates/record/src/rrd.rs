@@ -13,7 +13,6 @@ pub struct RerunRecorder {
     staged: Option<Staged>,
     every: usize,
     n_grid: usize,
-    tris: Vec<[u32; 3]>,
     last_index: Option<usize>,
     error: Option<String>,
 }
@@ -34,7 +33,13 @@ impl RerunRecorder {
         ))
         .save(staged.path())?;
         let tris = drapelab_core::cloth::grid_triangles(grid);
-        // The mesh topology is static; positions change over time.
+        // Z is up in drapelab (gravity along −z).
+        rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        // The mesh topology is static; only the positions change over time.
+        rec.log_static(
+            "cloth/mesh",
+            &rerun::Mesh3D::update_fields().with_triangle_indices(tris.iter().copied()),
+        )?;
         rec.log_static(
             "cloth/rest",
             &rerun::Mesh3D::new(
@@ -57,7 +62,6 @@ impl RerunRecorder {
             staged: Some(staged),
             every,
             n_grid: grid.len(),
-            tris,
             last_index: None,
             error: None,
         })
@@ -75,7 +79,7 @@ impl RerunRecorder {
             .collect();
         rec.log(
             "cloth/mesh",
-            &rerun::Mesh3D::new(verts).with_triangle_indices(self.tris.iter().copied()),
+            &rerun::Mesh3D::update_fields().with_vertex_positions(verts),
         )?;
         rec.log(
             "stats/max_residual_N",

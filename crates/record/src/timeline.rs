@@ -43,7 +43,7 @@ impl TimelineRecorder {
             .truncate(true)
             .open(&file)?;
         let opts = mcap::WriteOptions::new()
-            .compression(None)
+            .compression(Some(mcap::Compression::Zstd))
             .profile("drapelab");
         let mut writer = opts.create(BufWriter::new(f))?;
         let s1 = writer.add_schema(

@@ -61,7 +61,7 @@ fn run(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
     done();
     rows.push(skip_cost_cache(&hang)?);
     done();
-    rows.push(skip_up_to_date_stage(ctx.input("hang")?)?);
+    rows.push(skip_up_to_date_stage(ctx.input("hang")?, &hang.name)?);
     done();
     rows.push(skip_unneeded_terms(&hang));
     done();
@@ -99,7 +99,7 @@ fn skip_recording(hang: &Scene, path: &Path) -> Result<SkipRow> {
 }
 
 /// Up-to-date stages: a one-stage pipeline run from scratch, then again (nothing to do).
-fn skip_up_to_date_stage(hang_file: &Path) -> Result<SkipRow> {
+fn skip_up_to_date_stage(hang_file: &Path, name: &str) -> Result<SkipRow> {
     let proj = tempfile::tempdir()?;
     std::fs::create_dir_all(proj.path().join("pipelines"))?;
     std::fs::create_dir_all(proj.path().join("datasets/scenes"))?;
@@ -120,7 +120,7 @@ fn skip_up_to_date_stage(hang_file: &Path) -> Result<SkipRow> {
     }
     Ok(SkipRow {
         skip: "up-to-date stage skipped".into(),
-        scene: "hang4 41×41".into(),
+        scene: format!("{name} 41×41"),
         time_with_skip_s: t[1],
         time_without_skip_s: t[0],
     })
