@@ -135,12 +135,9 @@ impl StageKind for Calibrate {
     const SUMMARY: &'static str =
         "ICA calibration of mass-spring parameters against measured edges";
     const INPUTS: &'static [Slot] = &[
-        Slot::one(
-            "edges",
-            "measured edges of every sample (a fit-edges table)",
-        ),
-        Slot::one("samples", "Table 2's densities (knitted_samples.csv)"),
-        Slot::one("scene", "the hang scene each sample is simulated in"),
+        crate::EDGES_SLOT,
+        crate::SAMPLES_SLOT,
+        crate::SCENE_SLOT,
         Slot::optional(
             "ica",
             "ICA settings as JSON (a tune stage's best_ica.json), with params.ica_from",

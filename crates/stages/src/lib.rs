@@ -39,7 +39,17 @@ pub use wrinkles::{
     SolvedCase, WrinkleOutputs, Wrinkles, WrinklesParams, report_markdown, write_wrinkles,
 };
 
-use drapelab_pipeline::Registry;
+use drapelab_pipeline::{Registry, Slot};
+
+/// The measured edges of the calibration stages (a fit-edges table).
+const EDGES_SLOT: Slot = Slot::one(
+    "edges",
+    "measured edges of every sample (a fit-edges table)",
+);
+/// Table 2's densities of the calibration stages.
+const SAMPLES_SLOT: Slot = Slot::one("samples", "Table 2's densities (knitted_samples.csv)");
+/// The hang scene of the calibration stages.
+const SCENE_SLOT: Slot = Slot::one("scene", "the hang scene each sample is simulated in");
 
 /// Every stage kind drapelab knows.
 pub fn registry() -> Registry {

@@ -535,7 +535,7 @@ fn table_10_1(
         .collect();
     let _ = write!(
         md,
-        "## Table 10.1: free end of the cantilever against the grid\n\n{}: exact elastica (src/elastica.rs) \
+        "## Table 10.1: free end of the cantilever against the grid\n\n{}: exact elastica (crates/core/src/elastica.rs) \
 −u = {:.4} cm, w = {:.4} cm. drapelab's grid of k intervals has k + 1 lines along the strip; non-uniform \
 is cosine-graded towards both ends (grading {}), the seed's is finer at the clamp.\n\n| grid | seed 003 −u cm | \
 seed 003 w cm | drapelab −u cm | drapelab w cm | drapelab distance to the elastica cm | status |\n|---|---|---|---|---|---|---|\n",

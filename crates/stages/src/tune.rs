@@ -119,14 +119,7 @@ impl StageKind for Tune {
     const KIND: &'static str = "tune";
     const SUMMARY: &'static str =
         "Taguchi L27 tuning of ICA's seven settings (seed 000 Table 1, Fig. 10)";
-    const INPUTS: &'static [Slot] = &[
-        Slot::one(
-            "edges",
-            "measured edges of every sample (a fit-edges table)",
-        ),
-        Slot::one("samples", "Table 2's densities (knitted_samples.csv)"),
-        Slot::one("scene", "the hang scene each sample is simulated in"),
-    ];
+    const INPUTS: &'static [Slot] = &[crate::EDGES_SLOT, crate::SAMPLES_SLOT, crate::SCENE_SLOT];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("table", "tune.parquet: one row per design row"),
         Slot::one(

@@ -251,7 +251,7 @@ from 1.33 to 2.60, still finds 2 wrinkles. The seed's own Q values do not follow
 w or h (Table I's Q is not even monotone in h), so no choice of c reproduces all twelve cases: its Q \
 evidently carries the rounding of n and iteration details that the text does not give.\n\
 - The reading of Eqs. 8 and 9 (the upper boundary takes up the length L − l; the centre fibre keeps the \
-height h across n strips, with a₀ = h) is stated in `src/wrinkles/mod.rs`; the seed's a₀ = 1.0h and \
+height h across n strips, with a₀ = h) is stated in `crates/core/src/wrinkles/mod.rs`; the seed's a₀ = 1.0h and \
 a_n = 0.01h start values and z_max = 0.014 m tentative value are used as given.\n";
 
 /// The seed's n, z_max and Q beside drapelab's, with the deviations.
