@@ -417,7 +417,7 @@ fn simulate(scene: &Path, out: &Path, set: &[String]) -> Result<i32> {
     let loaded = load_scene(scene, set)?;
     let mut progress = SolveProgress::new(&loaded.scene.name);
     let report = crate::io::simulate_to_dir(&loaded, out, &mut progress)?;
-    progress.finish(&report);
+    progress.done(&report);
     eprintln!(
         "{}: {} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
         loaded.scene.name,

@@ -22,7 +22,7 @@ impl SolveProgress {
         Self { bar }
     }
     /// Clears the spinner.
-    pub fn finish(&self, _report: &SolveReport) {
+    pub fn done(&self, _report: &SolveReport) {
         self.bar.finish_and_clear();
     }
 }
@@ -31,7 +31,7 @@ impl Observer for SolveProgress {
     fn wants(&self, index: usize) -> bool {
         !self.bar.is_hidden() && index.is_multiple_of(100)
     }
-    fn observe(&mut self, ev: &StateEvent<'_>) {
+    fn observe(&mut self, ev: &StateEvent<'_>) -> anyhow::Result<()> {
         let t = ev
             .time_s
             .map(|t| format!(" t = {t:.4} s"))
@@ -40,5 +40,6 @@ impl Observer for SolveProgress {
             "step {}{t}, residual {:.3e} N",
             ev.index, ev.max_residual_N
         ));
+        Ok(())
     }
 }

@@ -317,3 +317,41 @@ fn a_strip_compressed_past_eulers_load_is_reported_as_unstable() {
     assert_eq!(straight(0.9), Some(true), "below Euler's load");
     assert_eq!(straight(1.1), Some(false), "above Euler's load");
 }
+
+/// An observer whose disk is full from its third state on.
+struct Failing;
+
+impl drapelab::solve::Observer for Failing {
+    fn wants(&self, index: usize) -> bool {
+        index >= 2
+    }
+    fn observe(&mut self, _: &drapelab::solve::StateEvent<'_>) -> anyhow::Result<()> {
+        anyhow::bail!("no space left on device")
+    }
+}
+
+#[test]
+fn a_failing_observer_stops_the_solve_with_its_reason_and_no_result() {
+    use drapelab::solve::{Status, StopReason};
+    for kind in ["static", "implicit-euler"] {
+        let s = scene(
+            "hang4.toml",
+            &[
+                "cloth.nx=11",
+                "cloth.ny=11",
+                &format!("solver.kind={kind}"),
+                "solver.dynamic.dt_s=0.01",
+            ],
+        );
+        let sol = drapelab::simulate::solve_scene(&s, &mut Failing);
+        assert_eq!(sol.report.stop, StopReason::Observer, "{kind}");
+        assert_eq!(sol.report.status, Status::Invalid, "{kind}");
+        assert!(!sol.report.is_converged());
+        assert!(
+            sol.report.message.contains("no space left on device"),
+            "{kind}: {}",
+            sol.report.message
+        );
+        assert_eq!(sol.report.iterations, 2, "{kind}: stopped where it failed");
+    }
+}

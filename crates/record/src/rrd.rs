@@ -14,7 +14,6 @@ pub struct RerunRecorder {
     every: usize,
     n_grid: usize,
     last_index: Option<usize>,
-    error: Option<String>,
 }
 
 impl RerunRecorder {
@@ -63,12 +62,14 @@ impl RerunRecorder {
             every,
             n_grid: grid.len(),
             last_index: None,
-            error: None,
         })
     }
 
     fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
-        let rec = self.rec.as_ref().expect("open recording");
+        let rec = self
+            .rec
+            .as_ref()
+            .ok_or_else(|| anyhow::anyhow!("the rerun recording is already closed"))?;
         match ev.time_s {
             Some(t) => rec.set_duration_secs("sim_time", t),
             None => rec.set_time_sequence("iteration", ev.index as i64),
@@ -89,32 +90,27 @@ impl RerunRecorder {
         self.last_index = Some(ev.index);
         Ok(())
     }
+}
 
+impl Observer for RerunRecorder {
+    fn wants(&self, index: usize) -> bool {
+        index.is_multiple_of(self.every)
+    }
+    fn observe(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+        self.write(ev)
+    }
     /// Records the final state and renames the recording into place.
-    pub fn finish(mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
+    fn finish(&mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
         if let Some(ev) = final_state
             && self.last_index != Some(ev.index)
         {
             self.write(ev)?;
         }
-        if let Some(e) = self.error.take() {
-            anyhow::bail!("writing the rerun recording failed: {e}");
+        if let (Some(rec), Some(staged)) = (self.rec.take(), self.staged.take()) {
+            rec.flush_blocking()?;
+            drop(rec);
+            staged.commit()?;
         }
-        let rec = self.rec.take().expect("open recording");
-        rec.flush_blocking()?;
-        drop(rec);
-        self.staged.take().expect("staged").commit()?;
         Ok(())
-    }
-}
-
-impl Observer for RerunRecorder {
-    fn wants(&self, index: usize) -> bool {
-        self.error.is_none() && index.is_multiple_of(self.every)
-    }
-    fn observe(&mut self, ev: &StateEvent<'_>) {
-        if let Err(e) = self.write(ev) {
-            self.error = Some(e.to_string());
-        }
     }
 }

@@ -7,7 +7,7 @@ use drapelab_core::atomic::write_atomic;
 use drapelab_core::build::{BuiltScene, build_scene};
 use drapelab_core::scene::{LoadedScene, Scene};
 use drapelab_core::simulate::solve_model;
-use drapelab_core::solve::{Observer, Observers, SolveReport, StateEvent, Status};
+use drapelab_core::solve::{Observer, Observers, SolveReport, StateEvent, Status, StopReason};
 use serde::Serialize;
 use std::path::Path;
 
@@ -83,12 +83,17 @@ pub fn simulate_to_dir(
         energy_J: report.energy_J,
     };
     let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));
+    // A recorder that failed during the solve is dropped (its temporary file with it), not finished.
+    if report.stop == StopReason::Observer {
+        timeline = None;
+        rrd = None;
+    }
     let mut outputs = vec!["run.json"];
-    if let Some(t) = timeline {
+    if let Some(mut t) = timeline {
         t.finish(finite.then_some(&final_ev))?;
         outputs.push("timeline.mcap");
     }
-    if let Some(r) = rrd {
+    if let Some(mut r) = rrd {
         r.finish(finite.then_some(&final_ev))?;
         outputs.push("drape.rrd");
     }

@@ -29,8 +29,6 @@ pub struct TimelineRecorder {
     n_grid: usize,
     indices: Vec<u32>,
     last_index: Option<usize>,
-    /// The first write error, reported at finish.
-    error: Option<String>,
 }
 
 impl TimelineRecorder {
@@ -67,7 +65,6 @@ impl TimelineRecorder {
                 .flatten()
                 .collect(),
             last_index: None,
-            error: None,
         })
     }
 
@@ -98,7 +95,10 @@ impl TimelineRecorder {
             }]
         });
         let stats = json!({"index": ev.index, "time_s": ev.time_s, "max_residual_N": ev.max_residual_N, "energy_J": ev.energy_J});
-        let w = self.writer.as_mut().expect("open writer");
+        let w = self
+            .writer
+            .as_mut()
+            .ok_or_else(|| anyhow::anyhow!("the timeline is already closed"))?;
         for (ch, body) in [(self.cloth, msg), (self.stats, stats)] {
             self.seq += 1;
             let header = MessageHeader {
@@ -112,32 +112,27 @@ impl TimelineRecorder {
         self.last_index = Some(ev.index);
         Ok(())
     }
+}
 
+impl Observer for TimelineRecorder {
+    fn wants(&self, index: usize) -> bool {
+        index.is_multiple_of(self.every)
+    }
+    fn observe(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+        self.write(ev)
+    }
     /// Records the final state (if it was not the last one recorded) and renames the file into place.
-    pub fn finish(mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
+    fn finish(&mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
         if let Some(ev) = final_state
             && self.last_index != Some(ev.index)
         {
             self.write(ev)?;
         }
-        if let Some(e) = self.error.take() {
-            anyhow::bail!("writing the timeline failed: {e}");
+        if let (Some(mut w), Some(staged)) = (self.writer.take(), self.staged.take()) {
+            w.finish()?;
+            drop(w);
+            staged.commit()?;
         }
-        let mut w = self.writer.take().expect("open writer");
-        w.finish()?;
-        drop(w);
-        self.staged.take().expect("staged").commit()?;
         Ok(())
-    }
-}
-
-impl Observer for TimelineRecorder {
-    fn wants(&self, index: usize) -> bool {
-        self.error.is_none() && index.is_multiple_of(self.every)
-    }
-    fn observe(&mut self, ev: &StateEvent<'_>) {
-        if let Err(e) = self.write(ev) {
-            self.error = Some(e.to_string());
-        }
     }
 }

@@ -393,14 +393,17 @@ impl Limits {
         let vmax = v.iter().map(|vi| vi.norm()).fold(0.0, f64::max);
         let etot = model.energy(x, 1.0) + kinetic_energy(model, v);
         let time = step as f64 * dt;
-        if let Some(obs) = observer {
-            obs.observe(&StateEvent {
+        if let Some(obs) = observer
+            && let Err(err) = obs.observe(&StateEvent {
                 index: step,
                 time_s: Some(time),
                 x,
                 max_residual_N: r,
                 energy_J: etot,
-            });
+            })
+        {
+            let msg = format!("an observer failed at step {step}: {err:#}");
+            return Some((Stop::Reason(StopReason::Observer), msg));
         }
         let divergence = if !etot.is_finite() || !r.is_finite() {
             Some(DivergenceReason::NonFinite)

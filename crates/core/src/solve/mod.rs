@@ -35,12 +35,18 @@ pub struct StateEvent<'a> {
     pub energy_J: f64,
 }
 
-/// Receives states during a solve (argmin's observer pattern): recorders, progress bars.
+/// Receives states during a solve (argmin's observer pattern): recorders, progress bars. Observers do
+/// the I/O and may fail: an error stops the solve ([`StopReason::Observer`]).
 pub trait Observer {
     /// Whether the observer wants the state at this index (so solvers skip the work of building it).
     fn wants(&self, index: usize) -> bool;
     /// Called with a state the observer wanted.
-    fn observe(&mut self, event: &StateEvent<'_>);
+    fn observe(&mut self, event: &StateEvent<'_>) -> anyhow::Result<()>;
+    /// The final call, once the solve is over, with its final state (None when that state is not
+    /// finite): recorders write it if they have not and close their files.
+    fn finish(&mut self, _final_state: Option<&StateEvent<'_>>) -> anyhow::Result<()> {
+        Ok(())
+    }
 }
 
 /// An observer that wants nothing.
@@ -50,7 +56,9 @@ impl Observer for NoObserver {
     fn wants(&self, _index: usize) -> bool {
         false
     }
-    fn observe(&mut self, _event: &StateEvent<'_>) {}
+    fn observe(&mut self, _event: &StateEvent<'_>) -> anyhow::Result<()> {
+        Ok(())
+    }
 }
 
 /// Fans one state out to several observers.
@@ -60,11 +68,18 @@ impl Observer for Observers<'_> {
     fn wants(&self, index: usize) -> bool {
         self.0.iter().any(|o| o.wants(index))
     }
-    fn observe(&mut self, event: &StateEvent<'_>) {
+    fn observe(&mut self, event: &StateEvent<'_>) -> anyhow::Result<()> {
         for o in self.0.iter_mut() {
             if o.wants(event.index) {
-                o.observe(event);
+                o.observe(event)?;
             }
         }
+        Ok(())
+    }
+    fn finish(&mut self, final_state: Option<&StateEvent<'_>>) -> anyhow::Result<()> {
+        for o in self.0.iter_mut() {
+            o.finish(final_state)?;
+        }
+        Ok(())
     }
 }

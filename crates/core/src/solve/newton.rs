@@ -346,14 +346,18 @@ pub fn solve_static_loads(
                 report.diverge(iter, None, DivergenceReason::NonFinite);
                 break 'load;
             }
-            if observer.wants(iter) {
-                observer.observe(&StateEvent {
+            if observer.wants(iter)
+                && let Err(err) = observer.observe(&StateEvent {
                     index: iter,
                     time_s: None,
                     x,
                     max_residual_N: r,
                     energy_J: e,
-                });
+                })
+            {
+                report.stop_for(StopReason::Observer);
+                report.message = format!("an observer failed at iteration {iter}: {err:#}");
+                break 'load;
             }
             if r <= tol && last {
                 report.stop_for(StopReason::Converged);

@@ -51,6 +51,8 @@ pub enum StopReason {
     Diverged,
     /// The problem cannot be solved as posed (nothing free, a non-positive step).
     Invalid,
+    /// An observer failed (a recording could not be written); the message says why.
+    Observer,
 }
 
 impl StopReason {
@@ -64,7 +66,7 @@ impl StopReason {
             | StopReason::LineSearch
             | StopReason::ContactRounds => Status::MaxIterations,
             StopReason::Diverged => Status::Diverged,
-            StopReason::Invalid => Status::Invalid,
+            StopReason::Invalid | StopReason::Observer => Status::Invalid,
         }
     }
 }
