@@ -11,7 +11,7 @@ pub use sample::{
 use crate::edges::scene_view;
 use crate::edges::{EdgeFit, curve_distance_pct, edges_from_particles};
 use crate::material::Topology;
-use crate::optim::{Ica, IcaReport, IcaSettings};
+use crate::optim::{Ica, IcaReport, IcaSettings, Minimizer};
 use crate::scene::Scene;
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
@@ -344,29 +344,20 @@ impl StartLattice {
 
 /// The cost restricted to the parameters a static drape depends on (stiffness and natural length, unit
 /// box), the others held at a base point: what the Nelder–Mead polish minimises.
-struct StaticSubspace<'a> {
-    problem: &'a Problem,
+struct StaticSubspace {
     base: Vec<f64>,
 }
 
 /// The coordinates of the unit box that a static drape can see: stiffness and natural length.
 const STATIC_DIMS: [usize; 2] = [0, 3];
 
-impl StaticSubspace<'_> {
+impl StaticSubspace {
     fn full(&self, v: &[f64]) -> Vec<f64> {
         let mut u = self.base.clone();
         for (&d, &x) in STATIC_DIMS.iter().zip(v) {
             u[d] = x.clamp(0.0, 1.0);
         }
         u
-    }
-}
-
-impl argmin::core::CostFunction for StaticSubspace<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-    fn cost(&self, v: &Self::Param) -> Result<f64, argmin::core::Error> {
-        Ok(self.problem.cost(&self.full(v)))
     }
 }
 
@@ -377,44 +368,18 @@ impl Problem {
     /// trade off), and a local simplex walks along it far more cheaply than more decades would.
     /// Returns the better of `u` and the polished point, with its cost.
     pub fn polish(&self, u: &[f64], max_iters: u64) -> (Vec<f64>, f64) {
-        use argmin::core::{Executor, State};
-        let start = self.cost(u);
-        if max_iters == 0 {
-            return (u.to_vec(), start);
-        }
-        let sub = StaticSubspace {
-            problem: self,
-            base: u.to_vec(),
-        };
+        let sub = StaticSubspace { base: u.to_vec() };
         let v0: Vec<f64> = STATIC_DIMS.iter().map(|&d| u[d]).collect();
-        let step = 0.02;
-        let mut simplex = vec![v0.clone()];
-        for k in 0..v0.len() {
-            let mut v = v0.clone();
-            v[k] += if v[k] + step <= 1.0 { step } else { -step };
-            simplex.push(v);
-        }
-        let solver = argmin::solver::neldermead::NelderMead::new(simplex)
-            .with_sd_tolerance(1e-7)
-            .expect("a valid tolerance");
-        let run = Executor::new(sub, solver)
-            .configure(|s| s.max_iters(max_iters))
-            .run();
-        match run {
-            Ok(res) => {
-                let best = res.state().get_best_param().cloned();
-                match best {
-                    Some(v) if res.state().get_best_cost() < start => {
-                        let sub = StaticSubspace {
-                            problem: self,
-                            base: u.to_vec(),
-                        };
-                        (sub.full(&v), res.state().get_best_cost())
-                    }
-                    _ => (u.to_vec(), start),
-                }
-            }
-            Err(_) => (u.to_vec(), start),
+        let nm = crate::optim::NelderMead {
+            max_iters,
+            step: 0.02,
+            sd_tolerance: 1e-7,
+        };
+        let r = nm.minimize(&|v: &[f64]| self.cost(&sub.full(v)), Some(&v0));
+        if r.best_x == v0 {
+            (u.to_vec(), r.best_cost)
+        } else {
+            (sub.full(&r.best_x), r.best_cost)
         }
     }
 }

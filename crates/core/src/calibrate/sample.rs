@@ -5,7 +5,7 @@
 
 use super::{Evaluation, Identifiability, Noise, Params, Problem, identifiability};
 use crate::edges::{EdgeFit, eq5_objective_pct};
-use crate::optim::{DecadeEvent, Ica, IcaSettings, cmaes};
+use crate::optim::{Cmaes, DecadeEvent, Ica, IcaSettings, Minimizer};
 use anyhow::Result;
 use std::sync::atomic::Ordering;
 
@@ -133,12 +133,12 @@ pub fn calibrate_sample(
         });
         if s.baseline_cmaes {
             let fresh = problem.fresh();
-            let cm = cmaes(
-                &|u: &[f64]| fresh.cost(u),
-                5,
-                report.evaluations,
-                s.ica.seed + r as u64,
-            );
+            let cm = Cmaes {
+                dim: 5,
+                budget: report.evaluations,
+                seed: s.ica.seed + r as u64,
+            }
+            .minimize(&|u: &[f64]| fresh.cost(u), None);
             runs.push(OptimizerRun {
                 optimizer: "cma-es",
                 run: r as u32,

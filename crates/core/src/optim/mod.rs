@@ -5,9 +5,11 @@
 mod cmaes;
 mod ica;
 mod lhs;
+mod minimizer;
 mod taguchi;
 
 pub use cmaes::{CmaesReport, cmaes};
 pub use ica::{DecadeEvent, Ica, IcaReport, IcaSettings};
 pub use lhs::latin_hypercube;
+pub use minimizer::{Cmaes, Cost, Minimizer, NelderMead, OptimReport, OptimStop};
 pub use taguchi::{L27, l27, main_effects, sn_smaller_the_better};
