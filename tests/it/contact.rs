@@ -264,13 +264,12 @@ fn bad_refined_lines_exit_2_naming_the_key() {
 
 #[test]
 fn the_quarter_table_model_is_an_equilibrium_of_the_full_model_and_matches_table_10_2() {
-    use drapelab::build::build_scene;
     let quarter = scene("table_wool_quarter.toml", &[]);
     let q = converged(&quarter);
     // Unfold the quarter (x, y ≥ 0) into the full sheet by the two mirrors (the graded grids match:
     // the full grid's lines mirror the quarter's).
     let full = scene("table_wool.toml", &[]);
-    let built = build_scene(&full);
+    let built = crate::support::built(&full);
     let (nq, nf) = (quarter.cloth.nx, full.cloth.nx);
     assert_eq!(2 * nq - 1, nf);
     let mut x = built.x0.clone();

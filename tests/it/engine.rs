@@ -2,7 +2,6 @@
 //! behaviour of the integrators. A failure here means drapelab's equilibria are wrong.
 
 use crate::support::scene;
-use drapelab::build::build_scene;
 use drapelab::scene::Scene;
 use drapelab::simulate::{Solution, solve_scene};
 use drapelab::solve::{
@@ -144,7 +143,7 @@ fn cantilever_converges_to_the_exact_elastica() {
 #[test]
 fn symplectic_euler_without_damping_conserves_energy() {
     let s = scene("hang4.toml", &["cloth.nx=5", "cloth.ny=5"]);
-    let built = build_scene(&s);
+    let built = crate::support::built(&s);
     let mut x = built.x0.clone();
     let mut v = vec![Vector3::zeros(); x.len()];
     let energy = |x: &[Vector3<f64>], v: &[Vector3<f64>]| {
@@ -204,7 +203,7 @@ fn explicit_integrators_above_their_stability_limit_report_divergence() {
         ("symplectic-euler", Integrator::SymplecticEuler),
     ] {
         let s = scene("hang4.toml", &["cloth.nx=11", "cloth.ny=11"]);
-        let built = build_scene(&s);
+        let built = crate::support::built(&s);
         let limit =
             stability_limit_dt(&built.model, &built.x0, integ, built.model.damping_Ns_per_m)
                 .unwrap();
@@ -236,7 +235,7 @@ fn explicit_integrators_above_their_stability_limit_report_divergence() {
 
 #[test]
 fn topology_b_builds_no_bend_terms_and_c_no_shear() {
-    let b = build_scene(&scene(
+    let b = crate::support::built(&scene(
         "hang4.toml",
         &["material.mass_spring.topology=\"b\""],
     ));
@@ -245,7 +244,7 @@ fn topology_b_builds_no_bend_terms_and_c_no_shear() {
         names.iter().any(|n| n.contains("shear")) && !names.iter().any(|n| n.contains("bend")),
         "{names:?}"
     );
-    let c = build_scene(&scene(
+    let c = crate::support::built(&scene(
         "hang4.toml",
         &["material.mass_spring.topology=\"c\""],
     ));
@@ -354,4 +353,38 @@ fn a_failing_observer_stops_the_solve_with_its_reason_and_no_result() {
         );
         assert_eq!(sol.report.iterations, 2, "{kind}: stopped where it failed");
     }
+}
+
+#[test]
+fn a_scene_made_invalid_in_code_solves_to_an_invalid_status_naming_the_key() {
+    use drapelab::solve::{Status, StopReason};
+    // Only a checked scene reaches the model builder: a scene changed in code after loading is
+    // checked again by the solve, and a bad value is a status with the key, not a panic.
+    let mut s = scene("hang4.toml", &["cloth.nx=11", "cloth.ny=11"]);
+    s.cloth.nx = 1;
+    let sol = solve_scene(&s, &mut drapelab::solve::NoObserver);
+    assert_eq!(sol.report.status, Status::Invalid);
+    assert_eq!(sol.report.stop, StopReason::Invalid);
+    assert!(
+        sol.report.message.contains("cloth.nx"),
+        "{}",
+        sol.report.message
+    );
+    assert!(sol.x.is_empty() && sol.grid.is_empty());
+    let mut t = scene("hang4.toml", &["cloth.nx=11", "cloth.ny=11"]);
+    t.material.mass_spring.as_mut().unwrap().stiffness_N_per_m = f64::NAN;
+    let sol = solve_scene(&t, &mut drapelab::solve::NoObserver);
+    assert_eq!(sol.report.status, Status::Invalid);
+    assert!(
+        sol.report.message.contains("stiffness_N_per_m"),
+        "{}",
+        sol.report.message
+    );
+    // The checked scene reads as the scene it wraps, and a change through it is checked.
+    let v = scene("hang4.toml", &["cloth.nx=11", "cloth.ny=11"])
+        .validated()
+        .unwrap();
+    assert_eq!(v.cloth.nx, 11);
+    assert!(v.modify(|s| s.cloth.ny = 0).is_err());
+    assert_eq!(v.modify(|s| s.cloth.ny = 21).unwrap().cloth.ny, 21);
 }

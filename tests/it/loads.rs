@@ -2,7 +2,6 @@
 //! buckles only when perturbed (seed 003 §10.5), and a twisted plate bends alike in every direction.
 
 use crate::support::scene;
-use drapelab::build::build_scene;
 use drapelab::simulate::solve_scene;
 use drapelab::solve::{NoObserver, Status};
 use nalgebra::Vector3;
@@ -130,7 +129,7 @@ fn with_twist_a_plate_bends_alike_about_a_diagonal_and_a_grid_line() {
                 &format!("material.continuum.bending_twist_gf_cm2_per_cm={twist}"),
             ],
         );
-        let built = build_scene(&s);
+        let built = crate::support::built(&s);
         let bend = |z: &dyn Fn(f64, f64) -> f64| -> f64 {
             let x: Vec<Vector3<f64>> = built
                 .x0

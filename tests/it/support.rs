@@ -19,6 +19,7 @@ pub fn scene(name: &str, sets: &[&str]) -> Scene {
     Scene::load(&root().join("datasets/scenes").join(name), &overrides)
         .expect("valid scene")
         .scene
+        .into_inner()
 }
 
 /// The drapelab binary built for these tests.
@@ -168,4 +169,9 @@ pub fn assert_bad_edits(command: &str, path: &str, edits: &[(&str, &str, &str)])
             out.display()
         );
     }
+}
+
+/// Builds a scene's model (the builder takes only a checked scene).
+pub fn built(s: &Scene) -> drapelab::build::BuiltScene {
+    drapelab::build::build_scene(&s.clone().validated().expect("valid scene"))
 }

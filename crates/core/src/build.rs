@@ -6,7 +6,7 @@ use crate::material::Rigidities;
 use crate::physics::{
     CellShear, CellTwist, EnergyTerm, Gravity, LinearBending, Model, SpringFamily, Springs,
 };
-use crate::scene::Scene;
+use crate::scene::{Scene, ValidatedScene};
 use nalgebra::Vector3;
 
 /// A scene turned into a model with its grid and initial positions.
@@ -46,7 +46,7 @@ pub fn initial_positions(scene: &Scene) -> Vec<Vector3<f64>> {
 }
 
 /// Builds the model of a validated scene.
-pub fn build_scene(scene: &Scene) -> BuiltScene {
+pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
     let c = &scene.cloth;
     let grid = scene.grid();
     let flat = grid.flat_positions();

@@ -337,7 +337,7 @@ impl Default for ContactSpec {
 #[derive(Debug, Clone)]
 pub struct LoadedScene {
     /// The validated scene.
-    pub scene: Scene,
+    pub scene: ValidatedScene,
     /// The file it was read from.
     pub path: PathBuf,
 }
@@ -464,7 +464,7 @@ impl Scene {
         }
         scene.validate(path)?;
         Ok(LoadedScene {
-            scene,
+            scene: ValidatedScene(scene),
             path: path.to_path_buf(),
         })
     }
@@ -783,6 +783,50 @@ impl Scene {
             return ck.err("record.every", "must be ≥ 1".into());
         }
         Ok(())
+    }
+}
+
+/// A scene whose every value has been range-checked ([`Scene::validate`]): what the model builder
+/// ([`crate::build::build_scene`]) and the solvers take. Read it as a [`Scene`] (`Deref`); change it
+/// with [`ValidatedScene::modify`], which checks the result again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValidatedScene(Scene);
+
+impl std::ops::Deref for ValidatedScene {
+    type Target = Scene;
+    fn deref(&self) -> &Scene {
+        &self.0
+    }
+}
+
+impl Serialize for ValidatedScene {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.serialize(s)
+    }
+}
+
+impl Scene {
+    /// Checks the scene (errors name the scene, not a file: it was built or changed in code).
+    pub fn validated(self) -> Result<ValidatedScene, InputError> {
+        self.validate(Path::new(&format!("scene `{}`", self.name)))?;
+        Ok(ValidatedScene(self))
+    }
+}
+
+impl ValidatedScene {
+    /// The scene, no longer known to be valid.
+    pub fn into_inner(self) -> Scene {
+        self.0
+    }
+    /// A changed copy, checked again.
+    pub fn modify(&self, change: impl FnOnce(&mut Scene)) -> Result<ValidatedScene, InputError> {
+        let mut s = self.0.clone();
+        change(&mut s);
+        s.validated()
+    }
+    /// [`Scene::regridded`], checked again.
+    pub fn regridded(&self, nx: usize, ny: usize) -> Result<ValidatedScene, InputError> {
+        self.0.regridded(nx, ny).validated()
     }
 }
 

@@ -23,6 +23,37 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// The solution of a scene that failed its checks: no particles, status invalid, the error as
+    /// the message.
+    pub fn invalid(scene: &Scene, error: crate::error::InputError) -> Self {
+        let mut report = SolveReport::unsolved(match scene.solver.kind {
+            crate::scene::SolverKind::Static => "static-newton",
+            other => other.name(),
+        });
+        report.stop_for(crate::solve::StopReason::Invalid);
+        report.message = error.to_string();
+        Solution {
+            grid: Grid {
+                nx: 0,
+                ny: 0,
+                xs: Vec::new(),
+                ys: Vec::new(),
+            },
+            x: Vec::new(),
+            report,
+            terms: Vec::new(),
+            model: crate::physics::Model {
+                masses: Vec::new(),
+                fixed: Vec::new(),
+                held_components: Vec::new(),
+                n_grid: 0,
+                terms: Vec::new(),
+                gravity_m_per_s2: scene.gravity.g_m_per_s2,
+                damping_Ns_per_m: 0.0,
+                elongation_rate: None,
+            },
+        }
+    }
     /// Positions of the grid particles only.
     pub fn grid_positions(&self) -> &[Vector3<f64>] {
         &self.x[..self.grid.len()]
@@ -48,7 +79,9 @@ impl Solution {
     }
 }
 
-/// Solves a validated scene in memory with its configured solver; the observer sees each state.
+/// Solves a scene in memory with its configured solver; the observer sees each state. The scene is
+/// checked first ([`Scene::validated`]): an invalid one gives a solution with status invalid, the
+/// bad key in its message, and no particles.
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
     solve_built(scene, None, observer)
 }
@@ -69,6 +102,12 @@ fn solve_built(
     start: Option<&[Vector3<f64>]>,
     observer: &mut dyn Observer,
 ) -> Solution {
+    // Only a checked scene is built; one changed in code into an invalid one is a status, not a panic.
+    let scene = match scene.clone().validated() {
+        Ok(v) => v,
+        Err(e) => return Solution::invalid(scene, e),
+    };
+    let scene = &scene;
     let BuiltScene {
         grid,
         mut model,
@@ -78,7 +117,7 @@ fn solve_built(
         Some(x0) if x0.len() == x.len() => {
             x.copy_from_slice(x0);
             // A warm start is near its equilibrium: Newton starts far less damped.
-            let mut warm = scene.clone();
+            let mut warm = (**scene).clone();
             let lm = &mut warm.solver.static_.lm_damping_initial;
             *lm = lm.min(WARM_LM_DAMPING);
             let mut report = static_or_dynamic(&warm, &grid, &mut model, &mut x, observer);

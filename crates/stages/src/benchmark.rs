@@ -90,7 +90,7 @@ fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
     let scenes: Vec<Scene> = ctx
         .input_files("scenes")
         .iter()
-        .map(|f| Ok(Scene::load(f, &[])?.scene))
+        .map(|f| Ok(Scene::load(f, &[])?.scene.into_inner()))
         .collect::<Result<_>>()?;
     if scenes.is_empty() {
         bail!("a benchmark needs at least one scene file as input");

@@ -164,7 +164,7 @@ fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
         let peer = run_py(&explicit, &[n.to_string(), p.explicit_steps.to_string()])?;
         let mut s = bench_scene(&scene, n, SolverKind::ExplicitEuler, 1e-30);
         // A fixed number of steps at half the stability limit: stop by time, not by convergence.
-        let built = drapelab_core::build::build_scene(&s);
+        let built = drapelab_core::build::build_scene(&s.clone().validated()?);
         let dt = 0.5
             * drapelab_core::solve::stability_limit_dt(
                 &built.model,

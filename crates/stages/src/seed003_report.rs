@@ -120,7 +120,7 @@ impl StageKind for Seed003Report {
 }
 
 fn load(path: &Path) -> Result<Scene> {
-    Ok(Scene::load(path, &[])?.scene)
+    Ok(Scene::load(path, &[])?.scene.into_inner())
 }
 
 fn run(ctx: &StageContext<'_>, p: &Seed003ReportParams) -> Result<()> {
@@ -449,7 +449,7 @@ sticky vertical gap {:.2} cm from the friction barrier's corner: the two treatme
 /// Load–displacement by incremental loading against the single step (§10.3.3): the text and the SVG.
 fn load_displacement(c: &Scene, p: &Seed003ReportParams) -> Result<(String, String)> {
     let mut md = String::new();
-    let built = drapelab_core::build::build_scene(c);
+    let built = drapelab_core::build::build_scene(&c.clone().validated()?);
     let tip = built.grid.index(built.grid.nx - 1, built.grid.ny / 2);
     let opts = &c.solver.static_;
     let mut x = built.x0.clone();

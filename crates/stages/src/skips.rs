@@ -51,7 +51,9 @@ impl StageKind for Skips {
 /// population, measured on and off in the same run, into a Parquet table (`skip`, `scene`,
 /// `time_with_skip_s`, `time_without_skip_s`, `saved_fraction`).
 fn run(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
-    let load = |slot: &str| -> Result<Scene> { Ok(Scene::load(ctx.input(slot)?, &[])?.scene) };
+    let load = |slot: &str| -> Result<Scene> {
+        Ok(Scene::load(ctx.input(slot)?, &[])?.scene.into_inner())
+    };
     let (full, quarter, hang) = (load("full")?, load("quarter")?, load("hang")?);
     ctx.progress.stage_started(&ctx.stage.name, 6);
     let done = || ctx.progress.item_done(&ctx.stage.name);
@@ -82,7 +84,7 @@ fn skip_recording(hang: &Scene, path: &Path) -> Result<SkipRow> {
     let mut times = Vec::new();
     for (k, s) in [&hang4, &with_rec].iter().enumerate() {
         let loaded = LoadedScene {
-            scene: (*s).clone(),
+            scene: (*s).clone().validated()?,
             path: path.to_path_buf(),
         };
         let out = tmp.path().join(format!("r{k}"));

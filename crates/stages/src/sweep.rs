@@ -261,7 +261,7 @@ fn load_jobs(
                     overrides.push((sub.trim().to_string(), v.clone()));
                 }
             }
-            let mut scene = Scene::load(file, &overrides)?.scene;
+            let mut scene = Scene::load(file, &overrides)?.scene.into_inner();
             scene.record.timeline = false;
             scene.record.rerun = false;
             jobs.push((i as u32, scene));

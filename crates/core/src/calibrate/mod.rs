@@ -646,5 +646,5 @@ pub fn sample_scene(
     .iter()
     .map(|s| crate::config::parse_override(s))
     .collect::<Result<Vec<_>, _>>()?;
-    Ok(Scene::load(scene_file, &sets)?.scene)
+    Ok(Scene::load(scene_file, &sets)?.scene.into_inner())
 }

@@ -7,7 +7,7 @@
 //!   conjugate gradients with a block-Jacobi preconditioner.
 
 use super::linear::DofMap;
-use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
+use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -254,23 +254,10 @@ pub fn solve_dynamic(
     let free: Vec<bool> = model.fixed.iter().map(|f| !f).collect();
     let w_ref = model.reference_weight();
     let mut report = SolveReport {
-        solver: integrator.as_str().into(),
-        status: Status::MaxIterations,
         stop: StopReason::SimulatedTime,
-        iterations: 0,
-        linear_solves: 0,
-        factorizations: 0,
-        factor_time_s: 0.0,
-        inner_iterations: 0,
-        max_residual_N: f64::NAN,
-        max_residual_rel: f64::NAN,
-        energy_J: f64::NAN,
         sim_time_s: Some(0.0),
         dt_s: Some(dt),
-        wall_time_s: 0.0,
-        divergence: None,
-        message: String::new(),
-        minimum: None,
+        ..SolveReport::unsolved(integrator.as_str())
     };
     if !free.iter().any(|&f| f) || !w_ref.is_finite() || dt.is_nan() || dt <= 0.0 {
         report.stop_for(StopReason::Invalid);

@@ -307,25 +307,7 @@ pub fn solve_static_loads(
     let start = Instant::now();
     let w_ref = model.reference_weight();
     let tol = opts.residual_tol_rel * w_ref;
-    let mut report = SolveReport {
-        solver: "static-newton".into(),
-        status: Status::MaxIterations,
-        stop: StopReason::Iterations,
-        iterations: 0,
-        linear_solves: 0,
-        inner_iterations: 0,
-        factorizations: 0,
-        factor_time_s: 0.0,
-        max_residual_N: f64::NAN,
-        max_residual_rel: f64::NAN,
-        energy_J: f64::NAN,
-        sim_time_s: None,
-        dt_s: None,
-        wall_time_s: 0.0,
-        divergence: None,
-        message: String::new(),
-        minimum: None,
-    };
+    let mut report = SolveReport::unsolved("static-newton");
     let mut ws = Workspace::new(model, x, opts);
     if ws.dofs.n == 0 || !w_ref.is_finite() {
         report.stop_for(StopReason::Invalid);

@@ -163,6 +163,29 @@ pub struct SolveReport {
 }
 
 impl SolveReport {
+    /// The report a solve starts from: nothing done yet, stopped by its iteration budget until said
+    /// otherwise, residual and energy unknown.
+    pub fn unsolved(solver: impl Into<String>) -> Self {
+        SolveReport {
+            solver: solver.into(),
+            status: Status::MaxIterations,
+            stop: StopReason::Iterations,
+            iterations: 0,
+            linear_solves: 0,
+            inner_iterations: 0,
+            factorizations: 0,
+            factor_time_s: 0.0,
+            max_residual_N: f64::NAN,
+            max_residual_rel: f64::NAN,
+            energy_J: f64::NAN,
+            sim_time_s: None,
+            dt_s: None,
+            wall_time_s: 0.0,
+            divergence: None,
+            message: String::new(),
+            minimum: None,
+        }
+    }
     /// Whether the final state is an equilibrium that may be written as a result.
     pub fn is_converged(&self) -> bool {
         self.status == Status::Converged
