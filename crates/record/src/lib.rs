@@ -13,6 +13,7 @@ mod rrd;
 mod run_dir;
 mod table;
 mod timeline;
+mod wrinkles_rrd;
 
 pub use calibration_rrd::CalibrationRecorder;
 pub use drapelab_core::atomic::{Staged, write_atomic, write_text};
@@ -23,3 +24,4 @@ pub use rrd::RerunRecorder;
 pub use run_dir::simulate_to_dir;
 pub use table::write_parquet;
 pub use timeline::TimelineRecorder;
+pub use wrinkles_rrd::write_wrinkle_meshes;

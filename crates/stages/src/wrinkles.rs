@@ -8,9 +8,11 @@ use arrow::array::{
     ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
 };
 use arrow::datatypes::{DataType, Field, Schema};
-use drapelab_core::wrinkles::{WrinkleConfig, WrinkleResult, load_config, solve, wrinkle_mesh};
+use drapelab_core::wrinkles::{
+    WrinkleConfig, WrinkleMesh, WrinkleResult, load_config, solve, wrinkle_mesh,
+};
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::{Staged, write_parquet, write_text};
+use drapelab_record::{write_parquet, write_text};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -212,26 +214,17 @@ fn write_rrd(
     solved: &[SolvedCase],
     p: &WrinklesParams,
 ) -> Result<()> {
-    let staged = Staged::new(out)?;
-    let rec = rerun::RecordingStreamBuilder::new("drapelab_wrinkles").save(staged.path())?;
-    for s in solved {
-        let c = &cfg.cases[s.index];
-        let m = wrinkle_mesh(&c.inputs(&cfg.defaults), &s.result, p.mesh_nx, p.mesh_ny);
-        let path = format!("cases/{}/mesh", c.case.replace(['/', '='], "_"));
-        rec.log_static(
-            path,
-            &rerun::Mesh3D::new(
-                m.points
-                    .iter()
-                    .map(|q| [q[0] as f32, q[2] as f32, -q[1] as f32]),
+    let meshes: Vec<(String, WrinkleMesh)> = solved
+        .iter()
+        .map(|s| {
+            let c = &cfg.cases[s.index];
+            (
+                c.case.clone(),
+                wrinkle_mesh(&c.inputs(&cfg.defaults), &s.result, p.mesh_nx, p.mesh_ny),
             )
-            .with_triangle_indices(m.triangles()),
-        )?;
-    }
-    rec.flush_blocking()?;
-    drop(rec);
-    staged.commit()?;
-    Ok(())
+        })
+        .collect();
+    drapelab_record::write_wrinkle_meshes(out, &meshes)
 }
 
 const REPORT_HEAD: &str = "# Tension-field wrinkles (seed 002, Tables I–IV)\n\nMade by the `wrinkles` stage \
