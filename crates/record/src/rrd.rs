@@ -2,18 +2,17 @@
 //! (dynamics) timeline, the pinned points, and the residual and energy as scalars.
 
 use crate::Staged;
+use crate::sampled::{Sampled, StateSink};
 use anyhow::Result;
 use drapelab_core::cloth::Grid;
-use drapelab_core::solve::{Observer, StateEvent};
+use drapelab_core::solve::StateEvent;
 use std::path::Path;
 
 /// An observer writing a rerun recording.
 pub struct RerunRecorder {
     rec: Option<rerun::RecordingStream>,
     staged: Option<Staged>,
-    every: usize,
     n_grid: usize,
-    last_index: Option<usize>,
 }
 
 impl RerunRecorder {
@@ -25,7 +24,7 @@ impl RerunRecorder {
         x0: &[nalgebra::Vector3<f64>],
         pins: &[usize],
         every: usize,
-    ) -> Result<Self> {
+    ) -> Result<Sampled<Self>> {
         let staged = Staged::new(path)?;
         let rec = rerun::RecordingStreamBuilder::new(rerun::ApplicationId::new_or_unknown(
             format!("drapelab_{app}"),
@@ -56,16 +55,17 @@ impl RerunRecorder {
             )
             .with_radii([0.004f32]),
         )?;
-        Ok(Self {
-            rec: Some(rec),
-            staged: Some(staged),
+        Ok(Sampled::new(
+            Self {
+                rec: Some(rec),
+                staged: Some(staged),
+                n_grid: grid.len(),
+            },
             every,
-            n_grid: grid.len(),
-            last_index: None,
-        })
+        ))
     }
 
-    fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+    fn log_state(&mut self, ev: &StateEvent<'_>) -> Result<()> {
         let rec = self
             .rec
             .as_ref()
@@ -87,25 +87,15 @@ impl RerunRecorder {
             &rerun::Scalars::single(ev.max_residual_N),
         )?;
         rec.log("stats/energy_J", &rerun::Scalars::single(ev.energy_J))?;
-        self.last_index = Some(ev.index);
         Ok(())
     }
 }
 
-impl Observer for RerunRecorder {
-    fn wants(&self, index: usize) -> bool {
-        index.is_multiple_of(self.every)
+impl StateSink for RerunRecorder {
+    fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+        self.log_state(ev)
     }
-    fn observe(&mut self, ev: &StateEvent<'_>) -> Result<()> {
-        self.write(ev)
-    }
-    /// Records the final state and renames the recording into place.
-    fn finish(&mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
-        if let Some(ev) = final_state
-            && self.last_index != Some(ev.index)
-        {
-            self.write(ev)?;
-        }
+    fn close(&mut self) -> Result<()> {
         if let (Some(rec), Some(staged)) = (self.rec.take(), self.staged.take()) {
             rec.flush_blocking()?;
             drop(rec);

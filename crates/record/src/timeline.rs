@@ -4,9 +4,10 @@
 //! replays the first; any MCAP reader decodes both as JSON.
 
 use crate::Staged;
+use crate::sampled::{Sampled, StateSink};
 use anyhow::Result;
 use drapelab_core::cloth::Grid;
-use drapelab_core::solve::{Observer, StateEvent};
+use drapelab_core::solve::StateEvent;
 use mcap::records::MessageHeader;
 use serde_json::json;
 use std::collections::BTreeMap;
@@ -25,15 +26,13 @@ pub struct TimelineRecorder {
     cloth: u16,
     stats: u16,
     seq: u32,
-    every: usize,
     n_grid: usize,
     indices: Vec<u32>,
-    last_index: Option<usize>,
 }
 
 impl TimelineRecorder {
     /// Starts recording to `path`, keeping every `every`-th state.
-    pub fn new(path: &Path, grid: &Grid, every: usize) -> Result<Self> {
+    pub fn new(path: &Path, grid: &Grid, every: usize) -> Result<Sampled<Self>> {
         let staged = Staged::new(path)?;
         let file = staged.path().to_path_buf();
         let f = std::fs::OpenOptions::new()
@@ -52,23 +51,24 @@ impl TimelineRecorder {
         let cloth = writer.add_channel(s1, "/drapelab/cloth", "json", &BTreeMap::new())?;
         let s2 = writer.add_schema("drapelab.Stats", "jsonschema", STATS_SCHEMA.as_bytes())?;
         let stats = writer.add_channel(s2, "/drapelab/stats", "json", &BTreeMap::new())?;
-        Ok(Self {
-            writer: Some(writer),
-            staged: Some(staged),
-            cloth,
-            stats,
-            seq: 0,
+        Ok(Sampled::new(
+            Self {
+                writer: Some(writer),
+                staged: Some(staged),
+                cloth,
+                stats,
+                seq: 0,
+                n_grid: grid.len(),
+                indices: drapelab_core::cloth::grid_triangles(grid)
+                    .into_iter()
+                    .flatten()
+                    .collect(),
+            },
             every,
-            n_grid: grid.len(),
-            indices: drapelab_core::cloth::grid_triangles(grid)
-                .into_iter()
-                .flatten()
-                .collect(),
-            last_index: None,
-        })
+        ))
     }
 
-    fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+    fn log_state(&mut self, ev: &StateEvent<'_>) -> Result<()> {
         // Log time: simulated time for dynamics, the iteration as milliseconds for Newton.
         let t_ns = match ev.time_s {
             Some(t) => (t * 1e9).round() as u64,
@@ -109,25 +109,15 @@ impl TimelineRecorder {
             };
             w.write_to_known_channel(&header, serde_json::to_string(&body)?.as_bytes())?;
         }
-        self.last_index = Some(ev.index);
         Ok(())
     }
 }
 
-impl Observer for TimelineRecorder {
-    fn wants(&self, index: usize) -> bool {
-        index.is_multiple_of(self.every)
+impl StateSink for TimelineRecorder {
+    fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
+        self.log_state(ev)
     }
-    fn observe(&mut self, ev: &StateEvent<'_>) -> Result<()> {
-        self.write(ev)
-    }
-    /// Records the final state (if it was not the last one recorded) and renames the file into place.
-    fn finish(&mut self, final_state: Option<&StateEvent<'_>>) -> Result<()> {
-        if let Some(ev) = final_state
-            && self.last_index != Some(ev.index)
-        {
-            self.write(ev)?;
-        }
+    fn close(&mut self) -> Result<()> {
         if let (Some(mut w), Some(staged)) = (self.writer.take(), self.staged.take()) {
             w.finish()?;
             drop(w);
