@@ -109,7 +109,7 @@ ica = { decades = 12, countries = 16, imperialists = 3, beta = 2.0, gamma = 0.5,
         ),
         (
             "ica = {",
-            "ica_from = \"x.json\"\nica = {",
+            "ica_from_input = true\nica = {",
             "stages.calibrate.params.ica",
         ),
     ] {

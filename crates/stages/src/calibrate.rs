@@ -140,7 +140,7 @@ impl StageKind for Calibrate {
         crate::SCENE_SLOT,
         Slot::optional(
             "ica",
-            "ICA settings as JSON (a tune stage's best_ica.json), with params.ica_from",
+            "ICA settings as JSON (a tune stage's best_ica.json), with params.ica_from_input",
         ),
     ];
     const OUTPUTS: &'static [Slot] = &[
