@@ -714,6 +714,9 @@ impl Scene {
 
     /// Every obstacle valid and clear of the flat sheet.
     fn check_obstacles(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        if self.obstacles.is_empty() {
+            return Ok(());
+        }
         let c = &self.cloth;
         let flat = self.initial_positions();
         for (k, o) in self.obstacles.iter().enumerate() {
@@ -823,10 +826,6 @@ impl ValidatedScene {
         let mut s = self.0.clone();
         change(&mut s);
         s.validated()
-    }
-    /// [`Scene::regridded`], checked again.
-    pub fn regridded(&self, nx: usize, ny: usize) -> Result<ValidatedScene, InputError> {
-        self.0.regridded(nx, ny).validated()
     }
 }
 

@@ -96,9 +96,18 @@ fn slot_inputs(plan: &Plan, s: &PlannedStage) -> BTreeMap<String, BTreeSet<Strin
 
 /// Every input file of a stage now with its content hash (None when missing).
 fn current_inputs(plan: &Plan, s: &PlannedStage) -> BTreeMap<String, Option<String>> {
-    slot_inputs(plan, s)
-        .into_values()
+    hashed(plan, &slot_inputs(plan, s))
+}
+
+/// The files of every slot with their content hashes (None when missing).
+fn hashed(
+    plan: &Plan,
+    slots: &BTreeMap<String, BTreeSet<String>>,
+) -> BTreeMap<String, Option<String>> {
+    slots
+        .values()
         .flatten()
+        .cloned()
         .map(|p| {
             let h = hash_file(&plan.root.join(&p)).ok();
             (p, h)
@@ -284,7 +293,7 @@ fn run_stage(
 ) -> Result<String> {
     let start = Instant::now();
     let slots = slot_inputs(plan, s);
-    let inputs_now = current_inputs(plan, s);
+    let inputs_now = hashed(plan, &slots);
     let outputs: BTreeMap<String, PathBuf> = s
         .outputs
         .iter()

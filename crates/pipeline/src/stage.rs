@@ -183,11 +183,6 @@ impl Registry {
             .insert(K::KIND, Arc::new(Typed::<K>(PhantomData)));
         self
     }
-    /// Adds a kind given as a trait object.
-    pub fn with_stage(mut self, stage: Arc<dyn Stage>) -> Self {
-        self.kinds.insert(stage.kind(), stage);
-        self
-    }
     /// The kind called `name`, shared.
     pub fn shared(&self, name: &str) -> Option<Arc<dyn Stage>> {
         self.kinds.get(name).cloned()

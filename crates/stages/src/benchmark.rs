@@ -2,6 +2,7 @@
 //! and error, into a Parquet table; optionally seed 000's slack-net population. The sibling kinds are
 //! `peers`, `skips` and `benchmark-report`.
 
+use crate::report::f64s;
 use anyhow::{Context, Result, bail};
 use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
 use arrow::datatypes::{DataType, Field, Schema};
@@ -50,7 +51,7 @@ pub struct BenchmarkParams {
     pub slack_net_population: usize,
 }
 
-fn default_sizes() -> Vec<usize> {
+pub(crate) fn default_sizes() -> Vec<usize> {
     vec![11, 21, 41]
 }
 fn default_tols() -> Vec<f64> {
@@ -58,10 +59,6 @@ fn default_tols() -> Vec<f64> {
 }
 fn default_explicit() -> usize {
     21
-}
-
-fn f64s(v: Vec<f64>) -> ArrayRef {
-    Arc::new(Float64Array::from(v))
 }
 
 /// Runs a benchmark stage.

@@ -3,6 +3,7 @@
 //! Writes `results.parquet` (one row per sample, with the runs' spread and each parameter's
 //! identifiability) and `evaluations.parquet` (every country of every decade of every run).
 
+use crate::report::f64s;
 use anyhow::{Context, Result, bail};
 use arrow::array::{
     ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
@@ -268,10 +269,6 @@ fn record_decade(
         origin,
         side_cm,
     )
-}
-
-fn f64s(v: Vec<f64>) -> ArrayRef {
-    Arc::new(Float64Array::from(v))
 }
 
 /// `results.parquet`: one row per sample.

@@ -2,6 +2,7 @@
 //! from `benches/peers/`, run beside drapelab in the same stage so that the ratios hold on a noisy
 //! machine.
 
+use crate::report::f64s;
 use anyhow::{Context, Result, bail};
 use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
 use arrow::datatypes::{DataType, Field, Schema};
@@ -14,14 +15,6 @@ use drapelab_record::write_parquet;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
-fn default_sizes() -> Vec<usize> {
-    vec![11, 21, 41]
-}
-
-fn f64s(v: Vec<f64>) -> ArrayRef {
-    Arc::new(Float64Array::from(v))
-}
-
 /// Parameters of a peers stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -31,7 +24,7 @@ pub struct PeersParams {
     #[serde(default = "default_python")]
     pub python: String,
     /// Sides of the hang4 grid for the static comparison. Default [11, 21, 41].
-    #[serde(default = "default_sizes")]
+    #[serde(default = "crate::benchmark::default_sizes")]
     pub static_sizes: Vec<usize>,
     /// Sides for the per-step explicit Euler comparison. Default [21, 41].
     #[serde(default = "default_step_sizes")]

@@ -1,7 +1,8 @@
 //! `skips`: each skip the engine makes, measured on and off in the same run.
 
+use crate::report::f64s;
 use anyhow::Result;
-use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray};
+use arrow::array::{ArrayRef, RecordBatch, StringArray};
 use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::benchmark::{
     SkipRow, skip_cost_cache, skip_second_thread, skip_symmetry, skip_unneeded_terms,
@@ -15,10 +16,6 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
-
-fn f64s(v: Vec<f64>) -> ArrayRef {
-    Arc::new(Float64Array::from(v))
-}
 
 /// Parameters of a skips stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
