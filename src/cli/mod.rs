@@ -104,6 +104,11 @@ pub enum Command {
     },
     /// List the stage kinds a pipeline may use, with their input and output slots.
     Kinds,
+    /// List every Parquet table drapelab writes: its columns (units in the names), types, nullability.
+    ///
+    /// The listing is traced from the tables' row types, the one place each schema is written; the
+    /// README's "Tables" section is this output.
+    Tables,
     /// Solve a 4- or 2-corner hang and render it as a photo.
     ///
     /// The camera faces the sheet (along +y). Writes DIR/photo.png (or .jpg), camera.json (exact
@@ -322,6 +327,10 @@ pub fn run(cli: Cli) -> Result<i32> {
         Command::Status { pipeline, check } => status(&pipeline, check),
         Command::Kinds => {
             print!("{}", kinds_text());
+            Ok(EXIT_OK)
+        }
+        Command::Tables => {
+            print!("{}", crate::stages::tables_markdown()?);
             Ok(EXIT_OK)
         }
         Command::Render {

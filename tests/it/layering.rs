@@ -39,9 +39,10 @@ const NOT_IN_CORE: [&str; 8] = [
 ];
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank.
-const CORE_RANKS: [(&str, u8); 19] = [
+const CORE_RANKS: [(&str, u8); 21] = [
     ("error", 0),
     ("atomic", 0),
+    ("table", 0),
     ("material", 0),
     ("contact", 0),
     ("optim", 0),
@@ -53,6 +54,7 @@ const CORE_RANKS: [(&str, u8); 19] = [
     ("build", 4),
     ("simulate", 5),
     ("measure", 5),
+    ("cusick", 6),
     ("elastica", 6),
     ("edges", 6),
     ("wrinkles", 6),

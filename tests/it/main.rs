@@ -4,6 +4,7 @@
 mod calibrate;
 mod cli;
 mod contact;
+mod cusick;
 mod edges;
 mod engine;
 mod equilibria;

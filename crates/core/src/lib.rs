@@ -18,6 +18,7 @@ pub mod calibrate;
 pub mod cloth;
 pub mod config;
 pub mod contact;
+pub mod cusick;
 pub mod edges;
 pub mod elastica;
 pub mod error;
@@ -28,6 +29,7 @@ pub mod physics;
 pub mod scene;
 pub mod simulate;
 pub mod solve;
+pub mod table;
 pub mod wrinkles;
 
 /// Standard gravity in m/s², the default of every scene.

@@ -56,20 +56,60 @@ pub fn vertical_projection(
     let origin = [lo[0] - pixel, lo[1] - pixel];
     let nx = ((hi[0] - origin[0]) / pixel).ceil() as usize + 2;
     let ny = ((hi[1] - origin[1]) / pixel).ceil() as usize + 2;
-    let mut covered = vec![false; nx * ny];
-    let mut fill = |a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>| {
+    let mut proj = Projection {
+        nx,
+        ny,
+        pixel_m: pixel,
+        origin_m: origin,
+        covered: vec![false; nx * ny],
+    };
+    let tris = crate::cloth::grid_triangles(grid)
+        .into_iter()
+        .map(|t| t.map(|v| v as usize))
+        .filter(|t| t.iter().all(|&v| present[v]));
+    proj.fill_triangles(x, tris);
+    proj
+}
+
+impl Projection {
+    /// An empty raster of `nx` × `ny` pixels of side `pixel_m`, lower-left corner at `origin_m`.
+    pub fn empty(nx: usize, ny: usize, pixel_m: f64, origin_m: [f64; 2]) -> Self {
+        Projection {
+            nx,
+            ny,
+            pixel_m,
+            origin_m,
+            covered: vec![false; nx * ny],
+        }
+    }
+
+    /// Covers every pixel whose centre lies in the vertical projection of a triangle of `x`.
+    pub fn fill_triangles(
+        &mut self,
+        x: &[Vector3<f64>],
+        triangles: impl IntoIterator<Item = [usize; 3]>,
+    ) {
+        for [a, b, c] in triangles {
+            self.fill_triangle(&x[a], &x[b], &x[c]);
+        }
+    }
+
+    fn fill_triangle(&mut self, a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) {
+        let (nx, ny, pixel, origin) = (self.nx, self.ny, self.pixel_m, self.origin_m);
         let area2 = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
         if area2.abs() < 1e-300 {
             return;
         }
-        let col0 = (((a.x.min(b.x).min(c.x)) - origin[0]) / pixel)
-            .floor()
-            .max(0.0) as usize;
-        let col1 = ((((a.x.max(b.x).max(c.x)) - origin[0]) / pixel).ceil() as usize).min(nx - 1);
-        let row0 = (((a.y.min(b.y).min(c.y)) - origin[1]) / pixel)
-            .floor()
-            .max(0.0) as usize;
-        let row1 = ((((a.y.max(b.y).max(c.y)) - origin[1]) / pixel).ceil() as usize).min(ny - 1);
+        let lo = |v: f64, o: f64| ((v - o) / pixel).floor().max(0.0) as usize;
+        let hi = |v: f64, o: f64, n: usize| (((v - o) / pixel).ceil().max(0.0) as usize).min(n - 1);
+        let (col0, col1) = (
+            lo(a.x.min(b.x).min(c.x), origin[0]),
+            hi(a.x.max(b.x).max(c.x), origin[0], nx),
+        );
+        let (row0, row1) = (
+            lo(a.y.min(b.y).min(c.y), origin[1]),
+            hi(a.y.max(b.y).max(c.y), origin[1], ny),
+        );
         for row in row0..=row1 {
             for col in col0..=col1 {
                 let px = origin[0] + (col as f64 + 0.5) * pixel;
@@ -83,23 +123,10 @@ pub fn vertical_projection(
                     w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0
                 };
                 if inside {
-                    covered[row * nx + col] = true;
+                    self.covered[row * nx + col] = true;
                 }
             }
         }
-    };
-    for tri in crate::cloth::grid_triangles(grid) {
-        let [a, b, c] = tri.map(|v| v as usize);
-        if present[a] && present[b] && present[c] {
-            fill(&x[a], &x[b], &x[c]);
-        }
-    }
-    Projection {
-        nx,
-        ny,
-        pixel_m: pixel,
-        origin_m: origin,
-        covered,
     }
 }
 
@@ -132,18 +159,32 @@ pub fn outline_radii(proj: &Projection, centre: [f64; 2], bins: usize) -> Vec<f6
 /// `smooth` sectors on each side, that stand above both neighbouring minima by more than
 /// `prominence_rel` of the mean radius.
 pub fn count_nodes(radii: &[f64], smooth: usize, prominence_rel: f64) -> usize {
+    let s = smooth_circular(radii, smooth);
+    let mean = s.iter().sum::<f64>() / s.len().max(1) as f64;
+    count_rises(&s, prominence_rel * mean)
+}
+
+/// `radii` averaged over `smooth` sectors on each side, around the circle.
+pub fn smooth_circular(radii: &[f64], smooth: usize) -> Vec<f64> {
     let n = radii.len();
+    let w = 2 * smooth + 1;
+    (0..n)
+        .map(|k| {
+            (0..w)
+                .map(|d| radii[(k + n * w + d - smooth) % n])
+                .sum::<f64>()
+                / w as f64
+        })
+        .collect()
+}
+
+/// Number of maxima of the circular sequence `s` that stand above both neighbouring minima by more
+/// than `threshold` (the same unit as `s`).
+pub fn count_rises(s: &[f64], threshold: f64) -> usize {
+    let n = s.len();
     if n < 3 {
         return 0;
     }
-    let s: Vec<f64> = (0..n)
-        .map(|k| {
-            let w = 2 * smooth + 1;
-            (0..w).map(|d| radii[(k + n + d - smooth) % n]).sum::<f64>() / w as f64
-        })
-        .collect();
-    let mean = s.iter().sum::<f64>() / n as f64;
-    let threshold = prominence_rel * mean;
     // Walk the circle from its global minimum, counting rises and falls of at least the threshold.
     let start = (0..n).min_by(|&a, &b| s[a].total_cmp(&s[b])).unwrap_or(0);
     let (mut count, mut low, mut high, mut rising) = (0, s[start], s[start], true);

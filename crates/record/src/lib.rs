@@ -6,6 +6,7 @@
 #![allow(non_snake_case)]
 
 mod calibration_rrd;
+pub mod cusick;
 mod edges_table;
 mod particles;
 mod photo;
@@ -18,12 +19,16 @@ mod wrinkles_rrd;
 
 pub use calibration_rrd::CalibrationRecorder;
 pub use drapelab_core::atomic::{Staged, write_atomic, write_text};
+pub use edges_table::EdgeRow;
 pub use edges_table::{read_edges, write_edges};
-pub use particles::{read_particles, write_particles};
+pub use particles::{ParticleRow, read_particles, write_particles};
 pub use photo::{fit_photo, render_scene, score_files};
 pub use rrd::RerunRecorder;
 pub use run_dir::simulate_to_dir;
 pub use sampled::{Sampled, StateSink};
-pub use table::write_parquet;
+pub use table::{
+    Table, join_columns, read_table, table_batch, table_fields, table_markdown, write_parquet,
+    write_table,
+};
 pub use timeline::TimelineRecorder;
 pub use wrinkles_rrd::write_wrinkle_meshes;

@@ -2,17 +2,13 @@
 //! and error, into a Parquet table; optionally seed 000's slack-net population. The sibling kinds are
 //! `peers`, `skips` and `benchmark-report`.
 
-use crate::report::f64s;
 use anyhow::{Context, Result, bail};
-use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::benchmark::{BenchLimits, BenchRow, bench_rows};
 use drapelab_core::scene::{Scene, SolverKind};
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::write_parquet;
+use drapelab_record::write_table;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::sync::Arc;
 
 /// Parameters of a benchmark stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -111,58 +107,7 @@ fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
         rows.extend(bench_rows(s, sizes, &p.tolerances, &limits, |_| {}));
         ctx.progress.item_done(&ctx.stage.name);
     }
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("scene", DataType::Utf8, false),
-        Field::new("particles_per_side", DataType::UInt64, false),
-        Field::new("solver", DataType::Utf8, false),
-        Field::new("tolerance_rel", DataType::Float64, false),
-        Field::new("status", DataType::Utf8, false),
-        Field::new("wall_time_s", DataType::Float64, false),
-        Field::new("iterations", DataType::UInt64, false),
-        Field::new("linear_solves", DataType::UInt64, false),
-        Field::new("factorizations", DataType::UInt64, false),
-        Field::new("factor_time_s", DataType::Float64, false),
-        Field::new("error_m", DataType::Float64, true),
-        Field::new("peak_rss_bytes", DataType::UInt64, true),
-    ]));
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(
-            rows.iter().map(|r| r.scene.clone()),
-        )),
-        Arc::new(UInt64Array::from_iter_values(
-            rows.iter().map(|r| r.n as u64),
-        )),
-        Arc::new(StringArray::from_iter_values(
-            rows.iter().map(|r| r.solver.name().to_string()),
-        )),
-        f64s(rows.iter().map(|r| r.tol).collect()),
-        Arc::new(StringArray::from_iter_values(
-            rows.iter().map(|r| r.status.clone()),
-        )),
-        f64s(rows.iter().map(|r| r.wall_time_s).collect()),
-        Arc::new(UInt64Array::from_iter_values(
-            rows.iter().map(|r| r.iterations as u64),
-        )),
-        Arc::new(UInt64Array::from_iter_values(
-            rows.iter().map(|r| r.linear_solves as u64),
-        )),
-        Arc::new(UInt64Array::from_iter_values(
-            rows.iter().map(|r| r.factorizations as u64),
-        )),
-        f64s(rows.iter().map(|r| r.factor_time_s).collect()),
-        Arc::new(Float64Array::from_iter(
-            rows.iter()
-                .map(|r| r.error_m.is_finite().then_some(r.error_m)),
-        )),
-        Arc::new(UInt64Array::from_iter(
-            rows.iter().map(|r| r.peak_rss_bytes),
-        )),
-    ];
-    write_parquet(
-        ctx.output("table")?,
-        &RecordBatch::try_new(schema, cols)?,
-        None,
-    )?;
+    write_table(ctx.output("table")?, &rows)?;
     if p.slack_net_population > 0 {
         let out = ctx
             .optional_output("population")
@@ -173,47 +118,7 @@ fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
             drapelab_core::benchmark::warm_start_population(&scenes[0], p.slack_net_population, 9)
                 .0,
         );
-        write_population(out, &rows)?;
+        write_table(out, &rows)?;
     }
     Ok(())
-}
-
-/// Writes the slack-net population's solves as a Parquet table.
-fn write_population(
-    out: &std::path::Path,
-    rows: &[drapelab_core::benchmark::PopulationRow],
-) -> Result<()> {
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("start", DataType::Utf8, false),
-        Field::new("stiffness_N_per_m", DataType::Float64, false),
-        Field::new("natural_length_m", DataType::Float64, false),
-        Field::new("topology", DataType::Utf8, false),
-        Field::new("areal_density_kg_per_m2", DataType::Float64, false),
-        Field::new("status", DataType::Utf8, false),
-        Field::new("iterations", DataType::UInt64, false),
-        Field::new("factorizations", DataType::UInt64, false),
-        Field::new("wall_time_s", DataType::Float64, false),
-        Field::new("factor_time_s", DataType::Float64, false),
-    ]));
-    let u64s = |f: &dyn Fn(&drapelab_core::benchmark::PopulationRow) -> usize| -> ArrayRef {
-        Arc::new(UInt64Array::from_iter_values(
-            rows.iter().map(|r| f(r) as u64),
-        ))
-    };
-    let strs = |f: &dyn Fn(&drapelab_core::benchmark::PopulationRow) -> String| -> ArrayRef {
-        Arc::new(StringArray::from_iter_values(rows.iter().map(f)))
-    };
-    let cols: Vec<ArrayRef> = vec![
-        strs(&|r| r.start.clone()),
-        f64s(rows.iter().map(|r| r.stiffness_N_per_m).collect()),
-        f64s(rows.iter().map(|r| r.natural_length_m).collect()),
-        strs(&|r| r.topology.clone()),
-        f64s(rows.iter().map(|r| r.areal_density_kg_per_m2).collect()),
-        strs(&|r| r.status.clone()),
-        u64s(&|r| r.iterations),
-        u64s(&|r| r.factorizations),
-        f64s(rows.iter().map(|r| r.wall_time_s).collect()),
-        f64s(rows.iter().map(|r| r.factor_time_s).collect()),
-    ];
-    write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)
 }

@@ -3,24 +3,18 @@
 //! Writes `results.parquet` (one row per sample, with the runs' spread and each parameter's
 //! identifiability) and `evaluations.parquet` (every country of every decade of every run).
 
-use crate::report::f64s;
+use crate::calibration_tables::{ComparisonRow, EvaluationRow, ResultRow};
 use anyhow::{Context, Result, bail};
-use arrow::array::{
-    ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
-};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::calibrate::{
-    EvaluatedCountry, Noise, OptimizerRun, Problem, SampleCalibration, SampleSettings,
-    calibrate_sample, read_sample_densities, sample_scene,
+    Noise, Problem, SampleCalibration, SampleSettings, calibrate_sample, read_sample_densities,
+    sample_scene,
 };
 use drapelab_core::edges::EdgeFit;
 use drapelab_core::optim::{DecadeEvent, IcaSettings};
 use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
-use drapelab_record::{CalibrationRecorder, read_edges, write_parquet};
+use drapelab_record::{CalibrationRecorder, read_edges, write_table};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
-use std::sync::Arc;
 
 /// Parameters of a calibrate stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -225,15 +219,9 @@ fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
         let found = calibrate_sample(&problem, measured, &settings, &mut observe, &done)?;
         results.push((sample.clone(), found));
     }
-    write_results(ctx.output("results")?, &results, p.runs)?;
+    write_tables(ctx, &results, p.runs)?;
     if let Some(rec) = recorder {
         rec.finish()?;
-    }
-    if let Some(out) = ctx.optional_output("comparison") {
-        write_comparison(out, &results)?;
-    }
-    if let Some(out) = ctx.optional_output("evaluations") {
-        write_evaluations(out, &results)?;
     }
     Ok(())
 }
@@ -271,164 +259,30 @@ fn record_decade(
     )
 }
 
-/// `results.parquet`: one row per sample.
-fn write_results(out: &Path, results: &[(String, SampleCalibration)], runs: usize) -> Result<()> {
-    let mut fields = vec![
-        Field::new("sample", DataType::Utf8, false),
-        Field::new("objective_pct", DataType::Float64, false),
-        Field::new("curve_distance_pct", DataType::Float64, false),
-        Field::new("ica_curve_distance_pct", DataType::Float64, false),
-        Field::new("stiffness_N_per_m", DataType::Float64, false),
-        Field::new("damping_Ns_per_m", DataType::Float64, false),
-        Field::new("elongation_rate", DataType::Float64, false),
-        Field::new("natural_length_m", DataType::Float64, false),
-        Field::new("topology", DataType::Utf8, false),
-        Field::new("runs", DataType::UInt32, false),
-        Field::new("spread_curve_distance_pct", DataType::Float64, false),
-        Field::new("simulations", DataType::UInt64, false),
-        Field::new("failed_simulations", DataType::UInt64, false),
-    ];
-    let r = |f: fn(&SampleCalibration) -> f64| f64s(results.iter().map(|(_, c)| f(c)).collect());
-    let mut cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(
-            results.iter().map(|(s, _)| s.clone()),
-        )),
-        r(|c| c.eq5_pct),
-        r(|c| c.curve_pct),
-        r(|c| c.ica_curve_pct),
-        r(|c| c.best.stiffness_N_per_m),
-        r(|c| c.best.damping_Ns_per_m),
-        r(|c| c.best.elongation_rate),
-        r(|c| c.best.natural_length_m),
-        Arc::new(StringArray::from_iter_values(
-            results.iter().map(|(_, c)| c.best.topology.letter()),
-        )),
-        Arc::new(UInt32Array::from_iter_values(
-            results.iter().map(|_| runs as u32),
-        )),
-        r(|c| c.spread_pct),
-        Arc::new(UInt64Array::from_iter_values(
-            results.iter().map(|(_, c)| c.simulations as u64),
-        )),
-        Arc::new(UInt64Array::from_iter_values(
-            results.iter().map(|(_, c)| c.failures as u64),
-        )),
-    ];
-    for (k, name) in [
-        "stiffness",
-        "damping",
-        "elongation_rate",
-        "natural_length",
-        "topology",
-    ]
-    .iter()
-    .enumerate()
-    {
-        fields.push(Field::new(
-            format!("identifiable_{name}"),
-            DataType::Boolean,
-            false,
-        ));
-        cols.push(Arc::new(BooleanArray::from(
-            results
-                .iter()
-                .map(|(_, c)| c.identifiability[k].identifiable)
-                .collect::<Vec<_>>(),
-        )));
-    }
-    // Half-widths of the intervals the photos allow (null where the cost is flat).
-    for (k, name) in [
-        "stiffness_uncertainty_N_per_m",
-        "damping_uncertainty_Ns_per_m",
-        "elongation_rate_uncertainty",
-        "natural_length_uncertainty_m",
-    ]
-    .iter()
-    .enumerate()
-    {
-        fields.push(Field::new(*name, DataType::Float64, true));
-        cols.push(Arc::new(Float64Array::from_iter(results.iter().map(
-            |(_, c)| {
-                let u = c.identifiability[k].uncertainty;
-                u.is_finite().then_some(u)
-            },
-        ))));
-    }
-    write_parquet(
-        out,
-        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
-        None,
-    )
-}
-
-/// `comparison.parquet`: every optimiser run's best cost.
-fn write_comparison(out: &Path, results: &[(String, SampleCalibration)]) -> Result<()> {
-    let rows: Vec<(&str, &OptimizerRun)> = results
+/// `results.parquet`, `comparison.parquet` and `evaluations.parquet` of the calibrated samples.
+fn write_tables(
+    ctx: &StageContext<'_>,
+    results: &[(String, SampleCalibration)],
+    runs: usize,
+) -> Result<()> {
+    let res: Vec<ResultRow> = results
         .iter()
-        .flat_map(|(s, c)| c.runs.iter().map(move |r| (s.as_str(), r)))
+        .map(|(s, c)| ResultRow::new(s, c, runs))
         .collect();
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("sample", DataType::Utf8, false),
-        Field::new("optimizer", DataType::Utf8, false),
-        Field::new("run", DataType::UInt32, false),
-        Field::new("evaluations", DataType::UInt64, false),
-        Field::new("best_cost_pct", DataType::Float64, false),
-    ]));
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(rows.iter().map(|c| c.0))),
-        Arc::new(StringArray::from_iter_values(
-            rows.iter().map(|c| c.1.optimizer),
-        )),
-        Arc::new(UInt32Array::from_iter_values(rows.iter().map(|c| c.1.run))),
-        Arc::new(UInt64Array::from_iter_values(
-            rows.iter().map(|c| c.1.evaluations),
-        )),
-        f64s(rows.iter().map(|c| c.1.best_cost_pct).collect()),
-    ];
-    write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)
-}
-
-/// `evaluations.parquet`: every country of every decade of every run.
-fn write_evaluations(out: &Path, results: &[(String, SampleCalibration)]) -> Result<()> {
-    let evals: Vec<(&str, &EvaluatedCountry)> = results
-        .iter()
-        .flat_map(|(s, c)| c.evaluations.iter().map(move |e| (s.as_str(), e)))
-        .collect();
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("sample", DataType::Utf8, false),
-        Field::new("run", DataType::UInt32, false),
-        Field::new("decade", DataType::UInt32, false),
-        Field::new("empire", DataType::UInt32, false),
-        Field::new("cost_pct", DataType::Float64, false),
-        Field::new("stiffness_N_per_m", DataType::Float64, false),
-        Field::new("natural_length_m", DataType::Float64, false),
-        Field::new("topology", DataType::Utf8, false),
-        Field::new("solver_status", DataType::Utf8, true),
-        Field::new("simulation_time_s", DataType::Float64, true),
-    ]));
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(evals.iter().map(|e| e.0))),
-        Arc::new(UInt32Array::from_iter_values(evals.iter().map(|e| e.1.run))),
-        Arc::new(UInt32Array::from_iter_values(
-            evals.iter().map(|e| e.1.decade),
-        )),
-        Arc::new(UInt32Array::from_iter_values(
-            evals.iter().map(|e| e.1.empire),
-        )),
-        f64s(evals.iter().map(|e| e.1.cost_pct).collect()),
-        f64s(evals.iter().map(|e| e.1.params.stiffness_N_per_m).collect()),
-        f64s(evals.iter().map(|e| e.1.params.natural_length_m).collect()),
-        Arc::new(StringArray::from_iter_values(
-            evals.iter().map(|e| e.1.params.topology.letter()),
-        )),
-        Arc::new(StringArray::from_iter(
-            evals.iter().map(|e| e.1.evaluation.map(|v| v.status)),
-        )),
-        Arc::new(Float64Array::from_iter(
-            evals
-                .iter()
-                .map(|e| e.1.evaluation.map(|v| v.simulation_time_s)),
-        )),
-    ];
-    write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)
+    write_table(ctx.output("results")?, &res)?;
+    if let Some(out) = ctx.optional_output("evaluations") {
+        let evals: Vec<EvaluationRow> = results
+            .iter()
+            .flat_map(|(s, c)| c.evaluations.iter().map(|e| EvaluationRow::new(s, e)))
+            .collect();
+        write_table(out, &evals)?;
+    }
+    if let Some(out) = ctx.optional_output("comparison") {
+        let cmp: Vec<ComparisonRow> = results
+            .iter()
+            .flat_map(|(s, c)| c.runs.iter().map(|r| ComparisonRow::new(s, r)))
+            .collect();
+        write_table(out, &cmp)?;
+    }
+    Ok(())
 }

@@ -9,6 +9,8 @@ mod benchmark;
 mod benchmark_report;
 mod calibrate;
 mod calibration_report;
+mod calibration_tables;
+mod cusick_measure;
 mod fit_edges;
 mod peers;
 pub mod report;
@@ -17,6 +19,7 @@ mod seed003_report;
 mod simulate;
 mod skips;
 mod sweep;
+mod sweep_table;
 mod tune;
 mod validate;
 mod wrinkles;
@@ -25,6 +28,7 @@ pub use benchmark::{Benchmark, BenchmarkParams};
 pub use benchmark_report::{BenchmarkReport, BenchmarkReportParams};
 pub use calibrate::{Calibrate, CalibrateParams};
 pub use calibration_report::{CalibrationReport, CalibrationReportParams};
+pub use cusick_measure::{CusickMeasure, CusickMeasureParams, ShadowRow, measure_dataset};
 pub use fit_edges::{FitEdges, FitEdgesParams};
 pub use peers::{Peers, PeersParams};
 pub use report::{Report, ReportParams};
@@ -69,4 +73,32 @@ pub fn registry() -> Registry {
         .with::<Peers>()
         .with::<BenchmarkReport>()
         .with::<Skips>()
+        .with::<CusickMeasure>()
+}
+
+/// Every Parquet table drapelab writes, each traced from its row type, as the Markdown the README's
+/// "Tables" section holds (`drapelab tables` prints it).
+pub fn tables_markdown() -> anyhow::Result<String> {
+    use drapelab_record::table_markdown as md;
+    let sections = [
+        md::<drapelab_record::ParticleRow>()?,
+        md::<drapelab_record::EdgeRow>()?,
+        md::<sweep_table::SweepPoint>()?,
+        md::<sweep_table::SweepOutcome>()?,
+        md::<drapelab_core::edges::ScoreRow>()?,
+        md::<calibration_tables::ResultRow>()?,
+        md::<calibration_tables::ComparisonRow>()?,
+        md::<calibration_tables::EvaluationRow>()?,
+        md::<validate::ValidationRow>()?,
+        md::<tune::TuneRow>()?,
+        md::<tune::MainEffectRow>()?,
+        md::<wrinkles::WrinkleRow>()?,
+        md::<wrinkles::WrinkleMeshRow>()?,
+        md::<drapelab_core::benchmark::BenchRow>()?,
+        md::<drapelab_core::benchmark::PopulationRow>()?,
+        md::<drapelab_core::benchmark::SkipRow>()?,
+        md::<peers::PeerRow>()?,
+        md::<cusick_measure::ShadowRow>()?,
+    ];
+    Ok(sections.join("\n"))
 }

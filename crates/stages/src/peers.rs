@@ -2,18 +2,39 @@
 //! from `benches/peers/`, run beside drapelab in the same stage so that the ratios hold on a noisy
 //! machine.
 
-use crate::report::f64s;
 use anyhow::{Context, Result, bail};
-use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::benchmark::bench_scene;
 use drapelab_core::scene::{Scene, SolverKind};
 use drapelab_core::simulate::solve_scene;
 use drapelab_core::solve::NoObserver;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::write_parquet;
+use drapelab_record::{Table, write_table};
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
+
+/// One comparison of drapelab with an independent implementation (`peers.parquet`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PeerRow {
+    /// What is compared, e.g. "static Newton: scipy / drapelab".
+    pub comparison: String,
+    /// Particles per side.
+    pub particles_per_side: u64,
+    /// The peer's wall time, s.
+    pub peer_time_s: f64,
+    /// drapelab's wall time, s.
+    pub drapelab_time_s: f64,
+    /// peer_time_s / drapelab_time_s.
+    pub ratio: f64,
+    /// The peer's centre height, m (None where the comparison has no solution to compare).
+    pub peer_centre_z_m: Option<f64>,
+    /// drapelab's centre height, m.
+    pub drapelab_centre_z_m: Option<f64>,
+}
+
+impl Table for PeerRow {
+    const FILE: &'static str = "peers.parquet";
+    const ROW: &'static str =
+        "One timing of drapelab against an independent Python implementation of the same solve.";
+}
 
 /// Parameters of a peers stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -181,30 +202,18 @@ fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
         ));
         ctx.progress.item_done(&ctx.stage.name);
     }
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("comparison", DataType::Utf8, false),
-        Field::new("particles_per_side", DataType::UInt64, false),
-        Field::new("peer_time_s", DataType::Float64, false),
-        Field::new("drapelab_time_s", DataType::Float64, false),
-        Field::new("ratio", DataType::Float64, false),
-        Field::new("peer_centre_z_m", DataType::Float64, true),
-        Field::new("drapelab_centre_z_m", DataType::Float64, true),
-    ]));
     let opt = |v: f64| v.is_finite().then_some(v);
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.0))),
-        Arc::new(UInt64Array::from_iter_values(
-            rows.iter().map(|r| r.1 as u64),
-        )),
-        f64s(rows.iter().map(|r| r.2).collect()),
-        f64s(rows.iter().map(|r| r.3).collect()),
-        f64s(rows.iter().map(|r| r.2 / r.3).collect()),
-        Arc::new(Float64Array::from_iter(rows.iter().map(|r| opt(r.4)))),
-        Arc::new(Float64Array::from_iter(rows.iter().map(|r| opt(r.5)))),
-    ];
-    write_parquet(
-        ctx.output("table")?,
-        &RecordBatch::try_new(schema, cols)?,
-        None,
-    )
+    let rows: Vec<PeerRow> = rows
+        .into_iter()
+        .map(|r| PeerRow {
+            comparison: r.0.to_string(),
+            particles_per_side: r.1 as u64,
+            peer_time_s: r.2,
+            drapelab_time_s: r.3,
+            ratio: r.2 / r.3,
+            peer_centre_z_m: opt(r.4),
+            drapelab_centre_z_m: opt(r.5),
+        })
+        .collect();
+    write_table(ctx.output("table")?, &rows)
 }

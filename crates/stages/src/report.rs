@@ -117,11 +117,6 @@ impl StageKind for Report {
     }
 }
 
-/// A Float64 column of a table.
-pub(crate) fn f64s(v: Vec<f64>) -> arrow::array::ArrayRef {
-    std::sync::Arc::new(arrow::array::Float64Array::from(v))
-}
-
 /// Runs the stage.
 fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
     let md = ctx.output("markdown")?;

@@ -2,13 +2,10 @@
 //! per sample folder), per sample and edge: seed 000 Eq. 5 and the curve distance, into `score.parquet`.
 
 use anyhow::{Context, Result, bail};
-use arrow::array::{Float64Array, RecordBatch, StringArray};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::edges::score_edges;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::{read_edges, write_parquet};
+use drapelab_record::{read_edges, write_table};
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
 
 /// Parameters of a score stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -74,33 +71,5 @@ fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
         rows.extend(score_edges(&real, &sim, p.side_cm));
         ctx.progress.item_done(&ctx.stage.name);
     }
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("sample", DataType::Utf8, false),
-        Field::new("edge", DataType::Utf8, false),
-        Field::new("objective_pct", DataType::Float64, false),
-        Field::new("objective_uncentred_pct", DataType::Float64, false),
-        Field::new("curve_distance_pct", DataType::Float64, false),
-    ]));
-    let batch = RecordBatch::try_new(
-        schema.clone(),
-        vec![
-            Arc::new(StringArray::from_iter_values(
-                rows.iter().map(|r| r.sample.clone()),
-            )),
-            Arc::new(StringArray::from_iter_values(
-                rows.iter().map(|r| r.edge.clone()),
-            )),
-            Arc::new(Float64Array::from_iter_values(
-                rows.iter().map(|r| r.objective_pct),
-            )),
-            Arc::new(Float64Array::from_iter_values(
-                rows.iter().map(|r| r.objective_uncentred_pct),
-            )),
-            Arc::new(Float64Array::from_iter_values(
-                rows.iter().map(|r| r.curve_distance_pct),
-            )),
-        ],
-    )?;
-    write_parquet(ctx.output("score")?, &batch, None)?;
-    Ok(())
+    write_table(ctx.output("score")?, &rows)
 }

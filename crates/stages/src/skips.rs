@@ -1,9 +1,6 @@
 //! `skips`: each skip the engine makes, measured on and off in the same run.
 
-use crate::report::f64s;
 use anyhow::Result;
-use arrow::array::{ArrayRef, RecordBatch, StringArray};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::benchmark::{
     SkipRow, skip_cost_cache, skip_second_thread, skip_symmetry, skip_unneeded_terms,
 };
@@ -11,10 +8,9 @@ use drapelab_core::scene::{LoadedScene, Scene};
 use drapelab_core::solve::NoObserver;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::simulate_to_dir;
-use drapelab_record::write_parquet;
+use drapelab_record::write_table;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Parameters of a skips stage.
@@ -66,7 +62,7 @@ fn run(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
     done();
     rows.push(skip_second_thread(&hang)?);
     done();
-    write_skips(ctx.output("table")?, &rows)
+    write_table(ctx.output("table")?, &rows)
 }
 
 /// Recording off: simulate at 21 × 21 with the timeline and the rerun recording off and on.
@@ -89,12 +85,12 @@ fn skip_recording(hang: &Scene, path: &Path) -> Result<SkipRow> {
         simulate_to_dir(&loaded, &out, &mut NoObserver)?;
         times.push(t.elapsed().as_secs_f64());
     }
-    Ok(SkipRow {
-        skip: "timeline and rerun recording off".into(),
-        scene: hang4.name.clone(),
-        time_with_skip_s: times[0],
-        time_without_skip_s: times[1],
-    })
+    Ok(SkipRow::new(
+        "timeline and rerun recording off",
+        hang4.name.clone(),
+        times[0],
+        times[1],
+    ))
 }
 
 /// Up-to-date stages: a one-stage pipeline run from scratch, then again (nothing to do).
@@ -117,39 +113,12 @@ fn skip_up_to_date_stage(hang_file: &Path, name: &str) -> Result<SkipRow> {
         drapelab_pipeline::run_pipeline(&plan, &Default::default(), &Silent)?;
         *t = start.elapsed().as_secs_f64();
     }
-    Ok(SkipRow {
-        skip: "up-to-date stage skipped".into(),
-        scene: format!("{name} 41×41"),
-        time_with_skip_s: t[1],
-        time_without_skip_s: t[0],
-    })
-}
-
-/// `skips.parquet`: skip, scene, time_with_skip_s, time_without_skip_s, saved_fraction.
-fn write_skips(out: &Path, rows: &[SkipRow]) -> Result<()> {
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("skip", DataType::Utf8, false),
-        Field::new("scene", DataType::Utf8, false),
-        Field::new("time_with_skip_s", DataType::Float64, false),
-        Field::new("time_without_skip_s", DataType::Float64, false),
-        Field::new("saved_fraction", DataType::Float64, false),
-    ]));
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(
-            rows.iter().map(|r| r.skip.clone()),
-        )),
-        Arc::new(StringArray::from_iter_values(
-            rows.iter().map(|r| r.scene.clone()),
-        )),
-        f64s(rows.iter().map(|r| r.time_with_skip_s).collect()),
-        f64s(rows.iter().map(|r| r.time_without_skip_s).collect()),
-        f64s(
-            rows.iter()
-                .map(|r| 1.0 - r.time_with_skip_s / r.time_without_skip_s)
-                .collect(),
-        ),
-    ];
-    write_parquet(out, &RecordBatch::try_new(schema, cols)?, None)
+    Ok(SkipRow::new(
+        "up-to-date stage skipped",
+        format!("{name} 41×41"),
+        t[1],
+        t[0],
+    ))
 }
 
 /// A progress that says nothing (the skips stage runs a pipeline of its own inside).

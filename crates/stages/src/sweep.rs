@@ -1,22 +1,16 @@
 //! `sweep`: every input scene solved at every point of a grid or a Latin hypercube over scene keys,
 //! in parallel (rayon), into one Parquet table. The schema is documented in the README.
 
+use crate::sweep_table::{SweepOutcome, SweepPoint, as_f64, write_sweep};
 use anyhow::{Result, bail};
-use arrow::array::{
-    ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
-};
-use arrow::datatypes::{DataType, Field, Schema};
-use drapelab_core::cloth::Corner;
 use drapelab_core::scene::Scene;
 use drapelab_core::simulate::solve_scene;
-use drapelab_core::solve::{NoObserver, Status};
+use drapelab_core::solve::NoObserver;
 use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
-use drapelab_record::write_parquet;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::sync::Arc;
 
 /// How sweep points are chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -68,10 +62,6 @@ pub struct SweepParams {
 
 fn default_samples() -> usize {
     16
-}
-
-fn as_f64(v: &toml::Value) -> Option<f64> {
-    v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
 }
 
 impl SweepParams {
@@ -166,55 +156,6 @@ pub fn sweep_points(p: &SweepParams) -> Vec<Vec<toml::Value>> {
     }
 }
 
-/// Results of one point.
-struct PointResult {
-    scene: String,
-    point: u32,
-    particles: u32,
-    solver: String,
-    status: Status,
-    iterations: u64,
-    linear_solves: u64,
-    wall_time_s: f64,
-    max_residual_N: f64,
-    /// Whether a converged static equilibrium is a minimum (None: not checked).
-    minimum: Option<bool>,
-    /// centre z, min z, max z, corners (x, y, z) × 4, drape coefficient, folds, projected area, penetration
-    /// (NaN where not defined); None unless converged.
-    measures: Option<Vec<f64>>,
-}
-
-const CORNERS: [(Corner, &str); 4] = [
-    (Corner::XminYmin, "xmin_ymin"),
-    (Corner::XmaxYmin, "xmax_ymin"),
-    (Corner::XminYmax, "xmin_ymax"),
-    (Corner::XmaxYmax, "xmax_ymax"),
-];
-
-/// Names of the measure columns, in order.
-pub fn measure_columns() -> Vec<String> {
-    let mut v = vec![
-        "centre_z_m".to_string(),
-        "min_z_m".to_string(),
-        "max_z_m".to_string(),
-    ];
-    for (_, n) in CORNERS {
-        for c in ["x", "y", "z"] {
-            v.push(format!("corner_{n}_{c}_m"));
-        }
-    }
-    v.extend(
-        [
-            "drape_coefficient_pct",
-            "folds",
-            "projected_area_m2",
-            "max_penetration_m",
-        ]
-        .map(String::from),
-    );
-    v
-}
-
 /// Runs the stage.
 fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     let files = ctx.input_files("scenes");
@@ -230,7 +171,7 @@ fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
     // are put back in design order afterwards.
     let mut order: Vec<usize> = (0..jobs.len()).collect();
     order.sort_by_key(|&k| std::cmp::Reverse(jobs[k].1.cloth.nx * jobs[k].1.cloth.ny));
-    let mut unordered: Vec<(usize, PointResult)> = order
+    let mut unordered: Vec<(usize, (SweepPoint, SweepOutcome))> = order
         .par_iter()
         .map(|&k| {
             let (i, scene) = &jobs[k];
@@ -240,8 +181,8 @@ fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
         })
         .collect();
     unordered.sort_by_key(|(k, _)| *k);
-    let results: Vec<PointResult> = unordered.into_iter().map(|(_, r)| r).collect();
-    write_table(ctx.output("table")?, &results, &points, &keys)
+    let rows: Vec<(SweepPoint, SweepOutcome)> = unordered.into_iter().map(|(_, r)| r).collect();
+    write_sweep(ctx.output("table")?, &rows, &points, &keys)
 }
 
 /// Every scene at every point, loaded first: bad values are refused before any work.
@@ -271,138 +212,13 @@ fn load_jobs(
 }
 
 /// Solves one point and measures its drape (when it converged).
-fn solve_point(scene: &Scene, i: u32) -> PointResult {
+fn solve_point(scene: &Scene, i: u32) -> (SweepPoint, SweepOutcome) {
     let sol = solve_scene(scene, &mut NoObserver);
-    let converged = sol.report.status == Status::Converged;
-    let measures = converged.then(|| {
-        let g = &sol.grid;
-        let zs = sol.grid_positions().iter().map(|p| p.z);
-        let mut m = vec![
-            sol.at(g.nx / 2, g.ny / 2).z,
-            zs.clone().fold(f64::INFINITY, f64::min),
-            zs.fold(f64::NEG_INFINITY, f64::max),
-        ];
-        for (c, _) in CORNERS {
-            let (ci, cj) = c.ij(g);
-            let q = sol.at(ci, cj);
-            m.extend([q.x, q.y, q.z]);
-        }
-        let d = drapelab_core::measure::drape_measures(scene, g, &sol.x);
-        m.extend([
-            d.drape_coefficient_pct.unwrap_or(f64::NAN),
-            d.folds.map_or(f64::NAN, |f| f as f64),
-            d.projected_area_m2,
-            d.max_penetration_m,
-        ]);
-        m
-    });
-    PointResult {
+    let point = SweepPoint {
         scene: scene.name.clone(),
         point: i,
-        particles: sol.grid.len() as u32,
-        solver: sol.report.solver.clone(),
-        status: sol.report.status,
-        iterations: sol.report.iterations as u64,
-        linear_solves: sol.report.linear_solves as u64,
-        wall_time_s: sol.report.wall_time_s,
-        max_residual_N: sol.report.max_residual_N,
-        minimum: sol.report.minimum,
-        measures,
-    }
-}
-
-/// `sweep.parquet`: one row per scene and point, the axes' values as columns.
-fn write_table(
-    out: &std::path::Path,
-    results: &[PointResult],
-    points: &[Vec<toml::Value>],
-    keys: &[&String],
-) -> Result<()> {
-    // Columns.
-    let mut fields = vec![
-        Field::new("scene", DataType::Utf8, false),
-        Field::new("point", DataType::UInt32, false),
-    ];
-    let mut cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(
-            results.iter().map(|r| r.scene.clone()),
-        )),
-        Arc::new(UInt32Array::from_iter_values(
-            results.iter().map(|r| r.point),
-        )),
-    ];
-    for (a, key) in keys.iter().enumerate() {
-        let vals: Vec<&toml::Value> = results
-            .iter()
-            .map(|r| &points[r.point as usize][a])
-            .collect();
-        let col_name = key.split(',').next().unwrap_or(key).trim().to_string();
-        if vals.iter().all(|v| v.is_integer()) {
-            fields.push(Field::new(col_name, DataType::Int64, false));
-            cols.push(Arc::new(Int64Array::from_iter_values(
-                vals.iter().map(|v| v.as_integer().unwrap_or(0)),
-            )));
-        } else if vals.iter().all(|v| as_f64(v).is_some()) {
-            fields.push(Field::new(col_name, DataType::Float64, false));
-            cols.push(Arc::new(Float64Array::from_iter_values(
-                vals.iter().map(|v| as_f64(v).unwrap_or(f64::NAN)),
-            )));
-        } else {
-            fields.push(Field::new(col_name, DataType::Utf8, false));
-            cols.push(Arc::new(StringArray::from_iter_values(vals.iter().map(
-                |v| {
-                    v.as_str()
-                        .map(str::to_string)
-                        .unwrap_or_else(|| v.to_string())
-                },
-            ))));
-        }
-    }
-    fields.extend([
-        Field::new("particles", DataType::UInt32, false),
-        Field::new("solver", DataType::Utf8, false),
-        Field::new("status", DataType::Utf8, false),
-        Field::new("iterations", DataType::UInt64, false),
-        Field::new("linear_solves", DataType::UInt64, false),
-        Field::new("wall_time_s", DataType::Float64, false),
-        Field::new("max_residual_N", DataType::Float64, true),
-        Field::new("minimum", DataType::Boolean, true),
-    ]);
-    cols.push(Arc::new(UInt32Array::from_iter_values(
-        results.iter().map(|r| r.particles),
-    )));
-    cols.push(Arc::new(StringArray::from_iter_values(
-        results.iter().map(|r| r.solver.clone()),
-    )));
-    cols.push(Arc::new(StringArray::from_iter_values(
-        results.iter().map(|r| r.status.as_str()),
-    )));
-    cols.push(Arc::new(UInt64Array::from_iter_values(
-        results.iter().map(|r| r.iterations),
-    )));
-    cols.push(Arc::new(UInt64Array::from_iter_values(
-        results.iter().map(|r| r.linear_solves),
-    )));
-    cols.push(Arc::new(Float64Array::from_iter_values(
-        results.iter().map(|r| r.wall_time_s),
-    )));
-    cols.push(Arc::new(Float64Array::from_iter(results.iter().map(|r| {
-        r.max_residual_N.is_finite().then_some(r.max_residual_N)
-    }))));
-    cols.push(Arc::new(arrow::array::BooleanArray::from(
-        results.iter().map(|r| r.minimum).collect::<Vec<_>>(),
-    )));
-    for (m, name) in measure_columns().into_iter().enumerate() {
-        fields.push(Field::new(name, DataType::Float64, true));
-        cols.push(Arc::new(Float64Array::from_iter(results.iter().map(|r| {
-            r.measures
-                .as_ref()
-                .and_then(|v| v[m].is_finite().then_some(v[m]))
-        }))));
-    }
-    let schema = Arc::new(Schema::new(fields));
-    let batch = RecordBatch::try_new(schema, cols)?;
-    write_parquet(out, &batch, None)
+    };
+    (point, SweepOutcome::new(scene, &sol))
 }
 
 /// The `sweep` stage kind.

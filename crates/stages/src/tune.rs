@@ -6,16 +6,13 @@
 
 use crate::report::plot_panels;
 use anyhow::Result;
-use arrow::array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt32Array};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::calibrate::{Problem, read_sample_densities, sample_scene};
 use drapelab_core::edges::EdgeFit;
 use drapelab_core::optim::{Ica, IcaSettings, l27, main_effects, sn_smaller_the_better};
 use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
-use drapelab_record::{read_edges, write_atomic, write_parquet};
+use drapelab_record::{Table, read_edges, write_atomic, write_table};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::sync::Arc;
 
 /// The seven factors of Table 1 and their three levels.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -95,6 +92,55 @@ const FACTORS: [&str; 7] = [
     "F revolution_rate",
     "G xi",
 ];
+
+/// One row of the L27 array: the ICA settings' levels and what they cost (seed 000 §3.3).
+#[allow(non_snake_case)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TuneRow {
+    /// L27 row, 1..27.
+    pub row: u32,
+    /// Level (1..3) of factor A, the decades.
+    pub level_A: u32,
+    /// Level of factor B, the imperialists.
+    pub level_B: u32,
+    /// Level of factor C, the countries.
+    pub level_C: u32,
+    /// Level of factor D, β (assimilation).
+    pub level_D: u32,
+    /// Level of factor E, γ (deviation).
+    pub level_E: u32,
+    /// Level of factor F, the revolution rate.
+    pub level_F: u32,
+    /// Level of factor G, ξ (colonies' share of an empire's power).
+    pub level_G: u32,
+    /// Mean best cost over the row's runs, % of the side.
+    pub mean_cost_pct: f64,
+    /// Smaller-the-better signal-to-noise ratio, dB.
+    pub sn_db: f64,
+}
+
+impl Table for TuneRow {
+    const FILE: &'static str = "tune.parquet";
+    const ROW: &'static str =
+        "One row of the Taguchi L27 design over ICA's seven settings (seed 000 §3.3).";
+}
+
+/// One factor level's mean S/N over the rows at that level.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct MainEffectRow {
+    /// Factor (e.g. "A decades").
+    pub factor: String,
+    /// Level, 1..3.
+    pub level: u32,
+    /// Mean S/N of the rows at this level, dB.
+    pub mean_sn_db: f64,
+}
+
+impl Table for MainEffectRow {
+    const FILE: &'static str = "main_effects.parquet";
+    const ROW: &'static str =
+        "One level of one ICA setting: its mean S/N over the L27 rows (seed 000 Fig. 5).";
+}
 
 fn settings(levels: &Levels, l: &[u8], seed: u64) -> IcaSettings {
     let k = |f: usize| l[f] as usize;
@@ -187,37 +233,35 @@ fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
         .collect();
     let best = settings(&p.levels, &best_levels, p.seed);
     // tune.parquet
-    let mut fields = vec![Field::new("row", DataType::UInt32, false)];
-    let mut cols: Vec<ArrayRef> = vec![Arc::new(UInt32Array::from_iter_values(
-        1..=rows.len() as u32,
-    ))];
-    for (f, name) in FACTORS.iter().enumerate() {
-        fields.push(Field::new(
-            format!("level_{}", &name[..1]),
-            DataType::UInt32,
-            false,
-        ));
-        cols.push(Arc::new(UInt32Array::from_iter_values(
-            rows.iter().map(|l| l[f] as u32 + 1),
-        )));
-    }
-    fields.push(Field::new("mean_cost_pct", DataType::Float64, false));
-    cols.push(Arc::new(Float64Array::from(costs)));
-    fields.push(Field::new("sn_db", DataType::Float64, false));
-    cols.push(Arc::new(Float64Array::from(sn.clone())));
-    write_parquet(
-        ctx.output("table")?,
-        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
-        None,
-    )?;
+    let level = |r: &[u8], f: usize| r[f] as u32 + 1;
+    let table: Vec<TuneRow> = rows
+        .iter()
+        .zip(costs.iter().zip(&sn))
+        .enumerate()
+        .map(|(k, (r, (&mean_cost_pct, &sn_db)))| TuneRow {
+            row: k as u32 + 1,
+            level_A: level(r, 0),
+            level_B: level(r, 1),
+            level_C: level(r, 2),
+            level_D: level(r, 3),
+            level_E: level(r, 4),
+            level_F: level(r, 5),
+            level_G: level(r, 6),
+            mean_cost_pct,
+            sn_db,
+        })
+        .collect();
+    write_table(ctx.output("table")?, &table)?;
     // main_effects.parquet
-    let (mut fac, mut lev, mut val) = (Vec::new(), Vec::new(), Vec::new());
+    let mut me = Vec::new();
     let mut panels: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>> = BTreeMap::new();
     for (f, e) in effects.iter().enumerate() {
         for (k, v) in e.iter().enumerate() {
-            fac.push(FACTORS[f].to_string());
-            lev.push(k as u32 + 1);
-            val.push(*v);
+            me.push(MainEffectRow {
+                factor: FACTORS[f].to_string(),
+                level: k as u32 + 1,
+                mean_sn_db: *v,
+            });
         }
         panels.entry("main effects".into()).or_default().insert(
             FACTORS[f].to_string(),
@@ -227,21 +271,7 @@ fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
                 .collect(),
         );
     }
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("factor", DataType::Utf8, false),
-        Field::new("level", DataType::UInt32, false),
-        Field::new("mean_sn_db", DataType::Float64, false),
-    ]));
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from(fac)),
-        Arc::new(UInt32Array::from(lev)),
-        Arc::new(Float64Array::from(val)),
-    ];
-    write_parquet(
-        ctx.output("main_effects")?,
-        &RecordBatch::try_new(schema, cols)?,
-        None,
-    )?;
+    write_table(ctx.output("main_effects")?, &me)?;
     let json = serde_json::to_vec_pretty(&best)?;
     write_atomic(ctx.output("best_ica")?, |f| {
         use std::io::Write;

@@ -2,22 +2,18 @@
 //! hang, scored against the sample's measured 2-corner edges (a fit-edges table): `validation.parquet`
 //! with `sample`, `objective_pct` (Eq. 5, mean over the edges) and `curve_distance_pct` (seed 000 Table 6).
 
+use crate::calibration_tables::ResultRow;
 use anyhow::{Context, Result};
-use arrow::array::{Array, ArrayRef, Float64Array, RecordBatch, StringArray};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::calibrate::{
     Params, Problem, read_sample_densities, sample_number, sample_scene,
 };
 use drapelab_core::edges::{EdgeFit, edges_from_particles, scene_view, score_edges};
-use drapelab_core::material::Topology;
 use drapelab_core::simulate::solve_scene;
 use drapelab_core::solve::NoObserver;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::{read_edges, write_parquet};
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use drapelab_record::{Table, read_edges, read_table, write_table};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::sync::Arc;
 
 /// Parameters of a validate stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -40,48 +36,37 @@ fn default_side() -> f64 {
 
 /// Calibrated parameters by sample number from a results table.
 fn read_results(path: &std::path::Path) -> Result<BTreeMap<u32, Params>> {
-    let f = std::fs::File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
     let mut out = BTreeMap::new();
-    for batch in ParquetRecordBatchReaderBuilder::try_new(f)?.build()? {
-        let b = batch?;
-        let s = |n: &str| {
-            b.column_by_name(n)
-                .and_then(|c| c.as_any().downcast_ref::<StringArray>().cloned())
-                .with_context(|| format!("{n}: missing"))
+    for r in read_table::<ResultRow>(path)? {
+        let n = sample_number(&r.sample)
+            .with_context(|| format!("`{}`: no sample number", r.sample))?;
+        let params = Params {
+            stiffness_N_per_m: r.stiffness_N_per_m,
+            damping_Ns_per_m: r.damping_Ns_per_m,
+            elongation_rate: r.elongation_rate,
+            natural_length_m: r.natural_length_m,
+            topology: r.topology,
         };
-        let x = |n: &str| {
-            b.column_by_name(n)
-                .and_then(|c| c.as_any().downcast_ref::<Float64Array>().cloned())
-                .with_context(|| format!("{n}: missing"))
-        };
-        let (sample, topo) = (s("sample")?, s("topology")?);
-        let (k, c, e, l) = (
-            x("stiffness_N_per_m")?,
-            x("damping_Ns_per_m")?,
-            x("elongation_rate")?,
-            x("natural_length_m")?,
-        );
-        for r in 0..b.num_rows() {
-            let n = sample_number(sample.value(r))
-                .with_context(|| format!("`{}`: no sample number", sample.value(r)))?;
-            let topology = match topo.value(r) {
-                "b" => Topology::B,
-                "c" => Topology::C,
-                _ => Topology::A,
-            };
-            out.insert(
-                n,
-                Params {
-                    stiffness_N_per_m: k.value(r),
-                    damping_Ns_per_m: c.value(r),
-                    elongation_rate: e.value(r),
-                    natural_length_m: l.value(r),
-                    topology,
-                },
-            );
-        }
+        out.insert(n, params);
     }
     Ok(out)
+}
+
+/// One sample's calibrated parameters on the 2-corner hang, scored against its measured edges.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ValidationRow {
+    /// Sample name.
+    pub sample: String,
+    /// Mean seed 000 Eq. 5 over its edges, % (None when the hang did not converge).
+    pub objective_pct: Option<f64>,
+    /// Mean RMS distance of simulated from measured edges, % of the side (None likewise).
+    pub curve_distance_pct: Option<f64>,
+}
+
+impl Table for ValidationRow {
+    const FILE: &'static str = "validation.parquet";
+    const ROW: &'static str =
+        "One sample's calibrated parameters validated on the 2-corner hang (seed 000 Table 6).";
 }
 
 /// The `validate` stage kind.
@@ -158,24 +143,15 @@ fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
         dist.push(mean(rows.iter().map(|r| r.curve_distance_pct).collect()));
         ctx.progress.item_done(&ctx.stage.name);
     }
-    let schema = Arc::new(Schema::new(vec![
-        Field::new("sample", DataType::Utf8, false),
-        Field::new("objective_pct", DataType::Float64, true),
-        Field::new("curve_distance_pct", DataType::Float64, true),
-    ]));
-    let opt = |v: Vec<f64>| -> ArrayRef {
-        Arc::new(Float64Array::from_iter(
-            v.into_iter().map(|x| x.is_finite().then_some(x)),
-        ))
-    };
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(names)),
-        opt(eq5),
-        opt(dist),
-    ];
-    write_parquet(
-        ctx.output("validation")?,
-        &RecordBatch::try_new(schema, cols)?,
-        None,
-    )
+    let opt = |x: f64| x.is_finite().then_some(x);
+    let rows: Vec<ValidationRow> = names
+        .into_iter()
+        .zip(eq5.into_iter().zip(dist))
+        .map(|(sample, (e, d))| ValidationRow {
+            sample,
+            objective_pct: opt(e),
+            curve_distance_pct: opt(d),
+        })
+        .collect();
+    write_table(ctx.output("validation")?, &rows)
 }

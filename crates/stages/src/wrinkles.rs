@@ -4,19 +4,14 @@
 //! beside drapelab's.
 
 use anyhow::Result;
-use arrow::array::{
-    ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
-};
-use arrow::datatypes::{DataType, Field, Schema};
 use drapelab_core::wrinkles::{
     WrinkleConfig, WrinkleMesh, WrinkleResult, load_config, solve, wrinkle_mesh,
 };
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::{write_parquet, write_text};
+use drapelab_record::{Table, write_text};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 /// Parameters of a wrinkles stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -98,70 +93,105 @@ pub fn write_wrinkles(
     Ok(solved)
 }
 
+/// One seed 002 case: its inputs and the tension-field solution (Eqs. 5–7).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct WrinkleRow {
+    /// Case name.
+    pub case: String,
+    /// Horizontal length of the sheet L, m.
+    pub length_m: f64,
+    /// Height of the sheet h, m.
+    pub height_m: f64,
+    /// Thickness t, m.
+    pub thickness_m: f64,
+    /// Young's modulus E, Pa.
+    pub youngs_modulus_Pa: f64,
+    /// Poisson's ratio ν.
+    pub poisson_ratio: f64,
+    /// Weight per area w, N/m².
+    pub weight_N_per_m2: f64,
+    /// Inward displacement d of each support, m.
+    pub support_displacement_m: f64,
+    /// Load constant c of Eq. 7.
+    pub buckling_constant: f64,
+    /// Number of wrinkles.
+    pub n: u32,
+    /// Ratio of consecutive amplitudes (Eq. 5).
+    pub q: f64,
+    /// Critical ratio (Eq. 7).
+    pub q_critical: f64,
+    /// Largest out-of-plane displacement, cm.
+    pub zmax_cm: f64,
+    /// Iterations made.
+    pub iterations: u64,
+    /// Whether |L' − L| ≤ tolerance · L with n settled.
+    pub converged: bool,
+    /// Relative tolerance on L' against L.
+    pub tolerance_rel: f64,
+    /// |L' − L| / L at the last iteration.
+    pub length_error_rel: f64,
+    /// Why the iteration ended.
+    pub message: String,
+}
+
+impl Table for WrinkleRow {
+    const FILE: &'static str = "wrinkles.parquet";
+    const ROW: &'static str =
+        "One hung sheet of seed 002: inputs, wrinkle count and amplitudes' ratio.";
+}
+
+/// One point of a case's wrinkled surface (seed 002 Eq. 4 on a grid).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct WrinkleMeshRow {
+    /// Case name.
+    pub case: String,
+    /// Grid column.
+    pub column: u32,
+    /// Grid row.
+    pub row: u32,
+    /// Horizontal position, m.
+    pub x_m: f64,
+    /// Depth below the top edge, m.
+    pub y_down_m: f64,
+    /// Out-of-plane displacement, m.
+    pub z_out_of_plane_m: f64,
+}
+
+impl Table for WrinkleMeshRow {
+    const FILE: &'static str = "mesh.parquet";
+    const ROW: &'static str = "One grid point of a seed 002 case's wrinkled surface.";
+}
+
 fn write_table(out: &Path, cfg: &WrinkleConfig, solved: &[SolvedCase]) -> Result<()> {
-    let case = |s: &SolvedCase| &cfg.cases[s.index];
-    let inp = |s: &SolvedCase| case(s).inputs(&cfg.defaults);
-    let f = |g: &dyn Fn(&SolvedCase) -> f64| -> ArrayRef {
-        Arc::new(Float64Array::from_iter_values(solved.iter().map(g)))
-    };
-    let fields = vec![
-        Field::new("case", DataType::Utf8, false),
-        Field::new("length_m", DataType::Float64, false),
-        Field::new("height_m", DataType::Float64, false),
-        Field::new("thickness_m", DataType::Float64, false),
-        Field::new("youngs_modulus_Pa", DataType::Float64, false),
-        Field::new("poisson_ratio", DataType::Float64, false),
-        Field::new("weight_N_per_m2", DataType::Float64, false),
-        Field::new("support_displacement_m", DataType::Float64, false),
-        Field::new("buckling_constant", DataType::Float64, false),
-        Field::new("n", DataType::UInt32, false),
-        Field::new("q", DataType::Float64, false),
-        Field::new("q_critical", DataType::Float64, false),
-        Field::new("zmax_cm", DataType::Float64, false),
-        Field::new("iterations", DataType::UInt64, false),
-        Field::new("converged", DataType::Boolean, false),
-        Field::new("tolerance_rel", DataType::Float64, false),
-        Field::new("length_error_rel", DataType::Float64, false),
-        Field::new("message", DataType::Utf8, false),
-    ];
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(
-            solved.iter().map(|s| case(s).case.clone()),
-        )),
-        f(&|s| inp(s).length_m),
-        f(&|s| inp(s).height_m),
-        f(&|s| inp(s).thickness_m),
-        f(&|s| inp(s).youngs_modulus_Pa),
-        f(&|s| inp(s).poisson_ratio),
-        f(&|s| inp(s).weight_N_per_m2),
-        f(&|s| inp(s).support_displacement_m),
-        f(&|s| inp(s).buckling_constant),
-        Arc::new(UInt32Array::from_iter_values(
-            solved.iter().map(|s| s.result.n as u32),
-        )),
-        f(&|s| s.result.q),
-        f(&|s| s.result.q_critical),
-        f(&|s| 100.0 * s.result.zmax_m),
-        Arc::new(UInt64Array::from_iter_values(
-            solved.iter().map(|s| s.result.iterations as u64),
-        )),
-        Arc::new(BooleanArray::from(
-            solved
-                .iter()
-                .map(|s| s.result.converged)
-                .collect::<Vec<_>>(),
-        )),
-        f(&|s| inp(s).tolerance_rel),
-        f(&|s| s.result.length_error_rel),
-        Arc::new(StringArray::from_iter_values(
-            solved.iter().map(|s| s.result.message.clone()),
-        )),
-    ];
-    write_parquet(
-        out,
-        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
-        None,
-    )
+    let rows: Vec<WrinkleRow> = solved
+        .iter()
+        .map(|s| {
+            let c = &cfg.cases[s.index];
+            let i = c.inputs(&cfg.defaults);
+            let r = &s.result;
+            WrinkleRow {
+                case: c.case.clone(),
+                length_m: i.length_m,
+                height_m: i.height_m,
+                thickness_m: i.thickness_m,
+                youngs_modulus_Pa: i.youngs_modulus_Pa,
+                poisson_ratio: i.poisson_ratio,
+                weight_N_per_m2: i.weight_N_per_m2,
+                support_displacement_m: i.support_displacement_m,
+                buckling_constant: i.buckling_constant,
+                n: r.n as u32,
+                q: r.q,
+                q_critical: r.q_critical,
+                zmax_cm: 100.0 * r.zmax_m,
+                iterations: r.iterations as u64,
+                converged: r.converged,
+                tolerance_rel: i.tolerance_rel,
+                length_error_rel: r.length_error_rel,
+                message: r.message.clone(),
+            }
+        })
+        .collect();
+    drapelab_record::write_table(out, &rows)
 }
 
 fn write_mesh(
@@ -170,41 +200,20 @@ fn write_mesh(
     solved: &[SolvedCase],
     p: &WrinklesParams,
 ) -> Result<()> {
-    let (mut case, mut col, mut row) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+    let mut rows = Vec::new();
     for s in solved {
         let c = &cfg.cases[s.index];
         let m = wrinkle_mesh(&c.inputs(&cfg.defaults), &s.result, p.mesh_nx, p.mesh_ny);
-        for (k, pt) in m.points.iter().enumerate() {
-            case.push(c.case.clone());
-            col.push((k % m.nx) as u32);
-            row.push((k / m.nx) as u32);
-            x.push(pt[0]);
-            y.push(pt[1]);
-            z.push(pt[2]);
-        }
+        rows.extend(m.points.iter().enumerate().map(|(k, pt)| WrinkleMeshRow {
+            case: c.case.clone(),
+            column: (k % m.nx) as u32,
+            row: (k / m.nx) as u32,
+            x_m: pt[0],
+            y_down_m: pt[1],
+            z_out_of_plane_m: pt[2],
+        }));
     }
-    let fields = vec![
-        Field::new("case", DataType::Utf8, false),
-        Field::new("column", DataType::UInt32, false),
-        Field::new("row", DataType::UInt32, false),
-        Field::new("x_m", DataType::Float64, false),
-        Field::new("y_down_m", DataType::Float64, false),
-        Field::new("z_out_of_plane_m", DataType::Float64, false),
-    ];
-    let cols: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from(case)),
-        Arc::new(UInt32Array::from(col)),
-        Arc::new(UInt32Array::from(row)),
-        Arc::new(Float64Array::from(x)),
-        Arc::new(Float64Array::from(y)),
-        Arc::new(Float64Array::from(z)),
-    ];
-    write_parquet(
-        out,
-        &RecordBatch::try_new(Arc::new(Schema::new(fields)), cols)?,
-        None,
-    )
+    drapelab_record::write_table(out, &rows)
 }
 
 /// Each case's deformed grid as a rerun mesh at `cases/NAME/mesh` (z up: (x, z_out, −y_down)).

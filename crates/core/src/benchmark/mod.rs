@@ -9,18 +9,22 @@ pub use skips::{SkipRow, skip_cost_cache, skip_second_thread, skip_symmetry, ski
 use crate::scene::{Scene, SolverKind};
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
+use crate::table::Table;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// One benchmark point.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BenchRow {
     /// Scene name.
     pub scene: String,
     /// Particles per side.
+    #[serde(rename = "particles_per_side")]
     pub n: usize,
     /// Solver.
     pub solver: SolverKind,
     /// Force tolerance: largest residual force / lightest particle's weight.
+    #[serde(rename = "tolerance_rel")]
     pub tol: f64,
     /// Solver status.
     pub status: String,
@@ -35,10 +39,16 @@ pub struct BenchRow {
     /// Wall time of the factorizations and triangular solves alone, s.
     pub factor_time_s: f64,
     /// Largest distance to the reference (the finest static solution at the shared grid points, or
-    /// the exact elastica), in m (NaN when the grids share no points or the solve did not converge).
-    pub error_m: f64,
+    /// the exact elastica), in m (None when the grids share no points or the solve did not converge).
+    pub error_m: Option<f64>,
     /// Peak resident memory of the process during the point, bytes (Linux; None elsewhere).
     pub peak_rss_bytes: Option<u64>,
+}
+
+impl Table for BenchRow {
+    const FILE: &'static str = "benchmark.parquet";
+    const ROW: &'static str =
+        "One solve of the accuracy–speed benchmark: scene × size × tolerance × solver.";
 }
 
 /// Which solvers run up to which size.
@@ -202,7 +212,7 @@ pub fn bench_rows(
                     linear_solves: sol.report.linear_solves,
                     factorizations: sol.report.factorizations,
                     factor_time_s: sol.report.factor_time_s,
-                    error_m,
+                    error_m: error_m.is_finite().then_some(error_m),
                     peak_rss_bytes: peak,
                 });
             }
@@ -275,7 +285,7 @@ pub fn markdown_table(rows: &[BenchRow]) -> String {
             r.linear_solves,
             r.factorizations,
             r.factor_time_s * 1e3,
-            r.error_m,
+            r.error_m.unwrap_or(f64::NAN),
             r.peak_rss_bytes
                 .map_or("–".into(), |b| format!("{:.1}", b as f64 / 1e6)),
             n = r.n
@@ -285,7 +295,7 @@ pub fn markdown_table(rows: &[BenchRow]) -> String {
 }
 
 /// One solve of seed 000's slack-net population.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PopulationRow {
     /// Where Newton started: "sagged" (the sagged start) or "lattice" (the calibration's warm start).
     pub start: String,
@@ -307,6 +317,12 @@ pub struct PopulationRow {
     pub wall_time_s: f64,
     /// Wall time of its factorizations and triangular solves alone, s.
     pub factor_time_s: f64,
+}
+
+impl Table for PopulationRow {
+    const FILE: &'static str = "population.parquet";
+    const ROW: &'static str =
+        "One Newton solve of seed 000's slack-net calibration population (benchmark stage).";
 }
 
 impl PopulationRow {

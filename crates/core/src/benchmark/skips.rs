@@ -8,11 +8,13 @@ use crate::contact::Obstacle;
 use crate::scene::Scene;
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;
+use crate::table::Table;
 use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// One skip, timed with and without it.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SkipRow {
     /// What is skipped.
     pub skip: String,
@@ -22,6 +24,27 @@ pub struct SkipRow {
     pub time_with_skip_s: f64,
     /// Wall time without it, s.
     pub time_without_skip_s: f64,
+    /// 1 − with / without: the fraction of the time the skip saves.
+    pub saved_fraction: f64,
+}
+
+impl SkipRow {
+    /// The row of a skip timed `with` and `without` it (s).
+    pub fn new(skip: impl Into<String>, scene: impl Into<String>, with: f64, without: f64) -> Self {
+        SkipRow {
+            skip: skip.into(),
+            scene: scene.into(),
+            time_with_skip_s: with,
+            time_without_skip_s: without,
+            saved_fraction: 1.0 - with / without,
+        }
+    }
+}
+
+impl Table for SkipRow {
+    const FILE: &'static str = "skips.parquet";
+    const ROW: &'static str =
+        "One skip drapelab makes (work a scene does not need), timed with and without it.";
 }
 
 fn timed(f: &mut dyn FnMut()) -> f64 {
@@ -38,12 +61,12 @@ pub fn skip_symmetry(full: &Scene, quarter: &Scene) -> SkipRow {
     let tf = timed(&mut || {
         solve_scene(full, &mut NoObserver);
     });
-    SkipRow {
-        skip: "symmetry reduction (quarter model)".into(),
-        scene: full.name.clone(),
-        time_with_skip_s: tq,
-        time_without_skip_s: tf,
-    }
+    SkipRow::new(
+        "symmetry reduction (quarter model)",
+        full.name.clone(),
+        tq,
+        tf,
+    )
 }
 
 /// The hang on seed 000's net at 11 × 11 with a measured drape to calibrate against.
@@ -75,12 +98,12 @@ pub fn skip_cost_cache(hang: &Scene) -> Result<SkipRow> {
             identifiability(&problem, &best, 0.1, 7, Noise::FromResidual, 0.05);
         });
     }
-    Ok(SkipRow {
-        skip: "cached parameter vectors (identifiability analysis)".into(),
-        scene: net.name,
-        time_with_skip_s: t[0],
-        time_without_skip_s: t[1],
-    })
+    Ok(SkipRow::new(
+        "cached parameter vectors (identifiability analysis)",
+        net.name,
+        t[0],
+        t[1],
+    ))
 }
 
 /// Terms a scene does not need: the hang (no obstacle, so no contact term is built) against the same
@@ -105,12 +128,12 @@ pub fn skip_unneeded_terms(hang: &Scene) -> SkipRow {
         }
         t[k] = best;
     }
-    SkipRow {
-        skip: "contact term not built (no obstacle within reach)".into(),
-        scene: format!("{} 19×19", hang.name),
-        time_with_skip_s: t[0],
-        time_without_skip_s: t[1],
-    }
+    SkipRow::new(
+        "contact term not built (no obstacle within reach)",
+        format!("{} 19×19", hang.name),
+        t[0],
+        t[1],
+    )
 }
 
 /// Threads: one ICA population (16 countries of a calibration, the cache off) costed on a rayon pool
@@ -136,10 +159,10 @@ pub fn skip_second_thread(hang: &Scene) -> Result<SkipRow> {
             });
         });
     }
-    Ok(SkipRow {
-        skip: "second thread (one calibration population of 16, 2 threads against 1)".into(),
-        scene: format!("{} 11×11", net.name),
-        time_with_skip_s: t[0],
-        time_without_skip_s: t[1],
-    })
+    Ok(SkipRow::new(
+        "second thread (one calibration population of 16, 2 threads against 1)",
+        format!("{} 11×11", net.name),
+        t[0],
+        t[1],
+    ))
 }

@@ -69,7 +69,7 @@ pub fn read_camera(path: &Path) -> Result<CameraFile, InputError> {
 }
 
 /// One row of a score: per sample and edge, Eq. 5 and the curve distance.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ScoreRow {
     /// Sample (of the measured table).
     pub sample: String,
@@ -81,6 +81,11 @@ pub struct ScoreRow {
     pub objective_uncentred_pct: f64,
     /// RMS vertical distance between the curves, % of the side.
     pub curve_distance_pct: f64,
+}
+
+impl crate::table::Table for ScoreRow {
+    const FILE: &'static str = "score.parquet";
+    const ROW: &'static str = "One edge of one sample: a simulation's edge polynomial scored against a photo's (seed 000 Eq. 5).";
 }
 
 /// Scores `sim` against `real`, pairing fits by sample and edge; when each table holds a single sample
