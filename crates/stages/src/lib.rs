@@ -11,6 +11,8 @@ mod calibrate;
 mod calibration_report;
 mod calibration_tables;
 mod cusick_measure;
+mod cusick_predict;
+mod cusick_report;
 mod fit_edges;
 mod peers;
 pub mod report;
@@ -29,6 +31,8 @@ pub use benchmark_report::{BenchmarkReport, BenchmarkReportParams};
 pub use calibrate::{Calibrate, CalibrateParams};
 pub use calibration_report::{CalibrationReport, CalibrationReportParams};
 pub use cusick_measure::{CusickMeasure, CusickMeasureParams, ShadowRow, measure_dataset};
+pub use cusick_predict::{CusickPredict, CusickPredictParams, PredictionRow};
+pub use cusick_report::{CusickReport, CusickReportParams};
 pub use fit_edges::{FitEdges, FitEdgesParams};
 pub use peers::{Peers, PeersParams};
 pub use report::{Report, ReportParams};
@@ -74,6 +78,8 @@ pub fn registry() -> Registry {
         .with::<BenchmarkReport>()
         .with::<Skips>()
         .with::<CusickMeasure>()
+        .with::<CusickPredict>()
+        .with::<CusickReport>()
 }
 
 /// Every Parquet table drapelab writes, each traced from its row type, as the Markdown the README's
@@ -99,6 +105,7 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<drapelab_core::benchmark::SkipRow>()?,
         md::<peers::PeerRow>()?,
         md::<cusick_measure::ShadowRow>()?,
+        md::<cusick_predict::PredictionRow>()?,
     ];
     Ok(sections.join("\n"))
 }

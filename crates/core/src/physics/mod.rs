@@ -7,6 +7,7 @@ mod contact;
 mod friction;
 mod gravity;
 mod loads;
+mod mesh_bending;
 mod shear;
 mod springs;
 
@@ -15,6 +16,7 @@ pub use contact::{BarrierContact, max_penetration_m};
 pub use friction::{FrictionAnchor, LaggedFriction};
 pub use gravity::Gravity;
 pub use loads::PointLoads;
+pub use mesh_bending::MeshBending;
 pub use shear::CellShear;
 pub use springs::{SpringFamily, Springs};
 

@@ -4,6 +4,13 @@
 //! measures are taken of a photo's silhouette, of a mesh's vertical projection and of a hem polygon,
 //! so that each can be checked against the others (data: Gong, Mao & Wang, CVPR 2024).
 
+mod drape;
+
+pub use drape::{
+    DiscMesh, DrapeParams, calibrate_bending_length, drape_dc, drape_model, drape_start,
+    polar_disc, solve_drape,
+};
+
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
