@@ -130,6 +130,42 @@ impl EnergyTerm for MeshBending {
     }
 }
 
+/// Hinge bending (Bergou et al. 2006, "A quadratic bending model for inextensible surfaces"): per
+/// interior edge (x₀, x₁) with opposite vertices x₂, x₃, u = Σ Kᵢ xᵢ with
+/// K = (c₀₃ + c₀₄, c₀₁ + c₀₂, −c₀₁ − c₀₃, −c₀₂ − c₀₄) (cotangents of the rest angles at the edge's ends),
+/// and E = ½ k |u|², k = B/(A₀ + A₁) (so that a sheet rolled on a cylinder stores ½Bκ² per area):
+/// zero for a flat sheet, and reaching every edge next to the hem.
+pub fn hinge_bending(
+    rest: &[[f64; 2]],
+    triangles: &[[usize; 3]],
+    rigidity_N_m: f64,
+) -> super::QuadraticStencil<4> {
+    let p3 = |v: usize| Vector3::new(rest[v][0], rest[v][1], 0.0);
+    let cot = |a: Vector3<f64>, b: Vector3<f64>| a.dot(&b) / a.cross(&b).norm().max(1e-300);
+    // Each undirected edge → (opposite vertex, triangle area) of its triangles.
+    let mut sides: BTreeMap<(usize, usize), Vec<(usize, f64)>> = BTreeMap::new();
+    for t in triangles {
+        let a = 0.5 * (p3(t[1]) - p3(t[0])).cross(&(p3(t[2]) - p3(t[0]))).norm();
+        for k in 0..3 {
+            let (i, j, o) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            sides.entry((i.min(j), i.max(j))).or_default().push((o, a));
+        }
+    }
+    let (mut stencils, mut coef, mut stiff) = (Vec::new(), Vec::new(), Vec::new());
+    for (&(i0, i1), opp) in &sides {
+        let [(i2, a0), (i3, a1)] = opp.as_slice() else {
+            continue;
+        };
+        let (x0, x1, x2, x3) = (p3(i0), p3(i1), p3(*i2), p3(*i3));
+        let (e0, e1, e2, e3, e4) = (x1 - x0, x2 - x0, x3 - x0, x2 - x1, x3 - x1);
+        let (c01, c02, c03, c04) = (cot(e0, e1), cot(e0, e2), cot(-e0, e3), cot(-e0, e4));
+        stencils.push([i0, i1, *i2, *i3]);
+        coef.push([c03 + c04, c01 + c02, -c01 - c03, -c02 - c04]);
+        stiff.push(rigidity_N_m / (a0 + a1));
+    }
+    super::QuadraticStencil::from_stencils("bending/hinge", stencils, coef, stiff)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -186,6 +222,14 @@ mod tests {
         let exact = 0.5 * b / (radius * radius) * interior;
         let e = term.energy(&rolled);
         assert!((e / exact - 1.0).abs() < 0.01, "{e} vs {exact}");
+        let hinge = hinge_bending(&rest, &tris, b);
+        let whole = 0.5 * b / (radius * radius) * lx * ly;
+        let eh = hinge.energy(&rolled);
+        assert!(
+            (eh / whole - 1.0).abs() < 0.03,
+            "hinge: {eh} against {whole}"
+        );
+        assert!(hinge.energy(&flat).abs() < 1e-18);
         // A rigid motion of the rolled sheet changes nothing; the gradient is E's derivative.
         let r = nalgebra::Rotation3::from_euler_angles(0.3, -0.2, 0.7);
         let moved: Vec<Vector3<f64>> = rolled
