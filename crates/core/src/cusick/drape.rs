@@ -11,7 +11,7 @@ use crate::solve::{NoObserver, SolveReport, StaticOptions, solve_static};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeSet;
+use std::collections::BTreeMap;
 
 /// Parameters of a simulated Cusick drape.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -60,8 +60,10 @@ pub struct DiscMesh<'a> {
 pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Model {
     let n = mesh.rest_xy.len();
     let rest3 = |v: usize| Vector3::new(mesh.rest_xy[v][0], mesh.rest_xy[v][1], 0.0);
+    // Lumped vertex areas, and per edge the tributary area A_e = (its triangles' areas)/3: a spring
+    // over an edge of length l then carries k = E_t A_e / l².
     let mut area = vec![0.0; n];
-    let mut edges = BTreeSet::new();
+    let mut trib: BTreeMap<(usize, usize), f64> = BTreeMap::new();
     for t in mesh.triangles {
         let a = 0.5
             * (rest3(t[1]) - rest3(t[0]))
@@ -70,23 +72,10 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
         for k in 0..3 {
             area[t[k]] += a / 3.0;
             let (i, j) = (t[k], t[(k + 1) % 3]);
-            edges.insert((i.min(j), i.max(j)));
-        }
-    }
-    // Edge springs: a spring over an edge of length l with tributary area A_e ≈ (sum of the
-    // adjacent triangles' areas)/3 carries k = E_t A_e / l².
-    let mut trib = std::collections::BTreeMap::new();
-    for t in mesh.triangles {
-        let a = 0.5
-            * (rest3(t[1]) - rest3(t[0]))
-                .cross(&(rest3(t[2]) - rest3(t[0])))
-                .norm();
-        for k in 0..3 {
-            let (i, j) = (t[k], t[(k + 1) % 3]);
             *trib.entry((i.min(j), i.max(j))).or_insert(0.0) += a / 3.0;
         }
     }
-    let pairs: Vec<(usize, usize)> = edges.iter().copied().collect();
+    let pairs: Vec<(usize, usize)> = trib.keys().copied().collect();
     let rest: Vec<f64> = pairs
         .iter()
         .map(|&(i, j)| (rest3(i) - rest3(j)).norm())

@@ -118,12 +118,15 @@ pub fn hem_projection(hem: &[Vector3<f64>]) -> Projection {
             })
             .collect();
         xs.sort_by(f64::total_cmp);
+        // Pixel centres x = x₀ + (col + ½)·pixel inside [a, b): col from ⌈(a − x₀)/pixel − ½⌉.
+        let col_of = |x: f64| {
+            ((x - p.origin_m[0]) / p.pixel_m - 0.5)
+                .ceil()
+                .clamp(0.0, p.nx as f64) as usize
+        };
         for pair in xs.chunks_exact(2) {
-            for col in 0..p.nx {
-                let x = p.centre(col, row)[0];
-                if x >= pair[0] && x < pair[1] {
-                    p.covered[row * p.nx + col] = true;
-                }
+            for col in col_of(pair[0])..col_of(pair[1]) {
+                p.covered[row * p.nx + col] = true;
             }
         }
     }
