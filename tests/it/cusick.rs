@@ -2,7 +2,7 @@
 //! captures' 3D meshes; a synthetic drape gives back its own measures through a photo; bad dataset
 //! files exit 2 naming the file.
 
-use crate::support::{drapelab, root, temp_project};
+use crate::support::{drapelab, root, run_plan, run_python, temp_project};
 use drapelab::cusick::{
     SilhouetteScale, Tester, mesh_projection, shadow_measures, silhouette_projection,
 };
@@ -28,8 +28,12 @@ fn group(rows: &[&drapelab::stages::ShadowRow]) -> (usize, f64, f64, usize) {
 #[test]
 fn dc_and_nodes_from_the_photos_match_the_mesh_projections_of_the_same_captures() {
     let data = CusickDataset::open(&root().join("datasets/cusick")).expect("bundled dataset");
-    let rows = drapelab::stages::measure_dataset(&data, &SilhouetteScale::default(), &|| {})
-        .expect("measured");
+    let rows: Vec<drapelab::stages::ShadowRow> =
+        drapelab::stages::measure_dataset(&data, &SilhouetteScale::default(), &|| {})
+            .expect("measured")
+            .into_iter()
+            .map(|(r, _)| r)
+            .collect();
     assert_eq!(rows.len(), data.captures.len());
     // The photos' single scale (723.2 px/m) fits the template registrations in the photo's frame;
     // the source's rotated batch and its hem-curve lofts are ~0.8 % smaller and ~0.5 % larger
@@ -168,4 +172,112 @@ fn a_missing_or_unreadable_photo_and_an_empty_fabric_exit_2_naming_the_file() {
         },
         "captures_index.csv",
     );
+}
+
+/// Keeps only `fabrics` in a copied dataset's fabrics.csv and captures_index.csv.
+fn keep_fabrics(dataset: &std::path::Path, fabrics: &[&str]) {
+    for name in ["fabrics.csv", "captures_index.csv"] {
+        let path = dataset.join(name);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let kept: Vec<&str> = text
+            .lines()
+            .filter(|l| {
+                l.starts_with('#')
+                    || l.starts_with("fabric,")
+                    || fabrics.iter().any(|f| l.starts_with(&format!("{f},")))
+            })
+            .collect();
+        std::fs::write(&path, kept.join("\n") + "\n").unwrap();
+    }
+}
+
+#[test]
+fn the_pipeline_calibrates_predicts_draws_and_records_two_fabrics() {
+    let pipeline = std::fs::read_to_string(root().join("pipelines/cusick.toml"))
+        .unwrap()
+        .replace(
+            "kind = \"cusick-predict\"",
+            "kind = \"cusick-predict\"\nparams = { seeds = 2 }",
+        );
+    let (tmp, file) = temp_project(
+        &[
+            "datasets/cusick/*.*",
+            "datasets/cusick/fabric_05/silhouettes/*.jpg",
+            "datasets/cusick/fabric_07/silhouettes/*.jpg",
+        ],
+        "cusick.toml",
+        &pipeline,
+    );
+    keep_fabrics(&tmp.path().join("datasets/cusick"), &["5", "7"]);
+    run_plan(&file);
+    let run = tmp.path().join("runs/cusick");
+    let rows: Vec<drapelab::stages::PredictionRow> =
+        drapelab::io::read_table(&run.join("predict/predictions.parquet")).unwrap();
+    assert_eq!(rows.iter().map(|r| r.fabric).collect::<Vec<_>>(), [5, 7]);
+    for r in &rows {
+        assert_eq!(r.status, "ok", "{r:?}");
+        let c = r.bending_length_warp_m.unwrap();
+        // The calibrated drape reproduces its target, and the interval holds c.
+        assert!(
+            (r.dc_predicted_pct.unwrap() - r.dc_calibration_pct).abs() < 3.0,
+            "{r:?}"
+        );
+        assert!(r.bending_length_lo_m.unwrap() < c && c < r.bending_length_hi_m.unwrap());
+        assert!(drapelab::stages::dc_within(r) == Some(true), "{r:?}");
+        assert!(r.solves >= 4 && r.solve_time_mean_s > 0.0, "{r:?}");
+    }
+    // The contract's columns and types, as another reader sees them.
+    let out = run_python(
+        r#"
+import sys, pyarrow.parquet as pq
+s = pq.read_schema(sys.argv[1])
+assert str(s.field("fabric").type) == "int32" and str(s.field("calibration_sample").type) == "int32"
+for c in ["bending_length_warp_m", "bending_length_weft_m", "dc_predicted_pct", "dc_predicted_sd_pct",
+          "dc_measured_mean_pct", "dc_measured_sd_pct", "nodes_predicted", "nodes_measured_median",
+          "profile_rms_mm"]:
+    assert str(s.field(c).type) == "double", c
+from rerun.experimental import RrdReader
+paths = set()
+for chunk in RrdReader(sys.argv[2]).stream().to_chunks():
+    paths.add(chunk.entity_path)
+need = {"/fabric_05/measured/s2_c1", "/fabric_05/simulated/seed_0", "/fabric_07/simulated/seed_1", "/fabric_07/pedestal"}
+assert need <= paths, sorted(paths)
+print("ok")
+"#,
+        &[
+            &run.join("predict/predictions.parquet"),
+            &run.join("predict/drapes.rrd"),
+        ],
+    );
+    assert_eq!(out.trim(), "ok");
+    let md = std::fs::read_to_string(tmp.path().join("reports/cusick.md")).unwrap();
+    assert!(md.contains("![shadows](cusick_shadows.svg)"), "{md}");
+    for svg in ["cusick_shadows.svg", "cusick_profiles.svg"] {
+        let text = std::fs::read_to_string(tmp.path().join("reports").join(svg)).unwrap();
+        assert!(text.contains("<svg") && text.contains("fabric 7"), "{svg}");
+    }
+}
+
+#[test]
+fn the_template_mesh_agrees_with_its_own_refinement() {
+    let data = CusickDataset::open(&root().join("datasets/cusick")).expect("bundled dataset");
+    let t = data.template().unwrap();
+    let tester = Tester::default();
+    let (fine, ftris) = drapelab::cusick::subdivide_disc(&t.rest_xy, &t.triangles, 0.15);
+    let p = drapelab::cusick::DrapeParams {
+        bending_length_m: 0.022,
+        ..Default::default()
+    };
+    let measure = |rest: &[[f64; 2]], tris: &[[usize; 3]]| {
+        let mesh = drapelab::cusick::DiscMesh {
+            rest_xy: rest,
+            triangles: tris,
+        };
+        let (dc, nodes, _) = drapelab::cusick::drape_dc(mesh, &p, &tester).expect("converged");
+        (dc, nodes)
+    };
+    let (coarse, refined) = (measure(&t.rest_xy, &t.triangles), measure(&fine, &ftris));
+    eprintln!("template {coarse:?}, refined (×4 triangles) {refined:?}");
+    assert!((coarse.0 - refined.0).abs() < 3.0, "{coarse:?} {refined:?}");
+    assert!(coarse.1.abs_diff(refined.1) <= 1, "{coarse:?} {refined:?}");
 }

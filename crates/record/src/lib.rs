@@ -7,6 +7,7 @@
 
 mod calibration_rrd;
 pub mod cusick;
+mod cusick_rrd;
 mod edges_table;
 mod particles;
 mod photo;
@@ -18,6 +19,7 @@ mod timeline;
 mod wrinkles_rrd;
 
 pub use calibration_rrd::CalibrationRecorder;
+pub use cusick_rrd::{FABRIC_SPACING_M, NamedMesh, write_cusick_drapes};
 pub use drapelab_core::atomic::{Staged, write_atomic, write_text};
 pub use edges_table::EdgeRow;
 pub use edges_table::{read_edges, write_edges};

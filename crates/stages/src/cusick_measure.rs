@@ -2,10 +2,11 @@
 //! its silhouette photo and from its 3D mesh (or hem), so that each measure checks the other:
 //! the drape coefficient (BS 5058) and the node count of the shadow's outline.
 
+use crate::cusick_tables::OutlineRow;
 use anyhow::Result;
 use drapelab_core::cusick::{
-    ShadowMeasures, SilhouetteScale, Tester, hem_projection, mesh_projection, shadow_measures,
-    silhouette_projection,
+    ShadowMeasures, SilhouetteScale, Tester, hem_projection, mesh_projection, sector_angle_rad,
+    shadow_measures, silhouette_projection,
 };
 use drapelab_core::table::Table;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
@@ -81,23 +82,55 @@ impl StageKind for CusickMeasure {
             "every file of the dataset (for the up-to-date check), e.g. datasets/cusick/*.* and its silhouettes",
         ),
     ];
-    const OUTPUTS: &'static [Slot] = &[Slot::one("table", "shadows.parquet: one row per capture")];
+    const OUTPUTS: &'static [Slot] = &[
+        Slot::one("table", "shadows.parquet: one row per capture"),
+        Slot::one(
+            "outlines",
+            "outlines.parquet: each photo's smoothed shadow outline r(θ), 1° sectors",
+        ),
+    ];
     fn run(ctx: &StageContext<'_>, p: &CusickMeasureParams) -> Result<()> {
         let index = ctx.input("index")?;
         let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
         ctx.progress
             .stage_started(&ctx.stage.name, data.captures.len() as u64);
-        let rows = measure_dataset(&data, &p.scale, &|| ctx.progress.item_done(&ctx.stage.name))?;
-        write_table(ctx.output("table")?, &rows)
+        let measured =
+            measure_dataset(&data, &p.scale, &|| ctx.progress.item_done(&ctx.stage.name))?;
+        let outlines: Vec<OutlineRow> = measured
+            .iter()
+            .flat_map(|(r, outline)| photo_outline(r, outline))
+            .collect();
+        let rows: Vec<ShadowRow> = measured.into_iter().map(|(r, _)| r).collect();
+        write_table(ctx.output("table")?, &rows)?;
+        write_table(ctx.output("outlines")?, &outlines)
     }
 }
 
-/// Measures every capture of `data` (in parallel), calling `done` after each.
+/// The outline rows of a capture's photo.
+fn photo_outline<'a>(
+    r: &'a ShadowRow,
+    outline_m: &'a [f64],
+) -> impl Iterator<Item = OutlineRow> + 'a {
+    outline_m
+        .iter()
+        .enumerate()
+        .map(|(k, &radius_m)| OutlineRow {
+            fabric: r.fabric,
+            sample: Some(r.sample),
+            capture: Some(r.capture),
+            seed: None,
+            theta_rad: sector_angle_rad(k, outline_m.len()),
+            radius_m,
+        })
+}
+
+/// Measures every capture of `data` (in parallel), calling `done` after each: its row and its
+/// photo's smoothed outline r(θ), m.
 pub fn measure_dataset(
     data: &CusickDataset,
     scale: &SilhouetteScale,
     done: &(dyn Fn() + Sync),
-) -> Result<Vec<ShadowRow>> {
+) -> Result<Vec<(ShadowRow, Vec<f64>)>> {
     let tester = Tester::default();
     let template = data.template()?;
     let meshes = data.meshes()?;
@@ -119,7 +152,8 @@ pub fn measure_dataset(
                 )),
             };
             done();
-            Ok(row(c, &photo, mesh.as_ref(), matching.as_ref()))
+            let r = row(c, &photo, mesh.as_ref(), matching.as_ref());
+            Ok((r, photo.outline_m))
         })
         .collect()
 }

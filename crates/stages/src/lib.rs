@@ -11,8 +11,10 @@ mod calibrate;
 mod calibration_report;
 mod calibration_tables;
 mod cusick_measure;
+mod cusick_plots;
 mod cusick_predict;
 mod cusick_report;
+mod cusick_tables;
 mod fit_edges;
 mod peers;
 pub mod report;
@@ -31,8 +33,9 @@ pub use benchmark_report::{BenchmarkReport, BenchmarkReportParams};
 pub use calibrate::{Calibrate, CalibrateParams};
 pub use calibration_report::{CalibrationReport, CalibrationReportParams};
 pub use cusick_measure::{CusickMeasure, CusickMeasureParams, ShadowRow, measure_dataset};
-pub use cusick_predict::{CusickPredict, CusickPredictParams, PredictionRow};
-pub use cusick_report::{CusickReport, CusickReportParams};
+pub use cusick_predict::{CusickPredict, CusickPredictParams};
+pub use cusick_report::{CusickReport, CusickReportParams, dc_within, nodes_within};
+pub use cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 pub use fit_edges::{FitEdges, FitEdgesParams};
 pub use peers::{Peers, PeersParams};
 pub use report::{Report, ReportParams};
@@ -105,7 +108,9 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<drapelab_core::benchmark::SkipRow>()?,
         md::<peers::PeerRow>()?,
         md::<cusick_measure::ShadowRow>()?,
-        md::<cusick_predict::PredictionRow>()?,
+        md::<cusick_tables::PredictionRow>()?,
+        md::<cusick_tables::OutlineRow>()?,
+        md::<cusick_tables::ProfileRow>()?,
     ];
     Ok(sections.join("\n"))
 }

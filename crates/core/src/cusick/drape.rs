@@ -191,6 +191,49 @@ pub fn polar_disc(radius_m: f64, rings: usize) -> (Vec<[f64; 2]>, Vec<[usize; 3]
     (rest, tris)
 }
 
+/// The disc mesh refined once: every triangle split into four at its edges' midpoints, the
+/// midpoints of boundary edges pushed out onto the circle of `radius_m` (for mesh convergence
+/// studies of a given mesh such as the dataset's template).
+pub fn subdivide_disc(
+    rest_xy: &[[f64; 2]],
+    triangles: &[[usize; 3]],
+    radius_m: f64,
+) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
+    let key = |a: usize, b: usize| (a.min(b), a.max(b));
+    let mut uses: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    for t in triangles {
+        for k in 0..3 {
+            *uses.entry(key(t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+        }
+    }
+    let mut rest = rest_xy.to_vec();
+    let mut mid: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    let mut midpoint = |a: usize, b: usize, rest: &mut Vec<[f64; 2]>| {
+        *mid.entry(key(a, b)).or_insert_with(|| {
+            let mut p = [
+                0.5 * (rest[a][0] + rest[b][0]),
+                0.5 * (rest[a][1] + rest[b][1]),
+            ];
+            if uses[&key(a, b)] == 1 {
+                let r = p[0].hypot(p[1]);
+                p = [p[0] * radius_m / r, p[1] * radius_m / r];
+            }
+            rest.push(p);
+            rest.len() - 1
+        })
+    };
+    let mut tris = Vec::with_capacity(4 * triangles.len());
+    for &[a, b, c] in triangles {
+        let (ab, bc, ca) = (
+            midpoint(a, b, &mut rest),
+            midpoint(b, c, &mut rest),
+            midpoint(c, a, &mut rest),
+        );
+        tris.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+    }
+    (rest, tris)
+}
+
 /// The drape coefficient (%) and node count of a solved drape, or None when the solve did not
 /// converge (never numbers passed off as a result).
 pub fn drape_dc(
@@ -204,44 +247,6 @@ pub fn drape_dc(
     }
     let m = super::shadow_measures(&super::mesh_projection(&x, mesh.triangles), tester);
     Some((m.dc_pct, m.nodes, x))
-}
-
-/// The bending length (m) whose simulated drape (seed `p.seed`) has the drape coefficient
-/// `target_dc_pct`: bisection on log c over [c_lo, c_hi] (DC rises with c), to a relative width of
-/// `rel_tol`. Err with the bracket's DCs when the target lies outside it or a solve fails.
-pub fn calibrate_bending_length(
-    mesh: DiscMesh<'_>,
-    target_dc_pct: f64,
-    p: &DrapeParams,
-    tester: &Tester,
-    bracket_m: [f64; 2],
-    rel_tol: f64,
-) -> Result<f64, String> {
-    let dc = |c: f64| {
-        let q = DrapeParams {
-            bending_length_m: c,
-            ..p.clone()
-        };
-        drape_dc(mesh, &q, tester)
-            .map(|r| r.0)
-            .ok_or_else(|| format!("the drape at c = {c} m did not converge"))
-    };
-    let [mut lo, mut hi] = bracket_m;
-    let (d_lo, d_hi) = (dc(lo)?, dc(hi)?);
-    if !(d_lo..=d_hi).contains(&target_dc_pct) {
-        return Err(format!(
-            "DC {target_dc_pct:.1} % lies outside [{d_lo:.1}, {d_hi:.1}] %, the drapes of c in [{lo}, {hi}] m"
-        ));
-    }
-    while hi / lo > 1.0 + rel_tol {
-        let mid = (lo * hi).sqrt();
-        if dc(mid)? < target_dc_pct {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Ok((lo * hi).sqrt())
 }
 
 #[cfg(test)]
@@ -269,6 +274,30 @@ mod tests {
     }
 
     #[test]
+    fn subdivision_keeps_the_disc_and_quadruples_the_triangles() {
+        let (rest, tris) = polar_disc(0.15, 8);
+        let (fine, ftris) = subdivide_disc(&rest, &tris, 0.15);
+        assert_eq!(ftris.len(), 4 * tris.len());
+        // V − E + F = 1 for a disc, before and after.
+        let edges = |t: &[[usize; 3]]| {
+            let mut e: Vec<(usize, usize)> = t
+                .iter()
+                .flat_map(|t| {
+                    (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+                })
+                .collect();
+            e.sort_unstable();
+            e.dedup();
+            e.len()
+        };
+        assert_eq!(fine.len() + ftris.len(), edges(&ftris) + 1);
+        // The refined area lies between the coarse polygon's and the circle's.
+        let (a0, a1) = (area(&rest, &tris), area(&fine, &ftris));
+        assert!(a1 > a0 && a1 < std::f64::consts::PI * 0.0225, "{a0} {a1}");
+        assert!(ftris.iter().all(|t| area(&fine, &[*t]) > 0.0));
+    }
+
+    #[test]
     fn a_stiff_specimen_stays_out_and_a_limp_one_hangs_in_folds() {
         let (rest, tris) = polar_disc(0.15, 24);
         let mesh = DiscMesh {
@@ -292,30 +321,6 @@ mod tests {
         );
         assert!(stiff.dc_pct > limp.dc_pct + 20.0);
         assert!((3..=14).contains(&limp.nodes));
-    }
-
-    #[test]
-    fn the_bending_length_of_a_synthetic_drape_is_recovered_from_its_dc() {
-        let (rest, tris) = polar_disc(0.15, 20);
-        let mesh = DiscMesh {
-            rest_xy: &rest,
-            triangles: &tris,
-        };
-        let t = Tester::default();
-        let truth = DrapeParams {
-            bending_length_m: 0.022,
-            seed: 7,
-            ..DrapeParams::default()
-        };
-        let (dc, _, _) = drape_dc(mesh, &truth, &t).expect("converged");
-        // Calibrated from another perturbation than the one that made the "measurement".
-        let p = DrapeParams {
-            seed: 1,
-            ..DrapeParams::default()
-        };
-        let c = calibrate_bending_length(mesh, dc, &p, &t, [0.01, 0.06], 0.01).expect("calibrated");
-        eprintln!("DC {dc:.2} %: c = {c:.5} m against 0.022");
-        assert!((c / 0.022 - 1.0).abs() < 0.05, "{c}");
     }
 
     #[test]

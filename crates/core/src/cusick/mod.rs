@@ -4,11 +4,13 @@
 //! measures are taken of a photo's silhouette, of a mesh's vertical projection and of a hem polygon,
 //! so that each can be checked against the others (data: Gong, Mao & Wang, CVPR 2024).
 
+mod calibrate;
 mod drape;
 
+pub use calibrate::{BendingCalibration, bisect_bending_length, calibrate_bending_length};
 pub use drape::{
-    DiscMesh, DrapeParams, calibrate_bending_length, drape_dc, drape_model, drape_start,
-    polar_disc, solve_drape,
+    DiscMesh, DrapeParams, drape_dc, drape_model, drape_start, polar_disc, solve_drape,
+    subdivide_disc,
 };
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};
@@ -144,6 +146,12 @@ pub struct ShadowMeasures {
     pub nodes: usize,
     /// The smoothed outline radius r(θ) in 1° sectors from θ = 0 (+x), m.
     pub outline_m: Vec<f64>,
+}
+
+/// The polar angle (rad, from +x) of the centre of sector `k` of `sectors` equal sectors of an
+/// outline r(θ) (sector k holds the angles [k, k + 1) · 2π / sectors).
+pub fn sector_angle_rad(k: usize, sectors: usize) -> f64 {
+    (k as f64 + 0.5) * std::f64::consts::TAU / sectors as f64
 }
 
 /// Sectors of the outline r(θ).

@@ -1,0 +1,102 @@
+//! The tables of the Cusick stages (issue 16) besides `shadows.parquet`: `predictions.parquet` (one
+//! row per fabric, the issue's contract), the shadow outlines r(θ) of photos and of simulated drapes,
+//! and the azimuthally averaged height profiles z(r), each row type its schema.
+
+use drapelab_core::table::Table;
+use serde::{Deserialize, Serialize};
+
+/// One fabric: calibrated on one specimen, predicted against the others.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PredictionRow {
+    /// Fabric number.
+    pub fabric: i32,
+    /// The specimen calibrated on (the lowest-numbered).
+    pub calibration_sample: i32,
+    /// Bending length along the warp, m (the model is isotropic: warp = weft; None if the calibration failed).
+    pub bending_length_warp_m: Option<f64>,
+    /// Bending length along the weft, m.
+    pub bending_length_weft_m: Option<f64>,
+    /// Bending rigidity, N·m (None where the areal density is unknown: it needs the weight).
+    pub bending_rigidity_N_m: Option<f64>,
+    /// Lower end of the 2σ interval of the bending length, m: c · exp(−2σ/s), σ the uncertainty of
+    /// the calibration's DC (its photos' SD/√n and the model's seed-to-seed SD), s = dDC/d ln c.
+    pub bending_length_lo_m: Option<f64>,
+    /// Upper end of that interval, m.
+    pub bending_length_hi_m: Option<f64>,
+    /// Sensitivity of the simulated DC to the bending length, dDC/d ln c, % (what pins c down).
+    pub dc_sensitivity_pct: Option<f64>,
+    /// Mean simulated DC over the perturbations, %.
+    pub dc_predicted_pct: Option<f64>,
+    /// SD of the simulated DC over the perturbations, %.
+    pub dc_predicted_sd_pct: Option<f64>,
+    /// Mean measured DC (photos) of the other specimens, %.
+    pub dc_measured_mean_pct: f64,
+    /// SD of the measured DC over the other specimens' captures, %.
+    pub dc_measured_sd_pct: f64,
+    /// DC of the calibration specimen (the target), %.
+    pub dc_calibration_pct: f64,
+    /// Mean simulated node count over the perturbations.
+    pub nodes_predicted: Option<f64>,
+    /// Median measured node count (photos) of the other specimens.
+    pub nodes_measured_median: f64,
+    /// RMS over the rings of simulated minus measured mean height z(r), mm (None without registered meshes).
+    pub profile_rms_mm: Option<f64>,
+    /// "ok", or why there is no prediction.
+    pub status: String,
+    /// Drape solves made (the calibration's and the predictions').
+    pub solves: i32,
+    /// Mean wall time of one drape solve, s.
+    pub solve_time_mean_s: f64,
+    /// Wall time of the fabric's calibration and predictions, s.
+    pub wall_time_s: f64,
+}
+
+impl Table for PredictionRow {
+    const FILE: &'static str = "predictions.parquet";
+    const ROW: &'static str = "One Cusick fabric: bending length calibrated on its lowest-numbered specimen, its other specimens predicted.";
+}
+
+/// One point of a shadow outline r(θ) (smoothed over ±5°) about the pedestal centre.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OutlineRow {
+    /// Fabric number.
+    pub fabric: i32,
+    /// Specimen of a photographed outline (None for a simulated one).
+    pub sample: Option<i32>,
+    /// Capture of a photographed outline.
+    pub capture: Option<i32>,
+    /// Perturbation seed of a simulated outline (None for a photographed one).
+    pub seed: Option<i32>,
+    /// Polar angle from +x, rad.
+    pub theta_rad: f64,
+    /// Radius of the outline, m.
+    pub radius_m: f64,
+}
+
+impl Table for OutlineRow {
+    const FILE: &'static str = "outlines.parquet";
+    const ROW: &'static str =
+        "One point of a Cusick shadow outline r(θ): a capture's photo or a simulated drape.";
+}
+
+/// One ring of a fabric's azimuthally averaged height profile z(r), measured and predicted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProfileRow {
+    /// Fabric number.
+    pub fabric: i32,
+    /// Rest (material) radius of the ring's centre, m.
+    pub radius_m: f64,
+    /// Mean height over the registered meshes of the predicted specimens, m (pedestal top z = 0).
+    pub z_measured_m: Option<f64>,
+    /// SD of that height over the meshes, m.
+    pub z_measured_sd_m: Option<f64>,
+    /// Mean height over the simulated drapes, m.
+    pub z_predicted_m: Option<f64>,
+    /// SD of that height over the perturbations, m.
+    pub z_predicted_sd_m: Option<f64>,
+}
+
+impl Table for ProfileRow {
+    const FILE: &'static str = "profiles.parquet";
+    const ROW: &'static str = "One ring of a Cusick fabric's azimuthally averaged height z(r): the registered meshes against the simulated drapes.";
+}
