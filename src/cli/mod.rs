@@ -154,7 +154,8 @@ pub enum Command {
     ///
     /// Seed 000 Figs 3, 11, 12. Writes DIR/edges.parquet (edge, power, coefficient of x^power in cm,
     /// RMS residual, points) and DIR/overlay.png (fitted curves red, reference line blue). Calibrate
-    /// with --px-per-cm and --corners, or --markers and --side-cm, or --camera-json from `render`.
+    /// with --px-per-cm and --corners, or --markers and --side-cm, or --camera-json (a camera file
+    /// as the README's "Camera files" describes it, or the one `render` writes).
     FitEdges {
         /// The photo (PNG or JPEG).
         photo: PathBuf,
@@ -164,7 +165,8 @@ pub enum Command {
         /// Scale in the plane of the fixed corners, px per cm.
         #[arg(long)]
         px_per_cm: Option<f64>,
-        /// Pixel positions of the two fixed corners: x1,y1,x2,y2.
+        /// Pixel positions of the two fixed corners: x1,y1,x2,y2 (pixel centres at integers, as
+        /// image viewers and OpenCV number them).
         #[arg(long)]
         corners: Option<String>,
         /// Find the corners from two red markers (needs --side-cm).
@@ -173,7 +175,8 @@ pub enum Command {
         /// Distance between the fixed corners, cm (with --markers).
         #[arg(long)]
         side_cm: Option<f64>,
-        /// A camera.json written by `render` (scale, corners and view).
+        /// A camera.json: view, side_cm, the scale (px_per_cm or a pinhole) and the corners
+        /// (corners_px or markers); `render`'s own settings are optional.
         #[arg(long)]
         camera_json: Option<PathBuf>,
         /// Which hang the photo shows (ignored with --camera-json, which names it).
@@ -552,10 +555,7 @@ fn fit_edges(
     let calibration = if let Some(cj) = c.camera_json {
         let cam = crate::edges::read_camera(&cj)?;
         view = cam.view;
-        crate::edges::Calibration::Given {
-            px_per_cm: cam.px_per_cm,
-            corners: cam.corners_px,
-        }
+        cam.calibration(&cj)?
     } else if c.markers {
         let side = c.side_cm.ok_or_else(|| {
             InputError::new(

@@ -4,7 +4,7 @@
 use crate::support::{root, scene};
 use drapelab::calibrate::Problem;
 use drapelab::edges::read_camera;
-use drapelab::edges::{Calibration, FitImageOptions, fit_image, read_gray};
+use drapelab::edges::{FitImageOptions, fit_image, read_gray};
 use drapelab::optim::IcaSettings;
 
 /// The edges fitted from sample 8's bundled 4-corner photo with its camera calibration.
@@ -17,10 +17,7 @@ fn sample_8_edges() -> Vec<drapelab::edges::EdgeFit> {
         &FitImageOptions {
             view: cam.view,
             degree: 4,
-            calibration: Calibration::Given {
-                px_per_cm: cam.px_per_cm,
-                corners: cam.corners_px,
-            },
+            calibration: cam.calibration(&dir.join("camera.json")).unwrap(),
         },
         &photo,
     )

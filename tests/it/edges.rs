@@ -38,10 +38,7 @@ fn rendered(
         &FitImageOptions {
             view: View::Hang4,
             degree: 4,
-            calibration: Calibration::Given {
-                px_per_cm: cam.px_per_cm,
-                corners: cam.corners_px,
-            },
+            calibration: cam.calibration(&dir.join("camera.json")).unwrap(),
         },
         &photo,
     )
@@ -59,7 +56,7 @@ fn rendered(
 #[test]
 fn fit_edges_recovers_a_known_polynomial_within_half_a_pixel() {
     // A sagging curve v(u) = v0 + f(u) between corners at u1 and u2 (same v0); fabric above it,
-    // drawn with exact area coverage (8 sub-columns per pixel).
+    // drawn with exact area coverage (8 sub-columns per pixel; pixel centres at integers).
     let (w, h, u1, u2, v0) = (520u32, 320u32, 30.0, 490.0, 60.0);
     let f = |u: f64| {
         let s = (u - u1) / (u2 - u1);
@@ -70,7 +67,7 @@ fn fit_edges_recovers_a_known_polynomial_within_half_a_pixel() {
         for v in 0..h {
             let mut c = 0.0;
             for k in 0..8 {
-                let uu = u as f64 + (k as f64 + 0.5) / 8.0;
+                let uu = u as f64 - 0.5 + (k as f64 + 0.5) / 8.0;
                 let edge = if (u1..=u2).contains(&uu) {
                     v0 + f(uu)
                 } else {
@@ -78,7 +75,7 @@ fn fit_edges_recovers_a_known_polynomial_within_half_a_pixel() {
                 };
                 // Fabric spans from v0 − 30 down to the curve.
                 let top = v0 - 30.0;
-                c += (edge.min(v as f64 + 1.0) - top.max(v as f64)).clamp(0.0, 1.0) / 8.0;
+                c += (edge.min(v as f64 + 0.5) - top.max(v as f64 - 0.5)).clamp(0.0, 1.0) / 8.0;
             }
             let g = (232.0 * (1.0 - c) + 90.0 * c).round() as u8;
             img.put_pixel(u, v, Rgb([g, g, g]));

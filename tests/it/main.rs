@@ -13,5 +13,6 @@ mod loads;
 mod pipeline;
 mod recordings;
 mod stress;
+mod subpixel;
 mod support;
 mod wrinkles;

@@ -58,10 +58,12 @@ pub fn render_scene(
     })?;
     let cam = CameraFile {
         view,
-        px_per_cm: photo.px_per_cm,
-        corners_px: photo.corners_px,
         side_cm: scene.cloth.size_x_m * 100.0,
-        render: opts.clone(),
+        px_per_cm: Some(photo.px_per_cm),
+        pinhole: None,
+        corners_px: Some(photo.corners_px),
+        markers: false,
+        render: Some(opts.clone()),
     };
     let json = serde_json::to_vec_pretty(&cam)?;
     write_atomic(&out.join("camera.json"), |f| {

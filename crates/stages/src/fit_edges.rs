@@ -3,9 +3,7 @@
 //! each row's `sample` being the photo's folder relative to the project root.
 
 use anyhow::{Result, bail};
-use drapelab_core::edges::{
-    Calibration, EdgeFit, FitImageOptions, fit_image, read_camera, read_gray,
-};
+use drapelab_core::edges::{EdgeFit, FitImageOptions, fit_image, read_camera, read_gray};
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::write_edges;
 use rayon::prelude::*;
@@ -65,15 +63,13 @@ fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
         .par_iter()
         .map(|photo| {
             let dir = photo.parent().unwrap_or(std::path::Path::new("."));
-            let cam = read_camera(&dir.join("camera.json"))?;
+            let camera = dir.join("camera.json");
+            let cam = read_camera(&camera)?;
             let img = read_gray(photo)?;
             let opts = FitImageOptions {
                 view: cam.view,
                 degree: p.degree,
-                calibration: Calibration::Given {
-                    px_per_cm: cam.px_per_cm,
-                    corners: cam.corners_px,
-                },
+                calibration: cam.calibration(&camera)?,
             };
             let fit = fit_image(&img, &opts, photo)?;
             let sample = dir

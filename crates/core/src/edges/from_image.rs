@@ -40,6 +40,8 @@ pub struct FitImageOptions {
 pub struct ImageFit {
     /// One fit per edge of the view.
     pub edges: Vec<EdgeFit>,
+    /// The traced edge points each fit was made from, (x, y) in cm in the reference line's frame.
+    pub points_cm: Vec<Vec<(f64, f64)>>,
     /// The photo with the reference line (blue) and the fitted curves (red).
     pub overlay: RgbImage,
     /// Corners used, px.
@@ -81,8 +83,8 @@ fn find_markers(img: &RgbImage) -> Option<([(f64, f64); 2], f64)> {
             seen[k] = true;
             while let Some((a, b)) = stack.pop() {
                 n += 1;
-                su += a as f64 + 0.5;
-                sv += b as f64 + 0.5;
+                su += a as f64;
+                sv += b as f64;
                 for (da, db) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
                     let (na, nb) = (a as i64 + da, b as i64 + db);
                     if na < 0 || nb < 0 || na >= w as i64 || nb >= h as i64 {
@@ -181,10 +183,52 @@ struct Segmented {
     threshold: f64,
     fabric_dark: bool,
     fabric: f64,
-    background: f64,
+    /// The background's grey level as a quadratic in (u, v) (uneven light, vignetting), fitted by
+    /// least squares to the background pixels at least `EDGE_WINDOW` + 4 px from any fabric.
+    background_model: [f64; 6],
+}
+
+/// The monomials of the background model at pixel (u, v), coordinates scaled to the image.
+fn quadratic_terms(u: f64, v: f64, w: f64, h: f64) -> [f64; 6] {
+    let (x, y) = (2.0 * u / w - 1.0, 2.0 * v / h - 1.0);
+    [1.0, x, y, x * x, x * y, y * y]
+}
+
+/// Least-squares quadratic of the background's grey level over the pixels `is_bg` admits.
+fn fit_background(gray: &GrayImage, is_bg: &dyn Fn(u32, u32) -> bool, fallback: f64) -> [f64; 6] {
+    let (w, h) = gray.dimensions();
+    let mut ata = nalgebra::SMatrix::<f64, 6, 6>::zeros();
+    let mut atb = nalgebra::SVector::<f64, 6>::zeros();
+    let mut n = 0usize;
+    for v in (0..h).step_by(2) {
+        for u in (0..w).step_by(2) {
+            if !is_bg(u, v) {
+                continue;
+            }
+            let t = nalgebra::SVector::<f64, 6>::from(quadratic_terms(
+                u as f64, v as f64, w as f64, h as f64,
+            ));
+            ata += t * t.transpose();
+            atb += t * gray.get_pixel(u, v).0[0] as f64;
+            n += 1;
+        }
+    }
+    match (n >= 60).then(|| ata.cholesky()).flatten() {
+        Some(c) => c.solve(&atb).into(),
+        None => [fallback, 0.0, 0.0, 0.0, 0.0, 0.0],
+    }
 }
 
 impl Segmented {
+    /// The background model's grey level at pixel (u, v).
+    fn background_at(&self, u: i64, v: i64) -> f64 {
+        let (w, h) = self.gray.dimensions();
+        quadratic_terms(u as f64, v as f64, w as f64, h as f64)
+            .iter()
+            .zip(&self.background_model)
+            .map(|(t, c)| t * c)
+            .sum()
+    }
     fn at(&self, u: u32, v: u32) -> f64 {
         self.gray.get_pixel(u, v).0[0] as f64
     }
@@ -252,12 +296,39 @@ fn segment(img: &RgbImage, file: &Path) -> Result<Segmented, InputError> {
             "no fabric found: the image is all background (or has no contrast)",
         ));
     }
+    // Background pixels far from the fabric (and from the markers): a coarse distance test on
+    // the fabric mask, checked along the axes and diagonals.
+    let r = EDGE_WINDOW + 4;
+    let clear = |u: u32, v: u32| {
+        let ok = |du: i64, dv: i64| {
+            let (a, b) = (u as i64 + du, v as i64 + dv);
+            if a < 0 || b < 0 || a >= w as i64 || b >= h as i64 {
+                return true;
+            }
+            let (a, b) = (a as u32, b as u32);
+            !is_fabric(at(a, b)) && !is_marker(img.get_pixel(a, b))
+        };
+        [
+            (0, 0),
+            (r, 0),
+            (-r, 0),
+            (0, r),
+            (0, -r),
+            (r, r),
+            (-r, -r),
+            (r, -r),
+            (-r, r),
+        ]
+        .iter()
+        .all(|&(du, dv)| ok(du, dv))
+    };
+    let background_model = fit_background(&gray, &clear, background);
     Ok(Segmented {
         gray,
         threshold: t as f64,
         fabric_dark,
         fabric,
-        background,
+        background_model,
     })
 }
 
@@ -272,7 +343,7 @@ pub fn fit_image(
     let seg = segment(img, file)?;
     let at = |u: u32, v: u32| seg.at(u, v);
     let is_fabric = |g: f64| seg.is_fabric(g);
-    let (fabric, background) = (seg.fabric, seg.background);
+    let fabric = seg.fabric;
     let mask = |u: i64, v: i64| {
         u >= 0 && v >= 0 && u < w as i64 && v < h as i64 && is_fabric(at(u as u32, v as u32))
     };
@@ -291,7 +362,6 @@ pub fn fit_image(
             ));
         }
     }
-    let cov = |g: f64, f: f64| ((g - background) / (f - background)).clamp(0.0, 1.0);
     let [c0, c1] = corners;
     let len = ((c1.0 - c0.0).powi(2) + (c1.1 - c0.1).powi(2)).sqrt();
     let tdir = ((c1.0 - c0.0) / len, (c1.1 - c0.1) / len);
@@ -305,34 +375,11 @@ pub fn fit_image(
     };
     let span_cm = len / s;
     let (u_lo, u_hi) = ((c0.0 + guard).ceil() as i64, (c1.0 - guard).floor() as i64);
-    // Sub-pixel boundary in a line of pixels `g(k)`, k in [a, b], fabric before the boundary (`forward`)
-    // or after it: the covered length is the sum of coverages.
-    let edge_pos = |vals: &[(i64, f64)], f: f64, fabric_first: bool| -> f64 {
-        let sum: f64 = vals.iter().map(|&(_, g)| cov(g, f)).sum();
-        if fabric_first {
-            vals[0].0 as f64 + sum
-        } else {
-            vals[vals.len() - 1].0 as f64 + 1.0 - sum
-        }
-    };
-    let local_fabric = |vals: Vec<f64>| {
-        if vals.is_empty() {
-            fabric
-        } else {
-            vals.iter().sum::<f64>() / vals.len() as f64
-        }
-    };
     let grey = |u: i64, v: i64| {
-        if u >= 0 && v >= 0 && u < w as i64 && v < h as i64 {
-            at(u as u32, v as u32)
-        } else {
-            background
-        }
+        (u >= 0 && v >= 0 && u < w as i64 && v < h as i64).then(|| at(u as u32, v as u32))
     };
     // The boundary along one line of pixels `px(k)`, k in 0..len: the last (or first) fabric pixel
-    // that has a fabric neighbour on the line, refined to sub-pixel by summing coverages over a window
-    // that starts one pixel inside the fabric; the fabric's grey level is taken from the pixels just
-    // inside it (shading varies across the sheet).
+    // that has a fabric neighbour on the line, refined to sub-pixel ([`subpixel_edge`]).
     let trace = |len: i64, px: &dyn Fn(i64) -> (i64, i64), last: bool| -> Option<f64> {
         let fab = |k: i64| {
             let (u, v) = px(k);
@@ -340,27 +387,27 @@ pub fn fit_image(
         };
         let mut hits = (0..len).filter(|&k| fab(k) && (fab(k + 1) || fab(k - 1)));
         let kb = if last { hits.next_back() } else { hits.next() }?;
-        let (a, b) = if last {
-            (kb - 1, kb + 3)
-        } else {
-            (kb - 3, kb + 1)
+        let line = |k: i64| {
+            let (u, v) = px(k);
+            grey(u, v).map(|g| (g, seg.background_at(u, v)))
         };
-        let vals: Vec<(i64, f64)> = (a..=b).map(|k| (k, grey(px(k).0, px(k).1))).collect();
-        let inside_range = if last { kb - 3..kb } else { kb + 1..kb + 4 };
-        let inside: Vec<f64> = inside_range
-            .filter(|&k| fab(k))
-            .map(|k| grey(px(k).0, px(k).1))
-            .collect();
-        Some(edge_pos(&vals, local_fabric(inside), last))
+        Some(subpixel_edge(
+            &line,
+            &fab,
+            kb,
+            if last { 1 } else { -1 },
+            fabric,
+        ))
     };
     let mut edges = Vec::new();
+    let mut points_cm = Vec::new();
     for &name in opts.view.edges() {
         let mut pts: Vec<(f64, f64)> = Vec::new();
         match name {
             "bottom" | "top" => {
                 for u in u_lo..=u_hi {
                     if let Some(ve) = trace(h as i64, &|v| (u, v), name == "bottom") {
-                        pts.push(to_cm(u as f64 + 0.5, ve));
+                        pts.push(to_cm(u as f64, ve));
                     }
                 }
             }
@@ -370,7 +417,7 @@ pub fn fit_image(
                 let offset = if name == "right" { span_cm } else { 0.0 };
                 for v in v_lo..h as i64 {
                     if let Some(ue) = trace(w as i64, &|u| (u, v), name == "right") {
-                        let (along, upc) = to_cm(ue, v as f64 + 0.5);
+                        let (along, upc) = to_cm(ue, v as f64);
                         pts.push((-upc, along - offset));
                     }
                 }
@@ -402,14 +449,69 @@ pub fn fit_image(
             ));
         };
         edges.push(fit);
+        points_cm.push(pts);
     }
     let overlay = draw_overlay(img, &edges, corners, s);
     Ok(ImageFit {
         edges,
+        points_cm,
         overlay,
         corners,
         px_per_cm: s,
     })
+}
+
+/// Half-width of the window over which [`subpixel_edge`] sums coverages, px: wide enough for a
+/// blur of σ = 1.5 px (3σ on each side) beyond the boundary pixel.
+const EDGE_WINDOW: i64 = 5;
+
+/// The sub-pixel position of a boundary along a line of pixels (pixel k spans [k − ½, k + ½): pixel
+/// centres at integers, as in OpenCV and imageproc). `kb` is the boundary pixel (the last fabric
+/// pixel going in direction `dir`, +1 or −1); `line(k)` the grey level and the background model's
+/// level there (None outside the image), `fab(k)` whether pixel k is fabric. A pixel's grey level is
+/// the area-weighted mix of the fabric's and the background's, so the fabric covers
+/// Σ (g − b)/(f − b) pixels of a window that starts inside the fabric. The background b comes from
+/// the image's background model (a gradient of light or vignetting leaves no bias); the fabric's f
+/// is read just inside the window, which starts as deep as the blur reaches beyond the boundary
+/// (shading varies across the sheet, so f is taken where the edge's shading still holds);
+/// `fabric` is the fallback where the line offers no fabric pixel.
+pub fn subpixel_edge(
+    line: &dyn Fn(i64) -> Option<(f64, f64)>,
+    fab: &dyn Fn(i64) -> bool,
+    kb: i64,
+    dir: i64,
+    fabric: f64,
+) -> f64 {
+    let m = EDGE_WINDOW;
+    let b_edge = line(kb).map_or(fabric, |p| p.1);
+    let contrast = (fabric - b_edge).abs();
+    // How far the blur reaches: the pixels beyond the boundary still 10 % of the contrast off the
+    // background. The window starts one pixel deeper than that into the fabric (at least one).
+    let reach = (1..=m)
+        .take_while(|&j| line(kb + dir * j).is_some_and(|(g, b)| (g - b).abs() > 0.1 * contrast))
+        .count() as i64;
+    let depth = (1..=(reach + 1).min(m - 1))
+        .take_while(|&j| fab(kb - dir * j))
+        .last()
+        .unwrap_or(0);
+    let inside: Vec<f64> = (depth + 1..=depth + 3)
+        .map(|j| kb - dir * j)
+        .filter(|&k| fab(k))
+        .filter_map(|k| line(k).map(|p| p.0))
+        .collect();
+    let f = if inside.is_empty() {
+        fabric
+    } else {
+        inside.iter().sum::<f64>() / inside.len() as f64
+    };
+    let start = kb - dir * depth;
+    let end = kb + dir * m;
+    let covered: f64 = (0..=(end - start) * dir)
+        .map(|j| start + dir * j)
+        .map(|k| line(k).map_or(0.0, |(g, b)| ((g - b) / (f - b)).clamp(0.0, 1.0)))
+        .sum();
+    // The fabric starts at the outer face of `start` and covers `covered` pixels in direction dir.
+    start as f64 - 0.5 * dir as f64 + dir as f64 * covered
 }
 
 /// The photo with the reference line in blue and the fitted curves in red.

@@ -14,7 +14,9 @@ mod render;
 
 pub use from_image::{Calibration, FitImageOptions, ImageFit, fit_image, read_gray};
 pub use from_particles::{ReferenceLine, edges_from_particles};
-pub use photo::{CameraFile, ScoreRow, read_camera, render_options, scene_view, score_edges};
+pub use photo::{
+    CameraFile, Pinhole, ScoreRow, read_camera, render_options, scene_view, score_edges,
+};
 pub use poly::{Polynomial, fit_polynomial};
 pub use render::{Camera, RenderOptions, RenderedPhoto, render_drape, render_view};
 

@@ -2,7 +2,8 @@
 //! `camera.json` written beside a rendered photo, and seed 000's Eq. 5 between two sets of edges.
 
 use super::{
-    Camera, EdgeFit, RenderOptions, View, curve_distance_pct, eq5_objective_pct, eq5_uncentred_pct,
+    Calibration, Camera, EdgeFit, RenderOptions, View, curve_distance_pct, eq5_objective_pct,
+    eq5_uncentred_pct,
 };
 use crate::cloth::Corner;
 use crate::error::InputError;
@@ -10,19 +11,90 @@ use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The calibration written beside a rendered photo (`camera.json`), readable by `fit-edges --camera-json`.
+/// What a camera gives about a photo (`camera.json`, read by `fit-edges --camera-json` and the
+/// `fit-edges` stage): the hang it shows, the scale at the sheet (`px_per_cm`, or a `pinhole`
+/// camera's focal length and distance, or the corners' distance over `side_cm`), and where the fixed
+/// corners are (`corners_px`, or `markers`: two red markers). Pixel coordinates put pixel centres at
+/// integers (u right, v down), as OpenCV and most image tools do. drapelab's own render settings,
+/// when it made the photo, ride along as provenance in `render`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CameraFile {
-    /// Which hang the photo shows.
+    /// Which hang the photo shows: `hang4` or `hang2`.
     pub view: View,
-    /// Pixels per cm in the plane of the fixed corners.
-    pub px_per_cm: f64,
-    /// Left and right fixed corners in the image, px (u right, v down).
-    pub corners_px: [(f64, f64); 2],
-    /// Side of the sheet, cm.
+    /// Distance between the two fixed corners, cm (the sheet's side).
     pub side_cm: f64,
-    /// The render options.
-    pub render: RenderOptions,
+    /// Pixels per cm in the plane of the fixed corners. Optional: else from `pinhole`, else from
+    /// the corners' distance in pixels over `side_cm`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub px_per_cm: Option<f64>,
+    /// A pinhole camera looking square at the sheet.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pinhole: Option<Pinhole>,
+    /// Left and right fixed corners in the image, px. Optional: else `markers` must be true.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corners_px: Option<[(f64, f64); 2]>,
+    /// Find the corners as the two largest red blobs in the photo. Default false.
+    #[serde(default)]
+    pub markers: bool,
+    /// drapelab's render settings, when drapelab rendered the photo (provenance only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub render: Option<RenderOptions>,
+}
+
+/// A pinhole camera whose axis meets the sheet's plane square on.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pinhole {
+    /// Focal length, px.
+    pub focal_length_px: f64,
+    /// Distance from the pinhole to the plane of the fixed corners, m.
+    pub distance_m: f64,
+    /// Principal point (u, v), px. Default: the image centre.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub principal_point_px: Option<(f64, f64)>,
+}
+
+impl CameraFile {
+    /// The scale at the sheet, px per cm, if the file gives one (directly or by its pinhole).
+    pub fn scale_px_per_cm(&self) -> Option<f64> {
+        self.px_per_cm.or(self
+            .pinhole
+            .map(|p| p.focal_length_px / (100.0 * p.distance_m)))
+    }
+
+    /// How the photo's pixels become centimetres; `path` names the file in errors.
+    pub fn calibration(&self, path: &Path) -> Result<Calibration, InputError> {
+        if !(self.side_cm.is_finite() && self.side_cm > 0.0) {
+            return Err(InputError::new(path, "side_cm", "must be a number > 0"));
+        }
+        if let Some(p) = self.pinhole
+            && !(p.focal_length_px > 0.0 && p.distance_m > 0.0)
+        {
+            return Err(InputError::new(
+                path,
+                "pinhole",
+                "focal_length_px and distance_m must be > 0",
+            ));
+        }
+        match (self.corners_px, self.markers) {
+            (Some(corners), _) => {
+                let d = (corners[1].0 - corners[0].0).hypot(corners[1].1 - corners[0].1);
+                Ok(Calibration::Given {
+                    px_per_cm: self.scale_px_per_cm().unwrap_or(d / self.side_cm),
+                    corners,
+                })
+            }
+            (None, true) => Ok(Calibration::Markers {
+                side_cm: self.side_cm,
+            }),
+            (None, false) => Err(InputError::new(
+                path,
+                "corners_px",
+                "give the fixed corners' pixels (corners_px) or set markers = true",
+            )),
+        }
+    }
 }
 
 /// The view of a scene (4 pinned corners: hang4; otherwise hang2) and its left/right fixed corners as

@@ -63,7 +63,8 @@ impl Default for RenderOptions {
 pub struct RenderedPhoto {
     /// The image.
     pub image: RgbImage,
-    /// Image positions (u right, v down; pixel (u, v) spans [u, u+1) × [v, v+1)) of the left and right fixed corners.
+    /// Image positions (u right, v down; pixel centres at integers, pixel (u, v) spanning
+    /// [u − ½, u + ½) × [v − ½, v + ½)) of the left and right fixed corners.
     pub corners_px: [(f64, f64); 2],
     /// Scale in the plane of the fixed corners, px per cm.
     pub px_per_cm: f64,
@@ -108,9 +109,11 @@ pub fn render_drape(
     let shift = |p: (f64, f64, f64)| (p.0 - umin + m, p.1 - vmin + m, p.2);
     let pts: Vec<(f64, f64, f64)> = pts.into_iter().map(shift).collect();
     let mut img = rasterize(&pts, x, crate::cloth::grid_triangles(grid), w, h);
+    // The rasterizer's pixel (u, v) spans [u, u + 1) × [v, v + 1); the photo's coordinates put pixel
+    // centres at integers (as fit_image, OpenCV and imageproc do), half a pixel less.
     let corner_px = |(i, j): (usize, usize)| {
         let p = pts[grid.index(i, j)];
-        (p.0, p.1)
+        (p.0 - 0.5, p.1 - 0.5)
     };
     let mut corners_px = [corner_px(corners[0]), corner_px(corners[1])];
     if opts.marker_radius_px > 0.0 {
@@ -120,7 +123,7 @@ pub fn render_drape(
                 for u in
                     (cu - r - 1.0).floor().max(0.0) as u32..((cu + r + 1.0).ceil() as u32).min(w)
                 {
-                    if ((u as f64 + 0.5 - cu).powi(2) + (v as f64 + 0.5 - cv).powi(2)).sqrt() <= r {
+                    if ((u as f64 - cu).powi(2) + (v as f64 - cv).powi(2)).sqrt() <= r {
                         img.put_pixel(u, v, Rgb([220, 30, 30]));
                     }
                 }
@@ -136,12 +139,12 @@ pub fn render_drape(
             imageproc::geometric_transformations::Border::Constant(Rgb([BACKGROUND as u8; 3])),
         );
         // imageproc maps p to c + R(θ)(p − c) with c = (w/2, h/2) in pixel-index coordinates (pixel
-        // centres at integers), i.e. c + 0.5 in ours.
+        // centres at integers), the photo's coordinates.
         let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
         let (sn, cs) = theta.sin_cos();
         for c in corners_px.iter_mut() {
-            let (du, dv) = (c.0 - 0.5 - cx, c.1 - 0.5 - cy);
-            *c = (cx + cs * du - sn * dv + 0.5, cy + sn * du + cs * dv + 0.5);
+            let (du, dv) = (c.0 - cx, c.1 - cy);
+            *c = (cx + cs * du - sn * dv, cy + sn * du + cs * dv);
         }
     }
     if opts.blur_sigma_px > 0.0 {
