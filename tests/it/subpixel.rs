@@ -256,3 +256,78 @@ fn a_camera_file_with_only_what_a_camera_gives_is_read() {
     );
     assert!(!tmp.path().join("out_bad/edges.parquet").exists());
 }
+
+/// Mean and RMS (px) of a photo's traced edge points against a simulated edge curve (cm), the curve
+/// interpolated at each point's x.
+fn against_curve(points: &[(f64, f64)], curve: &[(f64, f64)], px_per_cm: f64) -> (f64, f64) {
+    let at = |x: f64| {
+        let k = curve.partition_point(|p| p.0 < x).clamp(1, curve.len() - 1);
+        let (a, b) = (curve[k - 1], curve[k]);
+        a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+    };
+    let inside: Vec<f64> = points
+        .iter()
+        .filter(|p| p.0 >= curve[0].0 && p.0 <= curve[curve.len() - 1].0)
+        .map(|&(x, y)| (y - at(x)) * px_per_cm)
+        .collect();
+    let n = inside.len() as f64;
+    (
+        inside.iter().sum::<f64>() / n,
+        (inside.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
+    )
+}
+
+#[test]
+fn the_silhouette_edge_of_a_simulated_drape_is_the_rendered_photos_edge() {
+    use drapelab::edges::{EdgeSource, RenderOptions, render_drape, scene_view, simulated_edges};
+    for (file, sets) in [
+        ("hang4.toml", ["cloth.nx=21", "cloth.ny=21"]),
+        ("hang2.toml", ["cloth.nx=21", "cloth.ny=21"]),
+    ] {
+        let overrides: Vec<_> = sets
+            .iter()
+            .map(|s| drapelab::config::parse_override(s).unwrap())
+            .collect();
+        let loaded = drapelab::scene::Scene::load(
+            &crate::support::root().join("datasets/scenes").join(file),
+            &overrides,
+        )
+        .unwrap();
+        let scene = &loaded.scene;
+        let sol = drapelab::simulate::solve_scene(scene, &mut drapelab::solve::NoObserver);
+        assert!(sol.report.is_converged(), "{file}");
+        let (view, corners) = scene_view(scene).unwrap();
+        let opts = RenderOptions {
+            px_per_cm: 8.0,
+            ..Default::default()
+        };
+        let photo = render_drape(&sol.grid, &sol.x, corners, &opts);
+        let fit = fit_image(
+            &photo.image,
+            &FitImageOptions {
+                view,
+                degree: 4,
+                calibration: Calibration::Given {
+                    px_per_cm: photo.px_per_cm,
+                    corners: photo.corners_px,
+                },
+            },
+            Path::new(file),
+        )
+        .unwrap();
+        for source in [EdgeSource::Silhouette, EdgeSource::Particles] {
+            let sim = simulated_edges(&sol.grid, &sol.x, view, corners, source);
+            for ((name, curve), (fit, pts)) in sim.iter().zip(fit.edges.iter().zip(&fit.points_cm))
+            {
+                assert_eq!(name, &fit.edge);
+                let (mean, rms) = against_curve(pts, curve, opts.px_per_cm);
+                eprintln!(
+                    "{file} {name}, {source:?} edge: photo − simulated mean {mean:+.3} px, RMS {rms:.3} px"
+                );
+                if source == EdgeSource::Silhouette {
+                    assert!(mean.abs() < 0.1, "{file} {name}: {mean} px");
+                }
+            }
+        }
+    }
+}

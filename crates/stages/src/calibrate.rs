@@ -9,7 +9,7 @@ use drapelab_core::calibrate::{
     Noise, Problem, SampleCalibration, SampleSettings, calibrate_sample, read_sample_densities,
     sample_scene,
 };
-use drapelab_core::edges::EdgeFit;
+use drapelab_core::edges::{EdgeFit, EdgeSource};
 use drapelab_core::optim::{DecadeEvent, IcaSettings};
 use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
 use drapelab_record::{CalibrationRecorder, read_edges, write_table};
@@ -35,6 +35,10 @@ pub struct CalibrateParams {
     /// Side of the samples, cm. Default 50.
     #[serde(default = "default_side")]
     pub side_cm: f64,
+    /// Which curve of a simulated drape stands for its edges: "silhouette" (of its triangles, as a
+    /// photo shows it; default) or "particles" (the polyline through the edge particles).
+    #[serde(default)]
+    pub edge_source: EdgeSource,
     /// Measurement error of the photos in the cost's unit (curve distance, % of the side), for the
     /// identifiability analysis: a worst-case bound (0.03 is the photo-to-particle gap of the bundled
     /// dataset, README "Edges from photos"). Default: none, the standard error of least squares
@@ -207,7 +211,8 @@ fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
     let mut results = Vec::new();
     for (sample, measured) in &by_sample {
         let scene = sample_scene(scene_file, &densities, sample, p.grid)?;
-        let problem = Problem::new(scene, measured.clone(), p.side_cm);
+        let mut problem = Problem::new(scene, measured.clone(), p.side_cm);
+        problem.edge_source = p.edge_source;
         let mut observe = |r: usize, ev: &DecadeEvent<'_>| -> Result<()> {
             match &recorder {
                 Some(rec) => record_decade(rec, &problem, sample, r, ev, measured, p.side_cm)

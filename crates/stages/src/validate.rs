@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use drapelab_core::calibrate::{
     Params, Problem, read_sample_densities, sample_number, sample_scene,
 };
-use drapelab_core::edges::{EdgeFit, edges_from_particles, scene_view, score_edges};
+use drapelab_core::edges::{EdgeFit, EdgeSource, scene_view, score_edges, simulated_edges};
 use drapelab_core::simulate::solve_scene;
 use drapelab_core::solve::NoObserver;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
@@ -25,6 +25,10 @@ pub struct ValidateParams {
     /// Side of the samples, cm. Default 50.
     #[serde(default = "default_side")]
     pub side_cm: f64,
+    /// Which curve of a simulated drape stands for its edges: "silhouette" (of its triangles, as a
+    /// photo shows it; default) or "particles" (the polyline through the edge particles).
+    #[serde(default)]
+    pub edge_source: EdgeSource,
 }
 
 fn default_grid() -> usize {
@@ -121,11 +125,12 @@ fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
         let scene = problem.scene_for(params);
         let sol = solve_scene(&scene, &mut NoObserver);
         let (view, corners) = scene_view(&scene)?;
-        let sim: Vec<(String, EdgeFit)> = edges_from_particles(&sol.grid, &sol.x, view, corners)
-            .into_iter()
-            .filter_map(|(name, pts)| EdgeFit::from_points(&name, &pts, 4))
-            .map(|e| (sample.clone(), e))
-            .collect();
+        let sim: Vec<(String, EdgeFit)> =
+            simulated_edges(&sol.grid, &sol.x, view, corners, p.edge_source)
+                .into_iter()
+                .filter_map(|(name, pts)| EdgeFit::from_points(&name, &pts, 4))
+                .map(|e| (sample.clone(), e))
+                .collect();
         let rows = if sol.report.is_converged() {
             score_edges(measured, &sim, p.side_cm)
         } else {

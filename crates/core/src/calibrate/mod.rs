@@ -9,7 +9,7 @@ pub use sample::{
 };
 
 use crate::edges::scene_view;
-use crate::edges::{EdgeFit, curve_distance_pct, edges_from_particles};
+use crate::edges::{EdgeFit, EdgeSource, curve_distance_pct, simulated_edges};
 use crate::material::Topology;
 use crate::optim::{Ica, IcaReport, IcaSettings, Minimizer};
 use crate::scene::Scene;
@@ -107,6 +107,9 @@ pub struct Problem {
     /// the sagged start. Either way the cost stays a pure function of the parameter vector.
     /// Default true.
     pub warm_start: bool,
+    /// Which curve of a simulated drape is compared with the photo's edges. Default the
+    /// silhouette of its triangles, the curve a photo shows.
+    pub edge_source: EdgeSource,
     lattice: std::sync::Arc<std::sync::OnceLock<StartLattice>>,
     cache: Mutex<HashMap<Vec<u64>, Evaluation>>,
     /// Simulations run (cache misses).
@@ -126,6 +129,7 @@ impl Problem {
             penalty: 100.0,
             caching: true,
             warm_start: true,
+            edge_source: EdgeSource::default(),
             lattice: Default::default(),
             cache: Mutex::new(HashMap::new()),
             simulations: AtomicUsize::new(0),
@@ -233,7 +237,7 @@ impl Problem {
         };
         let edges = match (sol.report.is_converged(), scene_view(&scene)) {
             (true, Ok((view, corners))) => Some(
-                edges_from_particles(&sol.grid, &sol.x, view, corners)
+                simulated_edges(&sol.grid, &sol.x, view, corners, self.edge_source)
                     .into_iter()
                     .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
                     .collect(),

@@ -6,6 +6,7 @@
 use super::View;
 use crate::cloth::Grid;
 use nalgebra::{Vector2, Vector3};
+use serde::{Deserialize, Serialize};
 
 /// Reference frame of a photo: the line through the two fixed corners, in the image plane (x, z), m.
 #[derive(Debug, Clone, Copy)]
@@ -121,4 +122,153 @@ fn resample(mut pts: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     }
     out.extend(pts.last().copied());
     out
+}
+
+/// Which curve stands for a simulated drape's edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EdgeSource {
+    /// The silhouette of the drape's triangles as the camera sees it (what a photo shows).
+    #[default]
+    Silhouette,
+    /// The polyline through the particles: the lowest of each column (hang4) or the boundary rows
+    /// and columns (hang2).
+    Particles,
+}
+
+/// The edge points (cm) of a drape for `view`, as `source` says.
+pub fn simulated_edges(
+    grid: &Grid,
+    x: &[Vector3<f64>],
+    view: View,
+    corners: [(usize, usize); 2],
+    source: EdgeSource,
+) -> Vec<(String, Vec<(f64, f64)>)> {
+    match source {
+        EdgeSource::Particles => edges_from_particles(grid, x, view, corners),
+        EdgeSource::Silhouette => edges_from_silhouette(grid, x, view, corners),
+    }
+}
+
+/// A straight piece of the silhouette's boundary in (s, t): t as a function of s between two points.
+type Segment = ((f64, f64), (f64, f64));
+
+/// The lower (or upper) envelope t(s) of `segments` at each of `samples` (None where no segment
+/// spans s). The silhouette of a triangle mesh is bounded by its triangles' edges, so this envelope
+/// over every edge is the silhouette's boundary.
+fn envelope(segments: &[Segment], samples: &[f64], lower: bool) -> Vec<Option<f64>> {
+    let mut out: Vec<Option<f64>> = vec![None; samples.len()];
+    let (s0, ds) = (samples[0], samples[1] - samples[0]);
+    for &((sa, ta), (sb, tb)) in segments {
+        let (lo, hi) = (sa.min(sb), sa.max(sb));
+        let k0 = ((lo - s0) / ds).ceil().max(0.0) as usize;
+        let k1 = (((hi - s0) / ds).floor().max(-1.0) + 1.0) as usize;
+        for (k, o) in out
+            .iter_mut()
+            .enumerate()
+            .take(k1.min(samples.len()))
+            .skip(k0)
+        {
+            let s = samples[k];
+            let t = if (sb - sa).abs() < 1e-12 {
+                if lower { ta.min(tb) } else { ta.max(tb) }
+            } else {
+                ta + (tb - ta) * (s - sa) / (sb - sa)
+            };
+            *o = Some(match *o {
+                None => t,
+                Some(v) if lower => v.min(t),
+                Some(v) => v.max(t),
+            });
+        }
+    }
+    out
+}
+
+/// `n` + 1 equally spaced samples over [a, b].
+fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
+    (0..=n).map(|k| a + (b - a) * k as f64 / n as f64).collect()
+}
+
+/// The edge points (cm) of the silhouette of a drape's triangles, seen by the orthographic camera
+/// along +y: the lower boundary (hang4), or the top, bottom, left and right boundaries (hang2),
+/// sampled 16 times per grid spacing.
+pub fn edges_from_silhouette(
+    grid: &Grid,
+    x: &[Vector3<f64>],
+    view: View,
+    corners: [(usize, usize); 2],
+) -> Vec<(String, Vec<(f64, f64)>)> {
+    let proj = |p: &Vector3<f64>| Vector2::new(p.x, p.z);
+    let c0 = proj(&x[grid.index(corners[0].0, corners[0].1)]);
+    let c1 = proj(&x[grid.index(corners[1].0, corners[1].1)]);
+    let line = ReferenceLine::new(c0, c1);
+    let cm: Vec<(f64, f64)> = x[..grid.len()]
+        .iter()
+        .map(|p| {
+            let (a, u) = line.coords(proj(p));
+            (a * 100.0, u * 100.0)
+        })
+        .collect();
+    let mut along_up: Vec<Segment> = Vec::new();
+    for t in crate::cloth::grid_triangles(grid) {
+        for k in 0..3 {
+            along_up.push((cm[t[k] as usize], cm[t[(k + 1) % 3] as usize]));
+        }
+    }
+    let span = (c1 - c0).norm() * 100.0;
+    let n = 16 * (grid.nx.max(grid.ny) - 1);
+    let xs = linspace(0.0, span, n);
+    let curve = |lower: bool| -> Vec<(f64, f64)> {
+        xs.iter()
+            .zip(envelope(&along_up, &xs, lower))
+            .filter_map(|(&a, t)| Some((a, t?)))
+            .collect()
+    };
+    match view {
+        View::Hang4 => vec![(
+            "bottom".into(),
+            super::trim_edge("bottom", curve(true), span, 0.0),
+        )],
+        View::Hang2 => {
+            let bottom = curve(true);
+            let depth_at = |a: f64| {
+                let k = ((a / span) * n as f64).round() as usize;
+                -envelope(&along_up, &xs, true)[k.min(n)].unwrap_or(0.0)
+            };
+            // Side edges: x = depth below the line, y = offset along the line from the corner's
+            // vertical; the leftmost (rightmost) point of the silhouette at each depth.
+            let depth_up: Vec<Segment> = along_up
+                .iter()
+                .map(|&((a0, u0), (a1, u1))| ((-u0, a0), (-u1, a1)))
+                .collect();
+            let deepest = cm.iter().map(|p| -p.1).fold(0.0, f64::max);
+            let ds = linspace(0.0, deepest, n);
+            let side = |lower: bool, offset: f64| -> Vec<(f64, f64)> {
+                ds.iter()
+                    .zip(envelope(&depth_up, &ds, lower))
+                    .filter_map(|(&d, a)| Some((d, a? - offset)))
+                    .collect()
+            };
+            let (d_left, d_right) = (depth_at(0.0), depth_at(span));
+            vec![
+                (
+                    "top".into(),
+                    super::trim_edge("top", curve(false), span, 0.0),
+                ),
+                (
+                    "bottom".into(),
+                    super::trim_edge("bottom", bottom, span, 0.0),
+                ),
+                (
+                    "left".into(),
+                    super::trim_edge("left", side(true, 0.0), span, d_left),
+                ),
+                (
+                    "right".into(),
+                    super::trim_edge("right", side(false, span), span, d_right),
+                ),
+            ]
+        }
+    }
 }

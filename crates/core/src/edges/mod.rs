@@ -13,7 +13,9 @@ mod poly;
 mod render;
 
 pub use from_image::{Calibration, FitImageOptions, ImageFit, fit_image, read_gray};
-pub use from_particles::{ReferenceLine, edges_from_particles};
+pub use from_particles::{
+    EdgeSource, ReferenceLine, edges_from_particles, edges_from_silhouette, simulated_edges,
+};
 pub use photo::{
     CameraFile, Pinhole, ScoreRow, read_camera, render_options, scene_view, score_edges,
 };
