@@ -494,7 +494,10 @@ pub fn subpixel_edge(
         .take_while(|&j| fab(kb - dir * j))
         .last()
         .unwrap_or(0);
-    let inside: Vec<f64> = (depth + 1..=depth + 3)
+    // Without blur the nearest fabric pixel holds the edge's shading; with blur, one past the window
+    // start, beyond the blur's reach.
+    let at_depth = depth.max(1) + i64::from(reach > 0);
+    let inside: Vec<f64> = (at_depth..=at_depth)
         .map(|j| kb - dir * j)
         .filter(|&k| fab(k))
         .filter_map(|k| line(k).map(|p| p.0))

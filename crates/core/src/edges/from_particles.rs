@@ -192,7 +192,7 @@ fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
 
 /// The edge points (cm) of the silhouette of a drape's triangles, seen by the orthographic camera
 /// along +y: the lower boundary (hang4), or the top, bottom, left and right boundaries (hang2),
-/// sampled 16 times per grid spacing.
+/// sampled 64 times per grid spacing.
 pub fn edges_from_silhouette(
     grid: &Grid,
     x: &[Vector3<f64>],
@@ -217,7 +217,7 @@ pub fn edges_from_silhouette(
         }
     }
     let span = (c1 - c0).norm() * 100.0;
-    let n = 16 * (grid.nx.max(grid.ny) - 1);
+    let n = 64 * (grid.nx.max(grid.ny) - 1);
     let xs = linspace(0.0, span, n);
     let curve = |lower: bool| -> Vec<(f64, f64)> {
         xs.iter()
