@@ -219,6 +219,8 @@ inputs.scene = "datasets/scenes/hang4.toml"
 outputs.results = "{run}/calibrate/results.parquet"
 [stages.calibrate.params]
 runs = 1
+# Exact corners from the renderer, as in pipelines/knitted.toml: the residual's intervals alone.
+include_systematic = false
 ica = { decades = 40, countries = 15, imperialists = 5, beta = 2.0, gamma = 0.1, revolution_rate = 0.2, xi = 0.2, seed = 1 }
 "#,
     );
@@ -311,4 +313,79 @@ fn a_whole_calibration_is_identical_on_one_and_two_threads() {
         })
     };
     assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn a_misplaced_corner_is_covered_by_the_interval_with_the_systematic_part() {
+    // Sample 8 (natural length 55 mm) with both corners given half a pixel low, as a hand-picked
+    // corner can be: the calibrated drape follows the shifted line; the residual alone does not
+    // see it, the photo's systematic part (edges::with_systematics) does.
+    let dir = root().join("datasets/knitted/sample_08/hang4");
+    let cam = read_camera(&dir.join("camera.json")).unwrap();
+    let [(u0, v0), (u1, v1)] = cam.corners_px.unwrap();
+    let opts = FitImageOptions {
+        view: cam.view,
+        degree: 4,
+        calibration: drapelab::edges::Calibration::Given {
+            px_per_cm: cam.px_per_cm.unwrap(),
+            corners: [(u0, v0 + 0.5), (u1, v1 + 0.5)],
+        },
+    };
+    let photo = dir.join("photo.png");
+    let img = read_gray(&photo).unwrap();
+    let fit = fit_image(&img, &opts, &photo).unwrap();
+    let fit = drapelab::edges::with_systematics(&img, &opts, fit, &photo).unwrap();
+    let sys = fit.edges[0].systematic_pct.unwrap();
+    // Corners 0.5 px low at 5 px/cm move the curve by 0.1 cm = 0.2 % of the side; the other three
+    // setup errors add in quadrature over four.
+    assert!(
+        sys > 0.5 * 0.2 / 2.0 && sys < 0.2,
+        "systematic {sys} % of the side"
+    );
+    let s = scene(
+        "hang4.toml",
+        &[
+            "cloth.nx=14",
+            "cloth.ny=14",
+            "cloth.areal_density_kg_per_m2=0.05441",
+        ],
+    );
+    let problem = Problem::new(s, fit.edges.clone(), 50.0);
+    let settings = IcaSettings {
+        decades: 12,
+        countries: 16,
+        imperialists: 3,
+        beta: 2.0,
+        gamma: 0.5,
+        revolution_rate: 0.2,
+        xi: 0.1,
+        seed: 5,
+    };
+    let (_, report) = problem.run_ica(&settings);
+    let (u, _) = problem.polish(&report.best_x, 60);
+    let best = problem.bounds.decode(&u);
+    let half_width = |noise| {
+        drapelab::calibrate::identifiability(&problem, &u, 0.1, 7, noise, 0.05)
+            .iter()
+            .find(|i| i.name == "natural_length_m")
+            .unwrap()
+            .uncertainty
+    };
+    let residual = half_width(drapelab::calibrate::Noise::FromResidual);
+    let with_sys = half_width(drapelab::calibrate::Noise::for_edges(
+        None, &fit.edges, true,
+    ));
+    let err = (best.natural_length_m - 0.055).abs();
+    eprintln!(
+        "natural length {:.3} mm (truth 55), error {:.3} mm; 2σ {:.3} mm from the residual, {:.3} mm with the systematic part ({sys:.3} % of the side)",
+        1e3 * best.natural_length_m,
+        1e3 * err,
+        1e3 * residual,
+        1e3 * with_sys
+    );
+    assert!(with_sys > residual);
+    assert!(
+        err <= with_sys,
+        "truth outside the interval with the systematic part"
+    );
 }

@@ -255,6 +255,7 @@ fn score_is_zero_for_identical_curves_symmetric_and_follows_its_formula() {
         n_points: 50,
         x_min_cm: 0.0,
         x_max_cm: 50.0,
+        systematic_pct: None,
     };
     let mut b = a.clone();
     b.coefficients[2] += 0.001;

@@ -25,6 +25,9 @@ pub struct EdgeRow {
     pub x_min_cm: f64,
     /// Fitted x range, cm.
     pub x_max_cm: f64,
+    /// Systematic uncertainty of a photographed edge (corners, scale, blur, light perturbed), % of
+    /// the side; None for a simulated edge.
+    pub systematic_pct: Option<f64>,
 }
 
 impl Table for EdgeRow {
@@ -49,6 +52,7 @@ pub fn write_edges(path: &Path, fits: &[(String, EdgeFit)]) -> Result<()> {
                     n_points: f.n_points as u32,
                     x_min_cm: f.x_min_cm,
                     x_max_cm: f.x_max_cm,
+                    systematic_pct: f.systematic_pct,
                 })
         })
         .collect();
@@ -72,6 +76,7 @@ pub fn read_edges(path: &Path) -> Result<Vec<(String, EdgeFit)>> {
                     n_points: r.n_points as usize,
                     x_min_cm: r.x_min_cm,
                     x_max_cm: r.x_max_cm,
+                    systematic_pct: r.systematic_pct,
                 };
                 out.push((r.sample.clone(), fit));
                 out.len() - 1

@@ -6,7 +6,7 @@ use anyhow::{Result, bail};
 use drapelab_core::atomic::write_atomic;
 use drapelab_core::edges::{
     CameraFile, EdgeFit, FitImageOptions, RenderOptions, ScoreRow, edges_from_particles, fit_image,
-    read_gray, scene_view, score_edges,
+    read_gray, scene_view, score_edges, with_systematics,
 };
 use drapelab_core::error::InputError;
 use drapelab_core::scene::LoadedScene;
@@ -89,7 +89,7 @@ pub fn render_scene(
 /// Fits a photo and writes `edges.parquet` and `overlay.png` into `out` (created only on success).
 pub fn fit_photo(photo: &Path, out: &Path, opts: &FitImageOptions) -> Result<Vec<EdgeFit>> {
     let img = read_gray(photo)?;
-    let fit = fit_image(&img, opts, photo)?;
+    let fit = with_systematics(&img, opts, fit_image(&img, opts, photo)?, photo)?;
     std::fs::create_dir_all(out)?;
     write_atomic(&out.join("overlay.png"), |f| {
         fit.overlay

@@ -53,6 +53,10 @@ pub struct CalibrateParams {
     /// Table 3 range. Default 0.1.
     #[serde(default = "default_window")]
     pub identifiability_window: f64,
+    /// Add the photos' systematic uncertainty (the `systematic_pct` of their edges: corners, scale,
+    /// blur and light perturbed) to the residual's in the identifiability intervals. Default true.
+    #[serde(default = "default_true")]
+    pub include_systematic: bool,
     /// Nelder–Mead iterations that polish the best ICA optimum over stiffness and natural length
     /// ([`drapelab_core::calibrate::Problem::polish`]); 0 keeps seed 000's ICA alone. Default 60.
     #[serde(default = "default_polish")]
@@ -63,6 +67,9 @@ pub struct CalibrateParams {
     pub baseline_cmaes: bool,
 }
 
+fn default_true() -> bool {
+    true
+}
 fn default_runs() -> usize {
     10
 }
@@ -221,6 +228,10 @@ fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
             }
         };
         let done = || ctx.progress.item_done(&ctx.stage.name);
+        let settings = SampleSettings {
+            noise: Noise::for_edges(p.measurement_noise_pct, measured, p.include_systematic),
+            ..settings.clone()
+        };
         let found = calibrate_sample(&problem, measured, &settings, &mut observe, &done)?;
         results.push((sample.clone(), found));
     }

@@ -3,7 +3,9 @@
 //! each row's `sample` being the photo's folder relative to the project root.
 
 use anyhow::{Result, bail};
-use drapelab_core::edges::{EdgeFit, FitImageOptions, fit_image, read_camera, read_gray};
+use drapelab_core::edges::{
+    EdgeFit, FitImageOptions, fit_image, read_camera, read_gray, with_systematics,
+};
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::write_edges;
 use rayon::prelude::*;
@@ -71,7 +73,7 @@ fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
                 degree: p.degree,
                 calibration: cam.calibration(&camera)?,
             };
-            let fit = fit_image(&img, &opts, photo)?;
+            let fit = with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?;
             let sample = dir
                 .strip_prefix(&ctx.plan.root)
                 .unwrap_or(dir)

@@ -440,6 +440,25 @@ pub enum Noise {
     /// Nonlinear least squares: σ̂² from the residual at the optimum over the degrees of freedom left
     /// (5 coefficients per measured edge, minus the 2 fitted parameters), and a 2σ (about 95 %) interval.
     FromResidual,
+    /// The residual's σ̂ and a systematic σ of the photos (% of the side: the edges' RMS
+    /// [`crate::edges::systematic_pct`]) in quadrature: the setup's errors move whole curves and
+    /// leave no residual, so they widen the interval by 2σ_sys.
+    ResidualPlusSystematic(f64),
+}
+
+impl Noise {
+    /// The noise model for `measured` edges: a `given` bound if any; else the residual, with the
+    /// edges' systematic part (their RMS) when `systematic` and every edge carries one.
+    pub fn for_edges(given: Option<f64>, measured: &[EdgeFit], systematic: bool) -> Noise {
+        let sys: Option<Vec<f64>> = measured.iter().map(|e| e.systematic_pct).collect();
+        match (given, sys) {
+            (Some(n), _) => Noise::Given(n),
+            (None, Some(s)) if systematic && !s.is_empty() => Noise::ResidualPlusSystematic(
+                (s.iter().map(|x| x * x).sum::<f64>() / s.len() as f64).sqrt(),
+            ),
+            _ => Noise::FromResidual,
+        }
+    }
 }
 
 /// Identifiability of each parameter at the optimum `best_u` (seed 000's five: stiffness, damping,
@@ -510,6 +529,7 @@ pub fn identifiability(
     let delta = match noise {
         Noise::Given(n) => n * n,
         Noise::FromResidual => 4.0 * c0 * c0 / dof,
+        Noise::ResidualPlusSystematic(s) => 4.0 * c0 * c0 / dof + 4.0 * s * s,
     };
     let noise_pct = 0.5 * delta.sqrt();
     let reach: Vec<f64> = joint

@@ -11,6 +11,7 @@ mod from_particles;
 mod photo;
 mod poly;
 mod render;
+mod systematic;
 
 pub use from_image::{Calibration, FitImageOptions, ImageFit, fit_image, read_gray};
 pub use from_particles::{
@@ -21,6 +22,7 @@ pub use photo::{
 };
 pub use poly::{Polynomial, fit_polynomial};
 pub use render::{Camera, RenderOptions, RenderedPhoto, render_drape, render_view};
+pub use systematic::{PERTURBATIONS, edge_perturbations, systematic_pct, with_systematics};
 
 use serde::{Deserialize, Serialize};
 
@@ -59,6 +61,10 @@ pub struct EdgeFit {
     pub x_min_cm: f64,
     /// Range of x covered by the points, in cm.
     pub x_max_cm: f64,
+    /// Systematic uncertainty of a photographed edge, % of the side ([`systematic_pct`]; None for a
+    /// simulated edge or when not estimated).
+    #[serde(default)]
+    pub systematic_pct: Option<f64>,
 }
 
 impl EdgeFit {
@@ -77,6 +83,7 @@ impl EdgeFit {
             n_points: points.len(),
             x_min_cm: lo,
             x_max_cm: hi,
+            systematic_pct: None,
         })
     }
     /// The curve at x (cm).
