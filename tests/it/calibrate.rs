@@ -25,6 +25,20 @@ fn sample_8_edges() -> Vec<drapelab::edges::EdgeFit> {
     .edges
 }
 
+/// A short ICA (12 decades of 16 countries) for one sample.
+fn quick_ica() -> IcaSettings {
+    IcaSettings {
+        decades: 12,
+        countries: 16,
+        imperialists: 3,
+        beta: 2.0,
+        gamma: 0.5,
+        revolution_rate: 0.2,
+        xi: 0.1,
+        seed: 5,
+    }
+}
+
 #[test]
 fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
     // Sample 8: 54.41 g/m², 1100 N/m, natural length 55 mm (datasets/knitted/README.md).
@@ -38,16 +52,7 @@ fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
         ],
     );
     let problem = Problem::new(s, measured, 50.0);
-    let settings = IcaSettings {
-        decades: 12,
-        countries: 16,
-        imperialists: 3,
-        beta: 2.0,
-        gamma: 0.5,
-        revolution_rate: 0.2,
-        xi: 0.1,
-        seed: 5,
-    };
+    let settings = quick_ica();
     let (best, report) = problem.run_ica(&settings);
     let sims = problem
         .simulations
@@ -351,16 +356,7 @@ fn a_misplaced_corner_is_covered_by_the_interval_with_the_systematic_part() {
         ],
     );
     let problem = Problem::new(s, fit.edges.clone(), 50.0);
-    let settings = IcaSettings {
-        decades: 12,
-        countries: 16,
-        imperialists: 3,
-        beta: 2.0,
-        gamma: 0.5,
-        revolution_rate: 0.2,
-        xi: 0.1,
-        seed: 5,
-    };
+    let settings = quick_ica();
     let (_, report) = problem.run_ica(&settings);
     let (u, _) = problem.polish(&report.best_x, 60);
     let best = problem.bounds.decode(&u);

@@ -36,6 +36,27 @@ impl ReferenceLine {
     }
 }
 
+/// Every grid particle in the camera's frame, cm: (along the reference line from the left fixed
+/// corner, up from it), seen by the orthographic camera along +y; and the corners' span, cm.
+fn camera_cm(
+    grid: &Grid,
+    x: &[Vector3<f64>],
+    corners: [(usize, usize); 2],
+) -> (Vec<(f64, f64)>, f64) {
+    let proj = |p: &Vector3<f64>| Vector2::new(p.x, p.z);
+    let c0 = proj(&x[grid.index(corners[0].0, corners[0].1)]);
+    let c1 = proj(&x[grid.index(corners[1].0, corners[1].1)]);
+    let line = ReferenceLine::new(c0, c1);
+    let cm = x[..grid.len()]
+        .iter()
+        .map(|p| {
+            let (a, u) = line.coords(proj(p));
+            (a * 100.0, u * 100.0)
+        })
+        .collect();
+    (cm, (c1 - c0).norm() * 100.0)
+}
+
 /// The edge points (cm) of a drape for `view`; `corners` are the grid indices of the left and right
 /// fixed corners as the camera sees them.
 pub fn edges_from_particles(
@@ -44,25 +65,20 @@ pub fn edges_from_particles(
     view: View,
     corners: [(usize, usize); 2],
 ) -> Vec<(String, Vec<(f64, f64)>)> {
-    let proj = |p: &Vector3<f64>| Vector2::new(p.x, p.z);
-    let c0 = proj(&x[grid.index(corners[0].0, corners[0].1)]);
-    let c1 = proj(&x[grid.index(corners[1].0, corners[1].1)]);
-    let line = ReferenceLine::new(c0, c1);
-    let cm = |p: &Vector3<f64>| {
-        let (a, u) = line.coords(proj(p));
-        (a * 100.0, u * 100.0)
-    };
+    let (all, span) = camera_cm(grid, x, corners);
+    let cm = |i: usize, j: usize| all[grid.index(i, j)];
     match view {
         View::Hang4 => {
             let pts = (0..grid.nx)
                 .map(|i| {
-                    (0..grid.ny).map(|j| cm(&x[grid.index(i, j)])).fold(
-                        (0.0, f64::INFINITY),
-                        |best, p| if p.1 < best.1 { p } else { best },
-                    )
+                    (0..grid.ny)
+                        .map(|j| cm(i, j))
+                        .fold(
+                            (0.0, f64::INFINITY),
+                            |best, p| if p.1 < best.1 { p } else { best },
+                        )
                 })
                 .collect();
-            let span = (c1 - c0).norm() * 100.0;
             vec![(
                 "bottom".into(),
                 super::trim_edge("bottom", resample(pts), span, 0.0),
@@ -71,22 +87,17 @@ pub fn edges_from_particles(
         View::Hang2 => {
             let top_j = corners[0].1;
             let bottom_j = if top_j == 0 { grid.ny - 1 } else { 0 };
-            let row = |j: usize| {
-                (0..grid.nx)
-                    .map(|i| cm(&x[grid.index(i, j)]))
-                    .collect::<Vec<_>>()
-            };
+            let row = |j: usize| (0..grid.nx).map(|i| cm(i, j)).collect::<Vec<_>>();
             // Side edges: x = depth below the line, y = offset along the line from the corner's vertical.
-            let span = (c1 - c0).norm() * 100.0;
             let side = |i: usize, offset: f64| {
                 (0..grid.ny)
                     .map(|j| {
-                        let (a, u) = cm(&x[grid.index(i, j)]);
+                        let (a, u) = cm(i, j);
                         (-u, a - offset)
                     })
                     .collect::<Vec<_>>()
             };
-            let depth = |i: usize| -cm(&x[grid.index(i, bottom_j)]).1;
+            let depth = |i: usize| -cm(i, bottom_j).1;
             let trim = |name: &str, pts: Vec<(f64, f64)>, d: f64| {
                 super::trim_edge(name, resample(pts), span, d)
             };
@@ -199,24 +210,13 @@ pub fn edges_from_silhouette(
     view: View,
     corners: [(usize, usize); 2],
 ) -> Vec<(String, Vec<(f64, f64)>)> {
-    let proj = |p: &Vector3<f64>| Vector2::new(p.x, p.z);
-    let c0 = proj(&x[grid.index(corners[0].0, corners[0].1)]);
-    let c1 = proj(&x[grid.index(corners[1].0, corners[1].1)]);
-    let line = ReferenceLine::new(c0, c1);
-    let cm: Vec<(f64, f64)> = x[..grid.len()]
-        .iter()
-        .map(|p| {
-            let (a, u) = line.coords(proj(p));
-            (a * 100.0, u * 100.0)
-        })
-        .collect();
+    let (cm, span) = camera_cm(grid, x, corners);
     let mut along_up: Vec<Segment> = Vec::new();
     for t in crate::cloth::grid_triangles(grid) {
         for k in 0..3 {
             along_up.push((cm[t[k] as usize], cm[t[(k + 1) % 3] as usize]));
         }
     }
-    let span = (c1 - c0).norm() * 100.0;
     let n = 64 * (grid.nx.max(grid.ny) - 1);
     let xs = linspace(0.0, span, n);
     let curve = |lower: bool| -> Vec<(f64, f64)> {
