@@ -385,3 +385,55 @@ fn a_misplaced_corner_is_covered_by_the_interval_with_the_systematic_part() {
         "truth outside the interval with the systematic part"
     );
 }
+
+#[test]
+fn a_photo_from_another_renderer_gives_back_the_natural_length() {
+    // datasets/knitted_other/: sample 8 (55 mm, 1100 N/m) photographed by an independent renderer
+    // (smooth surface, texture, uneven light, JPEG, 15 px/cm) with a camera file of only what a
+    // camera gives.
+    let dir = root().join("datasets/knitted_other/sample_08/hang4");
+    let camera = dir.join("camera.json");
+    let cam = read_camera(&camera).unwrap();
+    assert!(cam.render.is_none());
+    let opts = FitImageOptions {
+        view: cam.view,
+        degree: 4,
+        calibration: cam.calibration(&camera).unwrap(),
+    };
+    let photo = dir.join("photo.jpg");
+    let img = read_gray(&photo).unwrap();
+    let fit = fit_image(&img, &opts, &photo).unwrap();
+    let fit = drapelab::edges::with_systematics(&img, &opts, fit, &photo).unwrap();
+    let s = scene(
+        "hang4.toml",
+        &[
+            "cloth.nx=14",
+            "cloth.ny=14",
+            "cloth.areal_density_kg_per_m2=0.05441",
+        ],
+    );
+    let problem = Problem::new(s, fit.edges.clone(), 50.0);
+    let (_, report) = problem.run_ica(&quick_ica());
+    let (u, _) = problem.polish(&report.best_x, 60);
+    let best = problem.bounds.decode(&u);
+    let noise = drapelab::calibrate::Noise::for_edges(None, &fit.edges, true);
+    let ident = drapelab::calibrate::identifiability(&problem, &u, 0.1, 7, noise, 0.05);
+    let half = |name: &str| ident.iter().find(|i| i.name == name).unwrap().uncertainty;
+    let (l_err, k_err) = (
+        (best.natural_length_m - 0.055).abs(),
+        (best.stiffness_N_per_m - 1100.0).abs(),
+    );
+    eprintln!(
+        "natural length {:.3} mm ± {:.3} (truth 55), stiffness {:.0} ± {:.0} N/m (truth 1100)",
+        1e3 * best.natural_length_m,
+        1e3 * half("natural_length_m"),
+        best.stiffness_N_per_m,
+        half("stiffness_N_per_m")
+    );
+    assert!(
+        l_err < 0.01 * 0.055,
+        "natural length {}",
+        best.natural_length_m
+    );
+    assert!(l_err <= half("natural_length_m") && k_err <= half("stiffness_N_per_m"));
+}

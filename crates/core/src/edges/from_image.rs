@@ -180,6 +180,8 @@ fn calibrate(
 /// mostly background), with the mean grey level of each.
 struct Segmented {
     gray: GrayImage,
+    /// The grey levels with the background model's variation taken out (what is thresholded).
+    flat: GrayImage,
     threshold: f64,
     fabric_dark: bool,
     fabric: f64,
@@ -232,7 +234,9 @@ impl Segmented {
     fn at(&self, u: u32, v: u32) -> f64 {
         self.gray.get_pixel(u, v).0[0] as f64
     }
-    fn is_fabric(&self, g: f64) -> bool {
+    /// Whether pixel (u, v) is fabric (thresholded on the flattened image).
+    fn fabric_at(&self, u: u32, v: u32) -> bool {
+        let g = self.flat.get_pixel(u, v).0[0] as f64;
         if self.fabric_dark {
             g <= self.threshold
         } else {
@@ -242,6 +246,28 @@ impl Segmented {
 }
 
 /// Segments a photo; an image with no fabric (or no contrast) is refused.
+/// Rounds of thresholding and background fitting in [`segment`].
+const SEGMENT_PASSES: usize = 2;
+
+/// Otsu's threshold of `flat` and the fabric's polarity (the border is mostly background).
+fn threshold(flat: &GrayImage) -> (f64, bool) {
+    let (w, h) = flat.dimensions();
+    let t = imageproc::contrast::otsu_level(flat) as f64;
+    let mut border_above = 0usize;
+    let mut border = 0usize;
+    for u in 0..w {
+        for v in [0, h - 1] {
+            border += 1;
+            border_above += (flat.get_pixel(u, v).0[0] as f64 > t) as usize;
+        }
+    }
+    (t, border_above * 2 >= border)
+}
+
+/// Segments a photo; an image with no fabric (or no contrast) is refused. Twice: Otsu's threshold on
+/// the grey levels, the background's quadratic fitted to what it calls background, then Otsu again
+/// on the image flattened by that background, and so on for [`SEGMENT_PASSES`] rounds (uneven light or vignetting otherwise pushes dim
+/// background corners over the threshold).
 fn segment(img: &RgbImage, file: &Path) -> Result<Segmented, InputError> {
     let (w, h) = img.dimensions();
     // Grey levels; marker pixels count as background.
@@ -255,29 +281,47 @@ fn segment(img: &RgbImage, file: &Path) -> Result<Segmented, InputError> {
         };
         gray.put_pixel(u, v, image::Luma([l.round() as u8]));
     }
-    let t = imageproc::contrast::otsu_level(&gray);
-    let at = |u: u32, v: u32| gray.get_pixel(u, v).0[0] as f64;
-    // Polarity: the border is mostly background.
-    let mut border_above = 0usize;
-    let mut border = 0usize;
-    for u in 0..w {
-        for v in [0, h - 1] {
-            border += 1;
-            border_above += (at(u, v) > t as f64) as usize;
-        }
+    let mut flat = gray.clone();
+    let mut seg = None;
+    for _ in 0..SEGMENT_PASSES {
+        let (t, fabric_dark) = threshold(&flat);
+        let is_fabric = |g: f64| if fabric_dark { g <= t } else { g > t };
+        let fab = |u: u32, v: u32| is_fabric(flat.get_pixel(u, v).0[0] as f64);
+        let levels = mean_levels(&gray, &fab);
+        let (fabric, background) = levels.ok_or_else(|| {
+            InputError::new(
+                file,
+                "",
+                "no fabric found: the image is all background (or has no contrast)",
+            )
+        })?;
+        let background_model = fit_background(&gray, &|u, v| clear_of(img, &fab, u, v), background);
+        let s = Segmented {
+            gray: gray.clone(),
+            flat: flat.clone(),
+            threshold: t,
+            fabric_dark,
+            fabric,
+            background_model,
+        };
+        flat = GrayImage::from_fn(w, h, |u, v| {
+            let g =
+                gray.get_pixel(u, v).0[0] as f64 - s.background_at(u as i64, v as i64) + background;
+            image::Luma([g.round().clamp(0.0, 255.0) as u8])
+        });
+        seg = Some(s);
     }
-    let fabric_dark = border_above * 2 >= border;
-    let is_fabric = |g: f64| {
-        if fabric_dark {
-            g <= t as f64
-        } else {
-            g > t as f64
-        }
-    };
+    seg.ok_or_else(|| InputError::new(file, "", "not segmented"))
+}
+
+/// The mean grey levels of fabric and background by `fab`; None when there is too little fabric or
+/// too little contrast to trace an edge.
+fn mean_levels(gray: &GrayImage, fab: &dyn Fn(u32, u32) -> bool) -> Option<(f64, f64)> {
+    let (w, h) = gray.dimensions();
     let (mut nf, mut sf, mut nb, mut sb) = (0usize, 0.0, 0usize, 0.0);
-    for p in gray.pixels() {
+    for (u, v, p) in gray.enumerate_pixels() {
         let g = p.0[0] as f64;
-        if is_fabric(g) {
+        if fab(u, v) {
             nf += 1;
             sf += g;
         } else {
@@ -289,47 +333,36 @@ fn segment(img: &RgbImage, file: &Path) -> Result<Segmented, InputError> {
         if nf > 0 { sf / nf as f64 } else { 0.0 },
         if nb > 0 { sb / nb as f64 } else { 0.0 },
     );
-    if nf < (w * h) as usize / 200 || nb == 0 || (fabric - background).abs() < 15.0 {
-        return Err(InputError::new(
-            file,
-            "",
-            "no fabric found: the image is all background (or has no contrast)",
-        ));
-    }
-    // Background pixels far from the fabric (and from the markers): a coarse distance test on
-    // the fabric mask, checked along the axes and diagonals.
+    (nf >= (w * h) as usize / 200 && nb > 0 && (fabric - background).abs() >= 15.0)
+        .then_some((fabric, background))
+}
+
+/// Whether pixel (u, v) is background far from the fabric (and from the markers): a coarse distance
+/// test on the fabric mask, checked along the axes and diagonals.
+fn clear_of(img: &RgbImage, fab: &dyn Fn(u32, u32) -> bool, u: u32, v: u32) -> bool {
+    let (w, h) = img.dimensions();
     let r = EDGE_WINDOW + 4;
-    let clear = |u: u32, v: u32| {
-        let ok = |du: i64, dv: i64| {
-            let (a, b) = (u as i64 + du, v as i64 + dv);
-            if a < 0 || b < 0 || a >= w as i64 || b >= h as i64 {
-                return true;
-            }
-            let (a, b) = (a as u32, b as u32);
-            !is_fabric(at(a, b)) && !is_marker(img.get_pixel(a, b))
-        };
-        [
-            (0, 0),
-            (r, 0),
-            (-r, 0),
-            (0, r),
-            (0, -r),
-            (r, r),
-            (-r, -r),
-            (r, -r),
-            (-r, r),
-        ]
-        .iter()
-        .all(|&(du, dv)| ok(du, dv))
+    let ok = |du: i64, dv: i64| {
+        let (a, b) = (u as i64 + du, v as i64 + dv);
+        if a < 0 || b < 0 || a >= w as i64 || b >= h as i64 {
+            return true;
+        }
+        let (a, b) = (a as u32, b as u32);
+        !fab(a, b) && !is_marker(img.get_pixel(a, b))
     };
-    let background_model = fit_background(&gray, &clear, background);
-    Ok(Segmented {
-        gray,
-        threshold: t as f64,
-        fabric_dark,
-        fabric,
-        background_model,
-    })
+    [
+        (0, 0),
+        (r, 0),
+        (-r, 0),
+        (0, r),
+        (0, -r),
+        (r, r),
+        (-r, -r),
+        (r, -r),
+        (-r, r),
+    ]
+    .iter()
+    .all(|&(du, dv)| ok(du, dv))
 }
 
 /// Fits the edges of a photo.
@@ -342,10 +375,9 @@ pub fn fit_image(
     let (corners, s, guard) = calibrate(img, opts, file)?;
     let seg = segment(img, file)?;
     let at = |u: u32, v: u32| seg.at(u, v);
-    let is_fabric = |g: f64| seg.is_fabric(g);
     let fabric = seg.fabric;
     let mask = |u: i64, v: i64| {
-        u >= 0 && v >= 0 && u < w as i64 && v < h as i64 && is_fabric(at(u as u32, v as u32))
+        u >= 0 && v >= 0 && u < w as i64 && v < h as i64 && seg.fabric_at(u as u32, v as u32)
     };
     for c in &corners {
         let r = guard as i64 + 3;

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Regenerates datasets/knitted_other/ (issue 17): seed 000's nine knitted samples simulated by drapelab
+# with their ground truth (the same Table 4 values as datasets/knitted/, see its README), then
+# photographed by an independent renderer (render.py: smooth Catmull-Rom surface, knit texture, uneven
+# light, jittered supersampling, JPEG; nothing shared with drapelab's renderer) at 15 px/cm, with a
+# camera.json of only what a camera gives. Run from the repository root:
+#   bash datasets/knitted_other/make.sh
+set -euo pipefail
+bin="${DRAPELAB:-cargo run --release --quiet --}"
+py="${PYTHON:-.venv/bin/python}"
+here=datasets/knitted_other
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+# sample, areal density (kg/m², Table 2), stiffness (N/m, Table 4), natural length (m, Table 4 read as mm)
+while IFS=, read -r s rho k l0; do
+  d=$(printf "%s/sample_%02d" "$here" "$s")
+  for hang in hang4 hang2; do
+    $bin simulate datasets/scenes/$hang.toml --out "$tmp/$s/$hang" -q \
+      --set cloth.nx=14 --set cloth.ny=14 --set cloth.areal_density_kg_per_m2="$rho" \
+      --set material.mass_spring.stiffness_N_per_m="$k" --set material.mass_spring.natural_length_m="$l0"
+    mkdir -p "$d/$hang"
+    "$py" "$here/render.py" "$tmp/$s/$hang/particles.parquet" "$hang" 15 "$d/$hang/photo.jpg" \
+      "$d/$hang/camera.json" "$s"
+  done
+done <<'TABLE'
+1,0.04165,852,0.049
+2,0.04414,942,0.047
+3,0.04676,988,0.053
+4,0.04463,945,0.040
+5,0.04962,1034,0.049
+6,0.02760,674,0.040
+7,0.05116,1092,0.040
+8,0.05441,1100,0.055
+9,0.05826,1100,0.050
+TABLE
