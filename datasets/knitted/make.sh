@@ -7,7 +7,8 @@
 set -euo pipefail
 bin="${DRAPELAB:-cargo run --release --quiet --}"
 here=datasets/knitted
-# sample, areal density (kg/m², Table 2), stiffness (N/m, Table 4), natural length (m, Table 4 read as mm)
+# One line per sample of datasets/knitted/ground_truth.csv: sample, areal density (kg/m²), stiffness
+# (N/m), natural length (m).
 while IFS=, read -r s rho k l0; do
   d=$(printf "%s/sample_%02d" "$here" "$s")
   for hang in hang4 hang2; do
@@ -16,14 +17,4 @@ while IFS=, read -r s rho k l0; do
       --set material.mass_spring.stiffness_N_per_m="$k" --set material.mass_spring.natural_length_m="$l0"
     rm -f "$d/$hang/particles.parquet"
   done
-done <<'TABLE'
-1,0.04165,852,0.049
-2,0.04414,942,0.047
-3,0.04676,988,0.053
-4,0.04463,945,0.040
-5,0.04962,1034,0.049
-6,0.02760,674,0.040
-7,0.05116,1092,0.040
-8,0.05441,1100,0.055
-9,0.05826,1100,0.050
-TABLE
+done < <(grep -v '^#' datasets/knitted/ground_truth.csv | tail -n +2)

@@ -25,6 +25,19 @@ fn sample_8_edges() -> Vec<drapelab::edges::EdgeFit> {
     .edges
 }
 
+/// Sample 8's 4-corner hang (14 × 14, 54.41 g/m²) against `measured` edges.
+fn sample_8_problem(measured: Vec<drapelab::edges::EdgeFit>) -> Problem {
+    let s = scene(
+        "hang4.toml",
+        &[
+            "cloth.nx=14",
+            "cloth.ny=14",
+            "cloth.areal_density_kg_per_m2=0.05441",
+        ],
+    );
+    Problem::new(s, measured, 50.0)
+}
+
 /// A short ICA (12 decades of 16 countries) for one sample.
 fn quick_ica() -> IcaSettings {
     IcaSettings {
@@ -43,15 +56,7 @@ fn quick_ica() -> IcaSettings {
 fn ica_recovers_the_natural_length_of_a_synthetic_sample() {
     // Sample 8: 54.41 g/m², 1100 N/m, natural length 55 mm (datasets/knitted/README.md).
     let measured = sample_8_edges();
-    let s = scene(
-        "hang4.toml",
-        &[
-            "cloth.nx=14",
-            "cloth.ny=14",
-            "cloth.areal_density_kg_per_m2=0.05441",
-        ],
-    );
-    let problem = Problem::new(s, measured, 50.0);
+    let problem = sample_8_problem(measured);
     let settings = quick_ica();
     let (best, report) = problem.run_ica(&settings);
     let sims = problem
@@ -347,15 +352,7 @@ fn a_misplaced_corner_is_covered_by_the_interval_with_the_systematic_part() {
         sys > 0.5 * 0.2 / 2.0 && sys < 0.2,
         "systematic {sys} % of the side"
     );
-    let s = scene(
-        "hang4.toml",
-        &[
-            "cloth.nx=14",
-            "cloth.ny=14",
-            "cloth.areal_density_kg_per_m2=0.05441",
-        ],
-    );
-    let problem = Problem::new(s, fit.edges.clone(), 50.0);
+    let problem = sample_8_problem(fit.edges.clone());
     let settings = quick_ica();
     let (_, report) = problem.run_ica(&settings);
     let (u, _) = problem.polish(&report.best_x, 60);
@@ -404,15 +401,7 @@ fn a_photo_from_another_renderer_gives_back_the_natural_length() {
     let img = read_gray(&photo).unwrap();
     let fit = fit_image(&img, &opts, &photo).unwrap();
     let fit = drapelab::edges::with_systematics(&img, &opts, fit, &photo).unwrap();
-    let s = scene(
-        "hang4.toml",
-        &[
-            "cloth.nx=14",
-            "cloth.ny=14",
-            "cloth.areal_density_kg_per_m2=0.05441",
-        ],
-    );
-    let problem = Problem::new(s, fit.edges.clone(), 50.0);
+    let problem = sample_8_problem(fit.edges.clone());
     let (_, report) = problem.run_ica(&quick_ica());
     let (u, _) = problem.polish(&report.best_x, 60);
     let best = problem.bounds.decode(&u);
