@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Regenerates datasets/knitted_other/ (issue 17): seed 000's nine knitted samples simulated by drapelab
 # with their ground truth (the same Table 4 values as datasets/knitted/, see its README), then
-# photographed by an independent renderer (render.py: smooth Catmull-Rom surface, knit texture, uneven
-# light, jittered supersampling, JPEG; nothing shared with drapelab's renderer) at 15 px/cm, with a
-# camera.json of only what a camera gives. Run from the repository root:
+# photographed by an independent renderer (render.py: knit texture, other light, uneven
+# background, jittered supersampling, JPEG; nothing shared with drapelab's renderer) at 15 px/cm, with a
+# camera.json of only what a camera gives, once with flat triangles between the particles (flat/) and
+# once with a smooth surface through them (smooth/). Run from the repository root:
 #   bash datasets/knitted_other/make.sh
 set -euo pipefail
 bin="${DRAPELAB:-cargo run --release --quiet --}"
@@ -14,13 +15,17 @@ trap 'rm -rf "$tmp"' EXIT
 # One line per sample of datasets/knitted/ground_truth.csv: sample, areal density (kg/m²), stiffness
 # (N/m), natural length (m).
 while IFS=, read -r s rho k l0; do
-  d=$(printf "%s/sample_%02d" "$here" "$s")
   for hang in hang4 hang2; do
     $bin simulate datasets/scenes/$hang.toml --out "$tmp/$s/$hang" -q \
       --set cloth.nx=14 --set cloth.ny=14 --set cloth.areal_density_kg_per_m2="$rho" \
       --set material.mass_spring.stiffness_N_per_m="$k" --set material.mass_spring.natural_length_m="$l0"
-    mkdir -p "$d/$hang"
-    "$py" "$here/render.py" "$tmp/$s/$hang/particles.parquet" "$hang" 15 "$d/$hang/photo.jpg" \
-      "$d/$hang/camera.json" "$s"
+    # Two surfaces between the particles: flat triangles (the surface drapelab's silhouette assumes)
+    # and a smooth Catmull-Rom surface (8 x 8 quads per cell).
+    for variant in flat:1 smooth:8; do
+      d=$(printf "%s/%s/sample_%02d/%s" "$here" "${variant%%:*}" "$s" "$hang")
+      mkdir -p "$d"
+      "$py" "$here/render.py" "$tmp/$s/$hang/particles.parquet" "$hang" 15 "$d/photo.jpg" \
+        "$d/camera.json" "$s" "${variant##*:}"
+    done
   done
 done < <(grep -v '^#' datasets/knitted/ground_truth.csv | tail -n +2)

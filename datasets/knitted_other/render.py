@@ -6,8 +6,9 @@ Input: a `particles.parquet` written by `drapelab simulate` (columns i, j, x_m, 
 photo and a camera.json with only what a camera gives (view, side_cm, px_per_cm, corners_px).
 
 What differs from drapelab's renderer:
-- the surface: a Catmull-Rom (bicubic) surface through the particles, 8 x 8 quads per grid cell,
-  instead of flat triangles between particles (a real fabric is smooth between its "particles");
+- the surface: by default a Catmull-Rom (bicubic) surface through the particles, 8 x 8 quads per grid
+  cell (a real fabric is smooth between its "particles"); with subdivisions 1, flat triangles between
+  the particles as drapelab's own renderer and silhouette assume;
 - the fabric: a knit texture (wales and courses, 0.5 cm period) on the material coordinates, a
   different light and a 0.3 ambient term;
 - the background: 190 grey levels with a left-to-right gradient of 20 levels and a vignette darkening
@@ -52,7 +53,7 @@ def upsample(grid, up):
     return along(a, ny, 0)[:, :, :]
 
 
-def render(particles, view, px_per_cm, out_png, out_json, seed):
+def render(particles, view, px_per_cm, out_png, out_json, seed, up=UP):
     t = pq.read_table(particles).to_pydict()
     i, j = np.array(t["i"]), np.array(t["j"])
     nx, ny = i.max() + 1, j.max() + 1
@@ -62,7 +63,7 @@ def render(particles, view, px_per_cm, out_png, out_json, seed):
         corners = [(0, 0), (nx - 1, 0)]
     else:
         corners = [(0, ny - 1), (nx - 1, ny - 1)]
-    fine = upsample(grid, UP)
+    fine = upsample(grid, up)
     Ny, Nx, _ = fine.shape
     s = px_per_cm * 100.0 * SS  # supersampled px per m
     margin = 40 * SS
@@ -132,7 +133,7 @@ def render(particles, view, px_per_cm, out_png, out_json, seed):
 
     def corner_px(ij):
         ci, cj = ij
-        k = (cj * UP, ci * UP)
+        k = (cj * up, ci * up)
         # Supersampled continuous coordinates (pixel k spans [k, k+1)) to photo pixels (centres at integers).
         return [U[k] / SS - 0.5, V[k] / SS - 0.5]
 
@@ -144,5 +145,8 @@ def render(particles, view, px_per_cm, out_png, out_json, seed):
 
 
 if __name__ == "__main__":
+    # Optional 7th argument: surface subdivisions per grid cell (default 8, a smooth surface; 1 draws
+    # flat triangles between the particles, the surface drapelab's silhouette assumes).
     particles, view, px, png, js, seed = sys.argv[1:7]
-    render(particles, view, float(px), png, js, int(seed))
+    up = int(sys.argv[7]) if len(sys.argv) > 7 else UP
+    render(particles, view, float(px), png, js, int(seed), up)

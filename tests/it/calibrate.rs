@@ -384,11 +384,11 @@ fn a_misplaced_corner_is_covered_by_the_interval_with_the_systematic_part() {
 }
 
 #[test]
-fn a_photo_from_another_renderer_gives_back_the_natural_length() {
-    // datasets/knitted_other/: sample 8 (55 mm, 1100 N/m) photographed by an independent renderer
-    // (smooth surface, texture, uneven light, JPEG, 15 px/cm) with a camera file of only what a
-    // camera gives.
-    let dir = root().join("datasets/knitted_other/sample_08/hang4");
+fn a_photo_from_another_renderer_gives_back_natural_length_and_stiffness() {
+    // datasets/knitted_other/flat/: sample 8 (55 mm, 1100 N/m) photographed by an independent
+    // renderer (flat triangles between the particles, texture, uneven light, JPEG, 15 px/cm) with a
+    // camera file of only what a camera gives.
+    let dir = root().join("datasets/knitted_other/flat/sample_08/hang4");
     let camera = dir.join("camera.json");
     let cam = read_camera(&camera).unwrap();
     assert!(cam.render.is_none());
@@ -423,6 +423,11 @@ fn a_photo_from_another_renderer_gives_back_the_natural_length() {
         l_err < 0.01 * 0.055,
         "natural length {}",
         best.natural_length_m
+    );
+    assert!(
+        k_err < 0.05 * 1100.0,
+        "stiffness {}",
+        best.stiffness_N_per_m
     );
     assert!(l_err <= half("natural_length_m") && k_err <= half("stiffness_N_per_m"));
 }
