@@ -196,6 +196,15 @@ fn quadratic_terms(u: f64, v: f64, w: f64, h: f64) -> [f64; 6] {
     [1.0, x, y, x * x, x * y, y * y]
 }
 
+/// The quadratic background `model` at pixel (u, v) of a `w` × `h` image.
+fn model_at(model: &[f64; 6], u: i64, v: i64, w: u32, h: u32) -> f64 {
+    quadratic_terms(u as f64, v as f64, w as f64, h as f64)
+        .iter()
+        .zip(model)
+        .map(|(t, c)| t * c)
+        .sum()
+}
+
 /// Least-squares quadratic of the background's grey level over the pixels `is_bg` admits.
 fn fit_background(gray: &GrayImage, is_bg: &dyn Fn(u32, u32) -> bool, fallback: f64) -> [f64; 6] {
     let (w, h) = gray.dimensions();
@@ -225,11 +234,7 @@ impl Segmented {
     /// The background model's grey level at pixel (u, v).
     fn background_at(&self, u: i64, v: i64) -> f64 {
         let (w, h) = self.gray.dimensions();
-        quadratic_terms(u as f64, v as f64, w as f64, h as f64)
-            .iter()
-            .zip(&self.background_model)
-            .map(|(t, c)| t * c)
-            .sum()
+        model_at(&self.background_model, u, v, w, h)
     }
     fn at(&self, u: u32, v: u32) -> f64 {
         self.gray.get_pixel(u, v).0[0] as f64
@@ -282,8 +287,8 @@ fn segment(img: &RgbImage, file: &Path) -> Result<Segmented, InputError> {
         gray.put_pixel(u, v, image::Luma([l.round() as u8]));
     }
     let mut flat = gray.clone();
-    let mut seg = None;
-    for _ in 0..SEGMENT_PASSES {
+    let mut pass = 0;
+    loop {
         let (t, fabric_dark) = threshold(&flat);
         let is_fabric = |g: f64| if fabric_dark { g <= t } else { g > t };
         let fab = |u: u32, v: u32| is_fabric(flat.get_pixel(u, v).0[0] as f64);
@@ -296,22 +301,24 @@ fn segment(img: &RgbImage, file: &Path) -> Result<Segmented, InputError> {
             )
         })?;
         let background_model = fit_background(&gray, &|u, v| clear_of(img, &fab, u, v), background);
-        let s = Segmented {
-            gray: gray.clone(),
-            flat: flat.clone(),
-            threshold: t,
-            fabric_dark,
-            fabric,
-            background_model,
-        };
+        pass += 1;
+        if pass == SEGMENT_PASSES {
+            return Ok(Segmented {
+                gray,
+                flat,
+                threshold: t,
+                fabric_dark,
+                fabric,
+                background_model,
+            });
+        }
         flat = GrayImage::from_fn(w, h, |u, v| {
-            let g =
-                gray.get_pixel(u, v).0[0] as f64 - s.background_at(u as i64, v as i64) + background;
+            let g = gray.get_pixel(u, v).0[0] as f64
+                - model_at(&background_model, u as i64, v as i64, w, h)
+                + background;
             image::Luma([g.round().clamp(0.0, 255.0) as u8])
         });
-        seg = Some(s);
     }
-    seg.ok_or_else(|| InputError::new(file, "", "not segmented"))
 }
 
 /// The mean grey levels of fabric and background by `fab`; None when there is too little fabric or

@@ -231,11 +231,14 @@ pub fn edges_from_silhouette(
             super::trim_edge("bottom", curve(true), span, 0.0),
         )],
         View::Hang2 => {
-            let bottom = curve(true);
-            let depth_at = |a: f64| {
-                let k = ((a / span) * n as f64).round() as usize;
-                -envelope(&along_up, &xs, true)[k.min(n)].unwrap_or(0.0)
-            };
+            // The lower envelope once: the bottom edge, and the depths at the two corners' verticals.
+            let lower = envelope(&along_up, &xs, true);
+            let bottom: Vec<(f64, f64)> = xs
+                .iter()
+                .zip(&lower)
+                .filter_map(|(&a, t)| Some((a, (*t)?)))
+                .collect();
+            let depth_at = |k: usize| -lower[k].unwrap_or(0.0);
             // Side edges: x = depth below the line, y = offset along the line from the corner's
             // vertical; the leftmost (rightmost) point of the silhouette at each depth.
             let depth_up: Vec<Segment> = along_up
@@ -250,7 +253,7 @@ pub fn edges_from_silhouette(
                     .filter_map(|(&d, a)| Some((d, a? - offset)))
                     .collect()
             };
-            let (d_left, d_right) = (depth_at(0.0), depth_at(span));
+            let (d_left, d_right) = (depth_at(0), depth_at(n));
             vec![
                 (
                     "top".into(),
