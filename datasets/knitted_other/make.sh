@@ -27,5 +27,18 @@ while IFS=, read -r s rho k l0; do
       "$py" "$here/render.py" "$tmp/$s/$hang/particles.parquet" "$hang" 15 "$d/photo.jpg" \
         "$d/camera.json" "$s" "${variant##*:}"
     done
+    # Another resolution (fine/): a 41 x 41 net with the same macroscopic sheet, i.e. the same spring
+    # stiffness (a square net's membrane stiffness per unit width is the spring's, whatever the spacing),
+    # areal density and natural sheet size (natural length scaled by 13/40), rendered with flat
+    # triangles. The truth for the 14 x 14 model is then the stated 14 x 14 values, up to discretisation.
+    l41=$(awk -v l="$l0" 'BEGIN { printf "%.9g", l * 13 / 40 }')
+    $bin simulate datasets/scenes/$hang.toml --out "$tmp/$s/fine_$hang" -q \
+      --set cloth.nx=41 --set cloth.ny=41 --set cloth.areal_density_kg_per_m2="$rho" \
+      --set material.mass_spring.stiffness_N_per_m="$k" --set material.mass_spring.natural_length_m="$l41" \
+      --set solver.static.max_iterations=2000
+    d=$(printf "%s/fine/sample_%02d/%s" "$here" "$s" "$hang")
+    mkdir -p "$d"
+    "$py" "$here/render.py" "$tmp/$s/fine_$hang/particles.parquet" "$hang" 15 "$d/photo.jpg" \
+      "$d/camera.json" "$s" 1
   done
 done < <(grep -v '^#' datasets/knitted/ground_truth.csv | tail -n +2)
