@@ -49,6 +49,24 @@ impl From<ViewArg> for crate::edges::View {
     }
 }
 
+/// Where the items of a stage run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ExecutorArg {
+    /// This process's threads (--jobs).
+    Local,
+    /// Slurm job arrays.
+    Slurm,
+}
+
+impl From<ExecutorArg> for crate::pipeline::ExecutorKind {
+    fn from(e: ExecutorArg) -> Self {
+        match e {
+            ExecutorArg::Local => crate::pipeline::ExecutorKind::Local,
+            ExecutorArg::Slurm => crate::pipeline::ExecutorKind::Slurm,
+        }
+    }
+}
+
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
@@ -91,6 +109,29 @@ pub enum Command {
         /// Print what would run and why; run nothing.
         #[arg(long)]
         dry_run: bool,
+        /// Where the items of sweep and calibrate stages run, overriding the pipeline's [executor]
+        /// kind: local (this process's threads) or slurm (one `sbatch --array` job per stage; needs
+        /// a filesystem shared with the nodes; README "Running on a Slurm cluster").
+        #[arg(long, value_enum)]
+        executor: Option<ExecutorArg>,
+    },
+    /// Compute some items of a stage, as one Slurm array task does (`drapelab run --executor slurm`
+    /// writes the task list and calls this; not needed by hand).
+    ///
+    /// Reads line TASK (0-based) of the task list: the items to compute. Items that already have a
+    /// part are skipped; the parts folder must be that of the stage's current inputs.
+    Worker {
+        /// The pipeline file.
+        pipeline: PathBuf,
+        /// The stage whose items to compute.
+        #[arg(long)]
+        stage: String,
+        /// The task list (one line of item numbers per task).
+        #[arg(long)]
+        tasks: PathBuf,
+        /// The task (line) to run, 0-based: $SLURM_ARRAY_TASK_ID.
+        #[arg(long)]
+        task: usize,
     },
     /// Say which stages of a pipeline are stale, and why.
     ///
@@ -285,6 +326,27 @@ pub fn run_pipeline_with(
     })
 }
 
+/// `drapelab worker`: the items of line `task` of the task list, computed into their parts.
+fn worker(pipeline: &Path, stage: &str, tasks: &Path, task: usize) -> Result<i32> {
+    let plan = crate::pipeline::load_plan(pipeline, &crate::stages::registry())?;
+    let text = std::fs::read_to_string(tasks)
+        .map_err(|e| InputError::new(tasks, "", format!("cannot read the task list: {e}")))?;
+    let line = text.lines().nth(task).ok_or_else(|| {
+        InputError::new(
+            "--task",
+            "",
+            format!("{} has no line {task}", tasks.display()),
+        )
+    })?;
+    let items = line
+        .split_whitespace()
+        .map(|w| w.parse::<usize>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| InputError::new(tasks, format!("line {task}"), e.to_string()))?;
+    crate::pipeline::run_worker(&plan, stage, &items)?;
+    Ok(EXIT_OK)
+}
+
 /// Loads a scene with `--set KEY=VALUE` overrides; an error caused by an override names the flag.
 pub fn load_scene(path: &Path, sets: &[String]) -> Result<LoadedScene, InputError> {
     let overrides = sets
@@ -318,6 +380,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             force,
             jobs,
             dry_run,
+            executor,
         } => run_pipeline_command(
             &pipeline,
             crate::pipeline::RunOptions {
@@ -325,8 +388,15 @@ pub fn run(cli: Cli) -> Result<i32> {
                 force,
                 jobs,
                 dry_run,
+                executor: executor.map(Into::into),
             },
         ),
+        Command::Worker {
+            pipeline,
+            stage,
+            tasks,
+            task,
+        } => worker(&pipeline, &stage, &tasks, task),
         Command::Status { pipeline, check } => status(&pipeline, check),
         Command::Kinds => {
             print!("{}", kinds_text());

@@ -12,6 +12,7 @@ mod layering;
 mod loads;
 mod pipeline;
 mod recordings;
+mod slurm;
 mod stress;
 mod subpixel;
 mod support;

@@ -6,14 +6,23 @@
 //! stands for `runs/<pipeline>`. An input equal to (or a glob matching) another stage's output makes
 //! that stage a dependency.
 
+mod executor;
+mod items;
 mod manifest;
 mod plan;
 mod progress;
 mod runner;
+mod slurm;
 mod stage;
 
+pub use executor::{ExecutorKind, ExecutorSettings};
+pub use items::{part_path, parts_dir};
 pub use manifest::{Manifest, hash_file};
 pub use plan::{Paths, Plan, PlannedStage, StageSpec, load_plan};
 pub use progress::{LogProgress, MultiBarProgress, Progress, progress_for_terminal};
-pub use runner::{RunOptions, RunSummary, StageState, manifest_path, run_pipeline, stage_states};
-pub use stage::{ParamError, Registry, Slot, Stage, StageContext, StageKind, typed_params};
+pub use runner::{
+    RunOptions, RunSummary, StageState, manifest_path, run_pipeline, run_worker, stage_states,
+};
+pub use stage::{
+    ItemKind, ParamError, Registry, Slot, Stage, StageContext, StageKind, typed_params,
+};

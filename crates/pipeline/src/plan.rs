@@ -3,6 +3,7 @@
 //! stages writing one output are refused with an [`InputError`] naming the file, the stage and the
 //! slot or key.
 
+use crate::executor::ExecutorSettings;
 use crate::stage::{Registry, Stage};
 use drapelab_core::config::{from_table, read_toml_table};
 use drapelab_core::error::InputError;
@@ -55,6 +56,8 @@ struct PipelineFile {
     #[serde(default)]
     description: String,
     stages: BTreeMap<String, StageSpec>,
+    #[serde(default)]
+    executor: ExecutorSettings,
 }
 
 /// A stage with resolved paths and its dependencies.
@@ -107,6 +110,8 @@ pub struct Plan {
     pub root: PathBuf,
     /// Stages in topological order (ties by name).
     pub stages: Vec<PlannedStage>,
+    /// Where items run (the `[executor]` table; `drapelab run --executor` overrides its kind).
+    pub executor: ExecutorSettings,
 }
 
 impl Plan {
@@ -174,6 +179,7 @@ pub fn load_plan(file: &Path, registry: &Registry) -> Result<Plan, InputError> {
             "must be a non-empty word of letters, digits, '-' or '_'",
         ));
     }
+    pf.executor.check(file)?;
     let root = project_root(file);
     let run = format!("runs/{}", pf.name);
     let mut stages = Vec::new();
@@ -190,6 +196,7 @@ pub fn load_plan(file: &Path, registry: &Registry) -> Result<Plan, InputError> {
         file: file.to_path_buf(),
         root,
         stages: topological(file, stages)?,
+        executor: pf.executor,
     })
 }
 

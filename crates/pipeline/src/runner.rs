@@ -1,6 +1,7 @@
 //! Running a plan make-style: a stage runs when it is stale (or forced), otherwise it is skipped
 //! in milliseconds. Outputs are written atomically by the stages; the manifest is written last.
 
+use crate::executor::{ExecutorKind, ExecutorSettings};
 use crate::manifest::{Manifest, build_id, hash_file, stage_key};
 use crate::plan::{Plan, PlannedStage};
 use crate::progress::Progress;
@@ -22,6 +23,8 @@ pub struct RunOptions {
     pub jobs: usize,
     /// Say what would run, run nothing.
     pub dry_run: bool,
+    /// The executor of items, overriding the pipeline's `[executor]` kind (`--executor`).
+    pub executor: Option<ExecutorKind>,
 }
 
 /// Whether a stage is up to date, and if not, why.
@@ -182,7 +185,7 @@ fn check(plan: &Plan, s: &PlannedStage, upstream_stale: &BTreeSet<String>) -> St
 }
 
 /// Removes temporary files left in `dir` by a killed run (`.NAME.*.partial`).
-fn remove_partials(dir: &Path) {
+pub(crate) fn remove_partials(dir: &Path) {
     if let Ok(entries) = std::fs::read_dir(dir) {
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().to_string();
@@ -219,6 +222,13 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
             )
             .into());
         }
+    }
+    let mut executor = plan.executor.clone();
+    if let Some(kind) = opts.executor {
+        executor.kind = kind;
+    }
+    if executor.kind == ExecutorKind::Slurm && !opts.dry_run {
+        crate::slurm::preflight(&executor, &plan.file)?;
     }
     let selected: BTreeSet<String> = match &opts.until {
         Some(u) => plan.ancestors(u),
@@ -272,7 +282,7 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
             summary.would_run.push((s.name.clone(), why));
             continue;
         }
-        let status = run_stage(plan, s, &pool, progress)?;
+        let status = run_stage(plan, s, &pool, &executor, progress)?;
         if status == "ok" {
             summary.ran.push(s.name.clone());
         } else {
@@ -283,28 +293,17 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
     Ok(summary)
 }
 
-/// Runs one stale stage in `pool` and writes its manifest: its status, "ok" or "failed: …" (an
-/// error, a panic, or an output not written). Bad input is returned as an error.
-fn run_stage(
-    plan: &Plan,
-    s: &PlannedStage,
-    pool: &rayon::ThreadPool,
-    progress: &dyn Progress,
-) -> Result<String> {
-    let start = Instant::now();
+/// The context of stage `s` now (its input files by slot, its outputs) and its input hashes.
+fn stage_context<'a>(
+    plan: &'a Plan,
+    s: &'a PlannedStage,
+    progress: &'a dyn Progress,
+) -> (StageContext<'a>, BTreeMap<String, String>) {
     let slots = slot_inputs(plan, s);
-    let inputs_now = hashed(plan, &slots);
-    let outputs: BTreeMap<String, PathBuf> = s
-        .outputs
-        .iter()
-        .map(|(k, o)| (k.clone(), plan.root.join(o)))
+    let inputs: BTreeMap<String, String> = hashed(plan, &slots)
+        .into_iter()
+        .map(|(p, h)| (p, h.unwrap_or_default()))
         .collect();
-    for o in outputs.values() {
-        if let Some(d) = o.parent() {
-            std::fs::create_dir_all(d)?;
-            remove_partials(d);
-        }
-    }
     let ctx = StageContext {
         plan,
         stage: s,
@@ -312,11 +311,82 @@ fn run_stage(
             .into_iter()
             .map(|(k, files)| (k, files.iter().map(|p| plan.root.join(p)).collect()))
             .collect(),
-        outputs: outputs.clone(),
+        outputs: s
+            .outputs
+            .iter()
+            .map(|(k, o)| (k.clone(), plan.root.join(o)))
+            .collect(),
         progress,
     };
+    (ctx, inputs)
+}
+
+/// The key of a stage's parts: its up-to-date key and the build (parts of another build are
+/// recomputed).
+fn parts_key(s: &PlannedStage, inputs: &BTreeMap<String, String>) -> String {
+    format!(
+        "{}-{}",
+        stage_key(s.kind.kind(), &s.params, inputs),
+        build_id()
+    )
+}
+
+/// Runs a stage: by items through the executor when its kind has items, else in one piece.
+fn run_whole_or_items(
+    ctx: &StageContext<'_>,
+    inputs: &BTreeMap<String, String>,
+    executor: &ExecutorSettings,
+) -> Result<()> {
+    match ctx.stage.kind.items(ctx)? {
+        Some(n) => crate::items::run_by_items(ctx, n, &parts_key(ctx.stage, inputs), executor),
+        None => ctx.stage.kind.run(ctx),
+    }
+}
+
+/// `drapelab worker`: computes `items` of stage `stage` of `plan` (those without a part), on this
+/// process's threads, as one Slurm array task does. The parts folder must have been prepared for
+/// the stage's current inputs and parameters by `drapelab run` (else the inputs changed since).
+pub fn run_worker(plan: &Plan, stage: &str, items: &[usize]) -> Result<()> {
+    let s = plan.stage(stage).ok_or_else(|| {
+        InputError::new(&plan.file, "stages", format!("no stage named `{stage}`"))
+    })?;
+    let progress = crate::progress::LogProgress::default();
+    let (ctx, inputs) = stage_context(plan, s, &progress);
+    let dir = crate::items::parts_dir(&plan.run_dir(), stage);
+    if !crate::items::parts_match(&dir, &parts_key(s, &inputs)) {
+        anyhow::bail!(
+            "{}: the parts folder is not that of stage `{stage}` with its current inputs,              parameters and build (they changed since `drapelab run` submitted the work); run it again",
+            dir.display()
+        );
+    }
+    let todo: Vec<usize> = items
+        .iter()
+        .copied()
+        .filter(|&i| !crate::items::part_path(&dir, i).exists())
+        .collect();
+    crate::items::compute_local(&ctx, &todo, &dir)
+}
+
+/// Runs one stale stage in `pool` and writes its manifest: its status, "ok" or "failed: …" (an
+/// error, a panic, or an output not written). Bad input is returned as an error.
+fn run_stage(
+    plan: &Plan,
+    s: &PlannedStage,
+    pool: &rayon::ThreadPool,
+    executor: &ExecutorSettings,
+    progress: &dyn Progress,
+) -> Result<String> {
+    let start = Instant::now();
+    let (ctx, inputs) = stage_context(plan, s, progress);
+    for o in ctx.outputs.values() {
+        if let Some(d) = o.parent() {
+            std::fs::create_dir_all(d)?;
+            remove_partials(d);
+        }
+    }
+    let outputs = ctx.outputs.clone();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        pool.install(|| s.kind.run(&ctx))
+        pool.install(|| run_whole_or_items(&ctx, &inputs, executor))
     }));
     let status = match result {
         Ok(Ok(())) => match outputs.values().find(|o| !o.exists()) {
@@ -331,10 +401,6 @@ fn run_stage(
         ),
     };
     let wall = start.elapsed().as_secs_f64();
-    let inputs: BTreeMap<String, String> = inputs_now
-        .into_iter()
-        .map(|(p, h)| (p, h.unwrap_or_default()))
-        .collect();
     let manifest = Manifest {
         stage: s.name.clone(),
         kind: s.kind.kind().into(),

@@ -99,8 +99,23 @@ pub trait Stage: Send + Sync {
     /// Checks a params table; the resolved parameters (defaults filled in) as JSON, part of the
     /// up-to-date key.
     fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError>;
-    /// Runs the stage.
+    /// Runs the stage (a stage with items runs through [`Stage::items`] instead).
     fn run(&self, ctx: &StageContext<'_>) -> Result<()>;
+    /// How many independent items the stage has, when it runs by items (parts and executors,
+    /// [`ItemKind`]); None: it runs as one piece through [`Stage::run`].
+    fn items(&self, _ctx: &StageContext<'_>) -> Result<Option<usize>> {
+        Ok(None)
+    }
+    /// Computes item `item` and writes its part at `part` (last, atomically; side files beside it).
+    fn compute_item(&self, ctx: &StageContext<'_>, item: usize, part: &Path) -> Result<()> {
+        let _ = (item, part);
+        anyhow::bail!("stage `{}` does not run by items", ctx.stage.name)
+    }
+    /// Writes the stage's outputs from the parts of every item, in item order.
+    fn gather(&self, ctx: &StageContext<'_>, parts: &[PathBuf]) -> Result<()> {
+        let _ = parts;
+        anyhow::bail!("stage `{}` does not run by items", ctx.stage.name)
+    }
 }
 
 /// A stage kind with typed parameters: implement this, register it with [`Registry::with`].
@@ -119,8 +134,33 @@ pub trait StageKind: Send + Sync + 'static {
     fn check(_params: &Self::Params) -> Result<(), ParamError> {
         Ok(())
     }
-    /// Runs the stage with its parameters.
-    fn run(ctx: &StageContext<'_>, params: &Self::Params) -> Result<()>;
+    /// Runs the stage with its parameters (not called for an [`ItemKind`]).
+    fn run(ctx: &StageContext<'_>, _params: &Self::Params) -> Result<()> {
+        anyhow::bail!(
+            "stage `{}` of kind {} runs by items",
+            ctx.stage.name,
+            Self::KIND
+        )
+    }
+}
+
+/// A stage kind whose work is independent items (sweep points, samples): each item writes one part,
+/// `{run}/parts/<stage>/part-00017.parquet` (atomically), and the outputs are the gather of the
+/// parts, so a killed run keeps its finished items and an executor (local threads, Slurm array
+/// tasks) can spread them. Register it with [`Registry::with_items`].
+pub trait ItemKind: StageKind {
+    /// The number of items (read from the inputs and parameters; cheap).
+    fn count(ctx: &StageContext<'_>, params: &Self::Params) -> Result<usize>;
+    /// Computes item `item` (0-based) and writes its part at `part`, last and atomically; side files
+    /// go beside it as `part-00017.NAME`. Must not depend on which other items ran in this process.
+    fn compute(
+        ctx: &StageContext<'_>,
+        params: &Self::Params,
+        item: usize,
+        part: &Path,
+    ) -> Result<()>;
+    /// Writes the stage's outputs from every item's part, in item order.
+    fn gather(ctx: &StageContext<'_>, params: &Self::Params, parts: &[PathBuf]) -> Result<()>;
 }
 
 /// Deserializes a params table into `T`, naming the bad key.
@@ -141,6 +181,44 @@ pub fn typed_params<T: DeserializeOwned>(params: &toml::Table) -> Result<T, Para
 
 struct Typed<K>(PhantomData<K>);
 
+/// The parameters of the stage in `ctx`, typed.
+fn params_of<K: StageKind>(ctx: &StageContext<'_>) -> Result<K::Params> {
+    typed_params(&ctx.stage.spec.params)
+        .map_err(|e| anyhow::anyhow!("params.{}: {}", e.key, e.message))
+}
+
+struct ItemTyped<K>(PhantomData<K>);
+
+impl<K: ItemKind> Stage for ItemTyped<K> {
+    fn kind(&self) -> &'static str {
+        K::KIND
+    }
+    fn summary(&self) -> &'static str {
+        K::SUMMARY
+    }
+    fn inputs(&self) -> &'static [Slot] {
+        K::INPUTS
+    }
+    fn outputs(&self) -> &'static [Slot] {
+        K::OUTPUTS
+    }
+    fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError> {
+        Typed::<K>(PhantomData).resolve(params)
+    }
+    fn run(&self, ctx: &StageContext<'_>) -> Result<()> {
+        K::run(ctx, &params_of::<K>(ctx)?)
+    }
+    fn items(&self, ctx: &StageContext<'_>) -> Result<Option<usize>> {
+        K::count(ctx, &params_of::<K>(ctx)?).map(Some)
+    }
+    fn compute_item(&self, ctx: &StageContext<'_>, item: usize, part: &Path) -> Result<()> {
+        K::compute(ctx, &params_of::<K>(ctx)?, item, part)
+    }
+    fn gather(&self, ctx: &StageContext<'_>, parts: &[PathBuf]) -> Result<()> {
+        K::gather(ctx, &params_of::<K>(ctx)?, parts)
+    }
+}
+
 impl<K: StageKind> Stage for Typed<K> {
     fn kind(&self) -> &'static str {
         K::KIND
@@ -160,9 +238,7 @@ impl<K: StageKind> Stage for Typed<K> {
         serde_json::to_value(&p).map_err(|e| ParamError::new("", e.to_string()))
     }
     fn run(&self, ctx: &StageContext<'_>) -> Result<()> {
-        let p: K::Params = typed_params(&ctx.stage.spec.params)
-            .map_err(|e| anyhow::anyhow!("params.{}: {}", e.key, e.message))?;
-        K::run(ctx, &p)
+        K::run(ctx, &params_of::<K>(ctx)?)
     }
 }
 
@@ -181,6 +257,12 @@ impl Registry {
     pub fn with<K: StageKind>(mut self) -> Self {
         self.kinds
             .insert(K::KIND, Arc::new(Typed::<K>(PhantomData)));
+        self
+    }
+    /// Adds a kind that runs by items ([`ItemKind`]).
+    pub fn with_items<K: ItemKind>(mut self) -> Self {
+        self.kinds
+            .insert(K::KIND, Arc::new(ItemTyped::<K>(PhantomData)));
         self
     }
     /// The kind called `name`, shared.

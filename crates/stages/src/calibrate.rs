@@ -1,20 +1,23 @@
 //! `calibrate`: for each sample of a fit-edges table, ICA runs over Table 3's box against the sample's
 //! measured 4-corner edges (the scene input with the sample's Table 2 density); the best run is kept.
 //! Writes `results.parquet` (one row per sample, with the runs' spread and each parameter's
-//! identifiability) and `evaluations.parquet` (every country of every decade of every run).
+//! identifiability) and `evaluations.parquet` (every country of every decade of every run). Each
+//! sample is an item: one part per sample, run by the pipeline's executor, then gathered.
 
 use crate::calibration_tables::{ComparisonRow, EvaluationRow, ResultRow};
 use anyhow::{Context, Result, bail};
 use drapelab_core::calibrate::{
-    Noise, Problem, SampleCalibration, SampleSettings, calibrate_sample, read_sample_densities,
-    sample_scene,
+    Noise, Problem, SampleSettings, calibrate_sample, read_sample_densities, sample_scene,
 };
 use drapelab_core::edges::{EdgeFit, EdgeSource};
 use drapelab_core::optim::{DecadeEvent, IcaSettings};
-use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
-use drapelab_record::{CalibrationRecorder, read_edges, write_table};
+use drapelab_pipeline::{ItemKind, ParamError, Slot, StageContext, StageKind};
+use drapelab_record::{
+    CalibrationRecorder, gather_parquet, merge_recordings, read_edges, write_table,
+};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// Parameters of a calibrate stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -167,8 +170,26 @@ impl StageKind for Calibrate {
     fn check(p: &CalibrateParams) -> Result<(), ParamError> {
         p.check().map_err(|(k, m)| ParamError::new(k, m))
     }
-    fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
-        run(ctx, p)
+}
+
+/// Items: the samples of the `edges` input, in name order; each sample's ICA runs stay in one item
+/// (they share the sample's cost cache, and its results do not depend on the executor).
+impl ItemKind for Calibrate {
+    fn count(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<usize> {
+        ica_settings(ctx, p)?;
+        read_sample_densities(ctx.input("samples")?)?;
+        Ok(edges_by_sample(ctx)?.len())
+    }
+    fn compute(
+        ctx: &StageContext<'_>,
+        p: &CalibrateParams,
+        item: usize,
+        part: &Path,
+    ) -> Result<()> {
+        compute(ctx, p, item, part)
+    }
+    fn gather(ctx: &StageContext<'_>, _p: &CalibrateParams, parts: &[PathBuf]) -> Result<()> {
+        gather(ctx, parts)
     }
 }
 
@@ -186,9 +207,8 @@ fn ica_settings(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<IcaSettin
     Ok(ica)
 }
 
-fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
-    let densities = read_sample_densities(ctx.input("samples")?)?;
-    let scene_file = ctx.input("scene")?;
+/// The measured edges of every sample of the `edges` input, by sample (the items, in this order).
+fn edges_by_sample(ctx: &StageContext<'_>) -> Result<BTreeMap<String, Vec<EdgeFit>>> {
     let edges_file = ctx.input("edges")?;
     let mut by_sample: BTreeMap<String, Vec<EdgeFit>> = BTreeMap::new();
     for (s, e) in read_edges(edges_file)? {
@@ -197,47 +217,82 @@ fn run(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<()> {
     if by_sample.is_empty() {
         bail!("{}: no edges", edges_file.display());
     }
-    ctx.progress
-        .stage_started(&ctx.stage.name, (by_sample.len() * p.runs) as u64);
+    Ok(by_sample)
+}
+
+/// A side file of a sample's part: `part-00003.NAME`.
+fn side(part: &Path, name: &str) -> PathBuf {
+    part.with_extension(name)
+}
+
+/// Calibrates sample `item` (in sample order) and writes its part: the results row at `part` (last),
+/// its evaluations, CMA-ES comparison and recording beside it when the stage writes them.
+fn compute(ctx: &StageContext<'_>, p: &CalibrateParams, item: usize, part: &Path) -> Result<()> {
+    let by_sample = edges_by_sample(ctx)?;
+    let Some((sample, measured)) = by_sample.iter().nth(item) else {
+        bail!("no sample {item} in {}", ctx.input("edges")?.display());
+    };
+    let densities = read_sample_densities(ctx.input("samples")?)?;
+    let scene = sample_scene(ctx.input("scene")?, &densities, sample, p.grid)?;
     let settings = SampleSettings {
         runs: p.runs,
         ica: ica_settings(ctx, p)?,
         side_cm: p.side_cm,
         polish_iterations: p.polish_iterations,
-        noise: p
-            .measurement_noise_pct
-            .map_or(Noise::FromResidual, Noise::Given),
+        noise: Noise::for_edges(p.measurement_noise_pct, measured, p.include_systematic),
         identifiable_rel: p.identifiable_rel,
         identifiability_window: p.identifiability_window,
         baseline_cmaes: p.baseline_cmaes,
     };
     let recorder = match ctx.optional_output("recording") {
-        Some(path) => Some(CalibrationRecorder::new(path)?),
+        Some(_) => Some(CalibrationRecorder::new(&side(part, "rrd"))?),
         None => None,
     };
-    let mut results = Vec::new();
-    for (sample, measured) in &by_sample {
-        let scene = sample_scene(scene_file, &densities, sample, p.grid)?;
-        let mut problem = Problem::new(scene, measured.clone(), p.side_cm);
-        problem.edge_source = p.edge_source;
-        let mut observe = |r: usize, ev: &DecadeEvent<'_>| -> Result<()> {
-            match &recorder {
-                Some(rec) => record_decade(rec, &problem, sample, r, ev, measured, p.side_cm)
-                    .context("writing the calibration recording"),
-                None => Ok(()),
-            }
-        };
-        let done = || ctx.progress.item_done(&ctx.stage.name);
-        let settings = SampleSettings {
-            noise: Noise::for_edges(p.measurement_noise_pct, measured, p.include_systematic),
-            ..settings.clone()
-        };
-        let found = calibrate_sample(&problem, measured, &settings, &mut observe, &done)?;
-        results.push((sample.clone(), found));
-    }
-    write_tables(ctx, &results, p.runs)?;
+    let mut problem = Problem::new(scene, measured.clone(), p.side_cm);
+    problem.edge_source = p.edge_source;
+    let mut observe = |r: usize, ev: &DecadeEvent<'_>| -> Result<()> {
+        match &recorder {
+            Some(rec) => record_decade(rec, &problem, sample, r, ev, measured, p.side_cm)
+                .context("writing the calibration recording"),
+            None => Ok(()),
+        }
+    };
+    let found = calibrate_sample(&problem, measured, &settings, &mut observe, &|| {})?;
     if let Some(rec) = recorder {
         rec.finish()?;
+    }
+    if ctx.optional_output("evaluations").is_some() {
+        let rows: Vec<EvaluationRow> = found
+            .evaluations
+            .iter()
+            .map(|e| EvaluationRow::new(sample, e))
+            .collect();
+        write_table(&side(part, "evaluations.parquet"), &rows)?;
+    }
+    if ctx.optional_output("comparison").is_some() {
+        let rows: Vec<ComparisonRow> = found
+            .runs
+            .iter()
+            .map(|r| ComparisonRow::new(sample, r))
+            .collect();
+        write_table(&side(part, "comparison.parquet"), &rows)?;
+    }
+    write_table(part, &[ResultRow::new(sample, &found, p.runs)])
+}
+
+/// `results.parquet`, and `evaluations.parquet`, `comparison.parquet` and `calibration.rrd` when
+/// asked, from the samples' parts.
+fn gather(ctx: &StageContext<'_>, parts: &[PathBuf]) -> Result<()> {
+    gather_parquet(parts, ctx.output("results")?)?;
+    let sides = |name: &str| -> Vec<PathBuf> { parts.iter().map(|p| side(p, name)).collect() };
+    if let Some(out) = ctx.optional_output("evaluations") {
+        gather_parquet(&sides("evaluations.parquet"), out)?;
+    }
+    if let Some(out) = ctx.optional_output("comparison") {
+        gather_parquet(&sides("comparison.parquet"), out)?;
+    }
+    if let Some(out) = ctx.optional_output("recording") {
+        merge_recordings(&sides("rrd"), out, "drapelab_calibration")?;
     }
     Ok(())
 }
@@ -273,32 +328,4 @@ fn record_decade(
         origin,
         side_cm,
     )
-}
-
-/// `results.parquet`, `comparison.parquet` and `evaluations.parquet` of the calibrated samples.
-fn write_tables(
-    ctx: &StageContext<'_>,
-    results: &[(String, SampleCalibration)],
-    runs: usize,
-) -> Result<()> {
-    let res: Vec<ResultRow> = results
-        .iter()
-        .map(|(s, c)| ResultRow::new(s, c, runs))
-        .collect();
-    write_table(ctx.output("results")?, &res)?;
-    if let Some(out) = ctx.optional_output("evaluations") {
-        let evals: Vec<EvaluationRow> = results
-            .iter()
-            .flat_map(|(s, c)| c.evaluations.iter().map(|e| EvaluationRow::new(s, e)))
-            .collect();
-        write_table(out, &evals)?;
-    }
-    if let Some(out) = ctx.optional_output("comparison") {
-        let cmp: Vec<ComparisonRow> = results
-            .iter()
-            .flat_map(|(s, c)| c.runs.iter().map(|r| ComparisonRow::new(s, r)))
-            .collect();
-        write_table(out, &cmp)?;
-    }
-    Ok(())
 }

@@ -66,11 +66,11 @@ const SCENE_SLOT: Slot = Slot::one("scene", "the hang scene each sample is simul
 pub fn registry() -> Registry {
     Registry::new()
         .with::<Simulate>()
-        .with::<Sweep>()
+        .with_items::<Sweep>()
         .with::<Report>()
         .with::<FitEdges>()
         .with::<Score>()
-        .with::<Calibrate>()
+        .with_items::<Calibrate>()
         .with::<Validate>()
         .with::<Tune>()
         .with::<CalibrationReport>()

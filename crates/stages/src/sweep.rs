@@ -1,16 +1,17 @@
 //! `sweep`: every input scene solved at every point of a grid or a Latin hypercube over scene keys,
-//! in parallel (rayon), into one Parquet table. The schema is documented in the README.
+//! one item per scene and point (a part each, run by the pipeline's executor), gathered into one
+//! Parquet table. The schema is documented in the README.
 
 use crate::sweep_table::{SweepOutcome, SweepPoint, as_f64, write_sweep};
 use anyhow::{Result, bail};
 use drapelab_core::scene::Scene;
 use drapelab_core::simulate::solve_scene;
 use drapelab_core::solve::NoObserver;
-use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
-
-use rayon::prelude::*;
+use drapelab_pipeline::{ItemKind, ParamError, Slot, StageContext, StageKind};
+use drapelab_record::gather_parquet;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// How sweep points are chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -156,59 +157,35 @@ pub fn sweep_points(p: &SweepParams) -> Vec<Vec<toml::Value>> {
     }
 }
 
-/// Runs the stage.
-fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
+/// The scene of item `k`: scene file `k / points`, design point `k % points`, with the sweep's keys
+/// set (recording off).
+fn item_scene(
+    files: &[std::path::PathBuf],
+    p: &SweepParams,
+    points: &[Vec<toml::Value>],
+    k: usize,
+) -> Result<(u32, Scene)> {
+    let (file, i) = (&files[k / points.len()], k % points.len());
+    let mut overrides: Vec<(String, toml::Value)> =
+        p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
+    for (key, v) in p.axes.keys().zip(&points[i]) {
+        for sub in key.split(',') {
+            overrides.push((sub.trim().to_string(), v.clone()));
+        }
+    }
+    let mut scene = Scene::load(file, &overrides)?.scene.into_inner();
+    scene.record.timeline = false;
+    scene.record.rerun = false;
+    Ok((i as u32, scene))
+}
+
+/// The scene files of the stage, at least one.
+fn scene_files<'a>(ctx: &'a StageContext<'_>) -> Result<&'a [std::path::PathBuf]> {
     let files = ctx.input_files("scenes");
     if files.is_empty() {
         bail!("input `scenes` matched no scene file");
     }
-    let points = sweep_points(p);
-    let keys: Vec<&String> = p.axes.keys().collect();
-    let jobs = load_jobs(files, p, &points, &keys)?;
-    let name = &ctx.stage.name;
-    ctx.progress.stage_started(name, jobs.len() as u64);
-    // Largest grids first, so that the last items to finish are small (balanced threads); the rows
-    // are put back in design order afterwards.
-    let mut order: Vec<usize> = (0..jobs.len()).collect();
-    order.sort_by_key(|&k| std::cmp::Reverse(jobs[k].1.cloth.nx * jobs[k].1.cloth.ny));
-    let mut unordered: Vec<(usize, (SweepPoint, SweepOutcome))> = order
-        .par_iter()
-        .map(|&k| {
-            let (i, scene) = &jobs[k];
-            let row = solve_point(scene, *i);
-            ctx.progress.item_done(name);
-            (k, row)
-        })
-        .collect();
-    unordered.sort_by_key(|(k, _)| *k);
-    let rows: Vec<(SweepPoint, SweepOutcome)> = unordered.into_iter().map(|(_, r)| r).collect();
-    write_sweep(ctx.output("table")?, &rows, &points, &keys)
-}
-
-/// Every scene at every point, loaded first: bad values are refused before any work.
-fn load_jobs(
-    files: &[std::path::PathBuf],
-    p: &SweepParams,
-    points: &[Vec<toml::Value>],
-    keys: &[&String],
-) -> Result<Vec<(u32, Scene)>> {
-    let mut jobs = Vec::new();
-    for file in files {
-        for (i, pt) in points.iter().enumerate() {
-            let mut overrides: Vec<(String, toml::Value)> =
-                p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
-            for (k, v) in keys.iter().zip(pt) {
-                for sub in k.split(',') {
-                    overrides.push((sub.trim().to_string(), v.clone()));
-                }
-            }
-            let mut scene = Scene::load(file, &overrides)?.scene.into_inner();
-            scene.record.timeline = false;
-            scene.record.rerun = false;
-            jobs.push((i as u32, scene));
-        }
-    }
-    Ok(jobs)
+    Ok(files)
 }
 
 /// Solves one point and measures its drape (when it converged).
@@ -239,8 +216,28 @@ impl StageKind for Sweep {
     fn check(p: &SweepParams) -> Result<(), ParamError> {
         p.check().map_err(|(k, m)| ParamError::new(k, m))
     }
-    fn run(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
-        run(ctx, p)
+}
+
+/// Items: every scene at every design point (scene-major), one row each.
+impl ItemKind for Sweep {
+    /// Every item's scene is loaded once here, so that a bad value is refused before any work.
+    fn count(ctx: &StageContext<'_>, p: &SweepParams) -> Result<usize> {
+        let files = scene_files(ctx)?;
+        let points = sweep_points(p);
+        let n = files.len() * points.len();
+        for k in 0..n {
+            item_scene(files, p, &points, k)?;
+        }
+        Ok(n)
+    }
+    fn compute(ctx: &StageContext<'_>, p: &SweepParams, item: usize, part: &Path) -> Result<()> {
+        let points = sweep_points(p);
+        let (i, scene) = item_scene(scene_files(ctx)?, p, &points, item)?;
+        let keys: Vec<&String> = p.axes.keys().collect();
+        write_sweep(part, &[solve_point(&scene, i)], &points, &keys)
+    }
+    fn gather(ctx: &StageContext<'_>, _p: &SweepParams, parts: &[PathBuf]) -> Result<()> {
+        gather_parquet(parts, ctx.output("table")?)
     }
 }
 

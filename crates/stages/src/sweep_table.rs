@@ -139,14 +139,15 @@ impl SweepOutcome {
     }
 }
 
-/// One swept key's values at every row, as the narrowest column that holds them all (integers,
-/// then floats, then strings); named by its first key.
-fn axis_column(key: &str, vals: &[&toml::Value]) -> (Field, ArrayRef) {
+/// One swept key's values at every row, as the narrowest column that holds every value of the
+/// design `all` (integers, then floats, then strings; so that one row's part has the whole table's
+/// type); named by its first key.
+fn axis_column(key: &str, vals: &[&toml::Value], all: &[&toml::Value]) -> (Field, ArrayRef) {
     let name = key.split(',').next().unwrap_or(key).trim().to_string();
-    if vals.iter().all(|v| v.is_integer()) {
+    if all.iter().all(|v| v.is_integer()) {
         let a = Int64Array::from_iter_values(vals.iter().map(|v| v.as_integer().unwrap_or(0)));
         (Field::new(name, DataType::Int64, false), Arc::new(a))
-    } else if vals.iter().all(|v| as_f64(v).is_some()) {
+    } else if all.iter().all(|v| as_f64(v).is_some()) {
         let a = Float64Array::from_iter_values(vals.iter().map(|v| as_f64(v).unwrap_or(f64::NAN)));
         (Field::new(name, DataType::Float64, false), Arc::new(a))
     } else {
@@ -178,7 +179,8 @@ pub fn write_sweep(
         .map(|(a, key)| {
             let vals: Vec<&toml::Value> =
                 pts.iter().map(|p| &points[p.point as usize][a]).collect();
-            axis_column(key, &vals)
+            let all: Vec<&toml::Value> = points.iter().map(|p| &p[a]).collect();
+            axis_column(key, &vals, &all)
         })
         .unzip();
     let axes = RecordBatch::try_new_with_options(

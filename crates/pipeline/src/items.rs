@@ -1,0 +1,98 @@
+//! Stages that run by items: each item's result is a part, `{run}/parts/<stage>/part-00017.parquet`
+//! (written atomically by the stage kind), the parts folder is kept while the stage's key (inputs,
+//! parameters, version, build) holds, so a rerun after a kill computes only the missing parts, and
+//! the outputs are the gather of every part. The local executor runs the missing items on this
+//! process's threads; [`crate::slurm`] runs them as array tasks.
+
+use crate::executor::{ExecutorKind, ExecutorSettings};
+use crate::stage::StageContext;
+use anyhow::{Context, Result};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// The parts folder of stage `stage`: `{run}/parts/<stage>`.
+pub fn parts_dir(run_dir: &Path, stage: &str) -> PathBuf {
+    run_dir.join("parts").join(stage)
+}
+
+/// The part of item `item` in `dir`: `part-00017.parquet`.
+pub fn part_path(dir: &Path, item: usize) -> PathBuf {
+    dir.join(format!("part-{item:05}.parquet"))
+}
+
+/// The file in a parts folder holding the key its parts were computed under.
+fn key_file(dir: &Path) -> PathBuf {
+    dir.join("key.txt")
+}
+
+/// Makes `dir` the parts folder of `key`: parts computed under another key (other inputs,
+/// parameters or build) are removed, so that only parts of this very stage are kept.
+pub fn prepare_parts(dir: &Path, key: &str) -> Result<()> {
+    let old = std::fs::read_to_string(key_file(dir)).unwrap_or_default();
+    if old.trim() != key {
+        if dir.exists() {
+            std::fs::remove_dir_all(dir)
+                .with_context(|| format!("cannot clear the parts folder {}", dir.display()))?;
+        }
+        std::fs::create_dir_all(dir)?;
+        drapelab_core::atomic::write_text(&key_file(dir), &format!("{key}\n"))?;
+    }
+    Ok(())
+}
+
+/// Whether `dir` holds parts computed under `key`.
+pub fn parts_match(dir: &Path, key: &str) -> bool {
+    std::fs::read_to_string(key_file(dir)).is_ok_and(|k| k.trim() == key)
+}
+
+/// The items of `0..n` without a part in `dir`.
+pub fn missing_items(dir: &Path, n: usize) -> Vec<usize> {
+    (0..n).filter(|&i| !part_path(dir, i).exists()).collect()
+}
+
+/// Computes `items` on this process's threads (the current rayon pool), one part each. Every item
+/// is tried; the first failure (by item) is returned after the others finished, so that their
+/// parts are kept.
+pub fn compute_local(ctx: &StageContext<'_>, items: &[usize], dir: &Path) -> Result<()> {
+    let kind = ctx.stage.kind.as_ref();
+    let mut failures: Vec<(usize, anyhow::Error)> = items
+        .par_iter()
+        .filter_map(|&i| {
+            let r = kind.compute_item(ctx, i, &part_path(dir, i));
+            ctx.progress.item_done(&ctx.stage.name);
+            r.err().map(|e| (i, e))
+        })
+        .collect();
+    failures.sort_by_key(|(i, _)| *i);
+    match failures.into_iter().next() {
+        Some((i, e)) => Err(e.context(format!("item {i}"))),
+        None => Ok(()),
+    }
+}
+
+/// Runs a stage of `n` items under `key`: the parts folder is prepared, the missing items are
+/// computed by the executor, and the parts are gathered into the outputs.
+pub fn run_by_items(
+    ctx: &StageContext<'_>,
+    n: usize,
+    key: &str,
+    executor: &ExecutorSettings,
+) -> Result<()> {
+    let dir = parts_dir(&ctx.plan.run_dir(), &ctx.stage.name);
+    prepare_parts(&dir, key)?;
+    crate::runner::remove_partials(&dir);
+    let missing = missing_items(&dir, n);
+    ctx.progress.stage_started(&ctx.stage.name, n as u64);
+    for _ in 0..n - missing.len() {
+        ctx.progress.item_done(&ctx.stage.name);
+    }
+    tracing::debug!(stage = %ctx.stage.name, items = n, missing = missing.len(), "parts");
+    if !missing.is_empty() {
+        match executor.kind {
+            ExecutorKind::Local => compute_local(ctx, &missing, &dir)?,
+            ExecutorKind::Slurm => crate::slurm::compute_slurm(ctx, &missing, &dir, executor)?,
+        }
+    }
+    let parts: Vec<PathBuf> = (0..n).map(|i| part_path(&dir, i)).collect();
+    ctx.stage.kind.gather(ctx, &parts)
+}
