@@ -45,9 +45,12 @@ pub fn parts_match(dir: &Path, key: &str) -> bool {
     std::fs::read_to_string(key_file(dir)).is_ok_and(|k| k.trim() == key)
 }
 
-/// The items of `0..n` without a part in `dir`.
-pub fn missing_items(dir: &Path, n: usize) -> Vec<usize> {
-    (0..n).filter(|&i| !part_path(dir, i).exists()).collect()
+/// The items of `items` without a part in `dir`, in order.
+pub fn without_part(dir: &Path, items: impl IntoIterator<Item = usize>) -> Vec<usize> {
+    items
+        .into_iter()
+        .filter(|&i| !part_path(dir, i).exists())
+        .collect()
 }
 
 /// Computes `items` on this process's threads (the current rayon pool), one part each. Every item
@@ -81,7 +84,7 @@ pub fn run_by_items(
     let dir = parts_dir(&ctx.plan.run_dir(), &ctx.stage.name);
     prepare_parts(&dir, key)?;
     crate::runner::remove_partials(&dir);
-    let missing = missing_items(&dir, n);
+    let missing = without_part(&dir, 0..n);
     ctx.progress.stage_started(&ctx.stage.name, n as u64);
     for _ in 0..n - missing.len() {
         ctx.progress.item_done(&ctx.stage.name);

@@ -359,11 +359,7 @@ pub fn run_worker(plan: &Plan, stage: &str, items: &[usize]) -> Result<()> {
             dir.display()
         );
     }
-    let todo: Vec<usize> = items
-        .iter()
-        .copied()
-        .filter(|&i| !crate::items::part_path(&dir, i).exists())
-        .collect();
+    let todo = crate::items::without_part(&dir, items.iter().copied());
     crate::items::compute_local(&ctx, &todo, &dir)
 }
 

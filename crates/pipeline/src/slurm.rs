@@ -5,7 +5,7 @@
 //! stage gathers the parts. Needs only a filesystem that the nodes share with this process.
 
 use crate::executor::ExecutorSettings;
-use crate::items::missing_items;
+use crate::items::without_part;
 use crate::stage::StageContext;
 use anyhow::{Context, Result, bail};
 use drapelab_core::error::InputError;
@@ -167,15 +167,7 @@ pub fn compute_slurm(
     dir: &Path,
     s: &ExecutorSettings,
 ) -> Result<()> {
-    let n_all = items.iter().max().map_or(0, |m| m + 1);
-    let wanted = |dir: &Path| -> Vec<usize> {
-        let missing = missing_items(dir, n_all);
-        items
-            .iter()
-            .copied()
-            .filter(|i| missing.contains(i))
-            .collect()
-    };
+    let wanted = |dir: &Path| without_part(dir, items.iter().copied());
     let mut todo = items.to_vec();
     let mut reported = 0;
     for attempt in 0..=s.max_resubmissions {
