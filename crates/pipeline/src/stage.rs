@@ -181,33 +181,46 @@ pub fn typed_params<T: DeserializeOwned>(params: &toml::Table) -> Result<T, Para
 
 struct Typed<K>(PhantomData<K>);
 
+struct ItemTyped<K>(PhantomData<K>);
+
 /// The parameters of the stage in `ctx`, typed.
 fn params_of<K: StageKind>(ctx: &StageContext<'_>) -> Result<K::Params> {
     typed_params(&ctx.stage.spec.params)
         .map_err(|e| anyhow::anyhow!("params.{}: {}", e.key, e.message))
 }
 
-struct ItemTyped<K>(PhantomData<K>);
+/// The [`Stage`] methods every typed kind shares: its metadata, its parameters and `run`.
+macro_rules! typed_stage_methods {
+    () => {
+        fn kind(&self) -> &'static str {
+            K::KIND
+        }
+        fn summary(&self) -> &'static str {
+            K::SUMMARY
+        }
+        fn inputs(&self) -> &'static [Slot] {
+            K::INPUTS
+        }
+        fn outputs(&self) -> &'static [Slot] {
+            K::OUTPUTS
+        }
+        fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError> {
+            let p: K::Params = typed_params(params)?;
+            K::check(&p)?;
+            serde_json::to_value(&p).map_err(|e| ParamError::new("", e.to_string()))
+        }
+        fn run(&self, ctx: &StageContext<'_>) -> Result<()> {
+            K::run(ctx, &params_of::<K>(ctx)?)
+        }
+    };
+}
+
+impl<K: StageKind> Stage for Typed<K> {
+    typed_stage_methods!();
+}
 
 impl<K: ItemKind> Stage for ItemTyped<K> {
-    fn kind(&self) -> &'static str {
-        K::KIND
-    }
-    fn summary(&self) -> &'static str {
-        K::SUMMARY
-    }
-    fn inputs(&self) -> &'static [Slot] {
-        K::INPUTS
-    }
-    fn outputs(&self) -> &'static [Slot] {
-        K::OUTPUTS
-    }
-    fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError> {
-        Typed::<K>(PhantomData).resolve(params)
-    }
-    fn run(&self, ctx: &StageContext<'_>) -> Result<()> {
-        K::run(ctx, &params_of::<K>(ctx)?)
-    }
+    typed_stage_methods!();
     fn items(&self, ctx: &StageContext<'_>) -> Result<Option<usize>> {
         K::count(ctx, &params_of::<K>(ctx)?).map(Some)
     }
@@ -216,29 +229,6 @@ impl<K: ItemKind> Stage for ItemTyped<K> {
     }
     fn gather(&self, ctx: &StageContext<'_>, parts: &[PathBuf]) -> Result<()> {
         K::gather(ctx, &params_of::<K>(ctx)?, parts)
-    }
-}
-
-impl<K: StageKind> Stage for Typed<K> {
-    fn kind(&self) -> &'static str {
-        K::KIND
-    }
-    fn summary(&self) -> &'static str {
-        K::SUMMARY
-    }
-    fn inputs(&self) -> &'static [Slot] {
-        K::INPUTS
-    }
-    fn outputs(&self) -> &'static [Slot] {
-        K::OUTPUTS
-    }
-    fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError> {
-        let p: K::Params = typed_params(params)?;
-        K::check(&p)?;
-        serde_json::to_value(&p).map_err(|e| ParamError::new("", e.to_string()))
-    }
-    fn run(&self, ctx: &StageContext<'_>) -> Result<()> {
-        K::run(ctx, &params_of::<K>(ctx)?)
     }
 }
 
