@@ -282,6 +282,13 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
             summary.would_run.push((s.name.clone(), why));
             continue;
         }
+        if forced.contains(&s.name) {
+            // Forced: computed afresh, parts included.
+            let parts = crate::items::parts_dir(&plan.run_dir(), &s.name);
+            if parts.exists() {
+                std::fs::remove_dir_all(&parts)?;
+            }
+        }
         let status = run_stage(plan, s, &pool, &executor, progress)?;
         if status == "ok" {
             summary.ran.push(s.name.clone());
