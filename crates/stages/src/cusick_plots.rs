@@ -10,6 +10,38 @@ use std::collections::BTreeMap;
 /// Panels: two per row.
 const COLS: usize = 2;
 
+/// One fabric's panel: caption, axes in mm with their names, `y.2` labels on y, no grid.
+fn panel<'a, 'b>(
+    area: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    caption: &str,
+    x: (std::ops::Range<f64>, &str),
+    y: (std::ops::Range<f64>, &str, usize),
+) -> Result<
+    ChartContext<
+        'a,
+        SVGBackend<'b>,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 16))
+        .margin(8)
+        .x_label_area_size(32)
+        .y_label_area_size(44)
+        .build_cartesian_2d(x.0, y.0)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(7)
+        .y_labels(y.2)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc(x.1)
+        .y_desc(y.1)
+        .draw()?;
+    Ok(chart)
+}
+
 /// A closed polyline (mm) of one outline's points.
 fn closed_mm(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     let mut v: Vec<(f64, f64)> = points
@@ -81,25 +113,12 @@ pub fn shadows_svg(
         let photo = RGBColor(40, 90, 200).mix(0.55);
         let sim = RGBColor(210, 40, 30);
         for (r, area) in rows.iter().zip(&areas) {
-            let mut chart = ChartBuilder::on(area)
-                .caption(
-                    format!("fabric {}: photos (blue), model (red)", r.fabric),
-                    ("sans-serif", 16),
-                )
-                .margin(8)
-                .x_label_area_size(32)
-                .y_label_area_size(44)
-                .build_cartesian_2d(-lim..lim, -lim..lim)?;
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_labels(7)
-                .y_labels(7)
-                .x_label_formatter(&|v| format!("{v:.0}"))
-                .y_label_formatter(&|v| format!("{v:.0}"))
-                .x_desc("x (mm)")
-                .y_desc("y (mm)")
-                .draw()?;
+            let mut chart = panel(
+                area,
+                &format!("fabric {}: photos (blue), model (red)", r.fabric),
+                (-lim..lim, "x (mm)"),
+                (-lim..lim, "y (mm)", 7),
+            )?;
             for radius in [pedestal_radius_m, specimen_radius_m] {
                 chart.draw_series(LineSeries::new(circle_mm(radius), RGBColor(170, 170, 170)))?;
             }
@@ -143,25 +162,12 @@ pub fn profiles_svg(rows: &[PredictionRow], profiles: &[ProfileRow]) -> Result<S
             (90.0, 150.0)
         };
         for (r, area) in rows.iter().zip(&areas) {
-            let mut chart = ChartBuilder::on(area)
-                .caption(
-                    format!("fabric {}: meshes (blue), model (red)", r.fabric),
-                    ("sans-serif", 16),
-                )
-                .margin(8)
-                .x_label_area_size(32)
-                .y_label_area_size(44)
-                .build_cartesian_2d(rmin - 2.0..rmax + 2.0, zmin - 5.0..zmax + 5.0)?;
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_labels(7)
-                .y_labels(6)
-                .x_label_formatter(&|v| format!("{v:.0}"))
-                .y_label_formatter(&|v| format!("{v:.0}"))
-                .x_desc("rest radius r (mm)")
-                .y_desc("mean height z (mm)")
-                .draw()?;
+            let mut chart = panel(
+                area,
+                &format!("fabric {}: meshes (blue), model (red)", r.fabric),
+                (rmin - 2.0..rmax + 2.0, "rest radius r (mm)"),
+                (zmin - 5.0..zmax + 5.0, "mean height z (mm)", 6),
+            )?;
             let mine: Vec<&ProfileRow> = profiles.iter().filter(|p| p.fabric == r.fabric).collect();
             let series =
                 |z: fn(&ProfileRow) -> Option<f64>, sd: fn(&ProfileRow) -> Option<f64>, k: f64| {
