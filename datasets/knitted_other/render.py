@@ -3,7 +3,8 @@ drapelab's own renderer (src: crates/core/src/edges/render.rs), so that calibrat
 inverse crime.
 
 Input: a `particles.parquet` written by `drapelab simulate` (columns i, j, x_m, y_m, z_m). Output: a JPEG
-photo and a camera.json with only what a camera gives (view, side_cm, px_per_cm, corners_px).
+photo and a camera.json with only what a camera gives (view, side_cm, px_per_cm or a pinhole's focal
+length, distance and principal point, corners_px).
 
 What differs from drapelab's renderer:
 - the surface: by default a Catmull-Rom (bicubic) surface through the particles, 8 x 8 quads per grid
@@ -14,7 +15,9 @@ What differs from drapelab's renderer:
 - the background: 190 grey levels with a left-to-right gradient of 20 levels and a vignette darkening
   the image's corners by 24 levels;
 - coverage by 5 x 5 jittered supersampling (not a regular 4 x 4), Gaussian noise sigma 3, JPEG quality 90;
-- pixel centres at integers (the convention of camera.json).
+- pixel centres at integers (the convention of camera.json);
+- optionally a pinhole camera (perspective: the far parts of the drape look smaller), aimed at the
+  middle of the sheet rather than drapelab's renderer's world origin.
 """
 import json
 import sys
@@ -53,7 +56,18 @@ def upsample(grid, up):
     return along(a, ny, 0)[:, :, :]
 
 
-def render(particles, view, px_per_cm, out_png, out_json, seed, up=UP):
+def project(fine, grid, corners, distance_m):
+    """Central projection of the surface points `fine` onto the plane of the fixed corners through a
+    pinhole `distance_m` in front of it (the camera looks along +y, its axis through the middle of the
+    sheet's bounding box); returns the projected (x, z) and the axis point."""
+    y_c = 0.5 * (grid[corners[0][1], corners[0][0], 1] + grid[corners[1][1], corners[1][0], 1])
+    x, y, z = fine[..., 0], fine[..., 1], fine[..., 2]
+    ax, az = 0.5 * (x.min() + x.max()), 0.5 * (z.min() + z.max())
+    k = distance_m / (distance_m + (y - y_c))
+    return ax + (x - ax) * k, az + (z - az) * k, (ax, az)
+
+
+def render(particles, view, px_per_cm, out_png, out_json, seed, up=UP, pinhole_m=0.0):
     t = pq.read_table(particles).to_pydict()
     i, j = np.array(t["i"]), np.array(t["j"])
     nx, ny = i.max() + 1, j.max() + 1
@@ -68,6 +82,9 @@ def render(particles, view, px_per_cm, out_png, out_json, seed, up=UP):
     s = px_per_cm * 100.0 * SS  # supersampled px per m
     margin = 40 * SS
     x, y, z = fine[..., 0], fine[..., 1], fine[..., 2]
+    axis = None
+    if pinhole_m > 0:
+        x, z, axis = project(fine, grid, corners, pinhole_m)
     x0, z1 = x.min(), z.max()
     U = (x - x0) * s + margin
     V = (z1 - z) * s + margin
@@ -139,6 +156,16 @@ def render(particles, view, px_per_cm, out_png, out_json, seed, up=UP):
 
     cam = {"view": view, "side_cm": side_cm, "px_per_cm": px_per_cm,
            "corners_px": [corner_px(corners[0]), corner_px(corners[1])]}
+    if axis is not None:
+        # A pinhole camera as its calibration gives it: focal length (px), distance to the corners'
+        # plane and principal point; the scale at the sheet follows from them.
+        del cam["px_per_cm"]
+        cam["pinhole"] = {
+            "focal_length_px": px_per_cm * 100.0 * pinhole_m,
+            "distance_m": pinhole_m,
+            "principal_point_px": [((axis[0] - x0) * s + margin) / SS - 0.5,
+                                   ((z1 - axis[1]) * s + margin) / SS - 0.5],
+        }
     with open(out_json, "w") as f:
         json.dump(cam, f, indent=2)
         f.write("\n")
@@ -146,7 +173,10 @@ def render(particles, view, px_per_cm, out_png, out_json, seed, up=UP):
 
 if __name__ == "__main__":
     # Optional 7th argument: surface subdivisions per grid cell (default 8, a smooth surface; 1 draws
-    # flat triangles between the particles, the surface drapelab's silhouette assumes).
+    # flat triangles between the particles, the surface drapelab's silhouette assumes). Optional 8th:
+    # a pinhole camera this far (m) in front of the fixed corners' plane (default 0: orthographic); the
+    # scale px_per_cm is then the one in that plane.
     particles, view, px, png, js, seed = sys.argv[1:7]
     up = int(sys.argv[7]) if len(sys.argv) > 7 else UP
-    render(particles, view, float(px), png, js, int(seed), up)
+    pinhole_m = float(sys.argv[8]) if len(sys.argv) > 8 else 0.0
+    render(particles, view, float(px), png, js, int(seed), up, pinhole_m)

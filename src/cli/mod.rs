@@ -622,9 +622,11 @@ fn fit_edges(
     degree: usize,
 ) -> Result<i32> {
     let mut view: crate::edges::View = view.into();
+    let mut pinhole = None;
     let calibration = if let Some(cj) = c.camera_json {
         let cam = crate::edges::read_camera(&cj)?;
         view = cam.view;
+        pinhole = cam.pinhole;
         cam.calibration(&cj)?
     } else if c.markers {
         let side = c.side_cm.ok_or_else(|| {
@@ -654,6 +656,7 @@ fn fit_edges(
             view,
             degree,
             calibration,
+            pinhole,
         },
     )?;
     for f in &fits {

@@ -18,6 +18,7 @@ fn sample_8_edges() -> Vec<drapelab::edges::EdgeFit> {
             view: cam.view,
             degree: 4,
             calibration: cam.calibration(&dir.join("camera.json")).unwrap(),
+            pinhole: cam.pinhole,
         },
         &photo,
     )
@@ -340,6 +341,7 @@ fn a_misplaced_corner_is_covered_by_the_interval_with_the_systematic_part() {
             px_per_cm: cam.px_per_cm.unwrap(),
             corners: [(u0, v0 + 0.5), (u1, v1 + 0.5)],
         },
+        pinhole: None,
     };
     let photo = dir.join("photo.png");
     let img = read_gray(&photo).unwrap();
@@ -396,6 +398,7 @@ fn a_photo_from_another_renderer_gives_back_natural_length_and_stiffness() {
         view: cam.view,
         degree: 4,
         calibration: cam.calibration(&camera).unwrap(),
+        pinhole: cam.pinhole,
     };
     let photo = dir.join("photo.jpg");
     let img = read_gray(&photo).unwrap();

@@ -39,6 +39,7 @@ fn rendered(
             view: View::Hang4,
             degree: 4,
             calibration: cam.calibration(&dir.join("camera.json")).unwrap(),
+            pinhole: cam.pinhole,
         },
         &photo,
     )
@@ -88,6 +89,7 @@ fn fit_edges_recovers_a_known_polynomial_within_half_a_pixel() {
             px_per_cm: 1.0,
             corners: [(u1, v0), (u2, v0)],
         },
+        pinhole: None,
     };
     let fit = fit_image(&img, &opts, Path::new("synthetic.png")).unwrap();
     let e = &fit.edges[0];
@@ -173,6 +175,7 @@ fn markers_give_the_same_fit_as_known_corners() {
             view: View::Hang4,
             degree: 4,
             calibration: Calibration::Markers { side_cm: 50.0 },
+            pinhole: None,
         },
         Path::new("photo.png"),
     )
@@ -256,6 +259,7 @@ fn score_is_zero_for_identical_curves_symmetric_and_follows_its_formula() {
         x_min_cm: 0.0,
         x_max_cm: 50.0,
         systematic_pct: None,
+        projection: Default::default(),
     };
     let mut b = a.clone();
     b.coefficients[2] += 0.001;

@@ -2,7 +2,7 @@
 
 use crate::table::{Table, read_table, write_table};
 use anyhow::Result;
-use drapelab_core::edges::EdgeFit;
+use drapelab_core::edges::{EdgeFit, Projection};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -28,6 +28,12 @@ pub struct EdgeRow {
     /// Systematic uncertainty of a photographed edge (corners, scale, blur, light perturbed), % of
     /// the side; None for a simulated edge.
     pub systematic_pct: Option<f64>,
+    /// The pinhole camera's distance to the corners' plane, m; None for an orthographic view.
+    pub camera_distance_m: Option<f64>,
+    /// Where the pinhole camera's axis meets the corners' plane, along the reference line, cm.
+    pub camera_axis_along_cm: Option<f64>,
+    /// Where the pinhole camera's axis meets the corners' plane, up from the reference line, cm.
+    pub camera_axis_up_cm: Option<f64>,
 }
 
 impl Table for EdgeRow {
@@ -40,6 +46,13 @@ pub fn write_edges(path: &Path, fits: &[(String, EdgeFit)]) -> Result<()> {
     let rows: Vec<EdgeRow> = fits
         .iter()
         .flat_map(|(s, f)| {
+            let pinhole = match f.projection {
+                Projection::Orthographic => None,
+                Projection::Pinhole {
+                    distance_m,
+                    axis_cm,
+                } => Some((distance_m, axis_cm)),
+            };
             f.coefficients
                 .iter()
                 .enumerate()
@@ -53,6 +66,9 @@ pub fn write_edges(path: &Path, fits: &[(String, EdgeFit)]) -> Result<()> {
                     x_min_cm: f.x_min_cm,
                     x_max_cm: f.x_max_cm,
                     systematic_pct: f.systematic_pct,
+                    camera_distance_m: pinhole.map(|p| p.0),
+                    camera_axis_along_cm: pinhole.map(|p| p.1.0),
+                    camera_axis_up_cm: pinhole.map(|p| p.1.1),
                 })
         })
         .collect();
@@ -77,6 +93,17 @@ pub fn read_edges(path: &Path) -> Result<Vec<(String, EdgeFit)>> {
                     x_min_cm: r.x_min_cm,
                     x_max_cm: r.x_max_cm,
                     systematic_pct: r.systematic_pct,
+                    projection: match (
+                        r.camera_distance_m,
+                        r.camera_axis_along_cm,
+                        r.camera_axis_up_cm,
+                    ) {
+                        (Some(distance_m), Some(a), Some(u)) => Projection::Pinhole {
+                            distance_m,
+                            axis_cm: (a, u),
+                        },
+                        _ => Projection::Orthographic,
+                    },
                 };
                 out.push((r.sample.clone(), fit));
                 out.len() - 1

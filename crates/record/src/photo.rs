@@ -37,7 +37,11 @@ pub fn render_scene(
     }
     std::fs::create_dir_all(out)?;
     let photo = drapelab_core::edges::render_drape(&sol.grid, &sol.x, corners, opts);
-    let truth: Vec<EdgeFit> = edges_from_particles(&sol.grid, &sol.x, view, corners)
+    let projection = photo
+        .pinhole
+        .map(|p| p.projection(photo.corners_px, photo.px_per_cm, photo.image.dimensions()))
+        .unwrap_or_default();
+    let truth: Vec<EdgeFit> = edges_from_particles(&sol.grid, &sol.x, view, corners, projection)
         .into_iter()
         .filter_map(|(name, pts)| EdgeFit::from_points(&name, &pts, degree))
         .collect();
@@ -59,8 +63,8 @@ pub fn render_scene(
     let cam = CameraFile {
         view,
         side_cm: scene.cloth.size_x_m * 100.0,
-        px_per_cm: Some(photo.px_per_cm),
-        pinhole: None,
+        px_per_cm: photo.pinhole.is_none().then_some(photo.px_per_cm),
+        pinhole: photo.pinhole,
         corners_px: Some(photo.corners_px),
         markers: false,
         render: Some(opts.clone()),

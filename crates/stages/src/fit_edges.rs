@@ -72,6 +72,7 @@ fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
                 view: cam.view,
                 degree: p.degree,
                 calibration: cam.calibration(&camera)?,
+                pinhole: cam.pinhole,
             };
             let fit = with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?;
             let sample = dir

@@ -125,8 +125,9 @@ fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
         let scene = problem.scene_for(params);
         let sol = solve_scene(&scene, &mut NoObserver);
         let (view, corners) = scene_view(&scene)?;
+        let projection = measured.first().map(|m| m.1.projection).unwrap_or_default();
         let sim: Vec<(String, EdgeFit)> =
-            simulated_edges(&sol.grid, &sol.x, view, corners, p.edge_source)
+            simulated_edges(&sol.grid, &sol.x, view, corners, p.edge_source, projection)
                 .into_iter()
                 .filter_map(|(name, pts)| EdgeFit::from_points(&name, &pts, 4))
                 .map(|e| (sample.clone(), e))

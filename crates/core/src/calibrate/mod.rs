@@ -9,7 +9,7 @@ pub use sample::{
 };
 
 use crate::edges::scene_view;
-use crate::edges::{EdgeFit, EdgeSource, curve_distance_pct, simulated_edges};
+use crate::edges::{EdgeFit, EdgeSource, Projection, curve_distance_pct, simulated_edges};
 use crate::material::Topology;
 use crate::optim::{Ica, IcaReport, IcaSettings, Minimizer};
 use crate::scene::Scene;
@@ -110,6 +110,9 @@ pub struct Problem {
     /// Which curve of a simulated drape is compared with the photo's edges. Default the
     /// silhouette of its triangles, the curve a photo shows.
     pub edge_source: EdgeSource,
+    /// How the photo's camera projected the drape (from the measured edges; orthographic if they
+    /// say nothing): the simulated drape is projected the same way.
+    pub projection: Projection,
     lattice: std::sync::Arc<std::sync::OnceLock<StartLattice>>,
     cache: Mutex<HashMap<Vec<u64>, Evaluation>>,
     /// Simulations run (cache misses).
@@ -121,6 +124,7 @@ pub struct Problem {
 impl Problem {
     /// A problem over `scene` against `measured` edges.
     pub fn new(scene: Scene, measured: Vec<EdgeFit>, side_cm: f64) -> Self {
+        let projection = measured.first().map(|m| m.projection).unwrap_or_default();
         Self {
             scene,
             measured,
@@ -130,6 +134,7 @@ impl Problem {
             caching: true,
             warm_start: true,
             edge_source: EdgeSource::default(),
+            projection,
             lattice: Default::default(),
             cache: Mutex::new(HashMap::new()),
             simulations: AtomicUsize::new(0),
@@ -145,6 +150,8 @@ impl Problem {
         p.penalty = self.penalty;
         p.caching = self.caching;
         p.warm_start = self.warm_start;
+        p.edge_source = self.edge_source;
+        p.projection = self.projection;
         p.lattice = self.lattice.clone();
         p
     }
@@ -237,10 +244,17 @@ impl Problem {
         };
         let edges = match (sol.report.is_converged(), scene_view(&scene)) {
             (true, Ok((view, corners))) => Some(
-                simulated_edges(&sol.grid, &sol.x, view, corners, self.edge_source)
-                    .into_iter()
-                    .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
-                    .collect(),
+                simulated_edges(
+                    &sol.grid,
+                    &sol.x,
+                    view,
+                    corners,
+                    self.edge_source,
+                    self.projection,
+                )
+                .into_iter()
+                .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
+                .collect(),
             ),
             _ => None,
         };

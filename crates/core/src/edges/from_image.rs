@@ -34,6 +34,9 @@ pub struct FitImageOptions {
     pub degree: usize,
     /// Scale and corners.
     pub calibration: Calibration,
+    /// The pinhole camera that took the photo, if known (its projection rides on every edge fit);
+    /// None: orthographic.
+    pub pinhole: Option<super::Pinhole>,
 }
 
 /// The result of fitting a photo.
@@ -491,6 +494,12 @@ pub fn fit_image(
         points_cm.push(pts);
     }
     let overlay = draw_overlay(img, &edges, corners, s);
+    if let Some(p) = opts.pinhole {
+        let projection = p.projection(corners, s, img.dimensions());
+        for e in edges.iter_mut() {
+            e.projection = projection;
+        }
+    }
     Ok(ImageFit {
         edges,
         points_cm,

@@ -1,9 +1,9 @@
-//! Edge points straight from a simulated drape, as the camera of [`super::render`] sees them: an
-//! orthographic view along +y, image plane (x, z). For a 4-corner hang the lower boundary of the
+//! Edge points straight from a simulated drape, as the camera of [`super::render`] sees them: a
+//! view along +y, image plane (x, z), orthographic or through a pinhole ([`Projection`]). For a 4-corner hang the lower boundary of the
 //! silhouette is, at each grid column, its lowest particle; for a 2-corner hang the four edges are the
 //! sheet's boundary rows and columns.
 
-use super::View;
+use super::{Projection, View};
 use crate::cloth::Grid;
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -37,21 +37,27 @@ impl ReferenceLine {
 }
 
 /// Every grid particle in the camera's frame, cm: (along the reference line from the left fixed
-/// corner, up from it), seen by the orthographic camera along +y; and the corners' span, cm.
+/// corner, up from it) in the image plane (x, z) of a camera looking along +y, projected by
+/// `projection` onto the plane of the fixed corners; and the corners' span, cm.
 fn camera_cm(
     grid: &Grid,
     x: &[Vector3<f64>],
     corners: [(usize, usize); 2],
+    projection: Projection,
 ) -> (Vec<(f64, f64)>, f64) {
     let proj = |p: &Vector3<f64>| Vector2::new(p.x, p.z);
-    let c0 = proj(&x[grid.index(corners[0].0, corners[0].1)]);
-    let c1 = proj(&x[grid.index(corners[1].0, corners[1].1)]);
+    let (a, b) = (
+        &x[grid.index(corners[0].0, corners[0].1)],
+        &x[grid.index(corners[1].0, corners[1].1)],
+    );
+    let (c0, c1) = (proj(a), proj(b));
+    let plane_y = 0.5 * (a.y + b.y);
     let line = ReferenceLine::new(c0, c1);
     let cm = x[..grid.len()]
         .iter()
         .map(|p| {
             let (a, u) = line.coords(proj(p));
-            (a * 100.0, u * 100.0)
+            projection.project((a * 100.0, u * 100.0), p.y - plane_y)
         })
         .collect();
     (cm, (c1 - c0).norm() * 100.0)
@@ -64,8 +70,9 @@ pub fn edges_from_particles(
     x: &[Vector3<f64>],
     view: View,
     corners: [(usize, usize); 2],
+    projection: Projection,
 ) -> Vec<(String, Vec<(f64, f64)>)> {
-    let (all, span) = camera_cm(grid, x, corners);
+    let (all, span) = camera_cm(grid, x, corners, projection);
     let cm = |i: usize, j: usize| all[grid.index(i, j)];
     match view {
         View::Hang4 => {
@@ -154,10 +161,11 @@ pub fn simulated_edges(
     view: View,
     corners: [(usize, usize); 2],
     source: EdgeSource,
+    projection: Projection,
 ) -> Vec<(String, Vec<(f64, f64)>)> {
     match source {
-        EdgeSource::Particles => edges_from_particles(grid, x, view, corners),
-        EdgeSource::Silhouette => edges_from_silhouette(grid, x, view, corners),
+        EdgeSource::Particles => edges_from_particles(grid, x, view, corners, projection),
+        EdgeSource::Silhouette => edges_from_silhouette(grid, x, view, corners, projection),
     }
 }
 
@@ -201,16 +209,17 @@ fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
     (0..=n).map(|k| a + (b - a) * k as f64 / n as f64).collect()
 }
 
-/// The edge points (cm) of the silhouette of a drape's triangles, seen by the orthographic camera
-/// along +y: the lower boundary (hang4), or the top, bottom, left and right boundaries (hang2),
+/// The edge points (cm) of the silhouette of a drape's triangles, seen by a camera along +y that
+/// projects as `projection` says: the lower boundary (hang4), or the top, bottom, left and right boundaries (hang2),
 /// sampled 64 times per grid spacing.
 pub fn edges_from_silhouette(
     grid: &Grid,
     x: &[Vector3<f64>],
     view: View,
     corners: [(usize, usize); 2],
+    projection: Projection,
 ) -> Vec<(String, Vec<(f64, f64)>)> {
-    let (cm, span) = camera_cm(grid, x, corners);
+    let (cm, span) = camera_cm(grid, x, corners, projection);
     let mut along_up: Vec<Segment> = Vec::new();
     for t in crate::cloth::grid_triangles(grid) {
         for k in 0..3 {
@@ -231,14 +240,12 @@ pub fn edges_from_silhouette(
             super::trim_edge("bottom", curve(true), span, 0.0),
         )],
         View::Hang2 => {
-            // The lower envelope once: the bottom edge, and the depths at the two corners' verticals.
-            let lower = envelope(&along_up, &xs, true);
-            let bottom: Vec<(f64, f64)> = xs
-                .iter()
-                .zip(&lower)
-                .filter_map(|(&a, t)| Some((a, (*t)?)))
-                .collect();
-            let depth_at = |k: usize| -lower[k].unwrap_or(0.0);
+            // The bottom edge, and its depths at the two corners' verticals taken as a photo's are:
+            // from the quartic through the trimmed edge (a pinhole tilts the side columns, so the
+            // silhouette's own end points are the corners, not the bottom).
+            let bottom = super::trim_edge("bottom", curve(true), span, 0.0);
+            let bottom_fit = super::EdgeFit::from_points("bottom", &bottom, 4);
+            let depth_at = |a: f64| bottom_fit.as_ref().map_or(0.0, |f| -f.eval(a));
             // Side edges: x = depth below the line, y = offset along the line from the corner's
             // vertical; the leftmost (rightmost) point of the silhouette at each depth.
             let depth_up: Vec<Segment> = along_up
@@ -253,16 +260,13 @@ pub fn edges_from_silhouette(
                     .filter_map(|(&d, a)| Some((d, a? - offset)))
                     .collect()
             };
-            let (d_left, d_right) = (depth_at(0), depth_at(n));
+            let (d_left, d_right) = (depth_at(0.0), depth_at(span));
             vec![
                 (
                     "top".into(),
                     super::trim_edge("top", curve(false), span, 0.0),
                 ),
-                (
-                    "bottom".into(),
-                    super::trim_edge("bottom", bottom, span, 0.0),
-                ),
+                ("bottom".into(), bottom),
                 (
                     "left".into(),
                     super::trim_edge("left", side(true, 0.0), span, d_left),

@@ -18,7 +18,7 @@ pub use from_particles::{
     EdgeSource, ReferenceLine, edges_from_particles, edges_from_silhouette, simulated_edges,
 };
 pub use photo::{
-    CameraFile, Pinhole, ScoreRow, read_camera, render_options, scene_view, score_edges,
+    CameraFile, Pinhole, Projection, ScoreRow, read_camera, render_options, scene_view, score_edges,
 };
 pub use poly::{Polynomial, fit_polynomial};
 pub use render::{Camera, RenderOptions, RenderedPhoto, render_drape, render_view};
@@ -65,6 +65,10 @@ pub struct EdgeFit {
     /// simulated edge or when not estimated).
     #[serde(default)]
     pub systematic_pct: Option<f64>,
+    /// How the camera projected the drape onto the corners' plane (photographed edges; a simulated
+    /// edge is projected by its problem's camera). Default orthographic.
+    #[serde(default)]
+    pub projection: Projection,
 }
 
 impl EdgeFit {
@@ -84,6 +88,7 @@ impl EdgeFit {
             x_min_cm: lo,
             x_max_cm: hi,
             systematic_pct: None,
+            projection: Projection::Orthographic,
         })
     }
     /// The curve at x (cm).

@@ -68,6 +68,9 @@ pub struct RenderedPhoto {
     pub corners_px: [(f64, f64); 2],
     /// Scale in the plane of the fixed corners, px per cm.
     pub px_per_cm: f64,
+    /// The pinhole camera as a camera file describes it (focal length, distance to the corners'
+    /// plane, principal point); None for the orthographic camera.
+    pub pinhole: Option<super::Pinhole>,
 }
 
 /// Background and fabric grey levels.
@@ -116,6 +119,8 @@ pub fn render_drape(
         (p.0 - 0.5, p.1 - 0.5)
     };
     let mut corners_px = [corner_px(corners[0]), corner_px(corners[1])];
+    // The camera's axis meets every plane y = const at x = z = 0.
+    let mut axis_px = (m - umin - 0.5, m - vmin - 0.5);
     if opts.marker_radius_px > 0.0 {
         let r = opts.marker_radius_px;
         for &(cu, cv) in &corners_px {
@@ -142,7 +147,7 @@ pub fn render_drape(
         // centres at integers), the photo's coordinates.
         let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
         let (sn, cs) = theta.sin_cos();
-        for c in corners_px.iter_mut() {
+        for c in corners_px.iter_mut().chain(std::iter::once(&mut axis_px)) {
             let (du, dv) = (c.0 - cx, c.1 - cy);
             *c = (cx + cs * du - sn * dv, cy + sn * du + cs * dv);
         }
@@ -161,10 +166,26 @@ pub fn render_drape(
             }
         }
     }
+    // A pinhole at y = −d has focal length s·d px; the corners' plane is d + y_c from it.
+    let plane_y = 0.5
+        * (x[grid.index(corners[0].0, corners[0].1)].y
+            + x[grid.index(corners[1].0, corners[1].1)].y);
+    let (px_per_cm, pinhole) = match opts.camera {
+        Camera::Orthographic => (opts.px_per_cm, None),
+        Camera::Pinhole { distance_m } => {
+            let p = super::Pinhole {
+                focal_length_px: s * distance_m,
+                distance_m: distance_m + plane_y,
+                principal_point_px: Some(axis_px),
+            };
+            (p.focal_length_px / (100.0 * p.distance_m), Some(p))
+        }
+    };
     RenderedPhoto {
         image: img,
         corners_px,
-        px_per_cm: opts.px_per_cm,
+        px_per_cm,
+        pinhole,
     }
 }
 
