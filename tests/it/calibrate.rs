@@ -434,3 +434,78 @@ fn a_photo_from_another_renderer_gives_back_natural_length_and_stiffness() {
     );
     assert!(l_err <= half("natural_length_m") && k_err <= half("stiffness_N_per_m"));
 }
+
+#[test]
+fn a_perspective_photo_is_calibrated_through_its_pinhole() {
+    // datasets/knitted_other/perspective/: sample 7 (51.16 g/m², 1092 N/m, 40 mm) photographed by
+    // the independent renderer through a pinhole 1.2 m from the fixed corners' plane; the camera file
+    // gives focal length, distance and principal point, no scale.
+    let dir = root().join("datasets/knitted_other/perspective/sample_07/hang4");
+    let camera = dir.join("camera.json");
+    let cam = read_camera(&camera).unwrap();
+    assert!(cam.px_per_cm.is_none() && cam.pinhole.is_some());
+    let opts = FitImageOptions {
+        view: cam.view,
+        degree: 4,
+        calibration: cam.calibration(&camera).unwrap(),
+        pinhole: cam.pinhole,
+    };
+    let photo = dir.join("photo.jpg");
+    let img = read_gray(&photo).unwrap();
+    let fit = fit_image(&img, &opts, &photo).unwrap();
+    let fit = drapelab::edges::with_systematics(&img, &opts, fit, &photo).unwrap();
+    assert!(matches!(
+        fit.edges[0].projection,
+        drapelab::edges::Projection::Pinhole { distance_m, .. } if distance_m == 1.2
+    ));
+    let s = scene(
+        "hang4.toml",
+        &[
+            "cloth.nx=14",
+            "cloth.ny=14",
+            "cloth.areal_density_kg_per_m2=0.05116",
+        ],
+    );
+    let problem = Problem::new(s, fit.edges.clone(), 50.0);
+    // At the truth the simulated drape, projected as the camera did, lies on the photo's edge; seen
+    // square on it would be far off (the sagging middle is 25 cm further from the camera).
+    // (Table 3's box: stiffness 500–1200 N/m, natural length 40–60 mm; topology a.)
+    let truth = [(1092.0 - 500.0) / 700.0, 0.5, 0.5, 0.0, 0.1];
+    let at_truth = problem.cost(&truth);
+    let mut square_on = problem.fresh();
+    square_on.projection = drapelab::edges::Projection::Orthographic;
+    let ignoring_camera = square_on.cost(&truth);
+    eprintln!(
+        "curve distance at the truth: {at_truth:.4} % through the pinhole, {ignoring_camera:.3} % square on"
+    );
+    assert!(at_truth < 0.02, "{at_truth}");
+    assert!(ignoring_camera > 50.0 * at_truth, "{ignoring_camera}");
+    let (_, report) = problem.run_ica(&quick_ica());
+    let (u, _) = problem.polish(&report.best_x, 60);
+    let best = problem.bounds.decode(&u);
+    let noise = drapelab::calibrate::Noise::for_edges(None, &fit.edges, true);
+    let ident = drapelab::calibrate::identifiability(&problem, &u, 0.1, 7, noise, 0.05);
+    let half = |name: &str| ident.iter().find(|i| i.name == name).unwrap().uncertainty;
+    let (l_err, k_err) = (
+        (best.natural_length_m - 0.040).abs(),
+        (best.stiffness_N_per_m - 1092.0).abs(),
+    );
+    eprintln!(
+        "natural length {:.3} mm ± {:.3} (truth 40), stiffness {:.0} ± {:.0} N/m (truth 1092)",
+        1e3 * best.natural_length_m,
+        1e3 * half("natural_length_m"),
+        best.stiffness_N_per_m,
+        half("stiffness_N_per_m")
+    );
+    assert!(
+        l_err < 0.01 * 0.040,
+        "natural length {}",
+        best.natural_length_m
+    );
+    assert!(
+        k_err < 0.05 * 1092.0,
+        "stiffness {}",
+        best.stiffness_N_per_m
+    );
+    assert!(l_err <= half("natural_length_m") && k_err <= half("stiffness_N_per_m"));
+}
