@@ -169,8 +169,10 @@ pub enum SolverKind {
     ExplicitEuler,
     /// Symplectic Euler.
     SymplecticEuler,
-    /// Implicit Euler (Baraff–Witkin).
+    /// Implicit Euler as an optimisation of the incremental potential (Newton, adaptive steps).
     ImplicitEuler,
+    /// Implicit Euler linearised once per step (Baraff–Witkin), fixed steps.
+    BaraffWitkin,
 }
 
 impl SolverKind {
@@ -181,6 +183,7 @@ impl SolverKind {
             SolverKind::ExplicitEuler => "explicit-euler",
             SolverKind::SymplecticEuler => "symplectic-euler",
             SolverKind::ImplicitEuler => "implicit-euler",
+            SolverKind::BaraffWitkin => "baraff-witkin",
         }
     }
     /// The dynamic integrator, if this is one.
@@ -190,6 +193,7 @@ impl SolverKind {
             SolverKind::ExplicitEuler => Some(Integrator::ExplicitEuler),
             SolverKind::SymplecticEuler => Some(Integrator::SymplecticEuler),
             SolverKind::ImplicitEuler => Some(Integrator::ImplicitEuler),
+            SolverKind::BaraffWitkin => Some(Integrator::BaraffWitkin),
         }
     }
 }
@@ -198,7 +202,8 @@ impl SolverKind {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
-    /// "static" (default), "explicit-euler", "symplectic-euler" or "implicit-euler".
+    /// "static" (default), "explicit-euler", "symplectic-euler", "implicit-euler" (the incremental
+    /// potential minimised per step) or "baraff-witkin" (implicit Euler linearised once per step).
     #[serde(default)]
     pub kind: SolverKind,
     /// Options of the static solver.
@@ -222,6 +227,11 @@ pub struct RecordSpec {
     /// Record every k-th Newton iteration or time step (the final state is always recorded). Default 1.
     #[serde(default = "default_every")]
     pub every: usize,
+    /// Dynamics: record frames at this rate of simulated time, Hz, instead of every k-th step (the
+    /// implicit integrator lands a step on each frame time; the explicit ones record the first step
+    /// at or past it). Default none.
+    #[serde(default)]
+    pub frame_rate_hz: Option<f64>,
 }
 
 fn default_every() -> usize {
@@ -234,6 +244,7 @@ impl Default for RecordSpec {
             timeline: false,
             rerun: false,
             every: 1,
+            frame_rate_hz: None,
         }
     }
 }
@@ -780,6 +791,14 @@ impl Scene {
             return ck.err(
                 "solver.dynamic.max_time_s",
                 "more than 1e9 steps: raise dt_s or lower max_time_s".into(),
+            );
+        }
+        if let Some(f) = self.record.frame_rate_hz
+            && !(f.is_finite() && f > 0.0)
+        {
+            return ck.err(
+                "record.frame_rate_hz",
+                format!("must be a number > 0, got {f}"),
             );
         }
         if self.record.every == 0 {

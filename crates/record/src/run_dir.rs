@@ -44,23 +44,25 @@ pub fn simulate_to_dir(
     let pins: Vec<usize> = (0..grid.len()).filter(|&p| model.fixed[p]).collect();
     let every = scene.record.every;
     let mut timeline = if scene.record.timeline {
-        Some(TimelineRecorder::new(
-            &out.join("timeline.mcap"),
-            &grid,
-            every,
-        )?)
+        Some(
+            TimelineRecorder::new(&out.join("timeline.mcap"), &grid, every)?
+                .at_frame_rate(scene.record.frame_rate_hz),
+        )
     } else {
         None
     };
     let mut rrd = if scene.record.rerun {
-        Some(RerunRecorder::new(
-            &out.join("drape.rrd"),
-            &scene.name,
-            &grid,
-            &x0,
-            &pins,
-            every,
-        )?)
+        Some(
+            RerunRecorder::new(
+                &out.join("drape.rrd"),
+                &scene.name,
+                &grid,
+                &x0,
+                &pins,
+                every,
+            )?
+            .at_frame_rate(scene.record.frame_rate_hz),
+        )
     } else {
         None
     };

@@ -17,6 +17,8 @@ pub trait StateSink {
 pub struct Sampled<S> {
     sink: S,
     every: usize,
+    /// Dynamics: frames at this interval of simulated time instead of every k-th step.
+    frame_interval_s: Option<f64>,
     last_index: Option<usize>,
 }
 
@@ -26,14 +28,25 @@ impl<S: StateSink> Sampled<S> {
         Self {
             sink,
             every: every.max(1),
+            frame_interval_s: None,
             last_index: None,
         }
+    }
+    /// Records dynamics as frames at `hz` of simulated time (the solver hands over exactly those
+    /// states); None keeps every k-th step.
+    pub fn at_frame_rate(mut self, hz: Option<f64>) -> Self {
+        self.frame_interval_s = hz.filter(|h| *h > 0.0).map(|h| 1.0 / h);
+        self
     }
 }
 
 impl<S: StateSink> Observer for Sampled<S> {
     fn wants(&self, index: usize) -> bool {
-        index.is_multiple_of(self.every)
+        // In frame mode the solver hands over exactly the frames (static solves: every iteration).
+        self.frame_interval_s.is_some() || index.is_multiple_of(self.every)
+    }
+    fn frame_interval_s(&self) -> Option<f64> {
+        self.frame_interval_s
     }
     fn observe(&mut self, ev: &StateEvent<'_>) -> Result<()> {
         self.sink.write(ev)?;

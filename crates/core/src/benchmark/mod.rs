@@ -117,7 +117,7 @@ pub fn bench_scene(scene: &Scene, n: usize, kind: SolverKind, tol: f64) -> Scene
     // the integrator's round-off floor then ends as max-iterations instead of running for hours.
     s.solver.dynamic.max_time_s = 5.0;
     match kind {
-        SolverKind::ImplicitEuler => s.solver.dynamic.dt_s = 0.01,
+        SolverKind::ImplicitEuler | SolverKind::BaraffWitkin => s.solver.dynamic.dt_s = 0.01,
         SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => {
             s.solver.dynamic.auto_dt_fraction = 0.8
         }
@@ -179,7 +179,9 @@ pub fn bench_rows(
                     SolverKind::ExplicitEuler | SolverKind::SymplecticEuler => {
                         n > limits.max_explicit_size
                     }
-                    SolverKind::ImplicitEuler => n > limits.max_implicit_size,
+                    SolverKind::ImplicitEuler | SolverKind::BaraffWitkin => {
+                        n > limits.max_implicit_size
+                    }
                     SolverKind::Static => false,
                 };
                 if skip {

@@ -3,9 +3,17 @@
 //! - explicit (forward) Euler as in seed 000: x ← x + Δt v, v ← v + Δt F/m with the damping force
 //!   −c v (Eq. 4), then Provot's position correction of springs stretched beyond the elongation rate;
 //! - symplectic (semi-implicit) Euler: v ← v + Δt F/m, x ← x + Δt v;
-//! - implicit Euler after Baraff & Witkin (1998): (M + Δt c + Δt² K) Δv = Δt (f − Δt K v), solved by
-//!   conjugate gradients with a block-Jacobi preconditioner.
+//! - implicit Euler as an optimisation (the default implicit integrator; [`super::incremental`]): each
+//!   step minimises the incremental potential with the static solver's Newton, adaptive steps, contact
+//!   kept outside by the line search's bound;
+//! - implicit Euler after Baraff & Witkin (1998): (M + Δt c + Δt² K) Δv = Δt (f − Δt K v), one
+//!   linearised step solved by conjugate gradients with a block-Jacobi preconditioner (kept for
+//!   comparison: it is cheaper per step but takes fixed steps and cuts them short at contact).
+//!
+//! The explicit integrators stop with [`StopReason::ContactTooStiff`] the first time a step would
+//! carry a particle into an obstacle: their step cannot resolve the barrier there.
 
+use super::incremental::{ImplicitSettings, Settle, integrate_implicit, observe_start};
 use super::linear::DofMap;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
 use crate::physics::{HessianBlocks, Model};
@@ -21,8 +29,10 @@ pub enum Integrator {
     ExplicitEuler,
     /// Semi-implicit (symplectic) Euler.
     SymplecticEuler,
-    /// Implicit Euler (Baraff–Witkin, conjugate gradients).
+    /// Implicit Euler as an optimisation of the incremental potential (Newton, adaptive steps).
     ImplicitEuler,
+    /// Implicit Euler linearised once per step (Baraff–Witkin, conjugate gradients, fixed steps).
+    BaraffWitkin,
 }
 
 impl Integrator {
@@ -32,6 +42,7 @@ impl Integrator {
             Integrator::ExplicitEuler => "explicit-euler",
             Integrator::SymplecticEuler => "symplectic-euler",
             Integrator::ImplicitEuler => "implicit-euler",
+            Integrator::BaraffWitkin => "baraff-witkin",
         }
     }
 }
@@ -40,9 +51,32 @@ impl Integrator {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DynamicOptions {
-    /// Time step in s. Default 1e-4.
+    /// Time step in s; implicit Euler's first step (it adapts from there). Default 1e-4.
     #[serde(default = "default_dt")]
     pub dt_s: f64,
+    /// Implicit Euler: grow the step (×2) while Newton converges within 4 iterations, halve it beyond
+    /// 10 and retry a step Newton cannot finish. Default true.
+    #[serde(default = "default_true")]
+    pub adaptive_dt: bool,
+    /// Implicit Euler: the largest step, s (a recording's frame interval caps it too). Default 0.5.
+    #[serde(default = "default_max_dt")]
+    pub max_dt_s: f64,
+    /// Implicit Euler: below this step, s, the integration stops (status max-iterations, reason
+    /// step-too-small). Default 1e-7.
+    #[serde(default = "default_min_dt")]
+    pub min_dt_s: f64,
+    /// Rayleigh damping, mass-proportional part α: a force −α m v on every particle, 1/s. Adds to the
+    /// material's particle damping c (seed 000's −c v, Eq. 4). Implicit Euler only. Default 0.
+    #[serde(default)]
+    pub rayleigh_mass_per_s: f64,
+    /// Rayleigh damping, stiffness-proportional part β: a force −β K v (K the projected Hessian at the
+    /// step's start), s. Implicit Euler only. Default 0.
+    #[serde(default)]
+    pub rayleigh_stiffness_s: f64,
+    /// Implicit Euler: Newton iterations allowed per step before the step is halved and retried.
+    /// Default 12.
+    #[serde(default = "default_newton_iterations")]
+    pub newton_iterations: usize,
     /// When > 0, explicit and symplectic Euler use this fraction of their estimated stability limit
     /// ([`stability_limit_dt`] at the initial state) instead of `dt_s`. Default 0 (use `dt_s`).
     #[serde(default)]
@@ -78,6 +112,15 @@ pub struct DynamicOptions {
 fn default_dt() -> f64 {
     1e-4
 }
+fn default_max_dt() -> f64 {
+    0.5
+}
+fn default_min_dt() -> f64 {
+    1e-7
+}
+fn default_newton_iterations() -> usize {
+    12
+}
 fn default_max_time() -> f64 {
     60.0
 }
@@ -104,6 +147,12 @@ impl Default for DynamicOptions {
     fn default() -> Self {
         Self {
             dt_s: default_dt(),
+            adaptive_dt: true,
+            max_dt_s: default_max_dt(),
+            min_dt_s: default_min_dt(),
+            rayleigh_mass_per_s: 0.0,
+            rayleigh_stiffness_s: 0.0,
+            newton_iterations: default_newton_iterations(),
             auto_dt_fraction: 0.0,
             max_time_s: default_max_time(),
             residual_tol_rel: default_tol(),
@@ -193,7 +242,10 @@ pub fn stability_limit_dt(
     integrator: Integrator,
     damping_Ns_per_m: f64,
 ) -> Option<f64> {
-    if integrator == Integrator::ImplicitEuler {
+    if matches!(
+        integrator,
+        Integrator::ImplicitEuler | Integrator::BaraffWitkin
+    ) {
         return None;
     }
     let (w, m) = highest_mode(model, x);
@@ -230,13 +282,17 @@ pub fn kinetic_energy(model: &Model, v: &[Vector3<f64>]) -> f64 {
 /// Integrates from rest at `x` (updated in place) until equilibrium, divergence or the time limit.
 /// `v` holds the velocities (in: initial, out: final).
 pub fn solve_dynamic(
-    model: &Model,
+    model: &mut Model,
     integrator: Integrator,
     x: &mut [Vector3<f64>],
     v: &mut [Vector3<f64>],
     opts: &DynamicOptions,
     observer: &mut dyn Observer,
 ) -> SolveReport {
+    if integrator == Integrator::ImplicitEuler {
+        return solve_implicit(model, x, v, opts, observer);
+    }
+    let model = &*model;
     let start = Instant::now();
     let n = model.len();
     let c = if opts.damping {
@@ -290,6 +346,14 @@ pub fn solve_dynamic(
         }
         stepper.step(model, x, v, &g, opts.cg_tol_rel, &mut report);
         step += 1;
+        if stepper.cut_steps > 0 && integrator != Integrator::BaraffWitkin {
+            report.stop_for(StopReason::ContactTooStiff);
+            report.message = format!(
+                "contact too stiff for an explicit step: at t = {:.4} s a step of {dt:e} s would carry a particle into an obstacle; use implicit-euler",
+                step as f64 * dt
+            );
+            break;
+        }
     }
     model.gradient(x, 1.0, &mut g);
     report.iterations = step;
@@ -298,12 +362,103 @@ pub fn solve_dynamic(
     report.max_residual_rel = report.max_residual_N / w_ref;
     report.energy_J = model.energy(x, 1.0);
     report.wall_time_s = start.elapsed().as_secs_f64();
-    if stepper.cut_steps > 0 {
+    if stepper.cut_steps > 0 && integrator == Integrator::BaraffWitkin {
         report.message = format!(
             "{} ({} steps cut short by contact)",
             report.message, stepper.cut_steps
         );
     }
+    report
+}
+
+/// Implicit Euler as an optimisation ([`integrate_implicit`]) with the options' steps, damping and
+/// settle criterion (the same as the other integrators': residual force and speed), and the report's
+/// final numbers.
+fn solve_implicit(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    v: &mut [Vector3<f64>],
+    opts: &DynamicOptions,
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let start = Instant::now();
+    let w_ref = model.reference_weight();
+    let mut report = SolveReport {
+        stop: StopReason::SimulatedTime,
+        sim_time_s: Some(0.0),
+        dt_s: Some(opts.dt_s),
+        ..SolveReport::unsolved(Integrator::ImplicitEuler.as_str())
+    };
+    let free = model.fixed.iter().any(|f| !f);
+    let steps_ok = opts.dt_s > 0.0 && opts.min_dt_s > 0.0 && opts.max_dt_s >= opts.min_dt_s;
+    if !free || !w_ref.is_finite() || !steps_ok {
+        report.stop_for(StopReason::Invalid);
+        report.message = "nothing free to integrate, or time steps that are not 0 < min_dt_s ≤ max_dt_s, dt_s > 0".into();
+        return report;
+    }
+    for (vi, f) in v.iter_mut().zip(&model.fixed) {
+        if *f {
+            *vi = Vector3::zeros();
+        }
+    }
+    let c = if opts.damping {
+        model.damping_Ns_per_m
+    } else {
+        0.0
+    };
+    let (alpha, beta) = if opts.damping {
+        (opts.rayleigh_mass_per_s, opts.rayleigh_stiffness_s)
+    } else {
+        (0.0, 0.0)
+    };
+    let settings = ImplicitSettings {
+        dt_s: opts.dt_s,
+        max_dt_s: opts.max_dt_s,
+        min_dt_s: opts.min_dt_s,
+        adaptive: opts.adaptive_dt,
+        damping: (c, alpha, beta),
+        newton_iterations: opts.newton_iterations,
+        // Each step well below the settle tolerance: a step's leftover force would move a soft mode
+        // by force/stiffness every step, a speed that never settles.
+        newton_tol_rel: 1e-2 * opts.residual_tol_rel,
+        projected_hessian: false,
+        strain_bound: opts.strain_bound,
+    };
+    let (lo, hi) = x.iter().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    let settle = Settle {
+        residual_N: opts.residual_tol_rel * w_ref,
+        speed_m_per_s: opts.speed_tol_m_per_s,
+        extent_m: (hi - lo).norm().max(1e-3),
+    };
+    let frame_s = observer.frame_interval_s();
+    if let Err(e) = observe_start(model, x, v, frame_s, observer) {
+        report.stop_for(StopReason::Observer);
+        report.message = format!("an observer failed at t = 0: {e:#}");
+        return report;
+    }
+    integrate_implicit(
+        model,
+        x,
+        v,
+        &settings,
+        &settle,
+        (opts.max_time_s, opts.max_wall_time_s),
+        frame_s,
+        observer,
+        &mut report,
+    );
+    let mut g = Vec::new();
+    model.gradient(x, 1.0, &mut g);
+    report.max_residual_N = model.max_residual(&g);
+    report.max_residual_rel = report.max_residual_N / w_ref;
+    report.energy_J = model.energy(x, 1.0);
+    report.wall_time_s = start.elapsed().as_secs_f64();
     report
 }
 
@@ -522,7 +677,7 @@ impl Stepper {
                     }
                 }
             }
-            Integrator::ImplicitEuler => {
+            Integrator::ImplicitEuler | Integrator::BaraffWitkin => {
                 let iters = self.implicit.step(model, x, v, g, c, dt, cg_tol_rel);
                 report.linear_solves += 1;
                 report.inner_iterations += iters;

@@ -4,6 +4,7 @@
 //! bad numerics. Observers ([`Observer`]) receive states and do the I/O.
 
 mod dynamic;
+mod incremental;
 mod linear;
 mod newton;
 mod report;
@@ -13,6 +14,7 @@ mod vertical_gap;
 pub use dynamic::{
     DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
 };
+pub use incremental::Inertia;
 pub use linear::{DofMap, SparseSpd};
 pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{Divergence, DivergenceReason, SolveReport, Status, StopReason};
@@ -42,6 +44,12 @@ pub trait Observer {
     fn wants(&self, index: usize) -> bool;
     /// Called with a state the observer wanted.
     fn observe(&mut self, event: &StateEvent<'_>) -> anyhow::Result<()>;
+    /// The simulated-time interval at which a dynamic solve should hand this observer its states
+    /// (a recording's frame rate), if it wants frames rather than step indices: the implicit
+    /// integrator lands a step on every frame time. Default none.
+    fn frame_interval_s(&self) -> Option<f64> {
+        None
+    }
     /// The final call, once the solve is over, with its final state (None when that state is not
     /// finite): recorders write it if they have not and close their files.
     fn finish(&mut self, _final_state: Option<&StateEvent<'_>>) -> anyhow::Result<()> {
@@ -81,5 +89,11 @@ impl Observer for Observers<'_> {
             o.finish(final_state)?;
         }
         Ok(())
+    }
+    fn frame_interval_s(&self) -> Option<f64> {
+        self.0
+            .iter()
+            .filter_map(|o| o.frame_interval_s())
+            .reduce(f64::min)
     }
 }

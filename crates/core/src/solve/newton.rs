@@ -43,6 +43,12 @@ pub struct StaticOptions {
     /// instead of the flat one. Default true.
     #[serde(default = "default_true")]
     pub sag_start: bool,
+    /// Use the projected (positive semi-definite) Hessian from the first try of every iteration
+    /// instead of the exact one: one factorization per iteration where the exact Hessian is
+    /// indefinite, at the price of slower convergence on nets under compression. Default false
+    /// (implicit Euler's steps set it: their inertia makes the projected system well conditioned).
+    #[serde(default)]
+    pub projected_hessian: bool,
 }
 
 fn default_true() -> bool {
@@ -75,6 +81,7 @@ impl Default for StaticOptions {
             strain_bound: default_strain(),
             coarse_start: true,
             sag_start: true,
+            projected_hessian: false,
         }
     }
 }
@@ -130,6 +137,8 @@ struct Workspace {
     mu: f64,
     /// The damping's initial value (it returns there when the Hessian is projected).
     mu_initial: f64,
+    /// Start every iteration with the projected Hessian.
+    projected_first: bool,
 }
 
 /// Smallest damping used once damping is needed (relative to the mean diagonal).
@@ -153,6 +162,7 @@ impl Workspace {
             shift: vec![0.0; n],
             mu: opts.lm_damping_initial,
             mu_initial: opts.lm_damping_initial,
+            projected_first: opts.projected_hessian,
         }
     }
 
@@ -269,7 +279,7 @@ impl Workspace {
         (r, tol): (f64, f64),
         report: &mut SolveReport,
     ) -> bool {
-        let mut projected = false;
+        let mut projected = self.projected_first;
         model.hessian(x, &mut self.h, projected);
         // The damping's scale: the mean diagonal of this iteration's exact Hessian.
         let scale = mean_free_diagonal(&self.h, &self.dofs, model.len());

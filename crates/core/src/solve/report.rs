@@ -53,6 +53,11 @@ pub enum StopReason {
     Invalid,
     /// An observer failed (a recording could not be written); the message says why.
     Observer,
+    /// An explicit integrator reached contact that its step cannot resolve (a step would carry a
+    /// particle into an obstacle): use implicit-euler. The state is not a result.
+    ContactTooStiff,
+    /// The implicit integrator's adaptive step fell below its minimum without Newton converging.
+    StepTooSmall,
 }
 
 impl StopReason {
@@ -64,9 +69,12 @@ impl StopReason {
             | StopReason::SimulatedTime
             | StopReason::WallTime
             | StopReason::LineSearch
-            | StopReason::ContactRounds => Status::MaxIterations,
+            | StopReason::ContactRounds
+            | StopReason::StepTooSmall => Status::MaxIterations,
             StopReason::Diverged => Status::Diverged,
-            StopReason::Invalid | StopReason::Observer => Status::Invalid,
+            StopReason::Invalid | StopReason::Observer | StopReason::ContactTooStiff => {
+                Status::Invalid
+            }
         }
     }
 }

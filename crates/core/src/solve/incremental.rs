@@ -1,0 +1,367 @@
+//! Implicit Euler as an optimisation (issue 19): each step minimises the incremental potential
+//!
+//!   Φ(x) = Σ_p m_p/(2h²)|x_p − x̃_p|² + Σ_p d_p/(2h)|x_p − xₙ,p|² + β/(2h) Δxᵀ Kₙ Δx + W(x),
+//!
+//! x̃ = xₙ + h vₙ, d_p = c + α m_p (seed 000's −c·v, Eq. 4, and Rayleigh's mass-proportional part), Kₙ
+//! the projected Hessian at xₙ (Rayleigh's stiffness-proportional part), W the scene's potential
+//! (elastic, gravity, barrier contact), with the static solver's Newton (projected Hessian where the
+//! exact one is indefinite, a line search bounded by the barrier's step bound, so no particle enters
+//! an obstacle at any step). Its stationarity condition M(v − vₙ)/h = −∇W(x) − D v − βKₙ v with
+//! v = (x − xₙ)/h is backward Euler. Steps adapt: they grow while Newton converges in few iterations
+//! and are halved and retried when it does not, and land on every frame time a recorder asks for.
+
+use super::newton::{StaticOptions, solve_static_loads};
+use super::{DivergenceReason, NoObserver, Observer, SolveReport, StateEvent, StopReason};
+use crate::physics::{EnergyTerm, HessianBlocks, Model, Vecs};
+use nalgebra::{Matrix3, Vector3};
+use std::time::Instant;
+
+/// The inertia and damping part of the incremental potential: Σ w_p/2 |x_p − c_p|² (the two
+/// quadratics about x̃ and xₙ merged: w = m/h² + d/h, c = (m/h² x̃ + d/h xₙ)/w) plus β/(2h) Δxᵀ Kₙ Δx.
+pub struct Inertia {
+    weight: Vec<f64>,
+    centre: Vec<Vector3<f64>>,
+    x_n: Vec<Vector3<f64>>,
+    /// Kₙ (projected) and β/h, when stiffness-proportional damping is on.
+    stiffness: Option<(HessianBlocks, f64)>,
+}
+
+impl Inertia {
+    /// The term for a step of `h` s from (`x_n`, `v_n`), particle damping `c` (N·s/m), Rayleigh
+    /// `alpha` (1/s) and `beta` (s); fixed particles get no weight.
+    pub fn new(
+        model: &Model,
+        x_n: &[Vector3<f64>],
+        v_n: &[Vector3<f64>],
+        h: f64,
+        (c, alpha, beta): (f64, f64, f64),
+    ) -> Self {
+        let (mut weight, mut centre) = (Vec::with_capacity(x_n.len()), Vec::new());
+        for p in 0..x_n.len() {
+            let (m, free) = (model.masses[p], !model.fixed[p]);
+            let (a, b) = if free {
+                (m / (h * h), (c + alpha * m) / h)
+            } else {
+                (0.0, 0.0)
+            };
+            weight.push(a + b);
+            let predicted = x_n[p] + v_n[p] * h;
+            centre.push(if a + b > 0.0 {
+                (predicted * a + x_n[p] * b) / (a + b)
+            } else {
+                x_n[p]
+            });
+        }
+        let stiffness = (beta > 0.0).then(|| {
+            let mut k = HessianBlocks::default();
+            model.hessian(x_n, &mut k, true);
+            (k, beta / h)
+        });
+        Self {
+            weight,
+            centre,
+            x_n: x_n.to_vec(),
+            stiffness,
+        }
+    }
+
+    fn delta(&self, x: &Vecs) -> Vec<Vector3<f64>> {
+        x.iter().zip(&self.x_n).map(|(a, b)| a - b).collect()
+    }
+}
+
+impl EnergyTerm for Inertia {
+    fn name(&self) -> String {
+        "inertia".into()
+    }
+    fn energy(&self, x: &Vecs) -> f64 {
+        let mut e: f64 = (0..x.len())
+            .map(|p| 0.5 * self.weight[p] * (x[p] - self.centre[p]).norm_squared())
+            .sum();
+        if let Some((k, s)) = &self.stiffness {
+            let d = self.delta(x);
+            let mut kd = vec![Vector3::zeros(); x.len()];
+            k.mul_add(&d, &mut kd);
+            e += 0.5 * s * d.iter().zip(&kd).map(|(a, b)| a.dot(b)).sum::<f64>();
+        }
+        e
+    }
+    fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
+        for p in 0..x.len() {
+            g[p] += (x[p] - self.centre[p]) * self.weight[p];
+        }
+        if let Some((k, s)) = &self.stiffness {
+            let d = self.delta(x);
+            let mut kd = vec![Vector3::zeros(); x.len()];
+            k.mul_add(&d, &mut kd);
+            for (gp, kdp) in g.iter_mut().zip(&kd) {
+                *gp += kdp * *s;
+            }
+        }
+    }
+    fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _project: bool) {
+        for (p, &w) in self.weight.iter().enumerate() {
+            if w > 0.0 {
+                h.push(p, p, Matrix3::identity() * w);
+            }
+        }
+        if let Some((k, s)) = &self.stiffness {
+            for (&(p, q), b) in k.pairs.iter().zip(&k.blocks) {
+                h.push(p as usize, q as usize, b * *s);
+            }
+        }
+    }
+    fn stiffness_scale(&self) -> f64 {
+        self.weight.iter().copied().fold(0.0, f64::max)
+    }
+}
+
+/// How the steps of one implicit integration go.
+pub struct ImplicitSettings {
+    /// First step, s.
+    pub dt_s: f64,
+    /// Largest step, s (a recorder's frame interval caps it too).
+    pub max_dt_s: f64,
+    /// Below this step, s, the integration gives up (status diverged).
+    pub min_dt_s: f64,
+    /// Grow and shrink the step with Newton's iteration count.
+    pub adaptive: bool,
+    /// Particle damping c (N·s/m), Rayleigh α (1/s) and β (s).
+    pub damping: (f64, f64, f64),
+    /// Newton iterations allowed per step.
+    pub newton_iterations: usize,
+    /// Newton's tolerance per step, relative to the lightest particle's weight.
+    pub newton_tol_rel: f64,
+    /// Newton on the projected Hessian from the first try (see [`StaticOptions::projected_hessian`]).
+    pub projected_hessian: bool,
+    /// A strain beyond which a step reports divergence.
+    pub strain_bound: f64,
+}
+
+/// The outcome of one step attempt.
+enum Attempt {
+    /// Accepted after this many Newton iterations.
+    Accepted(usize),
+    /// Newton did not converge; the state is unchanged.
+    Rejected,
+    /// Newton diverged (non-finite, strain beyond bound): the integration stops.
+    Diverged(DivergenceReason),
+}
+
+/// One step of `h` from (`x`, `v`), both updated on success; `work` gets the report's counters.
+fn step(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    v: &mut [Vector3<f64>],
+    h: f64,
+    s: &ImplicitSettings,
+    report: &mut SolveReport,
+) -> Attempt {
+    let x_n = x.to_vec();
+    let term = Inertia::new(model, &x_n, v, h, s.damping);
+    // Start from the inertial prediction xₙ + h vₙ, as far along it as contact allows.
+    let dx: Vec<Vector3<f64>> = v.iter().map(|vp| vp * h).collect();
+    let alpha = model.max_step(&x_n, &dx).min(1.0);
+    for p in 0..x.len() {
+        if !model.fixed[p] {
+            x[p] = x_n[p] + dx[p] * alpha;
+        }
+    }
+    model.terms.push(Box::new(term));
+    // Short steps make the inertia stiff (m/h²) and raise the round-off floor of forces with it:
+    // the step's tolerance stays 100 times above that floor.
+    let floor_rel = model.roundoff_force(x) / model.reference_weight();
+    let opts = StaticOptions {
+        residual_tol_rel: s.newton_tol_rel.max(100.0 * floor_rel),
+        max_iterations: s.newton_iterations,
+        lm_damping_initial: 1e-6,
+        projected_hessian: s.projected_hessian,
+        strain_bound: s.strain_bound,
+        ..StaticOptions::default()
+    };
+    let r = solve_static_loads(model, x, &opts, &[1.0], &mut NoObserver);
+    model.terms.pop();
+    report.factorizations += r.factorizations;
+    report.linear_solves += r.linear_solves;
+    report.inner_iterations += r.iterations;
+    report.factor_time_s += r.factor_time_s;
+    if r.is_converged() && x.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+        for p in 0..x.len() {
+            v[p] = if model.fixed[p] {
+                Vector3::zeros()
+            } else {
+                (x[p] - x_n[p]) / h
+            };
+        }
+        Attempt::Accepted(r.iterations)
+    } else if let Some(d) = r.divergence.filter(|_| r.status == super::Status::Diverged) {
+        Attempt::Diverged(d.reason)
+    } else {
+        x.copy_from_slice(&x_n);
+        Attempt::Rejected
+    }
+}
+
+/// The next step after one that took `iterations` Newton iterations: doubled when Newton converged
+/// within 6, kept up to 12, halved beyond.
+fn next_dt(h: f64, iterations: usize, s: &ImplicitSettings) -> f64 {
+    if !s.adaptive {
+        return h;
+    }
+    let f = match iterations {
+        0..=6 => 2.0,
+        7..=12 => 1.0,
+        _ => 0.5,
+    };
+    (h * f).clamp(s.min_dt_s, s.max_dt_s)
+}
+
+/// What a settled (or stopped) integration is checked against, and where it stands.
+pub struct Settle {
+    /// Largest residual force of W (without inertia) allowed, N.
+    pub residual_N: f64,
+    /// Largest speed allowed, m/s.
+    pub speed_m_per_s: f64,
+    /// Size of the drape (its bounding box's diagonal), m.
+    pub extent_m: f64,
+}
+
+/// Integrates from (`x`, `v`) (updated in place) until settled, stopped or out of time: each step
+/// minimises the incremental potential ([`Inertia`] + the model). `frame_s`: land a step on every
+/// multiple of it and hand that state to `observer` (stamped with the exact frame time).
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_implicit(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    v: &mut [Vector3<f64>],
+    s: &ImplicitSettings,
+    settle: &Settle,
+    (max_time_s, max_wall_s): (f64, Option<f64>),
+    frame_s: Option<f64>,
+    observer: &mut dyn Observer,
+    report: &mut SolveReport,
+) {
+    let start = Instant::now();
+    let (mut t, mut h, mut steps, mut frame) = (0.0f64, s.dt_s, 0usize, 1usize);
+    let mut g = Vec::new();
+    let (mut largest, mut cooldown, mut last_dt) = (0.0f64, 0usize, 0.0f64);
+    loop {
+        model.gradient(x, 1.0, &mut g);
+        let r = model.max_residual(&g);
+        let speed = v.iter().map(|p| p.norm()).fold(0.0, f64::max);
+        if !r.is_finite() {
+            report.diverge(steps, Some(h), DivergenceReason::NonFinite);
+            return;
+        }
+        // Recording frames, the state is judged on frame times only (the last one recorded is the
+        // final state).
+        let on_frame = frame_s.is_none_or(|f| (t / f - (t / f).round()).abs() < 1e-9);
+        // Near the round-off floor of forces a soft mode keeps moving by floor/stiffness per step:
+        // there the speed criterion becomes "no particle moved more than 1e-7 of the drape's size".
+        // (Each step's Newton stops within 100 times the floor of its own, inertia-stiffened forces.)
+        let floor = 100.0 * model.roundoff_force(x);
+        let still = speed <= settle.speed_m_per_s
+            || (r <= floor && speed * last_dt <= 1e-7 * settle.extent_m);
+        if on_frame && r <= settle.residual_N.max(floor) && still {
+            report.stop_for(StopReason::Converged);
+            report.message = format!(
+                "settled at t = {t:.4} s after {steps} steps (largest residual {r:.2e} N, largest speed {speed:.2e} m/s, kinetic energy {:.2e} J; largest step {largest:.1e} s)",
+                super::kinetic_energy(model, v),
+            );
+            break;
+        }
+        if t >= max_time_s * (1.0 - 1e-12) {
+            report.stop_for(StopReason::SimulatedTime);
+            report.message = format!(
+                "not settled within {max_time_s} s (residual {r:.3e} N, speed {speed:.3e} m/s)"
+            );
+            break;
+        }
+        if max_wall_s.is_some_and(|b| start.elapsed().as_secs_f64() > b) {
+            report.stop_for(StopReason::WallTime);
+            report.message = format!("wall-time budget spent at t = {t:.4} s (residual {r:.3e} N)");
+            break;
+        }
+        // The step: capped by the time budget and, when recording frames, landing on the next one.
+        let mut dt = h.min(max_time_s - t);
+        let next_frame = frame_s.map(|f| f * frame as f64);
+        if let Some(tf) = next_frame {
+            dt = dt.min(tf - t);
+        }
+        match step(model, x, v, dt, s, report) {
+            Attempt::Accepted(iterations) => {
+                steps += 1;
+                last_dt = dt;
+                largest = largest.max(dt);
+                t += dt;
+                let landed = next_frame.is_some_and(|tf| (tf - t).abs() <= 1e-9 * tf.max(1.0));
+                if landed {
+                    t = next_frame.unwrap_or(t);
+                    frame += 1;
+                }
+                if landed || (frame_s.is_none() && observer.wants(steps)) {
+                    let ev = StateEvent {
+                        index: steps,
+                        time_s: Some(t),
+                        x,
+                        max_residual_N: r,
+                        energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
+                    };
+                    if let Err(e) = observer.observe(&ev) {
+                        report.stop_for(StopReason::Observer);
+                        report.message = format!("an observer failed at t = {t:.4} s: {e:#}");
+                        break;
+                    }
+                }
+                // A step shortened to land on a frame does not set the next one, and for three
+                // steps after a rejected one the step does not grow.
+                cooldown = cooldown.saturating_sub(1);
+                if dt >= h * (1.0 - 1e-12) {
+                    h = next_dt(h, iterations, s).min(if cooldown > 0 { h } else { f64::INFINITY });
+                }
+            }
+            Attempt::Diverged(reason) => {
+                report.diverge(steps, Some(dt), reason);
+                report.message = format!("diverged at t = {t:.4} s (step {dt:e} s): {reason}");
+                break;
+            }
+            Attempt::Rejected => {
+                h = dt * 0.5;
+                cooldown = 3;
+                if h < s.min_dt_s {
+                    report.stop_for(StopReason::StepTooSmall);
+                    report.message = format!(
+                        "Newton failed at every step down to {:.1e} s at t = {t:.4} s",
+                        s.min_dt_s
+                    );
+                    break;
+                }
+            }
+        }
+    }
+    report.iterations = steps;
+    report.sim_time_s = Some(t);
+    report.dt_s = Some(largest);
+}
+
+/// Hands the initial state (t = 0) to `observer` when it records frames or wants step 0.
+pub fn observe_start(
+    model: &Model,
+    x: &[Vector3<f64>],
+    v: &[Vector3<f64>],
+    frame_s: Option<f64>,
+    observer: &mut dyn Observer,
+) -> anyhow::Result<()> {
+    if frame_s.is_some() || observer.wants(0) {
+        let mut g = Vec::new();
+        model.gradient(x, 1.0, &mut g);
+        observer.observe(&StateEvent {
+            index: 0,
+            time_s: Some(0.0),
+            x,
+            max_residual_N: model.max_residual(&g),
+            energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
+        })?;
+    }
+    Ok(())
+}
