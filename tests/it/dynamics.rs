@@ -2,7 +2,7 @@
 //! lands on the static drape, the explicit integrators stop with a status at contact they cannot
 //! resolve, and a timeline recorded at a frame rate has one frame per interval of simulated time.
 
-use crate::support::{drapelab, root, run_python, scene};
+use crate::support::{run_python, scene};
 use drapelab::simulate::solve_scene;
 use drapelab::solve::{NoObserver, Status, StopReason};
 
@@ -100,29 +100,17 @@ fn explicit_euler_on_the_rod_stops_with_the_contact_status_not_a_divergence() {
 
 #[test]
 fn a_timeline_recorded_at_a_frame_rate_has_one_frame_per_interval() {
-    let tmp = tempfile::tempdir().unwrap();
+    let (tmp, o) = crate::recordings::simulate_hang4_recorded(&[
+        "--set",
+        "solver.kind=implicit-euler",
+        "--set",
+        "solver.dynamic.dt_s=0.005",
+        "--set",
+        "solver.dynamic.max_time_s=0.6",
+        "--set",
+        "record.frame_rate_hz=50",
+    ]);
     let out = tmp.path().join("o");
-    let o = drapelab()
-        .arg("simulate")
-        .arg(root().join("datasets/scenes/hang4.toml"))
-        .arg("--out")
-        .arg(&out)
-        .args([
-            "--set",
-            "solver.kind=implicit-euler",
-            "--set",
-            "solver.dynamic.dt_s=0.005",
-            "--set",
-            "solver.dynamic.max_time_s=0.6",
-            "--set",
-            "record.timeline=true",
-            "--set",
-            "record.rerun=true",
-            "--set",
-            "record.frame_rate_hz=50",
-        ])
-        .output()
-        .unwrap();
     // 0.6 s is not enough to settle: the run ends with status max-iterations (exit 1), its
     // recordings written all the same.
     assert_eq!(

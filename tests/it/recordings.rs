@@ -5,6 +5,14 @@
 use crate::support::{drapelab, root, run_python};
 
 fn simulate_recorded(extra: &[&str]) -> tempfile::TempDir {
+    let (tmp, o) = simulate_hang4_recorded(extra);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    tmp
+}
+
+/// `drapelab simulate` of hang4 into `o/` of a temporary folder with `timeline.mcap` and `drape.rrd`
+/// and the `extra` arguments; the folder and the command's output.
+pub(crate) fn simulate_hang4_recorded(extra: &[&str]) -> (tempfile::TempDir, std::process::Output) {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("o");
     let o = drapelab()
@@ -21,8 +29,7 @@ fn simulate_recorded(extra: &[&str]) -> tempfile::TempDir {
         .args(extra)
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    tmp
+    (tmp, o)
 }
 
 #[test]
