@@ -119,19 +119,24 @@ fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
             .with_context(|| format!("sample {n} has no calibrated parameters"))?;
         let problem = Problem::new(
             sample_scene(scene_file, &densities, sample, p.grid)?,
-            Vec::new(),
+            measured.iter().map(|(_, e)| e.clone()).collect(),
             p.side_cm,
         );
         let scene = problem.scene_for(params);
         let sol = solve_scene(&scene, &mut NoObserver);
         let (view, corners) = scene_view(&scene)?;
-        let projection = measured.first().map(|m| m.1.projection).unwrap_or_default();
-        let sim: Vec<(String, EdgeFit)> =
-            simulated_edges(&sol.grid, &sol.x, view, corners, p.edge_source, projection)
-                .into_iter()
-                .filter_map(|(name, pts)| EdgeFit::from_points(&name, &pts, 4))
-                .map(|e| (sample.clone(), e))
-                .collect();
+        let sim: Vec<(String, EdgeFit)> = simulated_edges(
+            &sol.grid,
+            &sol.x,
+            view,
+            corners,
+            p.edge_source,
+            problem.projection,
+        )
+        .into_iter()
+        .filter_map(|(name, pts)| EdgeFit::from_points(&name, &pts, 4))
+        .map(|e| (sample.clone(), e))
+        .collect();
         let rows = if sol.report.is_converged() {
             score_edges(measured, &sim, p.side_cm)
         } else {

@@ -421,20 +421,12 @@ fn solve_implicit(
         // Each step well below the settle tolerance: a step's leftover force would move a soft mode
         // by force/stiffness every step, a speed that never settles.
         newton_tol_rel: 1e-2 * opts.residual_tol_rel,
-        projected_hessian: false,
         strain_bound: opts.strain_bound,
     };
-    let (lo, hi) = x.iter().fold(
-        (
-            Vector3::repeat(f64::INFINITY),
-            Vector3::repeat(f64::NEG_INFINITY),
-        ),
-        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-    );
     let settle = Settle {
         residual_N: opts.residual_tol_rel * w_ref,
         speed_m_per_s: opts.speed_tol_m_per_s,
-        extent_m: (hi - lo).norm().max(1e-3),
+        extent_m: extent_m(x),
     };
     let frame_s = observer.frame_interval_s();
     if let Err(e) = observe_start(model, x, v, frame_s, observer) {
@@ -460,6 +452,18 @@ fn solve_implicit(
     report.energy_J = model.energy(x, 1.0);
     report.wall_time_s = start.elapsed().as_secs_f64();
     report
+}
+
+/// The diagonal of the particles' bounding box, m (at least 1 mm): the drape's size.
+fn extent_m(x: &[Vector3<f64>]) -> f64 {
+    let (lo, hi) = x.iter().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    (hi - lo).norm().max(1e-3)
 }
 
 /// Why the time loop stops.
@@ -493,16 +497,7 @@ impl Limits {
         start: Instant,
     ) -> Self {
         let total_weight: f64 = model.masses.iter().sum::<f64>() * model.gravity_m_per_s2.max(1.0);
-        let extent = {
-            let (lo, hi) = x.iter().fold(
-                (
-                    Vector3::repeat(f64::INFINITY),
-                    Vector3::repeat(f64::NEG_INFINITY),
-                ),
-                |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-            );
-            (hi - lo).norm().max(1e-3)
-        };
+        let extent = extent_m(x);
         let e0 = model.energy(x, 1.0) + kinetic_energy(model, v);
         Self {
             dt,

@@ -132,8 +132,6 @@ pub struct ImplicitSettings {
     pub newton_iterations: usize,
     /// Newton's tolerance per step, relative to the lightest particle's weight.
     pub newton_tol_rel: f64,
-    /// Newton on the projected Hessian from the first try (see [`StaticOptions::projected_hessian`]).
-    pub projected_hessian: bool,
     /// A strain beyond which a step reports divergence.
     pub strain_bound: f64,
 }
@@ -175,7 +173,6 @@ fn step(
         residual_tol_rel: s.newton_tol_rel.max(100.0 * floor_rel),
         max_iterations: s.newton_iterations,
         lm_damping_initial: 1e-6,
-        projected_hessian: s.projected_hessian,
         strain_bound: s.strain_bound,
         ..StaticOptions::default()
     };
@@ -245,6 +242,8 @@ pub fn integrate_implicit(
     let (mut t, mut h, mut steps, mut frame) = (0.0f64, s.dt_s, 0usize, 1usize);
     let mut g = Vec::new();
     let (mut largest, mut cooldown, mut last_dt) = (0.0f64, 0usize, 0.0f64);
+    // Whether the state is at a frame time (t = 0 is one).
+    let mut at_frame = true;
     loop {
         model.gradient(x, 1.0, &mut g);
         let r = model.max_residual(&g);
@@ -255,7 +254,7 @@ pub fn integrate_implicit(
         }
         // Recording frames, the state is judged on frame times only (the last one recorded is the
         // final state).
-        let on_frame = frame_s.is_none_or(|f| (t / f - (t / f).round()).abs() < 1e-9);
+        let on_frame = frame_s.is_none() || at_frame;
         // Near the round-off floor of forces a soft mode keeps moving by floor/stiffness per step:
         // there the speed criterion becomes "no particle moved more than 1e-7 of the drape's size".
         // (Each step's Newton stops within 100 times the floor of its own, inertia-stiffened forces.)
@@ -295,6 +294,7 @@ pub fn integrate_implicit(
                 largest = largest.max(dt);
                 t += dt;
                 let landed = next_frame.is_some_and(|tf| (tf - t).abs() <= 1e-9 * tf.max(1.0));
+                at_frame = landed;
                 if landed {
                     t = next_frame.unwrap_or(t);
                     frame += 1;
@@ -341,7 +341,7 @@ pub fn integrate_implicit(
     }
     report.iterations = steps;
     report.sim_time_s = Some(t);
-    report.dt_s = Some(largest);
+    report.dt_s = Some(if steps > 0 { largest } else { s.dt_s });
 }
 
 /// Hands the initial state (t = 0) to `observer` when it records frames or wants step 0.

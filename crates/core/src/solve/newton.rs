@@ -43,12 +43,6 @@ pub struct StaticOptions {
     /// instead of the flat one. Default true.
     #[serde(default = "default_true")]
     pub sag_start: bool,
-    /// Use the projected (positive semi-definite) Hessian from the first try of every iteration
-    /// instead of the exact one: one factorization per iteration where the exact Hessian is
-    /// indefinite, at the price of slower convergence on nets under compression. Default false
-    /// (implicit Euler's steps set it: their inertia makes the projected system well conditioned).
-    #[serde(default)]
-    pub projected_hessian: bool,
 }
 
 fn default_true() -> bool {
@@ -81,7 +75,6 @@ impl Default for StaticOptions {
             strain_bound: default_strain(),
             coarse_start: true,
             sag_start: true,
-            projected_hessian: false,
         }
     }
 }
@@ -137,8 +130,6 @@ struct Workspace {
     mu: f64,
     /// The damping's initial value (it returns there when the Hessian is projected).
     mu_initial: f64,
-    /// Start every iteration with the projected Hessian.
-    projected_first: bool,
 }
 
 /// Smallest damping used once damping is needed (relative to the mean diagonal).
@@ -162,7 +153,6 @@ impl Workspace {
             shift: vec![0.0; n],
             mu: opts.lm_damping_initial,
             mu_initial: opts.lm_damping_initial,
-            projected_first: opts.projected_hessian,
         }
     }
 
@@ -279,7 +269,7 @@ impl Workspace {
         (r, tol): (f64, f64),
         report: &mut SolveReport,
     ) -> bool {
-        let mut projected = self.projected_first;
+        let mut projected = false;
         model.hessian(x, &mut self.h, projected);
         // The damping's scale: the mean diagonal of this iteration's exact Hessian.
         let scale = mean_free_diagonal(&self.h, &self.dofs, model.len());
