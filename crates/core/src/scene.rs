@@ -787,7 +787,14 @@ impl Scene {
                 ),
             );
         }
-        if d.max_time_s / d.dt_s > 1e9 {
+        // Adaptive implicit steps grow from dt_s to max_dt_s: their count is bounded by the larger.
+        let adaptive = self.solver.kind == SolverKind::ImplicitEuler && d.adaptive_dt;
+        let step = if adaptive {
+            d.max_dt_s.max(d.dt_s)
+        } else {
+            d.dt_s
+        };
+        if d.max_time_s / step > 1e9 {
             return ck.err(
                 "solver.dynamic.max_time_s",
                 "more than 1e9 steps: raise dt_s or lower max_time_s".into(),

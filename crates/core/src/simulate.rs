@@ -151,14 +151,19 @@ fn static_or_dynamic(
         None => static_solve(scene, grid, model, x, observer),
         Some(integ) => {
             let mut v = vec![Vector3::zeros(); x.len()];
-            solve_dynamic(model, integ, x, &mut v, &scene.solver.dynamic, observer)
+            let mut report =
+                solve_dynamic(model, integ, x, &mut v, &scene.solver.dynamic, observer);
+            check_minimum(model, x, &mut report);
+            report
         }
     }
 }
 
-/// Stability of a converged static state (once, after every load increment and contact round).
+/// Stability of a converged (or settled) state, checked once: after every load increment and contact
+/// round of a static solve, at the end of a dynamic one (a heavily damped sheet can come to rest on a
+/// saddle it would leave only slowly).
 fn check_minimum(model: &crate::physics::Model, x: &[Vector3<f64>], report: &mut SolveReport) {
-    if report.is_converged() && report.solver == "static-newton" {
+    if report.is_converged() && report.minimum.is_none() {
         let minimum = crate::solve::is_minimum(model, x);
         report.minimum = Some(minimum);
         if !minimum {

@@ -165,8 +165,8 @@ pub struct SolveReport {
     pub divergence: Option<Divergence>,
     /// A human-readable note (why it stopped).
     pub message: String,
-    /// For a converged static solve of a scene: whether the equilibrium is a minimum of the energy
-    /// ([`super::is_minimum`]). None when not checked (dynamics, no convergence).
+    /// For a converged solve of a scene (static, or dynamic once settled): whether the equilibrium is
+    /// a minimum of the energy ([`super::is_minimum`]). None when not checked (no convergence).
     pub minimum: Option<bool>,
 }
 
