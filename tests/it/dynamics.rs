@@ -311,3 +311,65 @@ assert len(RrdReader(sys.argv[2]).recordings()) == 1
     // 0, 20, …, 600 ms: 31 frames, every interval 20 ms of simulated time.
     assert_eq!(v, vec![31, 20_000_000, 20_000_000], "{py}");
 }
+
+#[test]
+fn the_replay_pipeline_records_the_rod_fall_at_its_frame_rate() {
+    // pipelines/replay.toml as bundled, its rod stage run in a copy of the project; every stage's
+    // scene and overrides checked (a typo in any would fail the plan's load).
+    let pipeline =
+        std::fs::read_to_string(crate::support::root().join("pipelines/replay.toml")).unwrap();
+    let (tmp, file) =
+        crate::support::temp_project(&["datasets/scenes/*.toml"], "replay.toml", &pipeline);
+    let plan = drapelab::pipeline::load_plan(&file, &drapelab::stages::registry()).unwrap();
+    assert_eq!(plan.stages.len(), 13);
+    for stage in &plan.stages {
+        let set = stage.params["set"].as_object().expect("params.set");
+        let overrides: Vec<(String, toml::Value)> = set
+            .iter()
+            .map(|(k, v)| (k.clone(), serde_json::from_value(v.clone()).unwrap()))
+            .collect();
+        let scene = tmp.path().join(&stage.input_patterns["scene"][0]);
+        drapelab::scene::Scene::load(&scene, &overrides)
+            .unwrap_or_else(|e| panic!("{}: {e:#}", stage.name));
+    }
+    let o = crate::support::drapelab()
+        .current_dir(tmp.path())
+        .args([
+            "run",
+            "pipelines/replay.toml",
+            "--until",
+            "rod_polyester",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let dir = tmp.path().join("runs/replay/rod_polyester");
+    let py = run_python(
+        r#"
+import sys, json
+from mcap.reader import make_reader
+times = []
+with open(sys.argv[1], "rb") as f:
+    for schema, channel, message in make_reader(f).iter_messages(topics=["/drapelab/cloth"]):
+        assert schema.name == "foxglove.SceneUpdate", schema.name
+        times.append(message.log_time)
+steps = sorted(set(b - a for a, b in zip(times, times[1:])))
+from rerun.experimental import RrdReader
+assert len(RrdReader(sys.argv[2]).recordings()) == 1
+report = json.load(open(sys.argv[3]))["report"]
+print(len(times), steps[0], steps[-1], times[-1], round(report["sim_time_s"] * 1e9))
+"#,
+        &[
+            &dir.join("timeline.mcap"),
+            &dir.join("drape.rrd"),
+            &dir.join("run.json"),
+        ],
+    );
+    let v: Vec<u64> = py.split_whitespace().map(|s| s.parse().unwrap()).collect();
+    eprintln!("rod fall: {py}");
+    // 25 frames per second of simulated time: every interval 40 ms, the last frame at the settle time.
+    assert!(v[0] > 25, "{py}");
+    assert_eq!((v[1], v[2]), (40_000_000, 40_000_000), "{py}");
+    assert_eq!(v[3], v[4], "{py}");
+}

@@ -81,6 +81,7 @@ point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
     md += &scaling_section(&c, p.scaling_tolerance);
     md += &endings_section(&c);
     md += &newton_work_section(&bench)?;
+    md += &settling_section(&bench)?;
     if let Some(pop) = ctx.optional_input("population")? {
         md += &population_section(&read(pop)?)?;
     }
@@ -346,6 +347,62 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
             w * 1e3,
             f * 1e3,
             (w - f) * 1e3
+        );
+    }
+    Ok(md)
+}
+
+/// Every dynamic point that settled: its settle time in simulated and wall time, beside the static
+/// solve of the same scene, size and tolerance (issue 19's goal: implicit Euler within 10× of it).
+fn settling_section(bench: &DataFrame) -> Result<String> {
+    let mut md = String::from(
+        "\n## Dynamic points that settled\n\nEach converged dynamic point from the flat sheet: simulated time and \
+wall time to settle, and its wall time over the static solve's at the same scene, size and tolerance (the static \
+solve starts from a coarse grid's solution or the sagged sheet; the fall starts flat). The settled drape may be \
+another local minimum than the static one (folds on the rod and the pedestal): its error is in the table of every point.\n\n\
+| scene | particles | tolerance | solver | steps | simulated time (s) | wall time (s) | static wall time (s) | ratio |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let col = |c: &str| bench.column(c).map(|c| c.as_materialized_series().clone());
+    let (scene, solver, status, n, tol, wall, it, sim) = (
+        col("scene")?,
+        col("solver")?,
+        col("status")?,
+        col("particles_per_side")?,
+        col("tolerance_rel")?,
+        col("wall_time_s")?,
+        col("iterations")?,
+        col("sim_time_s")?,
+    );
+    let key = |r: usize| -> Result<(Option<String>, Option<u64>, Option<f64>)> {
+        Ok((
+            scene.str()?.get(r).map(String::from),
+            n.u64()?.get(r),
+            tol.f64()?.get(r),
+        ))
+    };
+    for r in 0..bench.height() {
+        let sv = solver.str()?.get(r).unwrap_or("");
+        if sv == "static" || status.str()?.get(r) != Some("converged") {
+            continue;
+        }
+        let k = key(r)?;
+        let mut static_wall = None;
+        for q in 0..bench.height() {
+            if solver.str()?.get(q) == Some("static") && key(q)? == k {
+                static_wall = wall.f64()?.get(q);
+            }
+        }
+        let w = wall.f64()?.get(r).unwrap_or(f64::NAN);
+        let side = k.1.unwrap_or(0);
+        let _ = writeln!(
+            md,
+            "| {} | {side}×{side} | {:.0e} | {sv} | {} | {:.3} | {w:.3} | {} | {} |",
+            k.0.unwrap_or_default(),
+            k.2.unwrap_or(f64::NAN),
+            it.u64()?.get(r).unwrap_or(0),
+            sim.f64()?.get(r).unwrap_or(f64::NAN),
+            static_wall.map_or("–".into(), |s| format!("{s:.3}")),
+            static_wall.map_or("–".into(), |s| format!("{:.1}×", w / s)),
         );
     }
     Ok(md)

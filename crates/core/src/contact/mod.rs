@@ -111,6 +111,11 @@ fn revolution_sdf(profile: &[[f64; 2]], r: f64, z: f64) -> (f64, f64, f64) {
 }
 
 impl Obstacle {
+    /// Whether the solid is convex (every kind but a solid of revolution, whose profile may narrow).
+    pub fn is_convex(&self) -> bool {
+        !matches!(self, Obstacle::Revolution { .. })
+    }
+
     /// Signed distance (m, positive outside) and the unit outward normal at the closest point.
     pub fn signed_distance(&self, p: &Vector3<f64>) -> (f64, Vector3<f64>) {
         match self {

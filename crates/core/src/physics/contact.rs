@@ -115,11 +115,7 @@ impl EnergyTerm for BarrierContact {
                 continue;
             }
             for o in &self.obstacles {
-                let (d, n) = o.signed_distance(xp);
-                // Approach speed along the normal, plus a share of the tangential motion for the
-                // surface's curvature: a particle never covers more than 90 % of its gap in one step.
-                let towards = (-n.dot(&dx[p])).max(0.0) + 0.1 * len;
-                alpha = alpha.min(0.9 * d.max(0.0) / towards);
+                alpha = alpha.min(gap_bound(o, xp, &dx[p]));
             }
         }
         alpha
@@ -139,6 +135,38 @@ impl BarrierContact {
         });
         out
     }
+}
+
+/// The largest fraction of the step `dx` that a particle at `x` may take towards obstacle `o`: its
+/// approach along the outward normal covers at most 90 % of its gap d. For a convex obstacle that is
+/// exact (the segment stays beyond the tangent plane at the closest point, which the whole obstacle
+/// lies behind), so sliding along the surface is never slowed. A non-convex one (a solid of
+/// revolution) may curve into the path: there the bound is halved until four points along the step
+/// keep at least 10 % of the gap.
+fn gap_bound(o: &Obstacle, x: &Vector3<f64>, dx: &Vector3<f64>) -> f64 {
+    let (d, n) = o.signed_distance(x);
+    if d <= 0.0 {
+        return 0.0;
+    }
+    let approach = -n.dot(dx);
+    let mut a = if approach > 0.0 {
+        0.9 * d / approach
+    } else {
+        f64::INFINITY
+    };
+    if o.is_convex() {
+        return a;
+    }
+    a = a.min(1.0);
+    for _ in 0..60 {
+        let clear =
+            (1..=4).all(|k| o.signed_distance(&(x + dx * (a * k as f64 / 4.0))).0 >= 0.1 * d);
+        if clear {
+            return a;
+        }
+        a *= 0.5;
+    }
+    0.0
 }
 
 /// The largest penetration (m) of any particle into any obstacle: max(0, −d).

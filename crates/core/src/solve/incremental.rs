@@ -157,7 +157,9 @@ fn step(
 ) -> Attempt {
     let x_n = x.to_vec();
     let term = Inertia::new(model, &x_n, v, h, s.damping);
-    // Start from the inertial prediction xₙ + h vₙ, as far along it as contact allows.
+    // Start from the inertial prediction xₙ + h vₙ (as far along it as contact allows) or from xₙ,
+    // whichever has the lower incremental potential: long steps of an overdamped sheet overshoot
+    // their prediction by far.
     let dx: Vec<Vector3<f64>> = v.iter().map(|vp| vp * h).collect();
     let alpha = model.max_step(&x_n, &dx).min(1.0);
     for p in 0..x.len() {
@@ -166,6 +168,9 @@ fn step(
         }
     }
     model.terms.push(Box::new(term));
+    if model.energy(&x_n, 1.0) < model.energy(x, 1.0) {
+        x.copy_from_slice(&x_n);
+    }
     // Short steps make the inertia stiff (m/h²) and raise the round-off floor of forces with it:
     // the step's tolerance stays 100 times above that floor.
     let floor_rel = model.roundoff_force(x) / model.reference_weight();
