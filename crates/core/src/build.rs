@@ -291,10 +291,12 @@ pub fn barrier_contact(
             }
         })
         .collect();
+    let falling = scene.solver.kind.integrator() == Some(crate::solve::Integrator::ImplicitEuler);
     crate::physics::BarrierContact {
         obstacles: scene.obstacles.clone(),
         d_hat_m: d_hat,
         kappa_J: kappa,
+        sliding_share: if falling { 0.0 } else { 0.1 },
     }
 }
 

@@ -29,6 +29,7 @@ pub mod physics;
 pub mod scene;
 pub mod simulate;
 pub mod solve;
+pub mod surface;
 pub mod table;
 pub mod wrinkles;
 
