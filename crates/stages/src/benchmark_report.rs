@@ -81,7 +81,7 @@ point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
     md += &scaling_section(&c, p.scaling_tolerance);
     md += &endings_section(&c);
     md += &newton_work_section(&bench)?;
-    md += &settling_section(&bench)?;
+    md += &settling_section(&c, &bench)?;
     if let Some(pop) = ctx.optional_input("population")? {
         md += &population_section(&read(pop)?)?;
     }
@@ -354,7 +354,7 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
 
 /// Every dynamic point that settled: its settle time in simulated and wall time, beside the static
 /// solve of the same scene, size and tolerance (issue 19's goal: implicit Euler within 10× of it).
-fn settling_section(bench: &DataFrame) -> Result<String> {
+fn settling_section(c: &BenchCols, bench: &DataFrame) -> Result<String> {
     let mut md = String::from(
         "\n## Dynamic points that settled\n\nEach converged dynamic point from the flat sheet: simulated time and \
 wall time to settle, and its wall time over the static solve's at the same scene, size and tolerance (the static \
@@ -362,47 +362,46 @@ solve starts from a coarse grid's solution or the sagged sheet; the fall starts 
 another local minimum than the static one (folds on the rod and the pedestal): its error is in the table of every point.\n\n\
 | scene | particles | tolerance | solver | steps | simulated time (s) | wall time (s) | static wall time (s) | ratio |\n|---|---|---|---|---|---|---|---|---|\n",
     );
-    let col = |c: &str| bench.column(c).map(|c| c.as_materialized_series().clone());
-    let (scene, solver, status, n, tol, wall, it, sim) = (
-        col("scene")?,
-        col("solver")?,
-        col("status")?,
-        col("particles_per_side")?,
-        col("tolerance_rel")?,
-        col("wall_time_s")?,
-        col("iterations")?,
-        col("sim_time_s")?,
-    );
-    let key = |r: usize| -> Result<(Option<String>, Option<u64>, Option<f64>)> {
-        Ok((
-            scene.str()?.get(r).map(String::from),
-            n.u64()?.get(r),
-            tol.f64()?.get(r),
-        ))
+    let sim = bench.column("sim_time_s")?.f64()?.clone();
+    let BenchCols {
+        scene,
+        solver,
+        status,
+        n,
+        tol,
+        wall,
+        iters,
+        ..
+    } = c;
+    // The static solve's wall time of each (scene, size, tolerance).
+    let key = |r: usize| {
+        (
+            scene.get(r).map(String::from),
+            n.get(r),
+            tol.get(r).map(f64::to_bits),
+        )
     };
-    for r in 0..bench.height() {
-        let sv = solver.str()?.get(r).unwrap_or("");
-        if sv == "static" || status.str()?.get(r) != Some("converged") {
+    let static_wall: BTreeMap<_, f64> = (0..c.rows)
+        .filter(|&r| solver.get(r) == Some("static"))
+        .filter_map(|r| Some((key(r), wall.get(r)?)))
+        .collect();
+    for r in 0..c.rows {
+        let sv = solver.get(r).unwrap_or("");
+        if sv == "static" || status.get(r) != Some("converged") {
             continue;
         }
-        let k = key(r)?;
-        let mut static_wall = None;
-        for q in 0..bench.height() {
-            if solver.str()?.get(q) == Some("static") && key(q)? == k {
-                static_wall = wall.f64()?.get(q);
-            }
-        }
-        let w = wall.f64()?.get(r).unwrap_or(f64::NAN);
-        let side = k.1.unwrap_or(0);
+        let st = static_wall.get(&key(r)).copied();
+        let w = wall.get(r).unwrap_or(f64::NAN);
+        let side = n.get(r).unwrap_or(0);
         let _ = writeln!(
             md,
             "| {} | {side}×{side} | {:.0e} | {sv} | {} | {:.3} | {w:.3} | {} | {} |",
-            k.0.unwrap_or_default(),
-            k.2.unwrap_or(f64::NAN),
-            it.u64()?.get(r).unwrap_or(0),
-            sim.f64()?.get(r).unwrap_or(f64::NAN),
-            static_wall.map_or("–".into(), |s| format!("{s:.3}")),
-            static_wall.map_or("–".into(), |s| format!("{:.1}×", w / s)),
+            scene.get(r).unwrap_or(""),
+            tol.get(r).unwrap_or(f64::NAN),
+            iters.get(r).unwrap_or(0),
+            sim.get(r).unwrap_or(f64::NAN),
+            st.map_or("–".into(), |s| format!("{s:.3}")),
+            st.map_or("–".into(), |s| format!("{:.1}×", w / s)),
         );
     }
     Ok(md)
