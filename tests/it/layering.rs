@@ -39,14 +39,15 @@ const NOT_IN_CORE: [&str; 8] = [
 ];
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank.
-const CORE_RANKS: [(&str, u8); 22] = [
+const CORE_RANKS: [(&str, u8); 23] = [
     ("error", 0),
     ("atomic", 0),
     ("table", 0),
     ("material", 0),
     ("contact", 0),
     ("optim", 0),
-    ("surface", 0),
+    ("surface", 2),
+    ("raster", 0),
     ("config", 1),
     ("cloth", 1),
     ("physics", 1),

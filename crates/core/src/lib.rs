@@ -26,6 +26,7 @@ pub mod material;
 pub mod measure;
 pub mod optim;
 pub mod physics;
+pub mod raster;
 pub mod scene;
 pub mod simulate;
 pub mod solve;

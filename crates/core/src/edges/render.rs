@@ -199,65 +199,24 @@ fn rasterize(
     w: u32,
     h: u32,
 ) -> RgbImage {
-    // Supersampled coverage and shade with a depth buffer.
-    const SS: usize = 4;
-    let (sw, sh) = (w as usize * SS, h as usize * SS);
-    let mut depth = vec![f64::INFINITY; sw * sh];
-    let mut shade = vec![BACKGROUND; sw * sh];
     let light = Vector3::new(-0.3, -0.8, 0.5).normalize();
-    for tri in triangles {
-        let [a, b, c] = tri.map(|k| k as usize);
-        let n = (x[b] - x[a]).cross(&(x[c] - x[a]));
-        let lum = if n.norm() > 0.0 {
-            0.35 + 0.65 * n.normalize().dot(&light).abs()
-        } else {
-            1.0
-        };
-        let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
-        let area = (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0);
-        if area.abs() < 1e-12 {
-            continue;
-        }
-        let x0 = ((pa.0.min(pb.0).min(pc.0)) * SS as f64).floor().max(0.0) as usize;
-        let x1 = ((pa.0.max(pb.0).max(pc.0)) * SS as f64)
-            .ceil()
-            .min(sw as f64) as usize;
-        let y0 = ((pa.1.min(pb.1).min(pc.1)) * SS as f64).floor().max(0.0) as usize;
-        let y1 = ((pa.1.max(pb.1).max(pc.1)) * SS as f64)
-            .ceil()
-            .min(sh as f64) as usize;
-        for sy in y0..y1 {
-            for sx in x0..x1 {
-                let (px, py) = ((sx as f64 + 0.5) / SS as f64, (sy as f64 + 0.5) / SS as f64);
-                let w0 = ((pb.0 - px) * (pc.1 - py) - (pb.1 - py) * (pc.0 - px)) / area;
-                let w1 = ((pc.0 - px) * (pa.1 - py) - (pc.1 - py) * (pa.0 - px)) / area;
-                let w2 = 1.0 - w0 - w1;
-                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
-                    continue;
-                }
-                let d = w0 * pa.2 + w1 * pb.2 + w2 * pc.2;
-                let k = sy * sw + sx;
-                if d < depth[k] {
-                    depth[k] = d;
-                    shade[k] = ALBEDO * lum;
-                }
-            }
-        }
-    }
-    let mut img = RgbImage::new(w, h);
-    for v in 0..h as usize {
-        for u in 0..w as usize {
-            let mut acc = 0.0;
-            for dy in 0..SS {
-                for dx in 0..SS {
-                    acc += shade[(v * SS + dy) * sw + u * SS + dx];
-                }
-            }
-            let g = (acc / (SS * SS) as f64).round().clamp(0.0, 255.0) as u8;
-            img.put_pixel(u as u32, v as u32, Rgb([g, g, g]));
-        }
-    }
-    img
+    let tris: Vec<[u32; 3]> = triangles.into_iter().collect();
+    let grey: Vec<f64> = tris
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|k| k as usize);
+            let n = (x[b] - x[a]).cross(&(x[c] - x[a]));
+            let lum = if n.norm() > 0.0 {
+                0.35 + 0.65 * n.normalize().dot(&light).abs()
+            } else {
+                1.0
+            };
+            ALBEDO * lum
+        })
+        .collect();
+    crate::raster::rasterize(pts, &tris, (w, h), 4, [BACKGROUND; 3], |f| {
+        [grey[f.triangle]; 3]
+    })
 }
 
 /// A shaded picture of a drape for reports: an orthographic camera `elevation_deg` above the horizon

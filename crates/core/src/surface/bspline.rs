@@ -243,6 +243,25 @@ impl BSplineSurface {
             .map(|i| (0..ny).map(|j| nodes[j * nx + i]).collect())
             .collect();
         let (u, v) = (parameters(&rows, kind), parameters(&cols, kind));
+        Self::interpolate_at(nodes, nx, ny, u, v)
+    }
+
+    /// The surface through the `nx` × `ny` grid `nodes` (index j·nx + i) at the given node
+    /// parameters `u` (nx, increasing from 0 to 1) and `v` (ny): e.g. a drape's rest positions at its
+    /// deformed surface's parameters, for material coordinates. None when a system is singular.
+    pub fn interpolate_at(
+        nodes: &[Vector3<f64>],
+        nx: usize,
+        ny: usize,
+        u: Vec<f64>,
+        v: Vec<f64>,
+    ) -> Option<Self> {
+        if nx < 2 || ny < 2 || nodes.len() != nx * ny || u.len() != nx || v.len() != ny {
+            return None;
+        }
+        let rows: Vec<Vec<Vector3<f64>>> = (0..ny)
+            .map(|j| nodes[j * nx..(j + 1) * nx].to_vec())
+            .collect();
         let (bu, bv) = (Basis::interpolating(&u), Basis::interpolating(&v));
         // Along u for every row, then along v for every column of those control points.
         let r = solve_lines(&bu, &u, &rows)?;

@@ -1,0 +1,173 @@
+//! Trimming (seed 003 §10.8): the drape's outline in the surface's parameter plane as closed cubic
+//! B-spline curves, and which parameters lie inside it.
+//!
+//! The outline of the kept triangles of a drape's grid (a disc's staircase) is chained into loops;
+//! each loop is the control polygon of a uniform periodic cubic B-spline curve, which smooths the
+//! staircase to the curve through its middle. Corners on the border of the parameter square are kept
+//! sharp (their control point is tripled), so a region cut by the grid's edge keeps its straight edge.
+
+/// A trimming region: closed curves sampled as polygons in the (u, v) parameter plane, inside by the
+/// even–odd rule.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trim {
+    /// Closed polygons (first point not repeated), sampled from the B-spline curves.
+    pub loops: Vec<Vec<[f64; 2]>>,
+}
+
+/// Samples a curve segment gets per span of its control polygon.
+const SAMPLES_PER_SPAN: usize = 8;
+
+/// The uniform cubic B-spline basis at t ∈ [0, 1).
+fn basis(t: f64) -> [f64; 4] {
+    let s = 1.0 - t;
+    [
+        s * s * s / 6.0,
+        (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0,
+        (-3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+        t * t * t / 6.0,
+    ]
+}
+
+/// The closed uniform cubic B-spline curve with control polygon `ctrl`, sampled.
+fn periodic_curve(ctrl: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let n = ctrl.len();
+    let mut out = Vec::with_capacity(n * SAMPLES_PER_SPAN);
+    for k in 0..n {
+        for s in 0..SAMPLES_PER_SPAN {
+            let b = basis(s as f64 / SAMPLES_PER_SPAN as f64);
+            let mut p = [0.0; 2];
+            for (m, w) in b.iter().enumerate() {
+                let c = ctrl[(k + m) % n];
+                p[0] += w * c[0];
+                p[1] += w * c[1];
+            }
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Signed area of a closed polygon (counter-clockwise positive).
+fn signed_area(poly: &[[f64; 2]]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|k| {
+            let (a, b) = (poly[k], poly[(k + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// The outline of `triangles` (indices into `points`) as closed loops of point indices, each
+/// directed with the region on its left (outer loops counter-clockwise, holes clockwise).
+pub fn outline(points: &[[f64; 2]], triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    use std::collections::{BTreeMap, BTreeSet};
+    let mut directed = BTreeSet::new();
+    for t in triangles {
+        let poly: Vec<[f64; 2]> = t.iter().map(|&k| points[k as usize]).collect();
+        let [a, b, c] = if signed_area(&poly) >= 0.0 {
+            *t
+        } else {
+            [t[0], t[2], t[1]]
+        };
+        directed.extend([(a, b), (b, c), (c, a)]);
+    }
+    let mut next: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    for &(a, b) in &directed {
+        if !directed.contains(&(b, a)) {
+            next.entry(a).or_default().push(b);
+        }
+    }
+    let mut loops = Vec::new();
+    while let Some((&start, _)) = next.iter().find(|(_, v)| !v.is_empty()) {
+        let mut lp = vec![start];
+        let mut at = start;
+        loop {
+            let Some(b) = next.get_mut(&at).and_then(|v| v.pop()) else {
+                break;
+            };
+            if b == start {
+                break;
+            }
+            lp.push(b);
+            at = b;
+        }
+        if lp.len() >= 3 {
+            loops.push(lp);
+        }
+    }
+    loops
+}
+
+impl Trim {
+    /// The trimming curves of the region covered by `triangles` (indices into `points`, the nodes'
+    /// parameters in [0, 1]²).
+    pub fn from_triangles(points: &[[f64; 2]], triangles: &[[u32; 3]]) -> Self {
+        let on_border = |p: [f64; 2]| p.iter().any(|c| *c <= 1e-12 || *c >= 1.0 - 1e-12);
+        let loops = outline(points, triangles)
+            .into_iter()
+            .map(|lp| {
+                let n = lp.len();
+                let mut ctrl = Vec::with_capacity(n + 8);
+                for k in 0..n {
+                    let p = points[lp[k] as usize];
+                    let (a, b) = (
+                        points[lp[(k + n - 1) % n] as usize],
+                        points[lp[(k + 1) % n] as usize],
+                    );
+                    let turn = (p[0] - a[0]) * (b[1] - p[1]) - (p[1] - a[1]) * (b[0] - p[0]);
+                    let copies = if on_border(p) && turn.abs() > 1e-15 {
+                        3
+                    } else {
+                        1
+                    };
+                    ctrl.extend(std::iter::repeat_n(p, copies));
+                }
+                periodic_curve(&ctrl)
+            })
+            .collect();
+        Self { loops }
+    }
+
+    /// The u where the trimming curves cross the line of parameter v, sorted.
+    pub fn crossings(&self, v: f64) -> Vec<f64> {
+        let mut us = Vec::new();
+        for lp in &self.loops {
+            let n = lp.len();
+            for k in 0..n {
+                let (a, b) = (lp[k], lp[(k + 1) % n]);
+                if (a[1] <= v) != (b[1] <= v) {
+                    us.push(a[0] + (v - a[1]) / (b[1] - a[1]) * (b[0] - a[0]));
+                }
+            }
+        }
+        us.sort_by(f64::total_cmp);
+        us
+    }
+
+    /// Whether (u, v) lies inside (even–odd rule).
+    pub fn contains(&self, u: f64, v: f64) -> bool {
+        self.crossings(v).iter().filter(|c| **c < u).count() % 2 == 1
+    }
+
+    /// The area enclosed in the parameter plane (holes subtracted).
+    pub fn area(&self) -> f64 {
+        self.loops.iter().map(|l| signed_area(l)).sum::<f64>().abs()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_square_region_keeps_its_border_corners_and_area() {
+        // The whole parameter square as two triangles: its outline is the square, corners sharp.
+        let pts = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let t = Trim::from_triangles(&pts, &[[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(t.loops.len(), 1);
+        assert!((t.area() - 1.0).abs() < 1e-12, "{}", t.area());
+        assert!(t.contains(0.5, 0.5) && !t.contains(1.5, 0.5));
+    }
+}
