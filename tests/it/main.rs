@@ -17,4 +17,5 @@ mod slurm;
 mod stress;
 mod subpixel;
 mod support;
+mod surface;
 mod wrinkles;

@@ -22,6 +22,7 @@ mod score;
 mod seed003_report;
 mod simulate;
 mod skips;
+mod surface;
 mod sweep;
 mod sweep_table;
 mod tune;
@@ -43,6 +44,10 @@ pub use score::{Score, ScoreParams};
 pub use seed003_report::{Seed003Report, Seed003ReportParams};
 pub use simulate::{Simulate, SimulateParams};
 pub use skips::{Skips, SkipsParams};
+pub use surface::{
+    Drape, Dressed, Surface, SurfaceOutputs, SurfaceParams, SurfaceSummary, dress, load_run,
+    load_texture, make_surface, picture, solve_drape,
+};
 pub use sweep::{Axis, Design, Sweep, SweepParams, sweep_points};
 pub use tune::{Levels, Tune, TuneParams};
 pub use validate::{Validate, ValidateParams};
@@ -83,6 +88,7 @@ pub fn registry() -> Registry {
         .with::<CusickMeasure>()
         .with::<CusickPredict>()
         .with::<CusickReport>()
+        .with::<Surface>()
 }
 
 /// Every Parquet table drapelab writes, each traced from its row type, as the Markdown the README's

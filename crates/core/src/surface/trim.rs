@@ -4,7 +4,9 @@
 //! The outline of the kept triangles of a drape's grid (a disc's staircase) is chained into loops;
 //! each loop is the control polygon of a uniform periodic cubic B-spline curve, which smooths the
 //! staircase to the curve through its middle. Corners on the border of the parameter square are kept
-//! sharp (their control point is tripled), so a region cut by the grid's edge keeps its straight edge.
+//! sharp (their control point is tripled) where the outline runs along that border, so a region cut
+//! by the grid's edge keeps its straight edge and corners; a disc that only touches the border stays
+//! round there.
 
 /// A trimming region: closed curves sampled as polygons in the (u, v) parameter plane, inside by the
 /// even–odd rule.
@@ -104,7 +106,12 @@ impl Trim {
     /// The trimming curves of the region covered by `triangles` (indices into `points`, the nodes'
     /// parameters in [0, 1]²).
     pub fn from_triangles(points: &[[f64; 2]], triangles: &[[u32; 3]]) -> Self {
-        let on_border = |p: [f64; 2]| p.iter().any(|c| *c <= 1e-12 || *c >= 1.0 - 1e-12);
+        // A point where the outline leaves (or joins) a run along the square's border: both on the
+        // same border line.
+        let edge = |c: f64| c <= 1e-12 || c >= 1.0 - 1e-12;
+        let along_border = |p: [f64; 2], q: [f64; 2]| {
+            (0..2).any(|k| edge(p[k]) && edge(q[k]) && (p[k] - q[k]).abs() < 1e-12)
+        };
         let loops = outline(points, triangles)
             .into_iter()
             .map(|lp| {
@@ -117,11 +124,8 @@ impl Trim {
                         points[lp[(k + 1) % n] as usize],
                     );
                     let turn = (p[0] - a[0]) * (b[1] - p[1]) - (p[1] - a[1]) * (b[0] - p[0]);
-                    let copies = if on_border(p) && turn.abs() > 1e-15 {
-                        3
-                    } else {
-                        1
-                    };
+                    let corner = (along_border(a, p) || along_border(p, b)) && turn.abs() > 1e-15;
+                    let copies = if corner { 3 } else { 1 };
                     ctrl.extend(std::iter::repeat_n(p, copies));
                 }
                 periodic_curve(&ctrl)
