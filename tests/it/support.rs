@@ -40,7 +40,7 @@ pub fn python() -> PathBuf {
         let ready = |py: &Path| {
             py.exists()
                 && std::process::Command::new(py)
-                    .args(["-c", "import mcap, rerun, pyarrow, polars"])
+                    .args(["-c", "import mcap, rerun, pyarrow, polars, pygltflib"])
                     .output()
                     .is_ok_and(|o| o.status.success())
         };

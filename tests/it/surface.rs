@@ -1,6 +1,6 @@
 //! Issue 20: smooth textured drape surfaces (seed 003 §10.8) — trimming, texture mapping, glTF.
 
-use crate::support::{drapelab, root, scene};
+use crate::support::{drapelab, root, run_python, scene};
 use drapelab::scene::Scene;
 use drapelab_core::surface::{DrapeSurface, Parametrization, SurfaceMesh};
 use nalgebra::Vector3;
@@ -195,4 +195,219 @@ fn the_trimmed_skirt_covers_its_own_mesh_and_nothing_outside_it() {
         "the trimmed domain leaves the mesh's region by {:.3} cells",
         beyond / cell
     );
+}
+
+/// Installs the Khronos glTF validator (tests/gltf, `npm ci`) once per test process and validates
+/// `glb`: the report's JSON (issues and info).
+fn gltf_validate(glb: &std::path::Path) -> serde_json::Value {
+    static READY: std::sync::OnceLock<()> = std::sync::OnceLock::new();
+    let dir = root().join("tests/gltf");
+    READY.get_or_init(|| {
+        if !dir.join("node_modules/gltf-validator").exists() {
+            let ok = std::process::Command::new("npm")
+                .args(["ci", "--no-audit", "--no-fund", "--silent"])
+                .current_dir(&dir)
+                .status()
+                .is_ok_and(|s| s.success());
+            assert!(
+                ok,
+                "npm ci in tests/gltf failed: the tests need Node.js with npm"
+            );
+        }
+    });
+    let out = std::process::Command::new("node")
+        .arg(dir.join("validate.js"))
+        .arg(glb)
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.code().is_some_and(|c| c <= 1),
+        "the validator did not run: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("the validator's report")
+}
+
+/// `drapelab surface` on a run folder: drape.glb passes the Khronos validator with no errors,
+/// pygltflib reads as many vertices and triangles as surface.json says with the texture embedded
+/// and +Y up (its height range is the drape's z range), and rerun-sdk reads the textured mesh.
+#[test]
+fn the_glb_passes_the_khronos_validator_and_loads_in_python() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("run");
+    let o = drapelab()
+        .args(["simulate", "datasets/scenes/hang4.toml", "--out"])
+        .arg(&run)
+        .args(["--set", "cloth.nx=15", "--set", "cloth.ny=15"])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = tmp.path().join("surf");
+    let o = drapelab()
+        .arg("surface")
+        .arg(&run)
+        .args(["--out"])
+        .arg(&out)
+        .args([
+            "--resolution",
+            "57",
+            "--repeats",
+            "3,2",
+            "--rotation-deg",
+            "15",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("surface.json")).unwrap()).unwrap();
+    // A full rectangle: the 57 × 57 lattice (through every node of the 15 × 15 grid), two
+    // triangles a cell, no trimming.
+    assert_eq!(summary["vertices"], 57 * 57);
+    assert_eq!(summary["triangles"], 2 * 56 * 56);
+    assert_eq!(summary["trimmed"], false);
+    assert!(summary["max_node_distance_m"].as_f64().unwrap() < 1e-10);
+    let report = gltf_validate(&out.join("drape.glb"));
+    let issues = &report["issues"];
+    assert_eq!(issues["numErrors"], 0, "{issues}");
+    assert_eq!(issues["numWarnings"], 0, "{issues}");
+    assert_eq!(report["info"]["totalVertexCount"], 57 * 57);
+    assert_eq!(report["info"]["hasTextures"], true);
+    let printed = run_python(
+        r#"
+import sys, pygltflib, pyarrow.parquet as pq
+from rerun.experimental import RrdReader
+g = pygltflib.GLTF2().load(sys.argv[1])
+prim = g.meshes[0].primitives[0]
+pos = g.accessors[prim.attributes.POSITION]
+idx = g.accessors[prim.indices]
+assert g.accessors[prim.attributes.TEXCOORD_0].count == pos.count
+assert g.images[0].mimeType == "image/png" and g.textures[0].source == 0
+z = pq.read_table(sys.argv[2]).column("z_m").to_pylist()
+# +Z up became +Y up: the heights are the drape's z range (the lattice passes through the nodes).
+assert abs(pos.min[1] - min(z)) < 1e-6 and abs(pos.max[1] - max(z)) < 1e-6, (pos.min, pos.max, min(z), max(z))
+mesh = None
+for c in RrdReader(sys.argv[3]).stream().to_chunks():
+    if c.entity_path.startswith("/surface/"):
+        mesh = c.to_record_batch()
+assert mesh is not None
+names = set(mesh.schema.names)
+assert {"Mesh3D:vertex_texcoords", "Mesh3D:albedo_texture_buffer", "Mesh3D:vertex_normals"} <= names, names
+print(pos.count, idx.count // 3, len(mesh.column("Mesh3D:vertex_texcoords")[0]))
+"#,
+        &[
+            &out.join("drape.glb"),
+            &run.join("particles.parquet"),
+            &out.join("surface.rrd"),
+        ],
+    );
+    assert_eq!(printed.trim(), format!("3249 {} 3249", 2 * 56 * 56));
+}
+
+/// Bad inputs to `drapelab surface` exit 2 naming the flag, before any work, and write nothing.
+#[test]
+fn bad_surface_inputs_exit_2_naming_the_argument() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let scene = root().join("datasets/scenes/hang4.toml");
+    let not_image = root().join("README.md");
+    let missing = tmp.path().join("no_such.png");
+    let cases: Vec<(Vec<std::ffi::OsString>, Vec<&str>)> = vec![
+        (
+            vec!["--texture".into(), missing.clone().into()],
+            vec!["--texture", "no_such.png"],
+        ),
+        (
+            vec!["--texture".into(), not_image.clone().into()],
+            vec!["--texture", "README.md", "not a PNG or JPEG"],
+        ),
+        (
+            vec!["--repeats".into(), "0,3".into()],
+            vec!["--repeats", "> 0"],
+        ),
+        (vec!["--repeats".into(), "-2".into()], vec!["--repeats"]),
+        (vec!["--repeats".into(), "six".into()], vec!["--repeats"]),
+        (
+            vec!["--resolution".into(), "1".into()],
+            vec!["--resolution"],
+        ),
+    ];
+    for (extra, names) in cases {
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "surface".into(),
+            scene.clone().into(),
+            "--out".into(),
+            out.clone().into(),
+        ];
+        args.extend(extra);
+        crate::support::assert_bad_input(&args, &names);
+        assert!(!out.exists(), "{names:?}: the output folder was made");
+    }
+}
+
+/// A flat square sheet dressed with a checkerboard at 4 × 4 repeats, rendered from straight above:
+/// the squares come out square (aspect within 1 %); on a 0.9 × 0.6 m sheet with 3 × 2 repeats too
+/// (the repeats set per direction keep tiles square when they match the sides).
+#[test]
+fn a_flat_sheet_maps_a_checkerboard_without_distortion() {
+    for (lx, ly, reps) in [(0.6, 0.6, [4.0, 4.0]), (0.9, 0.6, [3.0, 2.0])] {
+        let grid = drapelab_core::cloth::Grid::uniform(13, 9, lx, ly);
+        let x = grid.flat_positions();
+        let surf = DrapeSurface::new(
+            &grid,
+            &x,
+            &vec![true; grid.len()],
+            Parametrization::ChordLength,
+        )
+        .unwrap();
+        let mesh = surf.tessellate(40);
+        assert!(
+            mesh.positions.iter().all(|p| p.z.abs() < 1e-12)
+                && mesh.normals.iter().all(|n| (n.z - 1.0).abs() < 1e-12)
+        );
+        let map = drapelab_core::surface::TextureMapping {
+            repeats: reps,
+            rotation_deg: 0.0,
+        };
+        let st: Vec<[f64; 2]> = mesh
+            .material_m
+            .iter()
+            .map(|m| map.texcoord(*m, surf.extent_m))
+            .collect();
+        let tex = drapelab_core::surface::checkerboard(64, 2);
+        let view = drapelab_core::surface::View {
+            azimuth_deg: 0.0,
+            elevation_deg: 90.0,
+        };
+        let img = drapelab_core::surface::render_surface(
+            &mesh,
+            &drapelab_core::surface::Paint::Texture(&tex, &st),
+            view,
+            (900, 900),
+            10,
+        );
+        // Transitions between dark and light along the middle row and column, px.
+        let dark = |x: u32, y: u32| img.get_pixel(x, y).0[0] < 120;
+        let edges = |n: u32, at: &dyn Fn(u32) -> bool| {
+            let mut e = Vec::new();
+            let mut prev = None;
+            for k in 0..n {
+                let d = at(k);
+                if prev.is_some_and(|p| p != d) {
+                    e.push(k as f64);
+                }
+                prev = Some(d);
+            }
+            e
+        };
+        let (w, h) = (img.width(), img.height());
+        let across = edges(w, &|k| dark(k, h / 2 + 7));
+        let down = edges(h, &|k| dark(w / 2 + 7, k));
+        let size = |e: &[f64]| (e[e.len() - 2] - e[1]) / (e.len() - 3) as f64;
+        let (sx, sy) = (size(&across), size(&down));
+        println!("{lx}×{ly} m, repeats {reps:?}: squares {sx:.2} × {sy:.2} px");
+        assert!(across.len() >= 6 && down.len() >= 6, "{across:?} {down:?}");
+        assert!((sx / sy - 1.0).abs() < 0.01, "squares {sx:.2} × {sy:.2} px");
+    }
 }
