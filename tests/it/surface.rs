@@ -411,3 +411,21 @@ fn a_flat_sheet_maps_a_checkerboard_without_distortion() {
         assert!((sx / sy - 1.0).abs() < 0.01, "squares {sx:.2} × {sy:.2} px");
     }
 }
+
+/// The bundled textures (datasets/textures) are exactly what drapelab's generators draw, so their
+/// provenance line holds; `DRAPELAB_BLESS=1` rewrites them.
+#[test]
+fn the_bundled_textures_are_drapelabs_own_drawings() {
+    let dir = root().join("datasets/textures");
+    for (file, img) in [
+        ("woven_check.png", drapelab_core::surface::woven_check(256)),
+        ("warp_stripes.png", drapelab_core::surface::warp_stripes(128)),
+    ] {
+        let path = dir.join(file);
+        if std::env::var("DRAPELAB_BLESS").is_ok_and(|v| v == "1") {
+            img.save(&path).unwrap();
+        }
+        let bundled = image::open(&path).unwrap().to_rgb8();
+        assert!(bundled == img, "{file} differs from its generator");
+    }
+}
