@@ -52,6 +52,7 @@ pub fn surface(a: SurfaceArgs) -> Result<i32> {
         rotation_deg: a.rotation_deg,
         resolution: a.resolution,
         view_deg: pair(&a.view, "--view")?,
+        picture_px: [1000, 750],
     };
     params.validate(|k| format!("--{}", k.replace('_', "-")))?;
     let texture = load_texture(a.texture.as_deref(), "--texture")?;

@@ -16,6 +16,7 @@ mod cusick_predict;
 mod cusick_report;
 mod cusick_tables;
 mod fit_edges;
+mod montage;
 mod peers;
 pub mod report;
 mod score;

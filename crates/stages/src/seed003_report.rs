@@ -104,6 +104,10 @@ impl StageKind for Seed003Report {
             "Table 10.1's free end against the grid (fvm_cantilever_convergence.csv)",
         ),
         Slot::optional_many("sweeps", "sweep tables shown as they are"),
+        Slot::optional_many(
+            "surfaces",
+            "pictures of textured drape surfaces (surface stages), shown in §10.8's section",
+        ),
     ];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("markdown", "the report, .md"),
@@ -172,6 +176,7 @@ fn run(ctx: &StageContext<'_>, p: &Seed003ReportParams) -> Result<()> {
     for f in ctx.input_files("sweeps") {
         md += &sweep_section(f)?;
     }
+    md += &surfaces_section(ctx)?;
     write_outputs(ctx, md, &solved, &load_svg)?;
     ctx.progress.item_done(&ctx.stage.name);
     Ok(())
@@ -615,6 +620,35 @@ fn sweep_section(f: &Path) -> Result<String> {
     Ok(md)
 }
 
+/// Seed 003 §10.8's textured surfaces: the pictures of the `surfaces` input, each captioned with its
+/// surface.json (beside the picture when the stage wrote one) or its file name.
+fn surfaces_section(ctx: &StageContext<'_>) -> Result<String> {
+    let files = ctx.input_files("surfaces");
+    if files.is_empty() {
+        return Ok(String::new());
+    }
+    let md_dir = ctx.output("markdown")?.parent().map(Path::to_path_buf);
+    let mut md = String::from(
+        "## Textured surfaces (§10.8)\n\nAs seed 003's Fig. 10.28: each drape interpolated by a bicubic B-spline \
+surface through every particle (uniform knots), a disc extended to the rectangle and trimmed along its outline \
+(closed cubic B-splines in the parameter plane), the fabric texture laid on the warp and weft with the repeats \
+given; the `.glb` beside each run opens in Blender or any glTF viewer (`drapelab surface --help`).\n\n",
+    );
+    for f in files {
+        let name = f
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        let link = if f.parent().map(Path::to_path_buf) == md_dir {
+            name.clone()
+        } else {
+            f.display().to_string()
+        };
+        let _ = writeln!(md, "![{name}]({link})\n");
+    }
+    Ok(md)
+}
+
 /// Writes the report, the drapes' SVG and, when asked, the load–displacement SVG and the montage.
 fn write_outputs(
     ctx: &StageContext<'_>,
@@ -632,8 +666,10 @@ fn write_outputs(
             .collect();
         let _ = write!(
             md,
-            "\nRendered (shaded, orthographic, 30° above the horizon, turned 30° about the vertical; pedestal \
-and table drapes also from straight above, their vertical projection), left to right and top to bottom: {}.\n\n\
+            "\nEach drape as its smooth bicubic B-spline surface (seed 003 §10.8; a disc trimmed along its \
+outline), lit by a key and a fill light, orthographic, 30° above the horizon and turned 30° about the \
+vertical; pedestal and table drapes also from straight above (their vertical projection). Left to right \
+and top to bottom: {}.\n\n\
 ![rendered drapes](seed003_drapes.png)\n",
             order.join(", ")
         );
@@ -666,69 +702,31 @@ fn corner_a(sol: &Solution) -> ((f64, f64, f64), (f64, f64, f64)) {
     ((a.x, a.y, -a.z), (-b.x, -b.y, -b.z))
 }
 
-/// Side of a tile of the rendered montage, px.
-const TILE_PX: u32 = 300;
-
-/// Every drape rendered in a tile of a montage (four tiles a row): seen obliquely, and for a scene
-/// with a table or pedestal also from above (each such scene takes two tiles).
+/// Every drape's tile of the montage (a drape on a table or pedestal also from above).
 fn drapes_png(solved: &[Solved]) -> image::RgbImage {
-    let mut tiles = Vec::new();
-    for s in solved {
-        let x = s.coarse.grid_positions();
-        let present: Vec<bool> = s.coarse.model.masses[..x.len()]
-            .iter()
-            .map(|m| *m > 0.0)
-            .collect();
-        // The diagonal of the drape's bounding box bounds its picture from any direction.
-        let (lo, hi) = x.iter().zip(&present).filter(|(_, p)| **p).fold(
-            (
-                nalgebra::Vector3::repeat(f64::INFINITY),
-                nalgebra::Vector3::repeat(f64::NEG_INFINITY),
-            ),
-            |(lo, hi), (q, _)| (lo.inf(q), hi.sup(q)),
-        );
-        let extent_cm = (hi - lo).norm() * 100.0;
-        let px_per_cm = (TILE_PX as f64 - 20.0) / extent_cm.max(1e-3);
-        let view = |el: f64| {
-            drapelab_core::edges::render_view(
-                &s.coarse.grid,
-                &s.coarse.x,
-                &present,
-                30.0,
-                el,
-                px_per_cm,
-                10,
-            )
-        };
-        tiles.push(view(30.0));
-        let supported = s.scene.obstacles.iter().any(|o| {
-            matches!(
-                o,
-                drapelab_core::contact::Obstacle::Box { .. }
-                    | drapelab_core::contact::Obstacle::Pedestal { .. }
-            )
-        });
-        if supported {
-            tiles.push(view(90.0));
-        }
-    }
-    let cols = 4u32;
-    let rows = (tiles.len() as u32).div_ceil(cols).max(1);
-    let mut canvas =
-        image::RgbImage::from_pixel(cols * TILE_PX, rows * TILE_PX, image::Rgb([255; 3]));
-    for (k, t) in tiles.iter().enumerate() {
-        let (c, r) = (k as u32 % cols, k as u32 / cols);
-        let t = image::imageops::crop_imm(t, 0, 0, t.width().min(TILE_PX), t.height().min(TILE_PX))
-            .to_image();
-        let (dx, dy) = ((TILE_PX - t.width()) / 2, (TILE_PX - t.height()) / 2);
-        image::imageops::overlay(
-            &mut canvas,
-            &t,
-            (c * TILE_PX + dx) as i64,
-            (r * TILE_PX + dy) as i64,
-        );
-    }
-    canvas
+    let tiles: Vec<crate::montage::Tile<'_>> = solved
+        .iter()
+        .map(|s| {
+            let n = s.coarse.grid.len();
+            crate::montage::Tile {
+                name: &s.scene.name,
+                grid: &s.coarse.grid,
+                x: &s.coarse.x[..n],
+                present: s.coarse.model.masses[..n]
+                    .iter()
+                    .map(|m| *m > 0.0)
+                    .collect(),
+                from_above: s.scene.obstacles.iter().any(|o| {
+                    matches!(
+                        o,
+                        drapelab_core::contact::Obstacle::Box { .. }
+                            | drapelab_core::contact::Obstacle::Pedestal { .. }
+                    )
+                }),
+            }
+        })
+        .collect();
+    crate::montage::montage(&tiles)
 }
 
 /// Each drape seen from above (x, y; darker is lower) and from the side (x, z), two panels per scene.

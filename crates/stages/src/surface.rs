@@ -119,6 +119,9 @@ pub struct SurfaceParams {
     /// Where the picture looks from: azimuth and elevation, degrees. Default [30, 30].
     #[serde(default = "default_view")]
     pub view_deg: [f64; 2],
+    /// Size of the picture, px (width, height). Default [1000, 750].
+    #[serde(default = "default_picture")]
+    pub picture_px: [u32; 2],
 }
 
 fn one_one() -> [f64; 2] {
@@ -130,6 +133,9 @@ fn default_resolution() -> usize {
 fn default_view() -> [f64; 2] {
     [30.0, 30.0]
 }
+fn default_picture() -> [u32; 2] {
+    [1000, 750]
+}
 
 impl Default for SurfaceParams {
     fn default() -> Self {
@@ -138,6 +144,7 @@ impl Default for SurfaceParams {
             rotation_deg: 0.0,
             resolution: default_resolution(),
             view_deg: default_view(),
+            picture_px: default_picture(),
         }
     }
 }
@@ -160,6 +167,16 @@ impl SurfaceParams {
                 flag("resolution"),
                 "",
                 format!("resolution must be 2..=2000 (got {})", self.resolution),
+            ));
+        }
+        if !self.picture_px.iter().all(|p| (16..=8000).contains(p)) {
+            return Err(InputError::new(
+                flag("picture_px"),
+                "",
+                format!(
+                    "picture sides must be 16..=8000 px (got {:?})",
+                    self.picture_px
+                ),
             ));
         }
         if !self.rotation_deg.is_finite() || !self.view_deg.iter().all(|v| v.is_finite()) {
@@ -285,7 +302,7 @@ pub fn picture(
 pub struct SurfaceOutputs {
     /// The binary glTF.
     pub glb: Option<PathBuf>,
-    /// The rendered picture (PNG, 1000 × 750 px).
+    /// The rendered picture (PNG, `picture_px`).
     pub picture: Option<PathBuf>,
     /// The rerun recording.
     pub recording: Option<PathBuf>,
@@ -310,7 +327,12 @@ pub fn make_surface(
         drapelab_record::write_surface_rrd(p, &d.mesh, &d.st, texture, name)?;
     }
     if let Some(p) = &out.picture {
-        let img = picture(&d, texture, params, (1000, 750));
+        let img = picture(
+            &d,
+            texture,
+            params,
+            (params.picture_px[0], params.picture_px[1]),
+        );
         drapelab_record::write_atomic(p, |f| {
             img.write_to(&mut std::io::BufWriter::new(f), image::ImageFormat::Png)?;
             Ok(())

@@ -2,8 +2,8 @@
 //! B-spline curves, and which parameters lie inside it.
 //!
 //! The outline of the kept triangles of a drape's grid (a disc's staircase) is chained into loops;
-//! each loop is the control polygon of a uniform periodic cubic B-spline curve, which smooths the
-//! staircase to the curve through its middle. Corners on the border of the parameter square are kept
+//! each loop, its one-cell zigzag removed by Taubin smoothing (which does not shrink it), is the
+//! control polygon of a uniform periodic cubic B-spline curve through the staircase's middle. Corners on the border of the parameter square are kept
 //! sharp (their control point is tripled) where the outline runs along that border, so a region cut
 //! by the grid's edge keeps its straight edge and corners; a disc that only touches the border stays
 //! round there.
@@ -47,6 +47,27 @@ fn periodic_curve(ctrl: &[[f64; 2]]) -> Vec<[f64; 2]> {
         }
     }
     out
+}
+
+/// Passes of Taubin smoothing of a staircase outline before it becomes a control polygon.
+const SMOOTHING_PASSES: usize = 4;
+
+/// Taubin's λ|μ smoothing of a closed polygon (λ = 0.5, μ = −0.53 a pass): removes the staircase's
+/// one-cell zigzag without shrinking the outline; `fixed` points (on the parameter square's border)
+/// stay.
+fn taubin(pts: &mut [[f64; 2]], fixed: &[bool], passes: usize) {
+    let n = pts.len();
+    for _ in 0..passes {
+        for f in [0.5, -0.53] {
+            let old = pts.to_vec();
+            for k in (0..n).filter(|&k| !fixed[k]) {
+                let (a, b) = (old[(k + n - 1) % n], old[(k + 1) % n]);
+                for c in 0..2 {
+                    pts[k][c] += f * (0.5 * (a[c] + b[c]) - old[k][c]);
+                }
+            }
+        }
+    }
 }
 
 /// Signed area of a closed polygon (counter-clockwise positive).
@@ -116,17 +137,19 @@ impl Trim {
             .into_iter()
             .map(|lp| {
                 let n = lp.len();
+                let mut pts: Vec<[f64; 2]> = lp.iter().map(|&k| points[k as usize]).collect();
+                let corner: Vec<bool> = (0..n)
+                    .map(|k| {
+                        let (a, p, b) = (pts[(k + n - 1) % n], pts[k], pts[(k + 1) % n]);
+                        let turn = (p[0] - a[0]) * (b[1] - p[1]) - (p[1] - a[1]) * (b[0] - p[0]);
+                        (along_border(a, p) || along_border(p, b)) && turn.abs() > 1e-15
+                    })
+                    .collect();
+                let fixed: Vec<bool> = pts.iter().map(|p| edge(p[0]) || edge(p[1])).collect();
+                taubin(&mut pts, &fixed, SMOOTHING_PASSES);
                 let mut ctrl = Vec::with_capacity(n + 8);
-                for k in 0..n {
-                    let p = points[lp[k] as usize];
-                    let (a, b) = (
-                        points[lp[(k + n - 1) % n] as usize],
-                        points[lp[(k + 1) % n] as usize],
-                    );
-                    let turn = (p[0] - a[0]) * (b[1] - p[1]) - (p[1] - a[1]) * (b[0] - p[0]);
-                    let corner = (along_border(a, p) || along_border(p, b)) && turn.abs() > 1e-15;
-                    let copies = if corner { 3 } else { 1 };
-                    ctrl.extend(std::iter::repeat_n(p, copies));
+                for (p, c) in pts.iter().zip(&corner) {
+                    ctrl.extend(std::iter::repeat_n(*p, if *c { 3 } else { 1 }));
                 }
                 periodic_curve(&ctrl)
             })
