@@ -54,7 +54,14 @@ pub fn surface(a: SurfaceArgs) -> Result<i32> {
         view_deg: pair(&a.view, "--view")?,
         picture_px: [1000, 750],
     };
-    params.validate(|k| format!("--{}", k.replace('_', "-")))?;
+    params.check().map_err(|(k, m)| {
+        let flag = if k == "view_deg" {
+            "--view".to_string()
+        } else {
+            format!("--{}", k.replace('_', "-"))
+        };
+        InputError::new(flag, "", m)
+    })?;
     let texture = load_texture(a.texture.as_deref(), "--texture")?;
     let src = &a.source;
     let is_run = src.is_dir() || src.extension().is_some_and(|e| e == "json");

@@ -434,3 +434,53 @@ fn the_bundled_textures_are_drapelabs_own_drawings() {
         assert!(bundled == img, "{file} differs from its generator");
     }
 }
+
+/// The `surface` stage kind in a pipeline: a scene solved in the stage and dressed with a bundled
+/// texture (its glb passes the validator, the picture is the size asked for); repeats ≤ 0 in its
+/// params are refused when the plan loads (exit 2, naming the file and key), before anything runs.
+#[test]
+fn the_surface_stage_dresses_a_scene_and_refuses_bad_repeats() {
+    let pipeline = r#"
+name = "t"
+[stages.dress]
+kind = "surface"
+inputs.drape = "datasets/scenes/hang4.toml"
+inputs.texture = "datasets/textures/warp_stripes.png"
+outputs.glb = "{run}/dress/drape.glb"
+outputs.picture = "{run}/dress/drape.png"
+outputs.summary = "{run}/dress/surface.json"
+params = { repeats = [2.0, 2.0], resolution = 41, picture_px = [320, 240] }
+"#;
+    let (tmp, file) = crate::support::temp_project(
+        &["datasets/scenes/hang4.toml", "datasets/textures/*.png"],
+        "t.toml",
+        pipeline,
+    );
+    crate::support::run_plan(&file);
+    let dir = tmp.path().join("runs/t/dress");
+    let pic = image::open(dir.join("drape.png")).unwrap();
+    assert_eq!((pic.width(), pic.height()), (320, 240));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("surface.json")).unwrap()).unwrap();
+    assert_eq!(s["vertices"], 41 * 41);
+    assert!(
+        s["texture"].as_str().unwrap().ends_with("warp_stripes.png"),
+        "{s}"
+    );
+    assert_eq!(
+        gltf_validate(&dir.join("drape.glb"))["issues"]["numErrors"],
+        0
+    );
+    let bad = file.with_file_name("bad.toml");
+    std::fs::write(
+        &bad,
+        pipeline.replace("repeats = [2.0, 2.0]", "repeats = [2.0, 0.0]"),
+    )
+    .unwrap();
+    let err = crate::support::assert_bad_input(
+        ["run".as_ref(), bad.as_os_str()],
+        &["bad.toml", "stages.dress.params.repeats"],
+    );
+    assert!(err.contains("> 0"), "{err}");
+    assert!(!tmp.path().join("runs/bad").exists(), "{err}");
+}

@@ -11,7 +11,7 @@ use drapelab_core::surface::{
     DrapeSurface, Paint, Parametrization, SurfaceMesh, TextureMapping, View, projected_area,
     render_surface, woven_check,
 };
-use drapelab_pipeline::{Slot, StageContext, StageKind};
+use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
 use image::RgbImage;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -150,40 +150,38 @@ impl Default for SurfaceParams {
 }
 
 impl SurfaceParams {
-    /// Checks the values; `flag` names each one's flag or key in the error (exit 2).
-    pub fn validate(&self, flag: impl Fn(&str) -> String) -> Result<(), InputError> {
+    /// Checks the values: the offending key and what is wrong.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
         if !self.repeats.iter().all(|r| r.is_finite() && *r > 0.0) {
-            return Err(InputError::new(
-                flag("repeats"),
-                "",
-                format!(
-                    "repeats must be > 0 along both directions (got {:?}), e.g. 6,6",
-                    self.repeats
-                ),
-            ));
+            let m = format!(
+                "repeats must be > 0 along both directions (got {:?}), e.g. 6,6",
+                self.repeats
+            );
+            return Err(("repeats", m));
         }
         if !(2..=2000).contains(&self.resolution) {
-            return Err(InputError::new(
-                flag("resolution"),
-                "",
+            return Err((
+                "resolution",
                 format!("resolution must be 2..=2000 (got {})", self.resolution),
             ));
         }
         if !self.picture_px.iter().all(|p| (16..=8000).contains(p)) {
-            return Err(InputError::new(
-                flag("picture_px"),
-                "",
-                format!(
-                    "picture sides must be 16..=8000 px (got {:?})",
-                    self.picture_px
-                ),
+            let m = format!(
+                "picture sides must be 16..=8000 px (got {:?})",
+                self.picture_px
+            );
+            return Err(("picture_px", m));
+        }
+        if !self.rotation_deg.is_finite() {
+            return Err((
+                "rotation_deg",
+                "the rotation must be a finite number of degrees".into(),
             ));
         }
-        if !self.rotation_deg.is_finite() || !self.view_deg.iter().all(|v| v.is_finite()) {
-            return Err(InputError::new(
-                flag("rotation_deg"),
-                "",
-                "angles must be finite numbers of degrees",
+        if !self.view_deg.iter().all(|v| v.is_finite()) {
+            return Err((
+                "view_deg",
+                "the view's angles must be finite numbers of degrees".into(),
             ));
         }
         Ok(())
@@ -370,8 +368,10 @@ impl StageKind for Surface {
         ),
         Slot::optional("summary", "counts, areas and settings, .json"),
     ];
+    fn check(p: &SurfaceParams) -> Result<(), ParamError> {
+        p.check().map_err(|(k, m)| ParamError::new(k, m))
+    }
     fn run(ctx: &StageContext<'_>, p: &SurfaceParams) -> Result<()> {
-        p.validate(|k| format!("stage `{}` params.{k}", ctx.stage.name))?;
         let path = ctx.input("drape")?;
         let texture_path = ctx.optional_input("texture")?;
         let texture = load_texture(texture_path, "inputs.texture")?;
