@@ -24,7 +24,7 @@ fn png_bytes(texture: &RgbImage) -> Result<Vec<u8>> {
 
 /// Appends `bytes` to `bin` (4-byte aligned) and returns its (offset, length).
 fn push_view(bin: &mut Vec<u8>, bytes: &[u8]) -> (usize, usize) {
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let off = bin.len();
@@ -80,7 +80,7 @@ pub fn glb_bytes(
         .iter()
         .map(|b| push_view(&mut bin, b))
         .collect();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let n = mesh.positions.len();
@@ -120,7 +120,7 @@ pub fn glb_bytes(
         "buffers": [{"byteLength": bin.len()}],
     });
     let mut js = serde_json::to_vec(&doc)?;
-    while js.len() % 4 != 0 {
+    while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
     let total = 12 + 8 + js.len() + 8 + bin.len();

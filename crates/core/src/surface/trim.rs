@@ -106,10 +106,7 @@ pub fn outline(points: &[[f64; 2]], triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
     while let Some((&start, _)) = next.iter().find(|(_, v)| !v.is_empty()) {
         let mut lp = vec![start];
         let mut at = start;
-        loop {
-            let Some(b) = next.get_mut(&at).and_then(|v| v.pop()) else {
-                break;
-            };
+        while let Some(b) = next.get_mut(&at).and_then(|v| v.pop()) {
             if b == start {
                 break;
             }
