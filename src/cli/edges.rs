@@ -1,20 +1,18 @@
-//! Parsing of the photo commands' flags.
+//! Parsing of comma-separated flags (the photo commands, `surface`).
 
 use drapelab_core::error::InputError;
 
-/// Parses `x1,y1,x2,y2`.
-pub fn parse_corners(s: &str) -> Result<[(f64, f64); 2], InputError> {
-    let v: Vec<f64> = s
-        .split(',')
+/// Parses comma-separated numbers given to `flag`; the error says what was `expected`.
+pub fn numbers(s: &str, flag: &str, expected: &str) -> Result<Vec<f64>, InputError> {
+    s.split(',')
         .map(|t| t.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| {
-            InputError::new(
-                "--corners",
-                "",
-                format!("expected x1,y1,x2,y2 in pixels, got `{s}`"),
-            )
-        })?;
+        .map_err(|_| InputError::new(format!("{flag} {s}"), "", format!("expected {expected}")))
+}
+
+/// Parses `x1,y1,x2,y2`.
+pub fn parse_corners(s: &str) -> Result<[(f64, f64); 2], InputError> {
+    let v = numbers(s, "--corners", "x1,y1,x2,y2 in pixels")?;
     if v.len() != 4 {
         return Err(InputError::new(
             "--corners",

@@ -162,34 +162,7 @@ pub enum Command {
     /// areas, settings).
     ///
     /// Example: drapelab surface datasets/scenes/skirt_wool.toml --out runs/skirt_surface --repeats 6,6
-    Surface {
-        /// A scene TOML (solved here) or a run folder (or its run.json) written by `simulate`.
-        #[arg(value_name = "SCENE_OR_RUN")]
-        source: PathBuf,
-        /// Output folder (created; files are written atomically).
-        #[arg(long)]
-        out: PathBuf,
-        /// The fabric's texture image, PNG or JPEG (default: drapelab's woven check, 256 px).
-        #[arg(long)]
-        texture: Option<PathBuf>,
-        /// Repeats of the texture along the warp and the weft, U,V (or one number for both), each > 0:
-        /// 1 lays the image once over the sheet, 6,6 as seed 003's Fig. 10.28.
-        #[arg(long, default_value = "1,1", allow_hyphen_values = true)]
-        repeats: String,
-        /// Rotation of the texture on the fabric, degrees counter-clockwise (0: its horizontal along
-        /// the warp).
-        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-        rotation_deg: f64,
-        /// Lattice of the surface's parameter square, points per side (2..=2000).
-        #[arg(long, default_value_t = 200)]
-        resolution: usize,
-        /// Where the picture looks from: azimuth,elevation in degrees (90 elevation: from above).
-        #[arg(long, default_value = "30,30", allow_hyphen_values = true)]
-        view: String,
-        /// Scene overrides when SCENE_OR_RUN is a scene, as for simulate.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-    },
+    Surface(surface::SurfaceArgs),
     /// Solve a 4- or 2-corner hang and render it as a photo.
     ///
     /// The camera faces the sheet (along +y). Writes DIR/photo.png (or .jpg), camera.json (exact
@@ -446,25 +419,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             print!("{}", crate::stages::tables_markdown()?);
             Ok(EXIT_OK)
         }
-        Command::Surface {
-            source,
-            out,
-            texture,
-            repeats,
-            rotation_deg,
-            resolution,
-            view,
-            set,
-        } => surface::surface(surface::SurfaceArgs {
-            source,
-            out,
-            texture,
-            repeats,
-            rotation_deg,
-            resolution,
-            view,
-            set,
-        }),
+        Command::Surface(args) => surface::surface(args),
         Command::Render {
             scene,
             out,

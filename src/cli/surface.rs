@@ -8,35 +8,44 @@ use crate::stages::{
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 
-/// The raw flags of `drapelab surface`.
+/// The flags of `drapelab surface`, as typed (checked once by [`surface`]).
+#[derive(clap::Args, Debug)]
 pub struct SurfaceArgs {
+    /// A scene TOML (solved here) or a run folder (or its run.json) written by `simulate`.
+    #[arg(value_name = "SCENE_OR_RUN")]
     pub source: PathBuf,
+    /// Output folder (created; files are written atomically).
+    #[arg(long)]
     pub out: PathBuf,
+    /// The fabric's texture image, PNG or JPEG (default: drapelab's woven check, 256 px).
+    #[arg(long)]
     pub texture: Option<PathBuf>,
+    /// Repeats of the texture along the warp and the weft, U,V (or one number for both), each > 0:
+    /// 1 lays the image once over the sheet, 6,6 as seed 003's Fig. 10.28.
+    #[arg(long, default_value = "1,1", allow_hyphen_values = true)]
     pub repeats: String,
+    /// Rotation of the texture on the fabric, degrees counter-clockwise (0: its horizontal along
+    /// the warp).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub rotation_deg: f64,
+    /// Lattice of the surface's parameter square, points per side (2..=2000).
+    #[arg(long, default_value_t = 200)]
     pub resolution: usize,
+    /// Where the picture looks from: azimuth,elevation in degrees (90 elevation: from above).
+    #[arg(long, default_value = "30,30", allow_hyphen_values = true)]
     pub view: String,
+    /// Scene overrides when SCENE_OR_RUN is a scene, as for simulate.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
 }
 
 /// Parses "A,B" (or "A" for both) as two numbers; `flag` names the flag in the error.
 fn pair(s: &str, flag: &str) -> Result<[f64; 2], InputError> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|t| t.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| {
-            InputError::new(
-                format!("{flag} {s}"),
-                "",
-                "expected two numbers A,B (or one for both), e.g. 6,6",
-            )
-        })?;
-    match v.as_slice() {
+    match super::edges::numbers(s, flag, "two numbers A,B (or one for both), e.g. 6,6")?.as_slice()
+    {
         [a] => Ok([*a, *a]),
         [a, b] => Ok([*a, *b]),
-        _ => Err(InputError::new(
+        v => Err(InputError::new(
             format!("{flag} {s}"),
             "",
             format!("expected two numbers A,B, got {}", v.len()),

@@ -31,7 +31,7 @@ pub use photo::{fit_photo, render_scene, score_files};
 pub use rrd::RerunRecorder;
 pub use run_dir::simulate_to_dir;
 pub use sampled::{Sampled, StateSink};
-pub use surface_out::{glb_bytes, write_glb, write_surface_rrd};
+pub use surface_out::{TexturedSurface, glb_bytes, write_glb, write_surface_rrd};
 pub use table::{
     Table, join_columns, read_table, table_batch, table_fields, table_markdown, write_parquet,
     write_table,

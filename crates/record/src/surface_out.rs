@@ -10,6 +10,20 @@ use serde_json::json;
 use std::io::Write;
 use std::path::Path;
 
+/// A textured drape surface to write: the mesh, a texture coordinate per vertex, the texture image
+/// and a name for the node and mesh.
+#[derive(Clone, Copy)]
+pub struct TexturedSurface<'a> {
+    /// The evaluated surface.
+    pub mesh: &'a SurfaceMesh,
+    /// Texture coordinates (s, t) of its vertices.
+    pub st: &'a [[f64; 2]],
+    /// The texture.
+    pub texture: &'a RgbImage,
+    /// Name of the node and mesh (the scene's).
+    pub name: &'a str,
+}
+
 /// drapelab's +Z-up metres to glTF's +Y-up metres: (x, y, z) → (x, z, −y), a rotation.
 fn y_up(p: &nalgebra::Vector3<f64>) -> [f32; 3] {
     [p.x as f32, p.z as f32, -p.y as f32]
@@ -32,15 +46,15 @@ fn push_view(bin: &mut Vec<u8>, bytes: &[u8]) -> (usize, usize) {
     (off, bytes.len())
 }
 
-/// The bytes of a binary glTF 2.0 of `mesh` with texture coordinates `st` (one per vertex) and
-/// `texture` embedded as PNG: positions and normals +Y up in metres, one double-sided material
-/// (metallic 0, roughness 1), the texture repeating. `name` names the node and mesh.
-pub fn glb_bytes(
-    mesh: &SurfaceMesh,
-    st: &[[f64; 2]],
-    texture: &RgbImage,
-    name: &str,
-) -> Result<Vec<u8>> {
+/// The bytes of a binary glTF 2.0 of `surface`, its texture embedded as PNG: positions and normals +Y up in metres, one double-sided material
+/// (metallic 0, roughness 1), the texture repeating.
+pub fn glb_bytes(surface: &TexturedSurface<'_>) -> Result<Vec<u8>> {
+    let TexturedSurface {
+        mesh,
+        st,
+        texture,
+        name,
+    } = *surface;
     anyhow::ensure!(
         st.len() == mesh.positions.len(),
         "one texture coordinate per vertex"
@@ -138,14 +152,8 @@ pub fn glb_bytes(
 }
 
 /// Writes [`glb_bytes`] to `out`, atomically.
-pub fn write_glb(
-    out: &Path,
-    mesh: &SurfaceMesh,
-    st: &[[f64; 2]],
-    texture: &RgbImage,
-    name: &str,
-) -> Result<()> {
-    let bytes = glb_bytes(mesh, st, texture, name)?;
+pub fn write_glb(out: &Path, surface: &TexturedSurface<'_>) -> Result<()> {
+    let bytes = glb_bytes(surface)?;
     write_atomic(out, |f| {
         f.write_all(&bytes)?;
         Ok(())
@@ -154,20 +162,17 @@ pub fn write_glb(
 }
 
 /// Writes a rerun recording of the textured surface at `surface/<name>` (Z up, metres), atomically.
-pub fn write_surface_rrd(
-    out: &Path,
-    mesh: &SurfaceMesh,
-    st: &[[f64; 2]],
-    texture: &RgbImage,
-    name: &str,
-) -> Result<()> {
+pub fn write_surface_rrd(out: &Path, surface: &TexturedSurface<'_>) -> Result<()> {
+    let TexturedSurface {
+        mesh, st, texture, ..
+    } = *surface;
     let staged = Staged::new(out)?;
     let rec = rerun::RecordingStreamBuilder::new("drapelab_surface").save(staged.path())?;
     rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
     let f3 = |p: &nalgebra::Vector3<f64>| [p.x as f32, p.y as f32, p.z as f32];
     let format = rerun::components::ImageFormat::rgb8([texture.width(), texture.height()]);
     rec.log_static(
-        format!("surface/{name}"),
+        format!("surface/{}", surface.name),
         &rerun::Mesh3D::new(mesh.positions.iter().map(f3))
             .with_vertex_normals(mesh.normals.iter().map(f3))
             .with_vertex_texcoords(st.iter().map(|s| [s[0] as f32, s[1] as f32]))

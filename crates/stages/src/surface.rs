@@ -318,11 +318,17 @@ pub fn make_surface(
 ) -> Result<SurfaceSummary> {
     let d = dress(drape, params, texture_name)?;
     let name = drape.scene.name.as_str();
+    let textured = drapelab_record::TexturedSurface {
+        mesh: &d.mesh,
+        st: &d.st,
+        texture,
+        name,
+    };
     if let Some(p) = &out.glb {
-        drapelab_record::write_glb(p, &d.mesh, &d.st, texture, name)?;
+        drapelab_record::write_glb(p, &textured)?;
     }
     if let Some(p) = &out.recording {
-        drapelab_record::write_surface_rrd(p, &d.mesh, &d.st, texture, name)?;
+        drapelab_record::write_surface_rrd(p, &textured)?;
     }
     if let Some(p) = &out.picture {
         let img = picture(
