@@ -224,6 +224,32 @@ fn solve_lines(
         .collect()
 }
 
+/// For fewer than four parameters `u`, the lines' Lagrange polynomial (degree 1 or 2 in the
+/// parameter) sampled at thirds (two nodes) or also at the midpoints (three); otherwise unchanged.
+fn densify(u: &[f64], lines: Vec<Vec<Vector3<f64>>>) -> (Vec<f64>, Vec<Vec<Vector3<f64>>>) {
+    let t: Vec<f64> = match u {
+        [a, b] => vec![*a, a + (b - a) / 3.0, a + 2.0 * (b - a) / 3.0, *b],
+        [a, b, c] => vec![*a, (a + b) / 2.0, *b, (b + c) / 2.0, *c],
+        _ => return (u.to_vec(), lines),
+    };
+    let lagrange = |l: &[Vector3<f64>], x: f64| -> Vector3<f64> {
+        (0..u.len())
+            .map(|k| {
+                let w: f64 = (0..u.len())
+                    .filter(|&m| m != k)
+                    .map(|m| (x - u[m]) / (u[k] - u[m]))
+                    .product();
+                l[k] * w
+            })
+            .sum()
+    };
+    let lines = lines
+        .iter()
+        .map(|l| t.iter().map(|&x| lagrange(l, x)).collect())
+        .collect();
+    (t, lines)
+}
+
 impl BSplineSurface {
     /// The surface through the `nx` × `ny` grid `nodes` (index j·nx + i), both at least 2. None when
     /// an interpolation system is singular (coincident parameters).
@@ -259,8 +285,24 @@ impl BSplineSurface {
         if nx < 2 || ny < 2 || nodes.len() != nx * ny || u.len() != nx || v.len() != ny {
             return None;
         }
+        let params = (u.clone(), v.clone());
+        // Fewer than four nodes along a direction (a 3-line strip): the polynomial through them,
+        // sampled at four or five parameters, which the cubic then reproduces exactly.
+        let (u, rows) = densify(
+            &u,
+            (0..ny)
+                .map(|j| nodes[j * nx..(j + 1) * nx].to_vec())
+                .collect(),
+        );
+        let (v, cols) = densify(
+            &v,
+            (0..u.len())
+                .map(|i| (0..ny).map(|j| rows[j][i]).collect())
+                .collect(),
+        );
+        let (nx, ny) = (u.len(), v.len());
         let rows: Vec<Vec<Vector3<f64>>> = (0..ny)
-            .map(|j| nodes[j * nx..(j + 1) * nx].to_vec())
+            .map(|j| (0..nx).map(|i| cols[i][j]).collect())
             .collect();
         let (bu, bv) = (Basis::interpolating(&u), Basis::interpolating(&v));
         // Along u for every row, then along v for every column of those control points.
@@ -279,7 +321,7 @@ impl BSplineSurface {
             bu,
             bv,
             ctrl,
-            params: (u, v),
+            params,
         })
     }
 
@@ -320,6 +362,27 @@ impl BSplineSurface {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_strip_of_three_lines_is_interpolated_through_its_nodes() {
+        // A cantilever's 41 × 3 grid: along v the quadratic through the three lines.
+        let (nx, ny) = (9, 3);
+        let nodes: Vec<Vector3<f64>> = (0..nx * ny)
+            .map(|p| {
+                let (i, j) = ((p % nx) as f64, (p / nx) as f64);
+                Vector3::new(0.1 * i, 0.05 * j, -0.01 * i * i + 0.002 * j * j)
+            })
+            .collect();
+        for n in [ny, 2] {
+            let s = BSplineSurface::interpolate(&nodes[..nx * n], nx, n, Parametrization::Uniform)
+                .expect("a surface");
+            let (u, v) = &s.params;
+            let worst = (0..nx * n)
+                .map(|p| (s.point(u[p % nx], v[p / nx]) - nodes[p]).norm())
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-12, "{n} lines: {worst:e}");
+        }
+    }
 
     /// A curved 9 × 7 grid: a draped-looking bump on an uneven grid.
     fn grid(nx: usize, ny: usize) -> Vec<Vector3<f64>> {
