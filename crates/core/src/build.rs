@@ -40,6 +40,15 @@ pub fn absent_particles(scene: &Scene, x0: &[Vector3<f64>]) -> Vec<bool> {
         .collect()
 }
 
+/// Which grid particles belong to the sheet: all of a square sheet, a disc's inside its circle (the
+/// complement of [`absent_particles`] at the flat start).
+pub fn present_particles(scene: &Scene) -> Vec<bool> {
+    absent_particles(scene, &initial_positions(scene))
+        .iter()
+        .map(|a| !a)
+        .collect()
+}
+
 /// Initial positions of the grid particles ([`Scene::initial_positions`]).
 pub fn initial_positions(scene: &Scene) -> Vec<Vector3<f64>> {
     scene.initial_positions()

@@ -292,10 +292,7 @@ pub fn drape_measures(
 ) -> DrapeMeasures {
     use crate::contact::Obstacle;
     let x0 = crate::build::initial_positions(scene);
-    let present: Vec<bool> = crate::build::absent_particles(scene, &x0)
-        .iter()
-        .map(|a| !a)
-        .collect();
+    let present = crate::build::present_particles(scene);
     let proj = vertical_projection(grid, x, &present, PIXELS);
     let flat_proj = vertical_projection(grid, &x0, &present, PIXELS);
     // The support: the first table or pedestal; its area is the part of the flat specimen above its

@@ -3,6 +3,20 @@
 //! [`crate::edges`] and the textured surfaces of [`crate::surface`].
 
 use image::{Rgb, RgbImage};
+use nalgebra::Vector3;
+
+/// An orthographic camera's frame for a view `elevation_deg` above the horizon (90: straight down),
+/// turned `azimuth_deg` about the vertical (0: looking along +y): right r, forward (into the picture)
+/// d, up u.
+pub fn camera_frame(azimuth_deg: f64, elevation_deg: f64) -> [Vector3<f64>; 3] {
+    let (sa, ca) = azimuth_deg.to_radians().sin_cos();
+    let (se, ce) = elevation_deg.to_radians().sin_cos();
+    [
+        Vector3::new(ca, -sa, 0.0),
+        Vector3::new(sa * ce, ca * ce, -se),
+        Vector3::new(sa * se, ca * se, ce),
+    ]
+}
 
 /// What the rasterizer hands the shader for a visible sample: the triangle (its position in the
 /// list given) and the sample's barycentric weights of its three corners.

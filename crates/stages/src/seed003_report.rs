@@ -712,10 +712,7 @@ fn drapes_png(solved: &[Solved]) -> image::RgbImage {
                 name: &s.scene.name,
                 grid: &s.coarse.grid,
                 x: &s.coarse.x[..n],
-                present: s.coarse.model.masses[..n]
-                    .iter()
-                    .map(|m| *m > 0.0)
-                    .collect(),
+                present: drapelab_core::build::present_particles(&s.scene),
                 from_above: s.scene.obstacles.iter().any(|o| {
                     matches!(
                         o,
@@ -739,10 +736,7 @@ fn drapes_svg(solved: &[Solved]) -> Result<String> {
         let rows = root.split_evenly((k, 2));
         for (s, pair) in solved.iter().zip(rows.chunks(2)) {
             let x = s.coarse.grid_positions();
-            let present: Vec<bool> = s.coarse.model.masses[..x.len()]
-                .iter()
-                .map(|m| *m > 0.0)
-                .collect();
+            let present = drapelab_core::build::present_particles(&s.scene);
             let pts: Vec<_> = x
                 .iter()
                 .zip(&present)

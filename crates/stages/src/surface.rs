@@ -3,7 +3,7 @@
 //! folder. [`make_surface`] is what `drapelab surface` and the stage kind share.
 
 use anyhow::{Context, Result, bail};
-use drapelab_core::build::build_scene;
+use drapelab_core::build::{self, build_scene};
 use drapelab_core::error::InputError;
 use drapelab_core::scene::{LoadedScene, Scene, ValidatedScene};
 use drapelab_core::solve::{NoObserver, Observer, Status};
@@ -67,17 +67,8 @@ pub fn load_run(path: &Path) -> Result<Drape> {
         }
         x[grid.index(i, j)] = p;
     }
-    let present = present_of(&scene);
+    let present = build::present_particles(&scene);
     Ok(Drape { scene, x, present })
-}
-
-/// Which of the scene's grid particles belong to the sheet (a disc leaves its corners out).
-fn present_of(scene: &ValidatedScene) -> Vec<bool> {
-    let built = build_scene(scene);
-    built.model.masses[..built.grid.len()]
-        .iter()
-        .map(|m| *m > 0.0)
-        .collect()
 }
 
 /// The drape of a scene, solved here (statically or as the scene says); an error when it does not
@@ -99,7 +90,7 @@ pub fn solve_drape(loaded: &LoadedScene, observer: &mut dyn Observer) -> Result<
     Ok(Drape {
         scene: scene.clone(),
         x,
-        present: present_of(scene),
+        present: build::present_particles(scene),
     })
 }
 

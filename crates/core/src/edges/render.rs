@@ -232,12 +232,7 @@ pub fn render_view(
     px_per_cm: f64,
     margin_px: u32,
 ) -> RgbImage {
-    let (sa, ca) = azimuth_deg.to_radians().sin_cos();
-    let (se, ce) = elevation_deg.to_radians().sin_cos();
-    // Camera frame: right r, forward (into the picture) d, up u.
-    let r = Vector3::new(ca, -sa, 0.0);
-    let d = Vector3::new(sa * ce, ca * ce, -se);
-    let u = Vector3::new(sa * se, ca * se, ce);
+    let [r, d, u] = crate::raster::camera_frame(azimuth_deg, elevation_deg);
     let s = px_per_cm * 100.0;
     let keep = |k: usize| present.get(k).copied().unwrap_or(true);
     let pts: Vec<(f64, f64, f64)> = x[..grid.len()]

@@ -36,12 +36,7 @@ pub fn render_surface(
     size: (u32, u32),
     margin: u32,
 ) -> RgbImage {
-    let (sa, ca) = view.azimuth_deg.to_radians().sin_cos();
-    let (se, ce) = view.elevation_deg.to_radians().sin_cos();
-    // Camera frame: right r, forward (into the picture) d, up u.
-    let r = Vector3::new(ca, -sa, 0.0);
-    let d = Vector3::new(sa * ce, ca * ce, -se);
-    let u = Vector3::new(sa * se, ca * se, ce);
+    let [r, d, u] = crate::raster::camera_frame(view.azimuth_deg, view.elevation_deg);
     let proj: Vec<(f64, f64, f64)> = mesh
         .positions
         .iter()
