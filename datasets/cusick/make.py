@@ -1,4 +1,4 @@
-"""Copies a subset of ../shared/cusick/ (samples 1-4 of every fabric) into datasets/cusick/, keeping
+"""Copies a subset of ../shared/cusick/ (samples 1-4 of every fabric: all of fabrics 11-15, which have two) into datasets/cusick/, keeping
 the source's layout, file names and column names. Run once, by hand, from the repository root:
     .venv/bin/python datasets/cusick/make.py /work/shared/cusick
 drapelab never reads the source folder at run or test time."""
@@ -46,7 +46,7 @@ for d in sorted(SRC.glob("fabric_*")):
             shutil.copy(jpg, out / jpg.name)
 readme = (SRC / "README.md").read_text()
 (DST / "README.md").write_text(
-    "> **Provenance (drapelab):** a subset (samples 1-4 of fabrics 1-10) of `../shared/cusick/`, copied by "
+    "> **Provenance (drapelab):** a subset (samples 1-4 of fabrics 1-10, both specimens of fabrics 11-15) of `../shared/cusick/`, copied by "
     "`datasets/cusick/make.py` with the source's layout, file names and columns; `fabrics.csv` still gives the "
     "source's counts (12 specimens, 48 captures). The data are the Cusick drape dataset of Gong, Mao & Wang, "
     "\"Bayesian Differentiable Physics for Cloth Digitalization\", CVPR 2024 (arXiv 2402.17664), as described below.\n\n"
