@@ -10,8 +10,9 @@ use crate::cusick_measure::ShadowRow;
 use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use anyhow::Result;
 use drapelab_core::cusick::{
-    DiscMesh, DrapeParams, Tester, calibrate_bending_length, drape_dc, height_profile,
-    mesh_projection, polar_disc, sector_angle_rad, shadow_measures, subdivide_disc,
+    BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricSettings, NodeDistribution, SpecimenTargets, Tester,
+    calibrate_fabric, height_profile, mesh_projection, polar_disc, sector_angle_rad,
+    seeded_drapes, shadow_measures, subdivide_disc,
 };
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -26,12 +27,8 @@ use std::time::Instant;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CusickPredictParams {
-    /// Perturbation seeds of each prediction. Default 4.
+    /// Perturbation seeds of each prediction (after the calibration's seeds). Default 6.
     pub seeds: u64,
-    /// Bending lengths the calibration searches, m. Default [0.008, 0.06] (below 8 mm the solves need more than their 1000 Newton iterations).
-    pub bracket_m: [f64; 2],
-    /// Relative width at which the calibration's bisection stops. Default 0.02.
-    pub rel_tol: f64,
     /// Rings of the height profile z(r) between pedestal and edge. Default 12.
     pub profile_bins: usize,
     /// Rings of a polar disc mesh to simulate on (6k vertices on ring k); 0, the default, simulates
@@ -40,19 +37,21 @@ pub struct CusickPredictParams {
     pub polar_rings: usize,
     /// Times the simulated mesh is refined (each triangle split into four). Default 0.
     pub subdivisions: usize,
-    /// The drape model (its bending length is what is calibrated).
+    /// How each fabric is calibrated: anisotropies tried, seeds per candidate, the bending-length
+    /// bracket.
+    pub calibration: FabricSettings,
+    /// The drape model (its bending length and anisotropy are what is calibrated).
     pub drape: DrapeParams,
 }
 
 impl Default for CusickPredictParams {
     fn default() -> Self {
         CusickPredictParams {
-            seeds: 4,
-            bracket_m: [0.008, 0.06],
-            rel_tol: 0.02,
+            seeds: 6,
             profile_bins: 12,
             polar_rings: 0,
             subdivisions: 0,
+            calibration: FabricSettings::default(),
             drape: DrapeParams::default(),
         }
     }
@@ -272,12 +271,11 @@ fn profile_rows(
     (rows, rms)
 }
 
-/// The measured side of a fabric: the calibration specimen, its target DC and that target's
-/// standard error, and the other specimens' DC mean, SD and median node count.
+/// The measured side of a fabric: the calibration specimen (its DC, that DC's standard error and
+/// its median node count) and the other specimens' DC mean, SD and median node count.
 struct Targets {
     calib: i32,
-    target_pct: f64,
-    target_se_pct: f64,
+    specimen: SpecimenTargets,
     others: Vec<CaptureKey>,
     dc_mean_pct: f64,
     dc_sd_pct: f64,
@@ -286,19 +284,18 @@ struct Targets {
 
 fn targets(rows: &[&ShadowRow]) -> Targets {
     let calib = rows.iter().map(|r| r.sample).min().unwrap_or(0);
-    let own: Vec<f64> = rows
-        .iter()
-        .filter(|r| r.sample == calib)
-        .map(|r| r.dc_photo_pct)
-        .collect();
-    let (target_pct, sd) = mean_sd(&own);
+    let own: Vec<&&ShadowRow> = rows.iter().filter(|r| r.sample == calib).collect();
+    let (dc_pct, sd) = mean_sd(&own.iter().map(|r| r.dc_photo_pct).collect::<Vec<_>>());
     let others: Vec<&&ShadowRow> = rows.iter().filter(|r| r.sample != calib).collect();
     let (dc_mean_pct, dc_sd_pct) =
         mean_sd(&others.iter().map(|r| r.dc_photo_pct).collect::<Vec<_>>());
     Targets {
         calib,
-        target_pct,
-        target_se_pct: sd / (own.len().max(1) as f64).sqrt(),
+        specimen: SpecimenTargets {
+            dc_pct,
+            dc_se_pct: sd / (own.len().max(1) as f64).sqrt(),
+            nodes: median(own.iter().map(|r| r.nodes_photo as f64).collect()),
+        },
         others: others
             .iter()
             .map(|r| (r.fabric, r.sample, r.capture))
@@ -307,6 +304,95 @@ fn targets(rows: &[&ShadowRow]) -> Targets {
         dc_sd_pct,
         nodes_median: median(others.iter().map(|r| r.nodes_photo as f64).collect()),
     }
+}
+
+fn empty_row(fabric: i32, tg: &Targets) -> PredictionRow {
+    PredictionRow {
+        fabric,
+        calibration_sample: tg.calib,
+        bending_length_warp_m: None,
+        bending_length_weft_m: None,
+        bending_length_mean_m: None,
+        bending_ratio_warp_over_weft: None,
+        bending_saturation_curvature_per_m: None,
+        laws_within_one_node: String::new(),
+        law_identifiable: None,
+        bending_length_lo_m: None,
+        bending_length_hi_m: None,
+        dc_sensitivity_pct: None,
+        bending_rigidity_N_m: None,
+        dc_predicted_pct: None,
+        dc_predicted_sd_pct: None,
+        dc_measured_mean_pct: tg.dc_mean_pct,
+        dc_measured_sd_pct: tg.dc_sd_pct,
+        dc_calibration_pct: tg.specimen.dc_pct,
+        nodes_predicted: None,
+        nodes_predicted_mode: None,
+        nodes_predicted_histogram: String::new(),
+        prediction_seeds: 0,
+        nodes_calibration_median: tg.specimen.nodes,
+        nodes_measured_median: tg.nodes_median,
+        profile_rms_mm: None,
+        status: String::new(),
+        solves: 0,
+        solve_time_mean_s: 0.0,
+        wall_time_s: 0.0,
+    }
+}
+
+/// A bending law in a few characters: "ρ=2", "ρ=1,κ₀c=2".
+pub fn law_label(law: &BendingLaw) -> String {
+    match law.bending_saturation {
+        Some(s) => format!("ρ={},κ₀c={s}", law.bending_ratio),
+        None => format!("ρ={}", law.bending_ratio),
+    }
+}
+
+/// The fitted parameters into a row: c and the law, warp and weft bending lengths (B ∝ c³, so
+/// c_warp = c ρ^(1/6)), the rigidity where the density is known.
+fn fill_fit(row: &mut PredictionRow, fit: &FabricFit, weight_N_per_m2: Option<f64>) {
+    let (c, rho) = (fit.bending_length_m, fit.law.bending_ratio);
+    row.bending_length_mean_m = Some(c);
+    row.bending_length_warp_m = Some(c * rho.powf(1.0 / 6.0));
+    row.bending_length_weft_m = Some(c * rho.powf(-1.0 / 6.0));
+    row.bending_ratio_warp_over_weft = Some(rho);
+    row.bending_saturation_curvature_per_m = fit.law.bending_saturation.map(|s| s / c);
+    row.laws_within_one_node = fit
+        .laws_within_one_node
+        .iter()
+        .map(law_label)
+        .collect::<Vec<_>>()
+        .join(" ");
+    row.law_identifiable = Some(fit.law_identifiable);
+    row.bending_rigidity_N_m = weight_N_per_m2.map(|w| w * c.powi(3));
+    row.dc_sensitivity_pct = fit.dc_sensitivity_pct;
+    if let Some([lo, hi]) = fit.bending_length_interval_m {
+        row.bending_length_lo_m = Some(lo);
+        row.bending_length_hi_m = Some(hi);
+    }
+}
+
+/// The predicted distribution into a row.
+fn fill_distribution(row: &mut PredictionRow, d: &NodeDistribution) {
+    row.dc_predicted_pct = Some(d.dc_mean_pct);
+    row.dc_predicted_sd_pct = Some(d.dc_sd_pct);
+    row.nodes_predicted = Some(d.nodes_mean);
+    row.nodes_predicted_mode = Some(d.nodes_mode as i32);
+    row.nodes_predicted_histogram = d
+        .histogram
+        .iter()
+        .map(|(n, k)| format!("{n}×{k}"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    row.status = if d.converged == d.tried {
+        "ok".into()
+    } else {
+        format!(
+            "{} of {} perturbed drapes did not converge",
+            d.tried - d.converged,
+            d.tried
+        )
+    };
 }
 
 fn predict_fabric(
@@ -321,93 +407,34 @@ fn predict_fabric(
     let tester = Tester::default();
     let tg = targets(rows);
     let mut out = FabricPrediction {
-        row: PredictionRow {
-            fabric,
-            calibration_sample: tg.calib,
-            bending_length_warp_m: None,
-            bending_length_weft_m: None,
-            bending_length_lo_m: None,
-            bending_length_hi_m: None,
-            dc_sensitivity_pct: None,
-            bending_rigidity_N_m: None,
-            dc_predicted_pct: None,
-            dc_predicted_sd_pct: None,
-            dc_measured_mean_pct: tg.dc_mean_pct,
-            dc_measured_sd_pct: tg.dc_sd_pct,
-            dc_calibration_pct: tg.target_pct,
-            nodes_predicted: None,
-            nodes_measured_median: tg.nodes_median,
-            profile_rms_mm: None,
-            status: String::new(),
-            solves: 0,
-            solve_time_mean_s: 0.0,
-            wall_time_s: 0.0,
-        },
+        row: empty_row(fabric, &tg),
         outlines: Vec::new(),
         profiles: Vec::new(),
         drapes: Vec::new(),
         measured: measured.of_fabric(fabric),
     };
-    let cal = calibrate_bending_length(
-        mesh,
-        tg.target_pct,
-        &p.drape,
-        &tester,
-        p.bracket_m,
-        p.rel_tol,
-    );
-    let cal = match cal {
-        Ok(c) => c,
+    let fit = match calibrate_fabric(mesh, &tg.specimen, &p.drape, &tester, &p.calibration) {
+        Ok(f) => f,
         Err(why) => {
             out.row.status = format!("not calibrated: {why}");
             out.row.wall_time_s = start.elapsed().as_secs_f64();
             return out;
         }
     };
-    let c = cal.bending_length_m;
-    let drapes: Vec<(u64, f64, usize, Vec<Vector3<f64>>)> = (0..p.seeds)
-        .into_par_iter()
-        .filter_map(|seed| {
-            let q = DrapeParams {
-                bending_length_m: c,
-                seed,
-                ..p.drape.clone()
-            };
-            drape_dc(mesh, &q, &tester).map(|(dc, nodes, x)| (seed, dc, nodes, x))
-        })
-        .collect();
-    let solves = cal.evaluations.len() + p.seeds as usize;
-    let row = &mut out.row;
-    row.solves = solves as i32;
-    row.solve_time_mean_s = start.elapsed().as_secs_f64() / solves as f64;
-    row.bending_length_warp_m = Some(c);
-    row.bending_length_weft_m = Some(c);
-    let w = p.drape.areal_density_kg_per_m2 * p.drape.gravity_m_per_s2;
-    row.bending_rigidity_N_m = density_known.then(|| w * c.powi(3));
-    row.dc_sensitivity_pct = cal.sensitivity_pct(1.3);
-    row.status = if drapes.len() as u64 == p.seeds {
-        "ok".into()
-    } else {
-        format!(
-            "{} of {} perturbed drapes did not converge",
-            p.seeds as usize - drapes.len(),
-            p.seeds
-        )
-    };
+    let weight = density_known.then(|| p.drape.areal_density_kg_per_m2 * p.drape.gravity_m_per_s2);
+    fill_fit(&mut out.row, &fit, weight);
+    let q = fit.law.apply(&p.drape, fit.bending_length_m);
+    let first = p.calibration.calibration_seeds;
+    let drapes = seeded_drapes(mesh, &q, &tester, first..first + p.seeds);
+    let solves = fit.solves + p.seeds as usize;
+    out.row.solves = solves as i32;
+    out.row.prediction_seeds = p.seeds as i32;
+    out.row.solve_time_mean_s = start.elapsed().as_secs_f64() / solves as f64;
+    match NodeDistribution::of(&drapes, p.seeds as usize) {
+        Some(d) => fill_distribution(&mut out.row, &d),
+        None => out.row.status = "no perturbed drape converged".into(),
+    }
     if !drapes.is_empty() {
-        let (m, sd) = mean_sd(&drapes.iter().map(|d| d.1).collect::<Vec<_>>());
-        row.dc_predicted_pct = Some(m);
-        row.dc_predicted_sd_pct = Some(sd);
-        row.nodes_predicted =
-            Some(drapes.iter().map(|d| d.2 as f64).sum::<f64>() / drapes.len() as f64);
-        // The calibration's DC is uncertain by its photos' standard error and by the seed it used.
-        let sigma = tg
-            .target_se_pct
-            .hypot(if drapes.len() > 1 { sd } else { 0.0 });
-        if let Some([lo, hi]) = cal.interval_m(sigma, 2.0) {
-            row.bending_length_lo_m = Some(lo);
-            row.bending_length_hi_m = Some(hi);
-        }
         let meas: Vec<Vec<f64>> = out
             .measured
             .iter()
@@ -416,17 +443,17 @@ fn predict_fabric(
             .collect();
         let sim: Vec<Vec<f64>> = drapes
             .iter()
-            .map(|d| height_profile(mesh.rest_xy, &d.3, &tester, p.profile_bins))
+            .map(|d| height_profile(mesh.rest_xy, &d.x, &tester, p.profile_bins))
             .collect();
         let (profiles, rms) = profile_rows(fabric, &meas, &sim, p.profile_bins);
         out.profiles = profiles;
         out.row.profile_rms_mm = if meas.is_empty() { None } else { rms };
         out.outlines = drapes
             .iter()
-            .flat_map(|(seed, _, _, x)| simulated_outline(fabric, *seed, x, mesh.triangles))
+            .flat_map(|d| simulated_outline(fabric, d.seed, &d.x, mesh.triangles))
             .collect();
     }
-    out.drapes = drapes.into_iter().map(|d| (d.0, d.3)).collect();
+    out.drapes = drapes.into_iter().map(|d| (d.seed, d.x)).collect();
     out.row.wall_time_s = start.elapsed().as_secs_f64();
     out
 }

@@ -12,10 +12,21 @@ pub struct PredictionRow {
     pub fabric: i32,
     /// The specimen calibrated on (the lowest-numbered).
     pub calibration_sample: i32,
-    /// Bending length along the warp, m (the model is isotropic: warp = weft; None if the calibration failed).
+    /// Bending length along the warp (the stiffer direction), c·ρ^(1/6), m (None if the calibration failed).
     pub bending_length_warp_m: Option<f64>,
-    /// Bending length along the weft, m.
+    /// Bending length along the weft, c·ρ^(−1/6), m.
     pub bending_length_weft_m: Option<f64>,
+    /// Calibrated bending length c of the geometric-mean rigidity √(B_warp B_weft), m.
+    pub bending_length_mean_m: Option<f64>,
+    /// Calibrated bending anisotropy ρ = B_warp / B_weft (1: isotropic).
+    pub bending_ratio_warp_over_weft: Option<f64>,
+    /// Calibrated curvature κ₀ beyond which the bending moment levels off, 1/m (None: linear bending).
+    pub bending_saturation_curvature_per_m: Option<f64>,
+    /// Every bending law tried whose drapes' mean node count lies within 1 of the calibration
+    /// target, e.g. "ρ=1 ρ=2 ρ=1,κ₀c=2" (κ₀c: saturation curvature times c).
+    pub laws_within_one_node: String,
+    /// Whether the laws' node counts tell them apart (they span more than one node).
+    pub law_identifiable: Option<bool>,
     /// Bending rigidity, N·m (None where the areal density is unknown: it needs the weight).
     pub bending_rigidity_N_m: Option<f64>,
     /// Lower end of the 2σ interval of the bending length, m: c · exp(−2σ/s), σ the uncertainty of
@@ -35,8 +46,16 @@ pub struct PredictionRow {
     pub dc_measured_sd_pct: f64,
     /// DC of the calibration specimen (the target), %.
     pub dc_calibration_pct: f64,
-    /// Mean simulated node count over the perturbations.
+    /// Mean simulated node count over the perturbation seeds.
     pub nodes_predicted: Option<f64>,
+    /// Most frequent simulated node count over the seeds (the smaller on a tie).
+    pub nodes_predicted_mode: Option<i32>,
+    /// The simulated node counts' histogram, "nodes×seeds" ascending (e.g. "6×2 7×4").
+    pub nodes_predicted_histogram: String,
+    /// Perturbation seeds of the prediction (disjoint from the calibration's).
+    pub prediction_seeds: i32,
+    /// Median node count of the calibration specimen's photos (the calibration's target).
+    pub nodes_calibration_median: f64,
     /// Median measured node count (photos) of the other specimens.
     pub nodes_measured_median: f64,
     /// RMS over the rings of simulated minus measured mean height z(r), mm (None without registered meshes).

@@ -6,8 +6,11 @@
 //! seeded random perturbation; the spread over seeds is part of the prediction.
 
 use super::Tester;
-use crate::physics::{Gravity, Model, SpringFamily, Springs, hinge_bending};
-use crate::solve::{NoObserver, SolveReport, StaticOptions, solve_static};
+use crate::physics::{Gravity, Model, SpringFamily, Springs, saturating_hinge_bending};
+use crate::solve::{
+    ImplicitSettings, NoObserver, Observer, Settle, SolveReport, StaticOptions, StopReason, integrate_implicit,
+    solve_static,
+};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -29,8 +32,39 @@ pub struct DrapeParams {
     pub perturbation_m: f64,
     /// Seed of the perturbation.
     pub seed: u64,
+    /// Angular modes of the perturbation: 0 lifts every vertex by its own random amount (white
+    /// noise, whose spectrum depends on the mesh); K > 0 lifts the sheet by a smooth field
+    /// Σ_{k=1..K} g_k cos(kθ + φ_k) of the material angle θ (g_k normal, φ_k uniform, seeded), the
+    /// same on every mesh. Default 16 (the fold count then converges with the mesh: README).
+    pub perturbation_modes: usize,
     /// Gravitational acceleration, m/s². Default 9.81.
     pub gravity_m_per_s2: f64,
+    /// Bending anisotropy B_warp / B_weft (≥ 1 puts the stiffer direction along the warp); the
+    /// bending length is that of the geometric mean √(B_warp B_weft). Default 1 (isotropic).
+    pub bending_ratio: f64,
+    /// Bending saturation: the curvature beyond which the bending moment levels off, in units of
+    /// 1/c (κ₀ = saturation / c; the moment then stays at B κ₀, as inter-fibre friction makes it
+    /// in fabric). Default none (linear bending, M = B κ).
+    pub bending_saturation: Option<f64>,
+    /// Direction of the warp from the template's +x, degrees. Default 0.
+    pub warp_angle_deg: f64,
+    /// How the drape reaches equilibrium. Default `cone`.
+    pub start: DrapeStart,
+    /// `fall` start: simulated time of the fall before Newton finishes the drape, s. Default 0.4.
+    pub fall_time_s: f64,
+    /// `fall` start: largest implicit-Euler step, s. Default 0.002.
+    pub fall_max_dt_s: f64,
+}
+
+/// The path by which a simulated specimen reaches its drape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DrapeStart {
+    /// Newton from the specimen lowered into a cone of `start_cone_deg`, perturbed.
+    Cone,
+    /// The instrument's path: the flat specimen, perturbed, released onto the pedestal and falling
+    /// under gravity (implicit Euler for `fall_time_s`), then Newton to the equilibrium.
+    Fall,
 }
 
 impl Default for DrapeParams {
@@ -42,7 +76,14 @@ impl Default for DrapeParams {
             start_cone_deg: 60.0,
             perturbation_m: 0.002,
             seed: 0,
+            perturbation_modes: 16,
             gravity_m_per_s2: 9.81,
+            bending_ratio: 1.0,
+            bending_saturation: None,
+            warp_angle_deg: 0.0,
+            start: DrapeStart::Cone,
+            fall_time_s: 0.4,
+            fall_max_dt_s: 0.002,
         }
     }
 }
@@ -88,6 +129,7 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
     let masses: Vec<f64> = area.iter().map(|a| a * p.areal_density_kg_per_m2).collect();
     let weight = p.areal_density_kg_per_m2 * p.gravity_m_per_s2;
     let rigidity = weight * p.bending_length_m.powi(3);
+    let root = p.bending_ratio.max(1e-6).sqrt();
     let fixed: Vec<bool> = mesh
         .rest_xy
         .iter()
@@ -100,7 +142,13 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
         n_grid: n,
         terms: vec![
             Box::new(Springs::new(SpringFamily::Tensile, pairs, rest, stiff)),
-            Box::new(hinge_bending(mesh.rest_xy, mesh.triangles, rigidity)),
+            Box::new(saturating_hinge_bending(
+                mesh.rest_xy,
+                mesh.triangles,
+                [rigidity * root, rigidity / root],
+                p.warp_angle_deg.to_radians(),
+                p.bending_saturation.map_or(f64::INFINITY, |s| s / p.bending_length_m),
+            )),
             Box::new(Gravity::new(masses, p.gravity_m_per_s2)),
         ],
         gravity_m_per_s2: p.gravity_m_per_s2,
@@ -113,8 +161,22 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
 /// free vertex lifted or lowered by a seeded random amount of RMS `perturbation_m`.
 pub fn drape_start(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Vec<Vector3<f64>> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(p.seed);
-    let (s, c) = p.start_cone_deg.to_radians().sin_cos();
+    let cone = match p.start {
+        DrapeStart::Cone => p.start_cone_deg,
+        DrapeStart::Fall => 0.0,
+    };
+    let (s, c) = cone.to_radians().sin_cos();
     let r0 = tester.pedestal_radius_m;
+    // The smooth field's modes: amplitude g_k (normal, by Box–Muller) and phase φ_k, scaled so that
+    // its RMS over θ is `perturbation_m` on average over seeds.
+    let modes: Vec<(f64, f64)> = (1..=p.perturbation_modes)
+        .map(|_| {
+            let (u, v): (f64, f64) = (rng.random(), rng.random());
+            let g = (-2.0 * (1.0 - u).ln()).sqrt() * (std::f64::consts::TAU * v).cos();
+            (g, std::f64::consts::TAU * rng.random::<f64>())
+        })
+        .collect();
+    let mode_scale = p.perturbation_m * (2.0 / p.perturbation_modes.max(1) as f64).sqrt();
     mesh.rest_xy
         .iter()
         .map(|q| {
@@ -124,7 +186,17 @@ pub fn drape_start(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Vec<
             }
             let out = r - r0;
             let rr = r0 + out * c;
-            let noise = p.perturbation_m * 3f64.sqrt() * (2.0 * rng.random::<f64>() - 1.0);
+            let noise = if modes.is_empty() {
+                p.perturbation_m * 3f64.sqrt() * (2.0 * rng.random::<f64>() - 1.0)
+            } else {
+                let theta = q[1].atan2(q[0]);
+                mode_scale
+                    * modes
+                        .iter()
+                        .enumerate()
+                        .map(|(k, (g, phi))| g * ((k + 1) as f64 * theta + phi).cos())
+                        .sum::<f64>()
+            };
             Vector3::new(
                 q[0] * rr / r,
                 q[1] * rr / r,
@@ -140,8 +212,48 @@ pub fn solve_drape(
     p: &DrapeParams,
     tester: &Tester,
 ) -> (SolveReport, Vec<Vector3<f64>>) {
-    let model = drape_model(mesh, p, tester);
+    solve_drape_observed(mesh, p, tester, &mut NoObserver)
+}
+
+/// [`solve_drape`] handing `observer` the states it wants: the fall's accepted time steps (a `fall`
+/// start), then Newton's iterations.
+pub fn solve_drape_observed(
+    mesh: DiscMesh<'_>,
+    p: &DrapeParams,
+    tester: &Tester,
+    observer: &mut dyn Observer,
+) -> (SolveReport, Vec<Vector3<f64>>) {
+    let mut model = drape_model(mesh, p, tester);
     let mut x = drape_start(mesh, p, tester);
+    let mut fall = None;
+    if p.start == DrapeStart::Fall {
+        let mut r = SolveReport::unsolved("implicit-euler");
+        let mut v = vec![Vector3::zeros(); x.len()];
+        let s = ImplicitSettings {
+            dt_s: p.fall_max_dt_s * 0.25,
+            max_dt_s: p.fall_max_dt_s,
+            min_dt_s: 1e-7,
+            adaptive: true,
+            damping: (0.0, 0.0, 0.0),
+            newton_iterations: 25,
+            newton_tol_rel: 1e-6,
+            strain_bound: 10.0,
+        };
+        // Never settled by its criteria: the fall runs its time, then Newton takes over.
+        let settle = Settle {
+            residual_N: 0.0,
+            speed_m_per_s: 0.0,
+            extent_m: 2.0 * tester.specimen_radius_m,
+        };
+        let budget = (p.fall_time_s, None);
+        integrate_implicit(
+            &mut model, &mut x, &mut v, &s, &settle, budget, None, observer, &mut r,
+        );
+        if r.stop != StopReason::SimulatedTime {
+            return (r, x);
+        }
+        fall = Some(r);
+    }
     let opts = StaticOptions {
         residual_tol_rel: 1e-6,
         max_iterations: 1000,
@@ -150,7 +262,11 @@ pub fn solve_drape(
         sag_start: false,
         ..StaticOptions::default()
     };
-    let report = solve_static(&model, &mut x, &opts, &mut NoObserver);
+    let mut report = solve_static(&model, &mut x, &opts, observer);
+    if let Some(f) = fall {
+        report.message = format!("after a fall of {} ({}): {}", p.fall_time_s, f.message, report.message);
+        report.inner_iterations += f.inner_iterations;
+    }
     (report, x)
 }
 

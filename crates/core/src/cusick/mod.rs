@@ -6,11 +6,17 @@
 
 mod calibrate;
 mod drape;
+mod fabric;
 
 pub use calibrate::{BendingCalibration, bisect_bending_length, calibrate_bending_length};
 pub use drape::{
-    DiscMesh, DrapeParams, drape_dc, drape_model, drape_start, polar_disc, solve_drape,
-    subdivide_disc,
+    DiscMesh, DrapeParams, DrapeStart, drape_dc, drape_model, drape_start, polar_disc, solve_drape,
+    solve_drape_observed, subdivide_disc,
+};
+pub use fabric::{
+    BendingLaw, FabricFit, FabricSettings, LawCandidate, NodeDistribution, SeededDrape,
+    SpecimenTargets,
+    calibrate_fabric, seeded_drapes,
 };
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};
@@ -176,6 +182,24 @@ pub fn shadow_measures(p: &Projection, tester: &Tester) -> ShadowMeasures {
     }
 }
 
+/// The two-fold component of outlines r(θ) (sectors from θ = 0, see [`sector_angle_rad`]), averaged
+/// as complex amplitudes over `outlines` (drapes of one fabric in one orientation): its amplitude
+/// a₂ (m) and the direction θ₂ ∈ [0, π) (rad) of its maximum, r(θ) ≈ r̄ + a₂ cos 2(θ − θ₂). An
+/// orthotropic fabric reaches furthest along its stiffer direction, so θ₂ estimates the warp.
+pub fn two_fold(outlines: &[Vec<f64>]) -> (f64, f64) {
+    let (mut re, mut im) = (0.0, 0.0);
+    for o in outlines {
+        let n = o.len();
+        for (k, r) in o.iter().enumerate() {
+            let t = 2.0 * sector_angle_rad(k, n);
+            re += 2.0 * r * t.cos() / (n * outlines.len()) as f64;
+            im += 2.0 * r * t.sin() / (n * outlines.len()) as f64;
+        }
+    }
+    let theta = 0.5 * im.atan2(re);
+    (re.hypot(im), theta.rem_euclid(std::f64::consts::PI))
+}
+
 /// The azimuthally averaged height profile z(r) of a drape: the mean z of the material points whose
 /// rest radius falls in each of `bins` rings between the pedestal and the specimen's edge (NaN for
 /// an empty ring). Independent of where the folds fall.
@@ -230,6 +254,20 @@ mod tests {
             flat.dc_pct
         );
         assert_eq!(flat.nodes, 0);
+    }
+
+    #[test]
+    fn the_two_fold_component_of_an_elliptic_outline_gives_its_amplitude_and_direction() {
+        let o = |dir: f64| -> Vec<f64> {
+            (0..360)
+                .map(|k| 0.12 + 0.01 * (2.0 * (sector_angle_rad(k, 360) - dir)).cos())
+                .collect()
+        };
+        for deg in [0.0f64, 30.0, 100.0, 170.0] {
+            let (a, t) = two_fold(&[o(deg.to_radians()), o(deg.to_radians())]);
+            assert!((a - 0.01).abs() < 1e-9, "{a}");
+            assert!((t.to_degrees() - deg).abs() < 1e-6, "{} vs {deg}", t.to_degrees());
+        }
     }
 
     #[test]

@@ -16,6 +16,10 @@ pub struct QuadraticStencil<const N: usize> {
     stencils: Vec<[u32; N]>,
     coef: Vec<[f64; N]>,
     stiffness: Vec<f64>,
+    /// Per stencil, the |u| at which the energy turns from quadratic to linear (empty: quadratic
+    /// throughout): E = k u₀² (√(1 + |u|²/u₀²) − 1), a convex (pseudo-Huber) energy whose force
+    /// saturates at k u₀ (see [`QuadraticStencil::with_saturation`]).
+    saturation: Vec<f64>,
 }
 
 /// Quadratic bending on triples (a, b, c) of consecutive particles of a grid line.
@@ -65,6 +69,27 @@ impl<const N: usize> QuadraticStencil<N> {
             stencils: stencils.into_iter().map(|t| t.map(|v| v as u32)).collect(),
             coef,
             stiffness,
+            saturation: Vec::new(),
+        }
+    }
+    /// The same stencils with an energy that saturates: quadratic ½ k |u|² for |u| ≪ u₀, linear
+    /// k u₀ |u| beyond (a bending moment that levels off at large curvature, as inter-fibre friction
+    /// makes it in fabric). `u0` holds one u₀ per stencil (m); an infinite u₀ keeps it quadratic.
+    pub fn with_saturation(mut self, u0: Vec<f64>) -> Self {
+        assert_eq!(u0.len(), self.stencils.len(), "one u₀ per stencil");
+        self.saturation = u0;
+        self
+    }
+    /// (E, dE/d|u|² ·2 = ∂E/∂u / u factor s₁, and s₃ = the factor of u uᵀ in ∂²E/∂u²) of stencil k at u.
+    fn law(&self, k: usize, u: &Vector3<f64>) -> (f64, f64, f64) {
+        let kk = self.stiffness[k];
+        let u2 = u.norm_squared();
+        match self.saturation.get(k) {
+            Some(&u0) if u0.is_finite() => {
+                let q = (1.0 + u2 / (u0 * u0)).sqrt();
+                (kk * u0 * u0 * (q - 1.0), kk / q, -kk / (u0 * u0 * q * q * q))
+            }
+            _ => (0.5 * kk * u2, kk, 0.0),
         }
     }
     fn u(&self, k: usize, x: &Vecs) -> Vector3<f64> {
@@ -80,12 +105,13 @@ impl<const N: usize> EnergyTerm for QuadraticStencil<N> {
     }
     fn energy(&self, x: &Vecs) -> f64 {
         (0..self.stencils.len())
-            .map(|k| 0.5 * self.stiffness[k] * self.u(k, x).norm_squared())
+            .map(|k| self.law(k, &self.u(k, x)).0)
             .sum()
     }
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
         for k in 0..self.stencils.len() {
-            let u = self.u(k, x) * self.stiffness[k];
+            let u = self.u(k, x);
+            let u = u * self.law(k, &u).1;
             for m in 0..N {
                 g[self.stencils[k][m] as usize] += u * self.coef[k][m];
             }
@@ -98,14 +124,18 @@ impl<const N: usize> EnergyTerm for QuadraticStencil<N> {
             .map(|(c, k)| k * c.iter().map(|v| v * v).fold(0.0, f64::max))
             .fold(0.0, f64::max)
     }
-    fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _project: bool) {
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, _project: bool) {
+        // ∂²E/∂u² = s₁ I + s₃ u uᵀ, positive definite (s₁ + s₃|u|² = k/q³ > 0): no projection needed.
         for k in 0..self.stencils.len() {
             let idx = self.stencils[k].map(|v| v as usize);
-            h.push_outer(
-                &idx,
-                &self.coef[k],
-                &(Matrix3::identity() * self.stiffness[k]),
-            );
+            let block = if self.saturation.is_empty() {
+                Matrix3::identity() * self.stiffness[k]
+            } else {
+                let u = self.u(k, x);
+                let (_, s1, s3) = self.law(k, &u);
+                Matrix3::identity() * s1 + u * u.transpose() * s3
+            };
+            h.push_outer(&idx, &self.coef[k], &block);
         }
     }
 }

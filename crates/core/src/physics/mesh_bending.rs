@@ -16,6 +16,38 @@ pub fn hinge_bending(
     triangles: &[[usize; 3]],
     rigidity_N_m: f64,
 ) -> super::QuadraticStencil<4> {
+    orthotropic_hinge_bending(rest, triangles, [rigidity_N_m; 2], 0.0)
+}
+
+/// Hinge bending of an orthotropic fabric of rigidities [B_warp, B_weft] (N·m), the warp at
+/// `warp_angle_rad` from +x. A hinge stores energy ∝ cos⁴ of the angle between its in-plane normal
+/// n and the direction of curvature; over hinges of every direction, weights
+/// b(θ) = B̄ + ¾ (B_warp − B_weft) cos 2θ (θ the angle of n from the warp, B̄ the mean) give a sheet
+/// rolled along direction φ the rigidity B_warp cos²φ + B_weft sin²φ (the average of
+/// cos⁴(θ − φ) b(θ) over θ, divided by that of cos⁴). b stays positive for B_warp/B_weft < 5; beyond,
+/// it is floored at 2 % of B̄. Equal rigidities give [`hinge_bending`].
+pub fn orthotropic_hinge_bending(
+    rest: &[[f64; 2]],
+    triangles: &[[usize; 3]],
+    rigidity_N_m: [f64; 2],
+    warp_angle_rad: f64,
+) -> super::QuadraticStencil<4> {
+    saturating_hinge_bending(rest, triangles, rigidity_N_m, warp_angle_rad, f64::INFINITY)
+}
+
+/// [`orthotropic_hinge_bending`] whose moment levels off beyond the curvature `kappa0_per_m`
+/// (1/m): a hinge of curvature κ = √3 |u| / (A₀ + A₁) (so that ½ k |u|² = ½ B κ² (A₀ + A₁)/3, its
+/// share of the sheet) stores B A κ₀² (√(1 + κ²/κ₀²) − 1): ½ B κ² A below κ₀, B κ₀ |κ| A above
+/// (moment B κ₀). An infinite κ₀ is the quadratic term.
+pub fn saturating_hinge_bending(
+    rest: &[[f64; 2]],
+    triangles: &[[usize; 3]],
+    rigidity_N_m: [f64; 2],
+    warp_angle_rad: f64,
+    kappa0_per_m: f64,
+) -> super::QuadraticStencil<4> {
+    let (ws, wc) = warp_angle_rad.sin_cos();
+    let mean = 0.5 * (rigidity_N_m[0] + rigidity_N_m[1]);
     let p3 = |v: usize| Vector3::new(rest[v][0], rest[v][1], 0.0);
     let cot = |a: Vector3<f64>, b: Vector3<f64>| a.dot(&b) / a.cross(&b).norm().max(1e-300);
     // Each undirected edge → (opposite vertex, triangle area) of its triangles.
@@ -27,7 +59,8 @@ pub fn hinge_bending(
             sides.entry((i.min(j), i.max(j))).or_default().push((o, a));
         }
     }
-    let (mut stencils, mut coef, mut stiff) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut stencils, mut coef, mut stiff, mut u0) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (&(i0, i1), opp) in &sides {
         let [(i2, a0), (i3, a1)] = opp.as_slice() else {
             continue;
@@ -37,9 +70,19 @@ pub fn hinge_bending(
         let (c01, c02, c03, c04) = (cot(e0, e1), cot(e0, e2), cot(-e0, e3), cot(-e0, e4));
         stencils.push([i0, i1, *i2, *i3]);
         coef.push([c03 + c04, c01 + c02, -c01 - c03, -c02 - c04]);
-        stiff.push(rigidity_N_m / (a0 + a1));
+        // Unit in-plane normal of the edge, then its share along the warp.
+        let along_warp = (e0.y * wc - e0.x * ws) / e0.norm();
+        let cos2 = 2.0 * along_warp.powi(2) - 1.0;
+        let b = (mean + 0.75 * (rigidity_N_m[0] - rigidity_N_m[1]) * cos2).max(0.02 * mean);
+        stiff.push(b / (a0 + a1));
+        u0.push(kappa0_per_m * (a0 + a1) / 3f64.sqrt());
     }
-    super::QuadraticStencil::from_stencils("bending/hinge", stencils, coef, stiff)
+    let term = super::QuadraticStencil::from_stencils("bending/hinge", stencils, coef, stiff);
+    if kappa0_per_m.is_finite() {
+        term.with_saturation(u0)
+    } else {
+        term
+    }
 }
 
 #[cfg(test)]
@@ -131,5 +174,98 @@ mod tests {
         for k in 0..rolled.len() {
             assert!((g2[k] - g[k] - hdx[k]).norm() < 1e-9 * (1.0 + hdx[k].norm()));
         }
+    }
+
+    #[test]
+    fn a_saturating_hinge_term_has_the_gradient_and_hessian_of_its_energy() {
+        use crate::physics::{EnergyTerm, HessianBlocks};
+        let (rest, tris) = sheet(21, 11, 0.2, 0.1);
+        let term = saturating_hinge_bending(&rest, &tris, [3e-5, 1e-5], 0.4, 20.0);
+        // A bent and twisted sheet, curvatures of order 1/(5 cm) = 20/m: both regimes present.
+        let x: Vec<Vector3<f64>> = rest
+            .iter()
+            .map(|p| {
+                let t = p[0] / 0.05;
+                Vector3::new(0.05 * t.sin(), p[1], 0.05 * (1.0 - t.cos()) + 3.0 * p[0] * p[1] * p[1])
+            })
+            .collect();
+        let mut g = vec![Vector3::zeros(); x.len()];
+        term.add_gradient(&x, &mut g);
+        let h = 1e-6;
+        for p in [12, 100, 150] {
+            for d in 0..3 {
+                let (mut plus, mut minus) = (x.clone(), x.clone());
+                plus[p][d] += h;
+                minus[p][d] -= h;
+                let fd = (term.energy(&plus) - term.energy(&minus)) / (2.0 * h);
+                assert!((fd - g[p][d]).abs() < 1e-5 * g[p].norm().max(1e-9), "{fd} vs {}", g[p][d]);
+            }
+        }
+        let mut hb = HessianBlocks::default();
+        term.add_hessian(&x, &mut hb, false);
+        let dx: Vec<Vector3<f64>> = (0..x.len())
+            .map(|k| Vector3::new((k as f64).sin(), (k as f64 * 0.7).cos(), 0.3) * 1e-3)
+            .collect();
+        let mut hdx = vec![Vector3::zeros(); x.len()];
+        hb.mul_add(&dx, &mut hdx);
+        let eps = 1e-3;
+        let shift = |s: f64| -> Vec<Vector3<f64>> { x.iter().zip(&dx).map(|(a, b)| a + b * s).collect() };
+        let (mut gp, mut gm) = (vec![Vector3::zeros(); x.len()], vec![Vector3::zeros(); x.len()]);
+        term.add_gradient(&shift(eps), &mut gp);
+        term.add_gradient(&shift(-eps), &mut gm);
+        let scale = hdx.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for k in 0..x.len() {
+            let fd = (gp[k] - gm[k]) / (2.0 * eps);
+            assert!((fd - hdx[k]).norm() < 1e-6 * scale, "{k}: {fd} vs {}", hdx[k]);
+        }
+    }
+
+    #[test]
+    fn an_orthotropic_disc_rolled_along_warp_and_weft_shows_its_two_rigidities() {
+        use crate::physics::EnergyTerm;
+        let (rest, tris) = crate::cusick::polar_disc(0.15, 30);
+        let radius = 0.2;
+        let roll = |dir: f64| -> Vec<Vector3<f64>> {
+            let (s, c) = dir.sin_cos();
+            rest.iter()
+                .map(|p| {
+                    // Curvature along (c, s): arc coordinate a along it, b across.
+                    let (a, b) = (p[0] * c + p[1] * s, -p[0] * s + p[1] * c);
+                    let t = a / radius;
+                    let (x, y) = (radius * t.sin(), b);
+                    Vector3::new(x * c - y * s, x * s + y * c, radius * (1.0 - t.cos()))
+                })
+                .collect()
+        };
+        let iso = hinge_bending(&rest, &tris, 1.0);
+        for (warp_deg, ratio) in [(0.0, 2.0), (30.0, 3.0), (-60.0, 4.0)] {
+            let w = f64::to_radians(warp_deg);
+            let term = orthotropic_hinge_bending(&rest, &tris, [ratio, 1.0], w);
+            // Relative to the isotropic sheet of B = 1 rolled the same way: B(φ) = B_warp cos²φ + B_weft sin²φ.
+            for phi_deg in [0.0, 45.0, 90.0] {
+                let phi = w + f64::to_radians(phi_deg);
+                let x = roll(phi);
+                let b = term.energy(&x) / iso.energy(&x);
+                let exact = ratio * phi_deg.to_radians().cos().powi(2)
+                    + phi_deg.to_radians().sin().powi(2);
+                assert!(
+                    (b / exact - 1.0).abs() < 0.06,
+                    "warp {warp_deg}°, ratio {ratio}, rolled at {phi_deg}° from it: {b:.3} vs {exact:.3}"
+                );
+            }
+        }
+        // A saturating term: quadratic well below κ₀, B A κ₀² (√(1 + κ²/κ₀²) − 1) at any κ.
+        let x = roll(0.3);
+        for kappa0 in [50.0, 5.0, 1.0] {
+            let sat = saturating_hinge_bending(&rest, &tris, [1.0, 1.0], 0.0, kappa0);
+            let r = 1.0 / (radius * kappa0);
+            let exact = 2.0 / (r * r) * ((1.0 + r * r).sqrt() - 1.0);
+            let got = sat.energy(&x) / iso.energy(&x);
+            assert!((got / exact - 1.0).abs() < 0.03, "κ₀ {kappa0}: {got:.4} vs {exact:.4}");
+        }
+        // Equal rigidities are the isotropic term.
+        let x = roll(0.3);
+        let same = orthotropic_hinge_bending(&rest, &tris, [1.0, 1.0], 0.7);
+        assert!((same.energy(&x) / iso.energy(&x) - 1.0).abs() < 1e-12);
     }
 }

@@ -16,7 +16,7 @@ pub use contact::{BarrierContact, max_penetration_m};
 pub use friction::{FrictionAnchor, LaggedFriction};
 pub use gravity::Gravity;
 pub use loads::PointLoads;
-pub use mesh_bending::hinge_bending;
+pub use mesh_bending::{hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending};
 pub use shear::CellShear;
 pub use springs::{SpringFamily, Springs};
 

@@ -14,7 +14,7 @@ mod vertical_gap;
 pub use dynamic::{
     DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
 };
-pub use incremental::Inertia;
+pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use linear::{DofMap, SparseSpd};
 pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{Divergence, DivergenceReason, SolveReport, Status, StopReason};

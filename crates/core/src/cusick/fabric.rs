@@ -1,0 +1,374 @@
+//! One fabric's calibrate → predict workflow (issue 31): what its calibration specimen shows — the
+//! drape coefficient and the node count — fits the bending length c (geometric mean of warp and
+//! weft) and the bending law (anisotropy B_warp/B_weft, saturation of the moment); the drapes of
+//! those parameters over seeded perturbations are then the prediction for the other specimens, as
+//! a distribution.
+//!
+//! DC pins c (DC rises with c). At a given DC the bending law moves the fold count: a stiffer
+//! direction opens fewer, larger folds on stiff fabrics, and a moment that levels off at large
+//! curvature (cheap sharp folds) gives fewer folds at any DC. So the node count chooses the law
+//! where it tells the laws apart, and the fit says when it does not (an identifiability flag).
+
+use super::{DiscMesh, DrapeParams, Tester, bisect_bending_length, drape_dc};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// What the calibration specimen's captures show.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SpecimenTargets {
+    /// Mean drape coefficient of its captures, %.
+    pub dc_pct: f64,
+    /// Standard error of that mean, %.
+    pub dc_se_pct: f64,
+    /// Median node count of its captures.
+    pub nodes: f64,
+}
+
+/// One bending law a calibration tries: an anisotropy and a saturation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BendingLaw {
+    /// B_warp / B_weft (1: isotropic).
+    pub bending_ratio: f64,
+    /// Saturation curvature in units of 1/c ([`DrapeParams::bending_saturation`]); None: linear.
+    #[serde(default)]
+    pub bending_saturation: Option<f64>,
+}
+
+impl BendingLaw {
+    /// A law with no saturation.
+    pub const fn linear(bending_ratio: f64) -> Self {
+        BendingLaw {
+            bending_ratio,
+            bending_saturation: None,
+        }
+    }
+    /// The drape parameters `base` with this law and bending length `c`.
+    pub fn apply(&self, base: &DrapeParams, c: f64) -> DrapeParams {
+        DrapeParams {
+            bending_length_m: c,
+            bending_ratio: self.bending_ratio,
+            bending_saturation: self.bending_saturation,
+            ..base.clone()
+        }
+    }
+}
+
+/// Settings of a fabric calibration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FabricSettings {
+    /// Bending laws tried; the first (its c found by bisection) is the simplest. Default: linear
+    /// isotropic; linear with B_warp/B_weft = 2 and 4 (cantilever measurements of 618 fabrics,
+    /// DrapeTester/ClothDrapeTester: 1.3–2.6 for the middle half, up to 4 for the top tenth);
+    /// isotropic saturating at 2/c and 1/c. A list of one fits c alone.
+    pub laws: Vec<BendingLaw>,
+    /// Perturbation seeds per law whose mean node count is compared with the target.
+    /// Default 6 (the mean's standard error ~0.35 node).
+    pub calibration_seeds: u64,
+    /// Bending lengths the first bisection searches, m. Default [0.008, 0.06].
+    pub bracket_m: [f64; 2],
+    /// Relative width at which the bisection stops. Default 0.02.
+    pub rel_tol: f64,
+    /// DC a later candidate's secant search must reach, points. Default 1.0.
+    pub dc_tol_pct: f64,
+}
+
+impl Default for FabricSettings {
+    fn default() -> Self {
+        FabricSettings {
+            laws: vec![
+                BendingLaw::linear(1.0),
+                BendingLaw::linear(2.0),
+                BendingLaw::linear(4.0),
+                BendingLaw {
+                    bending_ratio: 1.0,
+                    bending_saturation: Some(2.0),
+                },
+                BendingLaw {
+                    bending_ratio: 1.0,
+                    bending_saturation: Some(1.0),
+                },
+            ],
+            calibration_seeds: 6,
+            bracket_m: [0.008, 0.06],
+            rel_tol: 0.02,
+            dc_tol_pct: 1.0,
+        }
+    }
+}
+
+/// One simulated drape: its seed, DC (%), node count and vertices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeededDrape {
+    /// Perturbation seed.
+    pub seed: u64,
+    /// Drape coefficient, %.
+    pub dc_pct: f64,
+    /// Nodes of its shadow.
+    pub nodes: usize,
+    /// Positions, m.
+    pub x: Vec<Vector3<f64>>,
+}
+
+/// The distribution of the node count (and DC) over perturbation seeds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NodeDistribution {
+    /// Seeds that converged.
+    pub converged: usize,
+    /// Seeds tried.
+    pub tried: usize,
+    /// Mean node count.
+    pub nodes_mean: f64,
+    /// Most frequent node count (the smaller on a tie).
+    pub nodes_mode: usize,
+    /// (nodes, how many seeds) for every node count seen, ascending.
+    pub histogram: Vec<(usize, usize)>,
+    /// Mean DC, %.
+    pub dc_mean_pct: f64,
+    /// Sample SD of the DC, %.
+    pub dc_sd_pct: f64,
+}
+
+impl NodeDistribution {
+    /// The distribution of `drapes` out of `tried` seeds (None when none converged).
+    pub fn of(drapes: &[SeededDrape], tried: usize) -> Option<Self> {
+        if drapes.is_empty() {
+            return None;
+        }
+        let n = drapes.len() as f64;
+        let mut histogram: Vec<(usize, usize)> = Vec::new();
+        let mut counts: Vec<usize> = drapes.iter().map(|d| d.nodes).collect();
+        counts.sort_unstable();
+        for k in counts {
+            match histogram.last_mut() {
+                Some(h) if h.0 == k => h.1 += 1,
+                _ => histogram.push((k, 1)),
+            }
+        }
+        let top = histogram.iter().map(|h| h.1).max().unwrap_or(0);
+        let dc_mean = drapes.iter().map(|d| d.dc_pct).sum::<f64>() / n;
+        let var = drapes
+            .iter()
+            .map(|d| (d.dc_pct - dc_mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0).max(1.0);
+        Some(NodeDistribution {
+            converged: drapes.len(),
+            tried,
+            nodes_mean: drapes.iter().map(|d| d.nodes as f64).sum::<f64>() / n,
+            nodes_mode: histogram.iter().find(|h| h.1 == top).map_or(0, |h| h.0),
+            histogram,
+            dc_mean_pct: dc_mean,
+            dc_sd_pct: var.sqrt(),
+        })
+    }
+}
+
+/// The drapes of `p` at every seed in `seeds` (in parallel; the ones that did not converge left out).
+pub fn seeded_drapes(
+    mesh: DiscMesh<'_>,
+    p: &DrapeParams,
+    tester: &Tester,
+    seeds: std::ops::Range<u64>,
+) -> Vec<SeededDrape> {
+    seeds
+        .into_par_iter()
+        .filter_map(|seed| {
+            let q = DrapeParams { seed, ..p.clone() };
+            drape_dc(mesh, &q, tester).map(|(dc_pct, nodes, x)| SeededDrape {
+                seed,
+                dc_pct,
+                nodes,
+                x,
+            })
+        })
+        .collect()
+}
+
+/// One bending law tried by the calibration: the bending length that gives the target DC with it,
+/// and the node count of its drapes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LawCandidate {
+    /// The law.
+    pub law: BendingLaw,
+    /// Bending length (geometric mean) whose seed-0 drape has the target DC, m.
+    pub bending_length_m: f64,
+    /// The calibration seeds' node distribution at that bending length.
+    pub drapes: NodeDistribution,
+}
+
+/// A fabric's calibration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FabricFit {
+    /// The chosen bending length c (geometric mean of warp and weft), m.
+    pub bending_length_m: f64,
+    /// 2σ interval of c from the DC's uncertainty (delta method over dDC/d ln c), m.
+    pub bending_length_interval_m: Option<[f64; 2]>,
+    /// dDC/d ln c near the isotropic c, %.
+    pub dc_sensitivity_pct: Option<f64>,
+    /// The chosen bending law.
+    pub law: BendingLaw,
+    /// The laws whose mean node count lies within one node of the target (the chosen law's
+    /// interval on the laws tried).
+    pub laws_within_one_node: Vec<BendingLaw>,
+    /// Whether the node count tells the laws apart (their mean node counts span more than one
+    /// node); if not, the law is not identifiable from this specimen.
+    pub law_identifiable: bool,
+    /// Every law tried.
+    pub candidates: Vec<LawCandidate>,
+    /// Drape solves made.
+    pub solves: usize,
+}
+
+/// Calibrates a fabric on its calibration specimen: c by bisection on DC for the first law, by a
+/// secant in ln c for the others (starting from the previous c and slope); per law the mean node
+/// count over `calibration_seeds`; the law whose mean is nearest the target node count wins (ties
+/// to the earlier law). Err names what failed.
+pub fn calibrate_fabric(
+    mesh: DiscMesh<'_>,
+    target: &SpecimenTargets,
+    base: &DrapeParams,
+    tester: &Tester,
+    s: &FabricSettings,
+) -> Result<FabricFit, String> {
+    let mut solves = 0usize;
+    let dc_at = |c: f64, law: &BendingLaw| -> Result<f64, String> {
+        drape_dc(mesh, &law.apply(base, c), tester)
+            .map(|r| r.0)
+            .ok_or_else(|| format!("the drape at c = {c:.4} m, {law:?} did not converge"))
+    };
+    let first = s.laws.first().ok_or("no bending law to try")?;
+    let cal = bisect_bending_length(|c| dc_at(c, first), target.dc_pct, s.bracket_m, s.rel_tol)?;
+    solves += cal.evaluations.len();
+    let slope = cal.sensitivity_pct(1.3).unwrap_or(50.0);
+    let mut candidates = Vec::new();
+    let mut c = cal.bending_length_m;
+    for (k, law) in s.laws.iter().enumerate() {
+        if k > 0 {
+            // From the previous law's c; a law that cannot reach the target is left out.
+            match secant_bending_length(|c| dc_at(c, law), target.dc_pct, c, slope, s) {
+                Ok((found, n)) => {
+                    solves += n;
+                    c = found;
+                }
+                Err(_) => continue,
+            }
+        }
+        let drapes = seeded_drapes(mesh, &law.apply(base, c), tester, 0..s.calibration_seeds);
+        solves += s.calibration_seeds as usize;
+        let Some(d) = NodeDistribution::of(&drapes, s.calibration_seeds as usize) else {
+            continue;
+        };
+        candidates.push(LawCandidate {
+            law: *law,
+            bending_length_m: c,
+            drapes: d,
+        });
+    }
+    let miss = |r: &LawCandidate| (r.drapes.nodes_mean - target.nodes).abs();
+    let best = candidates
+        .iter()
+        .min_by(|a, b| miss(a).total_cmp(&miss(b)))
+        .ok_or("no candidate's drapes converged")?
+        .clone();
+    let near: Vec<BendingLaw> = candidates
+        .iter()
+        .filter(|r| miss(r) <= 1.0)
+        .map(|r| r.law)
+        .collect();
+    let (lo, hi) = candidates
+        .iter()
+        .map(|r| r.drapes.nodes_mean)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, m| (a.0.min(m), a.1.max(m)));
+    let sigma = target.dc_se_pct.hypot(best.drapes.dc_sd_pct);
+    let scale = best.bending_length_m / cal.bending_length_m;
+    Ok(FabricFit {
+        bending_length_m: best.bending_length_m,
+        bending_length_interval_m: cal
+            .interval_m(sigma, 2.0)
+            .map(|[a, b]| [a * scale, b * scale]),
+        dc_sensitivity_pct: cal.sensitivity_pct(1.3),
+        law: best.law,
+        laws_within_one_node: near,
+        law_identifiable: hi - lo > 1.0,
+        candidates,
+        solves,
+    })
+}
+
+/// The c where `dc(c)` meets `target` within `s.dc_tol_pct`: secant steps in ln c from `c0` with
+/// slope `slope` (%/unit ln c) at first, at most six solves, each step clamped to a factor 1.5 and
+/// to `s.bracket_m`. Returns (c, solves).
+fn secant_bending_length(
+    mut dc: impl FnMut(f64) -> Result<f64, String>,
+    target: f64,
+    c0: f64,
+    slope: f64,
+    s: &FabricSettings,
+) -> Result<(f64, usize), String> {
+    let (lo, hi) = (s.bracket_m[0].ln(), s.bracket_m[1].ln());
+    let mut l = c0.ln();
+    let mut d = dc(l.exp())?;
+    let mut slope = slope;
+    for n in 1..=6 {
+        if (d - target).abs() <= s.dc_tol_pct {
+            return Ok((l.exp(), n));
+        }
+        let next = (l + ((target - d) / slope).clamp(-0.4, 0.4)).clamp(lo, hi);
+        let dn = dc(next.exp())?;
+        let measured = (dn - d) / (next - l);
+        if measured.is_finite() && measured > 5.0 {
+            slope = measured;
+        }
+        (l, d) = (next, dn);
+    }
+    if (d - target).abs() <= 2.0 * s.dc_tol_pct {
+        Ok((l.exp(), 7))
+    } else {
+        Err(format!(
+            "the secant on c did not reach DC {target:.1} % (last {d:.1} % at c = {:.4} m)",
+            l.exp()
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn drape(seed: u64, dc: f64, nodes: usize) -> SeededDrape {
+        SeededDrape {
+            seed,
+            dc_pct: dc,
+            nodes,
+            x: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_node_distribution_has_its_mean_mode_and_histogram() {
+        let d = [drape(0, 70.0, 7), drape(1, 72.0, 8), drape(2, 71.0, 7), drape(3, 73.0, 9)];
+        let n = NodeDistribution::of(&d, 5).expect("some");
+        assert_eq!(n.histogram, vec![(7, 2), (8, 1), (9, 1)]);
+        assert_eq!(n.nodes_mode, 7);
+        assert!((n.nodes_mean - 7.75).abs() < 1e-12);
+        assert!((n.dc_mean_pct - 71.5).abs() < 1e-12);
+        assert!((n.dc_sd_pct - (5.0f64 / 3.0).sqrt()).abs() < 1e-12);
+        assert_eq!((n.converged, n.tried), (4, 5));
+        assert!(NodeDistribution::of(&[], 3).is_none());
+    }
+
+    #[test]
+    fn the_secant_finds_c_on_a_logarithmic_dc() {
+        // DC = 60 + 25 ln(c / 0.02): the secant lands within its tolerance in a few solves even from
+        // a wrong slope.
+        let s = FabricSettings::default();
+        let dc = |c: f64| Ok(60.0 + 25.0 * (c / 0.02).ln());
+        let (c, n) = secant_bending_length(dc, 70.0, 0.015, 60.0, &s).expect("found");
+        assert!((dc(c).unwrap() - 70.0).abs() <= 1.0, "{c}");
+        assert!(n <= 4, "{n} solves");
+        assert!(secant_bending_length(|_| Ok(10.0), 70.0, 0.02, 50.0, &s).is_err());
+    }
+}
