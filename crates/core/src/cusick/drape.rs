@@ -1,12 +1,16 @@
 //! A specimen draped on the tester, simulated on a disc mesh (not a square grid cut to a disc, whose
 //! four-fold symmetry biases the folds): stretching springs along the mesh edges, the isotropic
 //! hinge bending of Bergou et al. 2006 of rigidity B = w g c³ (c the bending length, w the areal density),
-//! gravity, and the vertices over the pedestal held (as the BDP authors' simulator does). The folds
+//! gravity, the vertices over the pedestal held (as the BDP authors' simulator does) and the pedestal
+//! itself an obstacle (a barrier) for the others. The folds
 //! come from an instability, so the solve starts from the specimen lowered into a cone with a small
 //! seeded random perturbation; the spread over seeds is part of the prediction.
 
 use super::Tester;
-use crate::physics::{Gravity, Model, SpringFamily, Springs, saturating_hinge_bending};
+use crate::contact::Obstacle;
+use crate::physics::{
+    BarrierContact, Gravity, Model, SpringFamily, Springs, saturating_hinge_bending,
+};
 use crate::solve::{
     ImplicitSettings, NoObserver, Observer, Settle, SolveReport, StaticOptions, StopReason, integrate_implicit,
     solve_static,
@@ -137,7 +141,7 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
         .collect();
     Model {
         masses: masses.clone(),
-        fixed,
+        fixed: fixed.clone(),
         held_components: Vec::new(),
         n_grid: n,
         terms: vec![
@@ -149,11 +153,46 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
                 p.warp_angle_deg.to_radians(),
                 p.bending_saturation.map_or(f64::INFINITY, |s| s / p.bending_length_m),
             )),
-            Box::new(Gravity::new(masses, p.gravity_m_per_s2)),
+            Box::new(Gravity::new(masses.clone(), p.gravity_m_per_s2)),
+            Box::new(pedestal_contact(&masses, &fixed, p, tester)),
         ],
         gravity_m_per_s2: p.gravity_m_per_s2,
         damping_Ns_per_m: 0.0,
         elongation_rate: None,
+    }
+}
+
+/// Activation distance of the pedestal's barrier, m (a third of a fabric's thickness).
+pub const PEDESTAL_CONTACT_M: f64 = 1e-4;
+
+/// The pedestal as an obstacle (its top at z = 0, 1 m deep): a barrier keeps every free vertex out
+/// of it on any path (the fall, Newton's iterations), exact step bound (it is convex).
+fn pedestal_contact(
+    masses: &[f64],
+    fixed: &[bool],
+    p: &DrapeParams,
+    tester: &Tester,
+) -> BarrierContact {
+    let kappa = masses
+        .iter()
+        .zip(fixed)
+        .map(|(m, &f)| {
+            if f {
+                0.0
+            } else {
+                BarrierContact::kappa_for_weight(m * p.gravity_m_per_s2, PEDESTAL_CONTACT_M)
+            }
+        })
+        .collect();
+    BarrierContact {
+        obstacles: vec![Obstacle::Pedestal {
+            centre_m: [0.0, 0.0, 0.0],
+            radius_m: tester.pedestal_radius_m,
+            height_m: 1.0,
+        }],
+        d_hat_m: PEDESTAL_CONTACT_M,
+        kappa_J: kappa,
+        sliding_share: 0.0,
     }
 }
 
