@@ -32,41 +32,58 @@ fn main() -> anyhow::Result<()> {
         if mesh_name == "sub1" {
             m = subdivide_disc(&m.0, &m.1, radius);
         }
-        let mesh = DiscMesh { rest_xy: &m.0, triangles: &m.1 };
+        let mesh = DiscMesh {
+            rest_xy: &m.0,
+            triangles: &m.1,
+        };
         for start in list(&args, "--start", "cone") {
             for c in list(&args, "--c-mm", "18") {
                 for sat in list(&args, "--sat", "inf") {
-                for ratio in list(&args, "--ratio", "1") {
-                    let p = DrapeParams {
-                        bending_length_m: c.parse::<f64>()? * 1e-3,
-                        bending_ratio: ratio.parse()?,
-                        bending_saturation: if sat == "inf" { None } else { Some(sat.parse()?) },
-                        warp_angle_deg: angle,
-                        perturbation_m: pert,
-                        perturbation_modes: modes,
-                        fall_time_s: fall_time,
-                        start: if start == "fall" { DrapeStart::Fall } else { DrapeStart::Cone },
-                        ..DrapeParams::default()
-                    };
-                    let t0 = Instant::now();
-                    let r: Vec<Option<(f64, usize)>> = (0..seeds)
-                        .into_par_iter()
-                        .map(|seed| {
-                            let q = DrapeParams { seed, ..p.clone() };
-                            drape_dc(mesh, &q, &Tester::default()).map(|d| (d.0, d.1))
-                        })
-                        .collect();
-                    let dc: Vec<String> = r.iter().map(|d| d.map_or("–".into(), |d| format!("{:.1}", d.0))).collect();
-                    let nodes: Vec<String> = r.iter().map(|d| d.map_or("–".into(), |d| d.1.to_string())).collect();
-                    let ok: Vec<usize> = r.iter().flatten().map(|d| d.1).collect();
-                    let mean = ok.iter().sum::<usize>() as f64 / ok.len().max(1) as f64;
-                    println!(
-                        "{start} {mesh_name} {c} sat {sat} {ratio} | {} | {} | {mean:.2} | {:.2}",
-                        dc.join(" "),
-                        nodes.join(" "),
-                        t0.elapsed().as_secs_f64() * 2.0 / seeds as f64
-                    );
-                }
+                    for ratio in list(&args, "--ratio", "1") {
+                        let p = DrapeParams {
+                            bending_length_m: c.parse::<f64>()? * 1e-3,
+                            bending_ratio: ratio.parse()?,
+                            bending_saturation: if sat == "inf" {
+                                None
+                            } else {
+                                Some(sat.parse()?)
+                            },
+                            warp_angle_deg: angle,
+                            perturbation_m: pert,
+                            perturbation_modes: modes,
+                            fall_time_s: fall_time,
+                            start: if start == "fall" {
+                                DrapeStart::Fall
+                            } else {
+                                DrapeStart::Cone
+                            },
+                            ..DrapeParams::default()
+                        };
+                        let t0 = Instant::now();
+                        let r: Vec<Option<(f64, usize)>> = (0..seeds)
+                            .into_par_iter()
+                            .map(|seed| {
+                                let q = DrapeParams { seed, ..p.clone() };
+                                drape_dc(mesh, &q, &Tester::default()).map(|d| (d.0, d.1))
+                            })
+                            .collect();
+                        let dc: Vec<String> = r
+                            .iter()
+                            .map(|d| d.map_or("–".into(), |d| format!("{:.1}", d.0)))
+                            .collect();
+                        let nodes: Vec<String> = r
+                            .iter()
+                            .map(|d| d.map_or("–".into(), |d| d.1.to_string()))
+                            .collect();
+                        let ok: Vec<usize> = r.iter().flatten().map(|d| d.1).collect();
+                        let mean = ok.iter().sum::<usize>() as f64 / ok.len().max(1) as f64;
+                        println!(
+                            "{start} {mesh_name} {c} sat {sat} {ratio} | {} | {} | {mean:.2} | {:.2}",
+                            dc.join(" "),
+                            nodes.join(" "),
+                            t0.elapsed().as_secs_f64() * 2.0 / seeds as f64
+                        );
+                    }
                 }
             }
         }

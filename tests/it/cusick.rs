@@ -235,8 +235,14 @@ fn the_pipeline_calibrates_predicts_draws_and_records_two_fabrics() {
         let c = r.bending_length_mean_m.unwrap();
         // Warp and weft bending lengths bracket their geometric mean, c_warp/c_weft = ρ^(1/3).
         let rho = r.bending_ratio_warp_over_weft.unwrap();
-        let (cw, cf) = (r.bending_length_warp_m.unwrap(), r.bending_length_weft_m.unwrap());
-        assert!(((cw * cf).sqrt() / c - 1.0).abs() < 1e-12 && ((cw / cf).powi(3) / rho - 1.0).abs() < 1e-9);
+        let (cw, cf) = (
+            r.bending_length_warp_m.unwrap(),
+            r.bending_length_weft_m.unwrap(),
+        );
+        assert!(
+            ((cw * cf).sqrt() / c - 1.0).abs() < 1e-12
+                && ((cw / cf).powi(3) / rho - 1.0).abs() < 1e-9
+        );
         assert_eq!(r.prediction_seeds, 2);
         assert!(r.nodes_predicted_mode.is_some() && !r.nodes_predicted_histogram.is_empty());
         // The calibrated drape reproduces its target, and the interval holds c.
@@ -379,7 +385,10 @@ fn a_synthetic_orthotropic_fabric_photographed_gives_its_parameters_back() {
         fit.bending_length_m, fit.law, fit.laws_within_one_node, fit.solves
     );
     for c in &fit.candidates {
-        eprintln!("  {:?}: c = {:.4} m, nodes {:.2}", c.law, c.bending_length_m, c.drapes.nodes_mean);
+        eprintln!(
+            "  {:?}: c = {:.4} m, nodes {:.2}",
+            c.law, c.bending_length_m, c.drapes.nodes_mean
+        );
     }
     // The law's c is the geometric mean of warp and weft: compared at the true anisotropy.
     let at_truth = fit
@@ -400,12 +409,24 @@ fn a_synthetic_orthotropic_fabric_photographed_gives_its_parameters_back() {
         "{:?}",
         fit.laws_within_one_node
     );
-    assert!(fit.law.bending_ratio > 1.0, "an anisotropy is found: {:?}", fit.law);
+    assert!(
+        fit.law.bending_ratio > 1.0,
+        "an anisotropy is found: {:?}",
+        fit.law
+    );
     let outlines: Vec<Vec<f64>> = photos.iter().map(|m| m.outline_m.clone()).collect();
     let (amp, dir) = two_fold(&outlines);
     let off = ((dir.to_degrees() - warp_deg + 90.0).rem_euclid(180.0) - 90.0).abs();
-    eprintln!("two-fold amplitude {:.1} mm at {:.1}°", 1e3 * amp, dir.to_degrees());
-    assert!(off < 15.0, "warp at {:.1}° against {warp_deg}°", dir.to_degrees());
+    eprintln!(
+        "two-fold amplitude {:.1} mm at {:.1}°",
+        1e3 * amp,
+        dir.to_degrees()
+    );
+    assert!(
+        off < 15.0,
+        "warp at {:.1}° against {warp_deg}°",
+        dir.to_degrees()
+    );
 }
 
 #[test]
@@ -450,9 +471,18 @@ fn the_fall_from_flat_never_passes_through_the_pedestal() {
     let (report, x) = drapelab::cusick::solve_drape_observed(mesh, &p, &Tester::default(), &mut o);
     assert!(report.is_converged(), "{}", report.message);
     assert!(o.states > 50, "{} states", o.states);
-    assert_eq!(o.worst_m, 0.0, "a vertex went {} m into the pedestal", o.worst_m);
+    assert_eq!(
+        o.worst_m, 0.0,
+        "a vertex went {} m into the pedestal",
+        o.worst_m
+    );
     let m = shadow_measures(&mesh_projection(&x, &tris), &Tester::default());
-    assert!(m.dc_pct < 60.0 && m.nodes >= 5, "{} % {} nodes", m.dc_pct, m.nodes);
+    assert!(
+        m.dc_pct < 60.0 && m.nodes >= 5,
+        "{} % {} nodes",
+        m.dc_pct,
+        m.nodes
+    );
 }
 
 #[test]

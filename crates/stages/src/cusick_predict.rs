@@ -10,9 +10,9 @@ use crate::cusick_measure::ShadowRow;
 use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use anyhow::Result;
 use drapelab_core::cusick::{
-    BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricSettings, NodeDistribution, SpecimenTargets, Tester,
-    calibrate_fabric, height_profile, mesh_projection, polar_disc, sector_angle_rad,
-    seeded_drapes, shadow_measures, subdivide_disc,
+    BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricSettings, NodeDistribution,
+    SpecimenTargets, Tester, calibrate_and_predict, height_profile, mesh_projection, polar_disc,
+    sector_angle_rad, shadow_measures, subdivide_disc,
 };
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -413,27 +413,32 @@ fn predict_fabric(
         drapes: Vec::new(),
         measured: measured.of_fabric(fabric),
     };
-    let fit = match calibrate_fabric(mesh, &tg.specimen, &p.drape, &tester, &p.calibration) {
-        Ok(f) => f,
+    let outcome = match calibrate_and_predict(
+        mesh,
+        &tg.specimen,
+        &p.drape,
+        &tester,
+        &p.calibration,
+        p.seeds,
+    ) {
+        Ok(o) => o,
         Err(why) => {
             out.row.status = format!("not calibrated: {why}");
             out.row.wall_time_s = start.elapsed().as_secs_f64();
             return out;
         }
     };
-    let weight = density_known.then(|| p.drape.areal_density_kg_per_m2 * p.drape.gravity_m_per_s2);
-    fill_fit(&mut out.row, &fit, weight);
-    let q = fit.law.apply(&p.drape, fit.bending_length_m);
-    let first = p.calibration.calibration_seeds;
-    let drapes = seeded_drapes(mesh, &q, &tester, first..first + p.seeds);
-    let solves = fit.solves + p.seeds as usize;
-    out.row.solves = solves as i32;
+    let weight =
+        density_known.then_some(p.drape.areal_density_kg_per_m2 * p.drape.gravity_m_per_s2);
+    fill_fit(&mut out.row, &outcome.fit, weight);
+    out.row.solves = outcome.solves as i32;
     out.row.prediction_seeds = p.seeds as i32;
-    out.row.solve_time_mean_s = start.elapsed().as_secs_f64() / solves as f64;
-    match NodeDistribution::of(&drapes, p.seeds as usize) {
-        Some(d) => fill_distribution(&mut out.row, &d),
+    out.row.solve_time_mean_s = start.elapsed().as_secs_f64() / outcome.solves as f64;
+    match &outcome.distribution {
+        Some(d) => fill_distribution(&mut out.row, d),
         None => out.row.status = "no perturbed drape converged".into(),
     }
+    let drapes = outcome.drapes;
     if !drapes.is_empty() {
         let meas: Vec<Vec<f64>> = out
             .measured

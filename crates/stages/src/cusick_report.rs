@@ -156,10 +156,16 @@ fn main_table(rows: &[PredictionRow]) -> String {
 /// spread).
 fn line_at(pts: &[(f64, f64)], x: f64) -> f64 {
     let n = pts.len().max(1) as f64;
-    let (mx, my) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
     let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
     let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    if sxx > 0.0 { my + sxy / sxx * (x - mx) } else { my }
+    if sxx > 0.0 {
+        my + sxy / sxx * (x - mx)
+    } else {
+        my
+    }
 }
 
 /// Predictions of the baselines for fabric `i`, each fitted on the other fabrics (leave one fabric

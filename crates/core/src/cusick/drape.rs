@@ -12,8 +12,8 @@ use crate::physics::{
     BarrierContact, Gravity, Model, SpringFamily, Springs, saturating_hinge_bending,
 };
 use crate::solve::{
-    ImplicitSettings, NoObserver, Observer, Settle, SolveReport, StaticOptions, StopReason, integrate_implicit,
-    solve_static,
+    ImplicitSettings, NoObserver, Observer, Settle, SolveReport, StaticOptions, StopReason,
+    integrate_implicit, solve_static,
 };
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -151,7 +151,8 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
                 mesh.triangles,
                 [rigidity * root, rigidity / root],
                 p.warp_angle_deg.to_radians(),
-                p.bending_saturation.map_or(f64::INFINITY, |s| s / p.bending_length_m),
+                p.bending_saturation
+                    .map_or(f64::INFINITY, |s| s / p.bending_length_m),
             )),
             Box::new(Gravity::new(masses.clone(), p.gravity_m_per_s2)),
             Box::new(pedestal_contact(&masses, &fixed, p, tester)),
@@ -303,7 +304,10 @@ pub fn solve_drape_observed(
     };
     let mut report = solve_static(&model, &mut x, &opts, observer);
     if let Some(f) = fall {
-        report.message = format!("after a fall of {} ({}): {}", p.fall_time_s, f.message, report.message);
+        report.message = format!(
+            "after a fall of {} ({}): {}",
+            p.fall_time_s, f.message, report.message
+        );
         report.inner_iterations += f.inner_iterations;
     }
     (report, x)

@@ -282,7 +282,9 @@ pub fn calibrate_fabric(
     let (lo, hi) = candidates
         .iter()
         .map(|r| r.drapes.nodes_mean)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, m| (a.0.min(m), a.1.max(m)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, m| {
+            (a.0.min(m), a.1.max(m))
+        });
     let sigma = target.dc_se_pct.hypot(best.drapes.dc_sd_pct);
     let scale = best.bending_length_m / cal.bending_length_m;
     Ok(FabricFit {
@@ -296,6 +298,45 @@ pub fn calibrate_fabric(
         law_identifiable: hi - lo > 1.0,
         candidates,
         solves,
+    })
+}
+
+/// A fabric's calibrate → predict outcome.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FabricOutcome {
+    /// The calibration on the calibration specimen.
+    pub fit: FabricFit,
+    /// The converged drapes of the fitted parameters at the prediction seeds.
+    pub drapes: Vec<SeededDrape>,
+    /// Their node and DC distribution (None when none converged).
+    pub distribution: Option<NodeDistribution>,
+    /// Prediction seeds tried.
+    pub seeds: u64,
+    /// Drape solves made, calibration included.
+    pub solves: usize,
+}
+
+/// The whole workflow of one fabric: [`calibrate_fabric`] on its calibration specimen, then the
+/// drapes of the fitted (c, law) at `seeds` further seeds (after the calibration's, so that no
+/// drape is both fitted and predicted) as the prediction for the other specimens.
+pub fn calibrate_and_predict(
+    mesh: DiscMesh<'_>,
+    target: &SpecimenTargets,
+    base: &DrapeParams,
+    tester: &Tester,
+    s: &FabricSettings,
+    seeds: u64,
+) -> Result<FabricOutcome, String> {
+    let fit = calibrate_fabric(mesh, target, base, tester, s)?;
+    let q = fit.law.apply(base, fit.bending_length_m);
+    let first = s.calibration_seeds;
+    let drapes = seeded_drapes(mesh, &q, tester, first..first + seeds);
+    Ok(FabricOutcome {
+        distribution: NodeDistribution::of(&drapes, seeds as usize),
+        solves: fit.solves + seeds as usize,
+        fit,
+        drapes,
+        seeds,
     })
 }
 
@@ -350,7 +391,12 @@ mod tests {
 
     #[test]
     fn a_node_distribution_has_its_mean_mode_and_histogram() {
-        let d = [drape(0, 70.0, 7), drape(1, 72.0, 8), drape(2, 71.0, 7), drape(3, 73.0, 9)];
+        let d = [
+            drape(0, 70.0, 7),
+            drape(1, 72.0, 8),
+            drape(2, 71.0, 7),
+            drape(3, 73.0, 9),
+        ];
         let n = NodeDistribution::of(&d, 5).expect("some");
         assert_eq!(n.histogram, vec![(7, 2), (8, 1), (9, 1)]);
         assert_eq!(n.nodes_mode, 7);

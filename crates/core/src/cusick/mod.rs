@@ -14,9 +14,8 @@ pub use drape::{
     solve_drape_observed, subdivide_disc,
 };
 pub use fabric::{
-    BendingLaw, FabricFit, FabricSettings, LawCandidate, NodeDistribution, SeededDrape,
-    SpecimenTargets,
-    calibrate_fabric, seeded_drapes,
+    BendingLaw, FabricFit, FabricOutcome, FabricSettings, LawCandidate, NodeDistribution,
+    SeededDrape, SpecimenTargets, calibrate_and_predict, calibrate_fabric, seeded_drapes,
 };
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};
@@ -266,7 +265,11 @@ mod tests {
         for deg in [0.0f64, 30.0, 100.0, 170.0] {
             let (a, t) = two_fold(&[o(deg.to_radians()), o(deg.to_radians())]);
             assert!((a - 0.01).abs() < 1e-9, "{a}");
-            assert!((t.to_degrees() - deg).abs() < 1e-6, "{} vs {deg}", t.to_degrees());
+            assert!(
+                (t.to_degrees() - deg).abs() < 1e-6,
+                "{} vs {deg}",
+                t.to_degrees()
+            );
         }
     }
 

@@ -87,7 +87,11 @@ impl<const N: usize> QuadraticStencil<N> {
         match self.saturation.get(k) {
             Some(&u0) if u0.is_finite() => {
                 let q = (1.0 + u2 / (u0 * u0)).sqrt();
-                (kk * u0 * u0 * (q - 1.0), kk / q, -kk / (u0 * u0 * q * q * q))
+                (
+                    kk * u0 * u0 * (q - 1.0),
+                    kk / q,
+                    -kk / (u0 * u0 * q * q * q),
+                )
             }
             _ => (0.5 * kk * u2, kk, 0.0),
         }
