@@ -11,8 +11,8 @@ use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use anyhow::Result;
 use drapelab_core::cusick::{
     BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricSettings, NodeDistribution,
-    SpecimenTargets, Tester, calibrate_and_predict, height_profile, mesh_projection, polar_disc,
-    sector_angle_rad, shadow_measures, subdivide_disc,
+    SpecimenTargets, Tester, calibrate_and_predict, height_profile, histogram, histogram_label,
+    mesh_projection, polar_disc, sector_angle_rad, shadow_measures, subdivide_disc,
 };
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -280,6 +280,8 @@ struct Targets {
     dc_mean_pct: f64,
     dc_sd_pct: f64,
     nodes_median: f64,
+    nodes_sd: f64,
+    nodes_histogram: String,
 }
 
 fn targets(rows: &[&ShadowRow]) -> Targets {
@@ -303,6 +305,14 @@ fn targets(rows: &[&ShadowRow]) -> Targets {
         dc_mean_pct,
         dc_sd_pct,
         nodes_median: median(others.iter().map(|r| r.nodes_photo as f64).collect()),
+        nodes_sd: mean_sd(
+            &others
+                .iter()
+                .map(|r| r.nodes_photo as f64)
+                .collect::<Vec<_>>(),
+        )
+        .1,
+        nodes_histogram: histogram_label(&histogram(others.iter().map(|r| r.nodes_photo as usize))),
     }
 }
 
@@ -332,6 +342,9 @@ fn empty_row(fabric: i32, tg: &Targets) -> PredictionRow {
         prediction_seeds: 0,
         nodes_calibration_median: tg.specimen.nodes,
         nodes_measured_median: tg.nodes_median,
+        nodes_measured_sd: tg.nodes_sd,
+        nodes_measured_histogram: tg.nodes_histogram.clone(),
+        nodes_predicted_sd: None,
         profile_rms_mm: None,
         status: String::new(),
         solves: 0,
@@ -378,12 +391,8 @@ fn fill_distribution(row: &mut PredictionRow, d: &NodeDistribution) {
     row.dc_predicted_sd_pct = Some(d.dc_sd_pct);
     row.nodes_predicted = Some(d.nodes_mean);
     row.nodes_predicted_mode = Some(d.nodes_mode as i32);
-    row.nodes_predicted_histogram = d
-        .histogram
-        .iter()
-        .map(|(n, k)| format!("{n}×{k}"))
-        .collect::<Vec<_>>()
-        .join(" ");
+    row.nodes_predicted_sd = Some(d.nodes_sd);
+    row.nodes_predicted_histogram = histogram_label(&d.histogram);
     row.status = if d.converged == d.tried {
         "ok".into()
     } else {

@@ -52,12 +52,18 @@ pub struct PredictionRow {
     pub nodes_predicted_mode: Option<i32>,
     /// The simulated node counts' histogram, "nodes×seeds" ascending (e.g. "6×2 7×4").
     pub nodes_predicted_histogram: String,
+    /// Sample SD of the simulated node count over the seeds.
+    pub nodes_predicted_sd: Option<f64>,
     /// Perturbation seeds of the prediction (disjoint from the calibration's).
     pub prediction_seeds: i32,
     /// Median node count of the calibration specimen's photos (the calibration's target).
     pub nodes_calibration_median: f64,
     /// Median measured node count (photos) of the other specimens.
     pub nodes_measured_median: f64,
+    /// Sample SD of the measured node count over the other specimens' captures.
+    pub nodes_measured_sd: f64,
+    /// The other specimens' captures' node counts as a histogram, "nodes×captures" ascending.
+    pub nodes_measured_histogram: String,
     /// RMS over the rings of simulated minus measured mean height z(r), mm (None without registered meshes).
     pub profile_rms_mm: Option<f64>,
     /// "ok", or why there is no prediction.

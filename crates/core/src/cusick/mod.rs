@@ -15,7 +15,8 @@ pub use drape::{
 };
 pub use fabric::{
     BendingLaw, FabricFit, FabricOutcome, FabricSettings, LawCandidate, NodeDistribution,
-    SeededDrape, SpecimenTargets, calibrate_and_predict, calibrate_fabric, seeded_drapes,
+    SeededDrape, SpecimenTargets, calibrate_and_predict, calibrate_fabric, histogram,
+    histogram_label, seeded_drapes,
 };
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};
