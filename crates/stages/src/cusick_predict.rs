@@ -12,7 +12,7 @@ use anyhow::Result;
 use drapelab_core::cusick::{
     BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricSettings, NodeDistribution,
     SpecimenTargets, Tester, calibrate_and_predict, height_profile, histogram, histogram_label,
-    mesh_projection, polar_disc, sector_angle_rad, shadow_measures, subdivide_disc,
+    mesh_projection, polar_disc, sector_angle_rad, shadow_measures, subdivide_disc, two_fold,
 };
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -71,6 +71,10 @@ impl StageKind for CusickPredict {
             "captures_index.csv of a Cusick dataset (its folder holds the rest)",
         ),
         Slot::one("shadows", "a cusick-measure stage's shadows.parquet"),
+        Slot::one(
+            "photo_outlines",
+            "a cusick-measure stage's outlines.parquet (the photos' outlines r(θ))",
+        ),
     ];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("predictions", "predictions.parquet: one row per fabric"),
@@ -91,6 +95,16 @@ impl StageKind for CusickPredict {
         let index = ctx.input("index")?;
         let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
         let shadows = read_table::<ShadowRow>(ctx.input("shadows")?)?;
+        let mut photo_outlines: BTreeMap<CaptureKey, Vec<f64>> = BTreeMap::new();
+        for o in read_table::<OutlineRow>(ctx.input("photo_outlines")?)? {
+            if let (Some(sample), Some(capture)) = (o.sample, o.capture) {
+                // Rows come in sector order per capture.
+                photo_outlines
+                    .entry((o.fabric, sample, capture))
+                    .or_default()
+                    .push(o.radius_m);
+            }
+        }
         let template = data.template()?;
         let meshes = data.meshes()?;
         let radius = Tester::default().specimen_radius_m;
@@ -104,6 +118,7 @@ impl StageKind for CusickPredict {
         let measured = Measured {
             template: &template,
             meshes: &meshes,
+            photo_outlines,
             rotated: data
                 .captures
                 .iter()
@@ -160,6 +175,8 @@ struct Measured<'a> {
     meshes: &'a BTreeMap<CaptureKey, Vec<Vector3<f64>>>,
     /// Captures whose meshes are stored turned by 90° about +z.
     rotated: std::collections::BTreeSet<CaptureKey>,
+    /// Each photo's outline r(θ) in 1° sectors from +x, m.
+    photo_outlines: BTreeMap<CaptureKey, Vec<f64>>,
 }
 
 impl Measured<'_> {
@@ -345,6 +362,9 @@ fn empty_row(fabric: i32, tg: &Targets) -> PredictionRow {
         nodes_measured_sd: tg.nodes_sd,
         nodes_measured_histogram: tg.nodes_histogram.clone(),
         nodes_predicted_sd: None,
+        warp_direction_deg: None,
+        outline_two_fold_measured_m: None,
+        outline_two_fold_predicted_m: None,
         profile_rms_mm: None,
         status: String::new(),
         solves: 0,
@@ -448,6 +468,30 @@ fn predict_fabric(
         None => out.row.status = "no perturbed drape converged".into(),
     }
     let drapes = outcome.drapes;
+    // The warp: the two-fold maximum of the calibration specimen's face-up photos (turned over, the
+    // direction mirrors about an unknown axis, so the face-down ones are left out).
+    let up: Vec<Vec<f64>> = rows
+        .iter()
+        .filter(|r| r.sample == tg.calib && r.face == "up")
+        .filter_map(|r| {
+            measured
+                .photo_outlines
+                .get(&(r.fabric, r.sample, r.capture))
+                .cloned()
+        })
+        .collect();
+    if !up.is_empty() {
+        let (amp, dir) = two_fold(&up);
+        out.row.outline_two_fold_measured_m = Some(amp);
+        out.row.warp_direction_deg = Some(dir.to_degrees());
+    }
+    let sim: Vec<Vec<f64>> = drapes
+        .iter()
+        .map(|d| shadow_measures(&mesh_projection(&d.x, mesh.triangles), &tester).outline_m)
+        .collect();
+    if !sim.is_empty() {
+        out.row.outline_two_fold_predicted_m = Some(two_fold(&sim).0);
+    }
     if !drapes.is_empty() {
         let meas: Vec<Vec<f64>> = out
             .measured

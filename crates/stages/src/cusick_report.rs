@@ -333,14 +333,14 @@ fn weakest(rows: &[PredictionRow]) -> String {
 /// The specimens' own spread against the model's spread over perturbations.
 fn spread_table(rows: &[PredictionRow]) -> String {
     let mut s = String::from(
-        "| fabric | specimens' DC SD (%) | model's DC SD over seeds (%) | share of the specimens' variance the perturbations reproduce | calibration specimen − others (points) | specimens' nodes (captures) | model's nodes (seeds) | nodes SD: specimens, model |\n|---|---|---|---|---|---|---|---|\n",
+        "| fabric | specimens' DC SD (%) | model's DC SD over seeds (%) | share of the specimens' variance the perturbations reproduce | calibration specimen − others (points) | specimens' nodes (captures) | model's nodes (seeds) | nodes SD: specimens, model | two-fold outline amplitude (mm): calibration photos, model | warp from the photos (°) |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let share = r
             .dc_predicted_sd_pct
             .map(|m| (m / r.dc_measured_sd_pct.max(1e-9)).powi(2).min(1.0) * 100.0);
         s += &format!(
-            "| {} | {:.1} | {} | {} % | {:+.1} | {} | {} | {:.2}, {} |\n",
+            "| {} | {:.1} | {} | {} % | {:+.1} | {} | {} | {:.2}, {} | {}, {} | {} |\n",
             r.fabric,
             r.dc_measured_sd_pct,
             opt(r.dc_predicted_sd_pct, 1),
@@ -349,7 +349,10 @@ fn spread_table(rows: &[PredictionRow]) -> String {
             r.nodes_measured_histogram,
             r.nodes_predicted_histogram,
             r.nodes_measured_sd,
-            opt(r.nodes_predicted_sd, 2)
+            opt(r.nodes_predicted_sd, 2),
+            opt(r.outline_two_fold_measured_m.map(|a| 1e3 * a), 1),
+            opt(r.outline_two_fold_predicted_m.map(|a| 1e3 * a), 1),
+            opt(r.warp_direction_deg, 0)
         );
     }
     s
@@ -401,7 +404,7 @@ pub fn report_markdown(rows: &[PredictionRow], shadows_svg: &str, profiles_svg: 
     s += "\n## Where the model misses\n\n";
     s += &misses(rows);
     s += &format!(
-        "\n## What the data pin down\n\nTwo numbers per fabric are fitted: the calibration specimen's mean DC and its median node count. The DC pins the bending length c: its 2σ interval comes from the uncertainty of that DC (the SD of the specimen's photos over √n, and the model's seed-to-seed SD) divided by the sensitivity dDC/d ln c of the simulated drapes near c: ± {wmin:.0}–{wmax:.0} % of c here. The node count chooses the bending law; \"laws within 1 node\" lists every law whose drapes' mean node count lies within one node of the target, and the law is marked not identifiable where the laws' mean node counts span no more than one node. Anisotropy moves the fold count only on stiff fabrics (at DC ≈ 80 %, ρ = 4 gives ~4.5 nodes against ~6 isotropic; at DC ≈ 55 % it moves it by < 0.5); saturation moves it at every DC (at DC ≈ 58 %: 8.0 nodes linear, 7.1 with κ₀c = 2, 6.6 with κ₀c = 1, eight seeds each). The direction of the warp does not enter the predicted DC or node count (the specimens lie on the tester at unknown orientations), so it is not fitted. The other specimens' DC, node counts and height profiles are not fitted; they test the model.\n\n## The specimens' own spread\n\nThe specimens of one fabric differ by more than the model's perturbations move its DC: the model, given one (c, law), explains the specimens' mean DC, not their spread. Their node counts are another matter: the node histograms of the other specimens' captures and of the model's prediction seeds stand side by side here, with their SDs. The rest is the fabric (specimen-to-specimen variation of bending, anisotropy, how each was laid on the pedestal).\n\n"
+        "\n## What the data pin down\n\nTwo numbers per fabric are fitted: the calibration specimen's mean DC and its median node count. The DC pins the bending length c: its 2σ interval comes from the uncertainty of that DC (the SD of the specimen's photos over √n, and the model's seed-to-seed SD) divided by the sensitivity dDC/d ln c of the simulated drapes near c: ± {wmin:.0}–{wmax:.0} % of c here. The node count chooses the bending law; \"laws within 1 node\" lists every law whose drapes' mean node count lies within one node of the target, and the law is marked not identifiable where the laws' mean node counts span no more than one node. Anisotropy moves the fold count only on stiff fabrics (at DC ≈ 80 %, ρ = 4 gives ~4.5 nodes against ~6 isotropic; at DC ≈ 55 % it moves it by < 0.5); saturation moves it at every DC (at DC ≈ 58 %: 8.0 nodes linear, 7.1 with κ₀c = 2, 6.6 with κ₀c = 1, eight seeds each). The direction of the warp does not enter the predicted DC or node count (the specimens lie on the tester at unknown orientations), so it is not fitted. The other specimens' DC, node counts and height profiles are not fitted; they test the model.\n\n## The specimens' own spread\n\nThe specimens of one fabric differ by more than the model's perturbations move its DC: the model, given one (c, law), explains the specimens' mean DC, not their spread. Their node counts are another matter: the node histograms of the other specimens' captures and of the model's prediction seeds stand side by side here, with their SDs. The outline's two-fold component (r(θ) ≈ r̄ + a₂ cos 2(θ − θ₂)) is what an anisotropy shows: its amplitude in the calibration specimen's face-up photos against the model's, and its direction θ₂ in the photos, the estimated warp. The rest is the fabric (specimen-to-specimen variation of bending, anisotropy, how each was laid on the pedestal).\n\n"
     );
     s += &spread_table(rows);
     s += &format!(

@@ -58,6 +58,15 @@ pub struct PredictionRow {
     pub prediction_seeds: i32,
     /// Median node count of the calibration specimen's photos (the calibration's target).
     pub nodes_calibration_median: f64,
+    /// Direction of the warp estimated from the calibration specimen's face-up photos: the maximum
+    /// of their outlines' two-fold component, degrees from the photo's +x in [0, 180) (an
+    /// orthotropic fabric reaches furthest along its stiffer direction). Not used by the prediction:
+    /// the specimens lie on the tester at unknown orientations.
+    pub warp_direction_deg: Option<f64>,
+    /// Amplitude of that two-fold component, m.
+    pub outline_two_fold_measured_m: Option<f64>,
+    /// Amplitude of the two-fold component of the simulated drapes' outlines (warp along +x), m.
+    pub outline_two_fold_predicted_m: Option<f64>,
     /// Median measured node count (photos) of the other specimens.
     pub nodes_measured_median: f64,
     /// Sample SD of the measured node count over the other specimens' captures.
