@@ -288,25 +288,15 @@ pub fn barrier_contact(
     } else {
         crate::STANDARD_GRAVITY_M_PER_S2
     };
-    let d_hat = scene.contact.distance_m;
-    let kappa = masses
-        .iter()
-        .zip(fixed.iter())
-        .map(|(m, f)| {
-            if *f || *m <= 0.0 {
-                0.0
-            } else {
-                crate::physics::BarrierContact::kappa_for_weight(m * g, d_hat)
-            }
-        })
-        .collect();
     let falling = scene.solver.kind.integrator() == Some(crate::solve::Integrator::ImplicitEuler);
-    crate::physics::BarrierContact {
-        obstacles: scene.obstacles.clone(),
-        d_hat_m: d_hat,
-        kappa_J: kappa,
-        sliding_share: if falling { 0.0 } else { 0.1 },
-    }
+    crate::physics::BarrierContact::for_particles(
+        scene.obstacles.clone(),
+        scene.contact.distance_m,
+        masses,
+        fixed,
+        g,
+        if falling { 0.0 } else { 0.1 },
+    )
 }
 
 /// Symmetry planes along grid edges (a quarter or half model, seed 003 §10.4.2): the particles on the

@@ -12,7 +12,7 @@ use anyhow::Result;
 use drapelab_core::cusick::{
     BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricSettings, NodeDistribution,
     SpecimenTargets, Tester, calibrate_and_predict, height_profile, histogram, histogram_label,
-    mesh_projection, polar_disc, sector_angle_rad, shadow_measures, subdivide_disc, two_fold,
+    polar_disc, sector_angle_rad, subdivide_disc, two_fold,
 };
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -485,10 +485,7 @@ fn predict_fabric(
         out.row.outline_two_fold_measured_m = Some(amp);
         out.row.warp_direction_deg = Some(dir.to_degrees());
     }
-    let sim: Vec<Vec<f64>> = drapes
-        .iter()
-        .map(|d| shadow_measures(&mesh_projection(&d.x, mesh.triangles), &tester).outline_m)
-        .collect();
+    let sim: Vec<Vec<f64>> = drapes.iter().map(|d| d.outline_m.clone()).collect();
     if !sim.is_empty() {
         out.row.outline_two_fold_predicted_m = Some(two_fold(&sim).0);
     }
@@ -508,7 +505,7 @@ fn predict_fabric(
         out.row.profile_rms_mm = if meas.is_empty() { None } else { rms };
         out.outlines = drapes
             .iter()
-            .flat_map(|d| simulated_outline(fabric, d.seed, &d.x, mesh.triangles))
+            .flat_map(|d| simulated_outline(fabric, d.seed, &d.outline_m))
             .collect();
     }
     out.drapes = drapes.into_iter().map(|d| (d.seed, d.x)).collect();
@@ -516,16 +513,10 @@ fn predict_fabric(
     out
 }
 
-/// The outline rows of a simulated drape's vertical projection.
-fn simulated_outline(
-    fabric: i32,
-    seed: u64,
-    x: &[Vector3<f64>],
-    triangles: &[[usize; 3]],
-) -> Vec<OutlineRow> {
-    let m = shadow_measures(&mesh_projection(x, triangles), &Tester::default());
-    let n = m.outline_m.len();
-    m.outline_m
+/// The outline rows of a simulated drape's shadow outline r(θ).
+fn simulated_outline(fabric: i32, seed: u64, outline_m: &[f64]) -> Vec<OutlineRow> {
+    let n = outline_m.len();
+    outline_m
         .iter()
         .enumerate()
         .map(|(k, &radius_m)| OutlineRow {

@@ -176,27 +176,19 @@ fn pedestal_contact(
     p: &DrapeParams,
     tester: &Tester,
 ) -> BarrierContact {
-    let kappa = masses
-        .iter()
-        .zip(fixed)
-        .map(|(m, &f)| {
-            if f {
-                0.0
-            } else {
-                BarrierContact::kappa_for_weight(m * p.gravity_m_per_s2, PEDESTAL_CONTACT_M)
-            }
-        })
-        .collect();
-    BarrierContact {
-        obstacles: vec![Obstacle::Pedestal {
-            centre_m: [0.0, 0.0, 0.0],
-            radius_m: tester.pedestal_radius_m,
-            height_m: 1.0,
-        }],
-        d_hat_m: PEDESTAL_CONTACT_M,
-        kappa_J: kappa,
-        sliding_share: 0.0,
-    }
+    let pedestal = Obstacle::Pedestal {
+        centre_m: [0.0, 0.0, 0.0],
+        radius_m: tester.pedestal_radius_m,
+        height_m: 1.0,
+    };
+    BarrierContact::for_particles(
+        vec![pedestal],
+        PEDESTAL_CONTACT_M,
+        masses,
+        fixed,
+        p.gravity_m_per_s2,
+        0.0,
+    )
 }
 
 /// The start: the specimen lowered into a cone of slope `start_cone_deg` outside the pedestal, every

@@ -9,7 +9,10 @@
 //! curvature (cheap sharp folds) gives fewer folds at any DC. So the node count chooses the law
 //! where it tells the laws apart, and the fit says when it does not (an identifiability flag).
 
-use super::{DiscMesh, DrapeParams, Tester, bisect_bending_length, drape_dc};
+use super::{
+    DiscMesh, DrapeParams, Tester, bisect_bending_length, drape_dc, mesh_projection,
+    shadow_measures, solve_drape,
+};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -109,6 +112,8 @@ pub struct SeededDrape {
     pub dc_pct: f64,
     /// Nodes of its shadow.
     pub nodes: usize,
+    /// Its shadow's smoothed outline r(θ) in 1° sectors from +x, m.
+    pub outline_m: Vec<f64>,
     /// Positions, m.
     pub x: Vec<Vector3<f64>>,
 }
@@ -201,11 +206,17 @@ pub fn seeded_drapes(
         .into_par_iter()
         .filter_map(|seed| {
             let q = DrapeParams { seed, ..p.clone() };
-            drape_dc(mesh, &q, tester).map(|(dc_pct, nodes, x)| SeededDrape {
-                seed,
-                dc_pct,
-                nodes,
-                x,
+            let (report, x) = solve_drape(mesh, &q, tester);
+            // Never numbers passed off as a result: a drape that did not converge is left out.
+            report.is_converged().then(|| {
+                let m = shadow_measures(&mesh_projection(&x, mesh.triangles), tester);
+                SeededDrape {
+                    seed,
+                    dc_pct: m.dc_pct,
+                    nodes: m.nodes,
+                    outline_m: m.outline_m,
+                    x,
+                }
             })
         })
         .collect()
@@ -408,6 +419,7 @@ mod tests {
             seed,
             dc_pct: dc,
             nodes,
+            outline_m: Vec::new(),
             x: Vec::new(),
         }
     }

@@ -51,6 +51,35 @@ impl BarrierContact {
         w / -db
     }
 
+    /// Barrier contact of `obstacles` for particles of `masses` (kg), each free one with the κ of
+    /// its weight under gravity `g` (m/s²) ([`Self::kappa_for_weight`]), fixed ones with none.
+    pub fn for_particles(
+        obstacles: Vec<Obstacle>,
+        d_hat_m: f64,
+        masses: &[f64],
+        fixed: &[bool],
+        g_m_per_s2: f64,
+        sliding_share: f64,
+    ) -> Self {
+        let kappa_J = masses
+            .iter()
+            .zip(fixed)
+            .map(|(m, &f)| {
+                if f || *m <= 0.0 {
+                    0.0
+                } else {
+                    Self::kappa_for_weight(m * g_m_per_s2, d_hat_m)
+                }
+            })
+            .collect();
+        BarrierContact {
+            obstacles,
+            d_hat_m,
+            kappa_J,
+            sliding_share,
+        }
+    }
+
     fn each(&self, x: &Vecs, mut f: impl FnMut(usize, f64, Vector3<f64>, &Obstacle)) {
         for (p, xp) in x.iter().enumerate() {
             let k = self.kappa_J.get(p).copied().unwrap_or(0.0);
