@@ -172,6 +172,9 @@ pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
     point_loads(scene, &grid, &absent, &x0, &mut terms);
     holds(scene, &grid, &mut held);
     contact_terms(scene, &x0, &masses, &mut fixed, &mut terms);
+    if let Some(t) = self_contact(scene, &grid, &absent, &x0, &masses) {
+        terms.push(Box::new(t));
+    }
     let model = Model {
         n_grid: grid.len(),
         masses,
@@ -297,6 +300,57 @@ pub fn barrier_contact(
         g,
         if falling { 0.0 } else { 0.1 },
     )
+}
+
+/// The thickness ξ of the sheet for self-contact, m ([`ContactSpec::self_thickness_m`](crate::scene::ContactSpec::self_thickness_m)):
+/// as given, else the material's thickness or 1 mm, at most a fifth of the shortest spacing.
+pub fn self_thickness_m(scene: &Scene) -> f64 {
+    scene.contact.self_thickness_m.unwrap_or_else(|| {
+        let t = scene
+            .material
+            .continuum
+            .as_ref()
+            .and_then(|c| c.thickness_m)
+            .unwrap_or(1e-3);
+        t.min(0.2 * scene.grid().min_spacing_m())
+    })
+}
+
+/// The sheet's self-contact term (when the scene's `contact.self` and solver ask for it): the grid
+/// triangulated over its present particles, thickness ξ ([`self_thickness_m`]), band ξ, κ from the
+/// mean particle weight.
+fn self_contact(
+    scene: &Scene,
+    grid: &Grid,
+    absent: &[bool],
+    x0: &[Vector3<f64>],
+    masses: &[f64],
+) -> Option<crate::physics::SelfContact> {
+    if !scene.solver.kind.self_contact(scene.contact.self_contact) {
+        return None;
+    }
+    let triangles: Vec<[u32; 3]> = crate::cloth::grid_triangles(grid)
+        .into_iter()
+        .filter(|t| t.iter().all(|&v| !absent[v as usize]))
+        .collect();
+    let heavy: Vec<f64> = masses[..grid.len()]
+        .iter()
+        .copied()
+        .filter(|m| *m > 0.0)
+        .collect();
+    if triangles.is_empty() || heavy.is_empty() {
+        return None;
+    }
+    let g = if scene.gravity.g_m_per_s2 > 0.0 {
+        scene.gravity.g_m_per_s2
+    } else {
+        crate::STANDARD_GRAVITY_M_PER_S2
+    };
+    let weight = g * heavy.iter().sum::<f64>() / heavy.len() as f64;
+    let xi = self_thickness_m(scene);
+    Some(crate::physics::SelfContact::new(
+        triangles, x0, xi, xi, weight,
+    ))
 }
 
 /// Symmetry planes along grid edges (a quarter or half model, seed 003 §10.4.2): the particles on the

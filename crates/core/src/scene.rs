@@ -186,6 +186,15 @@ impl SolverKind {
             SolverKind::BaraffWitkin => "baraff-witkin",
         }
     }
+    /// Whether the solver handles the sheet's self-contact (a barrier with a bounded step): the
+    /// static solve and implicit Euler.
+    pub fn supports_self_contact(self) -> bool {
+        matches!(self, SolverKind::Static | SolverKind::ImplicitEuler)
+    }
+    /// Whether the scene's sheet gets the self-contact term ([`ContactSpec::self_contact`]).
+    pub fn self_contact(self, mode: SelfContactMode) -> bool {
+        mode != SelfContactMode::Off && self.supports_self_contact()
+    }
     /// The dynamic integrator, if this is one.
     pub fn integrator(self) -> Option<Integrator> {
         match self {
@@ -327,6 +336,29 @@ pub struct ContactSpec {
     /// increments). Default 0 (frictionless).
     #[serde(default)]
     pub friction_coefficient: f64,
+    /// Self-contact of the sheet (written `self`): "auto" (default: on for the static solve and
+    /// implicit Euler, off for the explicit and linearised integrators, which a barrier would make
+    /// unstable), "on" (an input error with those integrators) or "off".
+    #[serde(default, rename = "self")]
+    pub self_contact: SelfContactMode,
+    /// Thickness ξ of the sheet for self-contact, m: two layers' mid-surfaces stay more than ξ apart
+    /// and repel from 2ξ (the activation distance). Default: the continuum material's `thickness_m`,
+    /// else 1 mm, at most a fifth of the grid's shortest spacing.
+    #[serde(default)]
+    pub self_thickness_m: Option<f64>,
+}
+
+/// Whether the sheet's self-contact is modelled ([`ContactSpec::self_contact`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SelfContactMode {
+    /// On wherever the solver supports it (the static solve, implicit Euler).
+    #[default]
+    Auto,
+    /// On; an input error with a solver that does not support it.
+    On,
+    /// Off: the sheet may pass through itself.
+    Off,
 }
 
 fn default_contact_distance() -> f64 {
@@ -340,6 +372,8 @@ impl Default for ContactSpec {
             distance_m: default_contact_distance(),
             fix_supported: false,
             friction_coefficient: 0.0,
+            self_contact: SelfContactMode::Auto,
+            self_thickness_m: None,
         }
     }
 }
@@ -720,6 +754,29 @@ impl Scene {
             "contact.friction_coefficient",
             self.contact.friction_coefficient,
         )?;
+        if let Some(t) = self.contact.self_thickness_m {
+            ck.pos("contact.self_thickness_m", t)?;
+            let h = self.grid().min_spacing_m();
+            if t > 0.2 * h {
+                return ck.err(
+                    "contact.self_thickness_m",
+                    format!(
+                        "{t} m is over a fifth of the grid's shortest spacing ({h:.4} m): the flat sheet \
+would already touch itself; use a coarser grid or a thinner sheet"
+                    ),
+                );
+            }
+        }
+        if self.contact.self_contact == SelfContactMode::On && !self.solver.kind.supports_self_contact()
+        {
+            return ck.err(
+                "contact.self",
+                format!(
+                    "\"on\" needs the static solver or implicit-euler, not {}; use \"auto\" or \"off\"",
+                    self.solver.kind.name()
+                ),
+            );
+        }
         Ok(())
     }
 

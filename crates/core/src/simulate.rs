@@ -79,6 +79,64 @@ impl Solution {
     }
 }
 
+/// The sheet's self-contact at the end of a solve, as `run.json` and the benchmark report it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SelfContactSummary {
+    /// "auto", "on" or "off", as the scene asks.
+    pub mode: crate::scene::SelfContactMode,
+    /// Whether the solve modelled self-contact (the term was built).
+    pub modelled: bool,
+    /// Thickness ξ, m (the closest two layers may come); null when not modelled.
+    pub thickness_m: Option<f64>,
+    /// Activation distance ξ + d̂, m; null when not modelled.
+    pub activation_distance_m: Option<f64>,
+    /// Smallest distance between two parts of the sheet that share no vertex, m (null when none is
+    /// within the longest edge of another); null when not modelled.
+    pub min_distance_m: Option<f64>,
+    /// Pairs within the activation distance at the end.
+    pub active_pairs: usize,
+    /// Broad phases the solve ran.
+    pub broad_phases: usize,
+    /// Wall time spent in self-contact (broad phase, collision detection, energy), s.
+    pub time_s: f64,
+    /// Mesh edges that cross a triangle sharing no vertex with them (segment–triangle tests on
+    /// the triangulated grid): the sheet passing through itself. Counted in every mode.
+    pub crossing_edges: usize,
+}
+
+/// The self-contact summary of a solved model at `x`.
+pub fn self_contact_summary(
+    scene: &Scene,
+    grid: &Grid,
+    model: &crate::physics::Model,
+    x: &[Vector3<f64>],
+) -> SelfContactSummary {
+    let present = crate::build::present_particles(scene);
+    let triangles: Vec<[u32; 3]> = crate::cloth::grid_triangles(grid)
+        .into_iter()
+        .filter(|t| t.iter().all(|&v| present[v as usize]))
+        .collect();
+    let topo = crate::contact::proximity::MeshTopology::from_triangles(triangles);
+    let crossing_edges = crate::contact::proximity::edge_triangle_crossings(&topo, x)
+        .iter()
+        .map(|c| c.0)
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    let state = model.self_contact(x);
+    let xi = state.map(|_| crate::build::self_thickness_m(scene));
+    SelfContactSummary {
+        mode: scene.contact.self_contact,
+        modelled: state.is_some(),
+        thickness_m: xi,
+        activation_distance_m: xi.map(|t| 2.0 * t),
+        min_distance_m: state.and_then(|s| s.min_distance_m.is_finite().then_some(s.min_distance_m)),
+        active_pairs: state.map_or(0, |s| s.active_pairs),
+        broad_phases: state.map_or(0, |s| s.broad_phases),
+        time_s: state.map_or(0.0, |s| s.time_s),
+        crossing_edges,
+    }
+}
+
 /// Solves a scene in memory with its configured solver; the observer sees each state. The scene is
 /// checked first ([`Scene::validated`]): an invalid one gives a solution with status invalid, the
 /// bad key in its message, and no particles.

@@ -23,6 +23,8 @@ struct RunRecord<'a> {
     outputs: Vec<&'a str>,
     /// Drape coefficient, folds and penetration, for a converged scene with obstacles.
     drape: Option<drapelab_core::measure::DrapeMeasures>,
+    /// The sheet's self-contact at the end: smallest distance, active pairs, crossings.
+    self_contact: drapelab_core::simulate::SelfContactSummary,
     scene: &'a Scene,
 }
 
@@ -124,6 +126,7 @@ pub fn simulate_to_dir(
         outputs,
         drape: (report.is_converged() && !scene.obstacles.is_empty())
             .then(|| drapelab_core::measure::drape_measures(scene, &grid, &x)),
+        self_contact: drapelab_core::simulate::self_contact_summary(scene, &grid, &model, &x),
         scene,
     };
     let json = serde_json::to_string_pretty(&record)?;

@@ -27,7 +27,7 @@ pub struct BarrierContact {
 }
 
 /// b(d), b'(d), b''(d) of the barrier (zero for d ≥ d̂; infinite energy for d ≤ 0).
-fn barrier(d: f64, dh: f64) -> (f64, f64, f64) {
+pub(crate) fn barrier(d: f64, dh: f64) -> (f64, f64, f64) {
     if d >= dh {
         return (0.0, 0.0, 0.0);
     }

@@ -8,6 +8,7 @@ mod friction;
 mod gravity;
 mod loads;
 mod mesh_bending;
+mod self_contact;
 mod shear;
 mod springs;
 
@@ -17,6 +18,7 @@ pub use friction::{FrictionAnchor, LaggedFriction};
 pub use gravity::Gravity;
 pub use loads::PointLoads;
 pub use mesh_bending::{hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending};
+pub use self_contact::{SelfContact, SelfContactState};
 pub use shear::CellShear;
 pub use springs::{SpringFamily, Springs};
 
@@ -112,6 +114,10 @@ pub trait EnergyTerm: Send + Sync {
     /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
     fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
         f64::INFINITY
+    }
+    /// The state of the sheet's self-contact at `x`, for a self-contact term (None for others).
+    fn self_contact(&self, _x: &Vecs) -> Option<SelfContactState> {
+        None
     }
 }
 
@@ -244,6 +250,10 @@ impl Model {
             .map(|t| t.max_strain(x))
             .fold(0.0, f64::max)
     }
+    /// The state of the sheet's self-contact at `x`, when the model has the term.
+    pub fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {
+        self.terms.iter().find_map(|t| t.self_contact(x))
+    }
     /// Names of the terms that were built.
     pub fn term_names(&self) -> Vec<String> {
         self.terms.iter().map(|t| t.name()).collect()
@@ -251,7 +261,7 @@ impl Model {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// Finite-difference check of every term's gradient and of the Hessian where it is exact.
