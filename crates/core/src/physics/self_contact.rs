@@ -75,7 +75,7 @@ impl SelfContact {
             .map(|e| (x0[e[0] as usize] - x0[e[1] as usize]).norm())
             .fold(f64::INFINITY, f64::min);
         let margin_m = if shortest.is_finite() {
-            (0.25 * shortest).max(thickness_m + band_m)
+            (0.1 * shortest).max(0.25 * (thickness_m + band_m))
         } else {
             thickness_m + band_m
         };
@@ -120,7 +120,31 @@ impl SelfContact {
         for &v in &self.topo.vertices {
             c.region[v as usize] = reach(v as usize).inflate(self.margin_m);
         }
-        c.pairs = candidate_pairs(&self.topo, &c.region, 0.5 * self.activation_m());
+        // Boxes overlap far more often than primitives come near (a triangle's box holds its
+        // neighbours' vertices): keep a pair only when, each vertex anywhere in its box, it could come
+        // within the activation distance: d(x) − ρ_A − ρ_B < ξ + d̂, ρ the farthest a primitive's
+        // vertices can move from x inside their boxes.
+        let rho: Vec<f64> = (0..x.len())
+            .map(|v| {
+                let b = &c.region[v];
+                (b.hi - x[v]).sup(&(x[v] - b.lo)).norm()
+            })
+            .collect();
+        let act = self.activation_m();
+        let topo = &self.topo;
+        c.pairs = candidate_pairs(topo, &c.region, 0.5 * act)
+            .into_iter()
+            .filter(|&pair| {
+                let idx = pair.vertices(topo);
+                let reach = |k: std::ops::Range<usize>| k.map(|i| rho[idx[i]]).fold(0.0, f64::max);
+                let (a, b) = if pair.is_point_triangle() {
+                    (reach(0..1), reach(1..4))
+                } else {
+                    (reach(0..2), reach(2..4))
+                };
+                pair_distance(pair.is_point_triangle(), &idx.map(|k| x[k])).0 - a - b < act
+            })
+            .collect();
         c.valid = true;
         c.broad_phases += 1;
     }
@@ -193,7 +217,9 @@ impl EnergyTerm for SelfContact {
         });
     }
     /// The barrier's curvature along the line between the closest points, κ b″ n nᵀ (positive
-    /// semi-definite in both modes: the curvature of the distance itself is left out).
+    /// semi-definite in both modes: the curvature of the distance itself is left out). Only pairs
+    /// in range push blocks: pushing every candidate's (zero) blocks to keep the pattern fixed made
+    /// the factor denser and the drapes slower (skirt_wool 9.8 s against 5.9 s).
     fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, _project: bool) {
         self.each_active(x, |idx, d, coef| {
             let d2b = barrier(d - self.thickness_m, self.band_m).2;
