@@ -104,6 +104,49 @@ pub struct SelfContactSummary {
     pub crossing_edges: usize,
 }
 
+/// A converged solve whose sheet passes through itself is not a drape: where self-contact was not
+/// modelled (with it no step can cross), the final state's crossing edges are counted and any
+/// makes the status invalid ([`StopReason::PassesThroughItself`](crate::solve::StopReason)).
+pub fn check_crossings(
+    scene: &Scene,
+    grid: &Grid,
+    model: &crate::physics::Model,
+    x: &[Vector3<f64>],
+    report: &mut SolveReport,
+) {
+    if !report.is_converged() || model.self_contact(x).is_some() || x.len() < grid.len() {
+        return;
+    }
+    let n = crossing_edges(scene, grid, x);
+    if n > 0 {
+        report.stop_for(crate::solve::StopReason::PassesThroughItself);
+        report.message += &format!(
+            "; the sheet passes through itself at {n} mesh edges (contact.self = \"{}\" on {}): not a drape",
+            match scene.contact.self_contact {
+                crate::scene::SelfContactMode::Off => "off",
+                crate::scene::SelfContactMode::On => "on",
+                crate::scene::SelfContactMode::Auto => "auto",
+            },
+            scene.solver.kind.name()
+        );
+    }
+}
+
+/// Mesh edges of the triangulated grid at `x` that cross a triangle sharing no vertex with them.
+fn crossing_edges(scene: &Scene, grid: &Grid, x: &[Vector3<f64>]) -> usize {
+    let present = crate::build::present_particles(scene);
+    let triangles: Vec<[u32; 3]> = crate::cloth::grid_triangles(grid)
+        .into_iter()
+        .filter(|t| t.iter().all(|&v| present[v as usize]))
+        .collect();
+    let topo = crate::contact::proximity::MeshTopology::from_triangles(triangles);
+    crate::contact::proximity::edge_triangle_crossings(&topo, x)
+        .iter()
+        .map(|c| c.0)
+        .collect::<std::collections::BTreeSet<_>>()
+        .len()
+}
+
 /// The self-contact summary of a solved model at `x`.
 pub fn self_contact_summary(
     scene: &Scene,
@@ -111,17 +154,7 @@ pub fn self_contact_summary(
     model: &crate::physics::Model,
     x: &[Vector3<f64>],
 ) -> SelfContactSummary {
-    let present = crate::build::present_particles(scene);
-    let triangles: Vec<[u32; 3]> = crate::cloth::grid_triangles(grid)
-        .into_iter()
-        .filter(|t| t.iter().all(|&v| present[v as usize]))
-        .collect();
-    let topo = crate::contact::proximity::MeshTopology::from_triangles(triangles);
-    let crossing_edges = crate::contact::proximity::edge_triangle_crossings(&topo, x)
-        .iter()
-        .map(|c| c.0)
-        .collect::<std::collections::BTreeSet<_>>()
-        .len();
+    let crossing_edges = crossing_edges(scene, grid, x);
     let state = model.self_contact(x);
     let xi = state.map(|_| crate::build::self_thickness_m(scene));
     SelfContactSummary {
@@ -184,6 +217,8 @@ fn solve_built(
         }
         _ => solve_model(scene, &grid, &mut model, &mut x, observer),
     };
+    let mut report = report;
+    check_crossings(scene, &grid, &model, &x, &mut report);
     Solution {
         grid,
         terms: model.term_names(),

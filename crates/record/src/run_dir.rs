@@ -77,7 +77,9 @@ pub fn simulate_to_dir(
         if let Some(r) = rrd.as_mut() {
             obs.push(r);
         }
-        solve_model(scene, &grid, &mut model, &mut x, &mut Observers(obs))
+        let mut r = solve_model(scene, &grid, &mut model, &mut x, &mut Observers(obs));
+        drapelab_core::simulate::check_crossings(scene, &grid, &model, &x, &mut r);
+        r
     };
     let final_ev = StateEvent {
         index: report.iterations,

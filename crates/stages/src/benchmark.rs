@@ -45,6 +45,14 @@ pub struct BenchmarkParams {
     /// `population.parquet`. Default 0 (none).
     #[serde(default)]
     pub slack_net_population: usize,
+    /// The `contact.self` settings every point is solved with, a row each ("auto", "on", "off").
+    /// Default ["auto"] (the scenes' own).
+    #[serde(default = "default_self_contact")]
+    pub self_contact: Vec<drapelab_core::scene::SelfContactMode>,
+}
+
+fn default_self_contact() -> Vec<drapelab_core::scene::SelfContactMode> {
+    vec![drapelab_core::scene::SelfContactMode::Auto]
 }
 
 pub(crate) fn default_sizes() -> Vec<usize> {
@@ -99,6 +107,7 @@ fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
         max_implicit_size: p.max_implicit_size,
         exact_elastica: p.exact_elastica,
         max_wall_time_s: p.max_wall_time_s,
+        self_contact: p.self_contact.clone(),
     };
     // Serial on purpose: the points are timed, and peak memory is per process.
     let mut rows: Vec<BenchRow> = Vec::new();

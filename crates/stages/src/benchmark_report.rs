@@ -48,6 +48,10 @@ impl StageKind for BenchmarkReport {
         Slot::optional("population", "population.parquet of a benchmark stage"),
         Slot::optional("peers", "peers.parquet"),
         Slot::optional("skips", "skips.parquet"),
+        Slot::optional(
+            "self_contact",
+            "bench.parquet of a benchmark stage run with self-contact on and off",
+        ),
     ];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("markdown", "the report, .md"),
@@ -84,6 +88,9 @@ point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
     md += &settling_section(&c, &bench)?;
     if let Some(pop) = ctx.optional_input("population")? {
         md += &population_section(&read(pop)?)?;
+    }
+    if let Some(sc) = ctx.optional_input("self_contact")? {
+        md += &self_contact_section(&read(sc)?)?;
     }
     md += "\n## Every point\n\n";
     md += &markdown(&bench);
@@ -347,6 +354,47 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
             w * 1e3,
             f * 1e3,
             (w - f) * 1e3
+        );
+    }
+    Ok(md)
+}
+
+/// Self-contact on and off (issue 32): per scene and size, the static solve's iterations, wall time,
+/// the share of it spent in self-contact, the pairs in contact at the end and the crossing edges.
+fn self_contact_section(t: &DataFrame) -> Result<String> {
+    let mut md = String::from(
+        "\n## Self-contact: what it costs and what it prevents\n\nThe drapes that touch themselves, each \
+solved statically with `contact.self = \"auto\"` (on) and `\"off\"`. Self-contact time is the wall time spent in its \
+broad phase, continuous collision detection, energy and derivatives; crossing edges are mesh edges of the final \
+drape that pass through a triangle of the sheet (segment–triangle tests). The every-point table above gives \
+the cost on the other scenes (`self_contact_time_s` of `bench.parquet`).\n\n| scene | particles | self-contact | \
+status | iterations | wall time (s) | self-contact time (s) | pairs in contact | crossing edges |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let col = |c: &str| t.column(c).map(|c| c.as_materialized_series().clone());
+    let (scene, status, n, mode, it, wall, sct, pairs, cross) = (
+        col("scene")?,
+        col("status")?,
+        col("particles_per_side")?,
+        col("self_contact")?,
+        col("iterations")?,
+        col("wall_time_s")?,
+        col("self_contact_time_s")?,
+        col("self_contact_pairs")?,
+        col("crossing_edges")?,
+    );
+    for r in 0..t.height() {
+        let k = n.u64()?.get(r).unwrap_or(0);
+        let _ = writeln!(
+            md,
+            "| {} | {k}×{k} | {} | {} | {} | {:.3} | {:.3} | {} | {} |",
+            scene.str()?.get(r).unwrap_or(""),
+            mode.str()?.get(r).unwrap_or(""),
+            status.str()?.get(r).unwrap_or(""),
+            it.u64()?.get(r).unwrap_or(0),
+            wall.f64()?.get(r).unwrap_or(f64::NAN),
+            sct.f64()?.get(r).unwrap_or(f64::NAN),
+            pairs.u64()?.get(r).unwrap_or(0),
+            cross.u64()?.get(r).unwrap_or(0),
         );
     }
     Ok(md)

@@ -45,6 +45,15 @@ pub struct BenchRow {
     pub error_m: Option<f64>,
     /// Peak resident memory of the process during the point, bytes (Linux; None elsewhere).
     pub peak_rss_bytes: Option<u64>,
+    /// The scene's `contact.self` for this point: "auto", "on" or "off".
+    pub self_contact: crate::scene::SelfContactMode,
+    /// Wall time spent in self-contact (broad phase, collision detection, energy), s; 0 when the
+    /// solve did not model it.
+    pub self_contact_time_s: f64,
+    /// Self-contact pairs within the activation distance at the end.
+    pub self_contact_pairs: usize,
+    /// Mesh edges of the final state that cross a triangle of the sheet (segment–triangle tests).
+    pub crossing_edges: usize,
 }
 
 impl Table for BenchRow {
@@ -67,6 +76,8 @@ pub struct BenchLimits {
     pub exact_elastica: bool,
     /// Wall-clock budget of one dynamic point in s (it ends as max-iterations past it); None: no cap.
     pub max_wall_time_s: Option<f64>,
+    /// The `contact.self` settings each point is solved with (one row each).
+    pub self_contact: Vec<crate::scene::SelfContactMode>,
 }
 
 /// What a benchmark point's error is measured against.
@@ -194,41 +205,57 @@ pub fn bench_rows(
                 if skip {
                     continue;
                 }
-                let mut s = bench_scene(scene, n, kind, tol);
-                s.solver.dynamic.max_wall_time_s = limits.max_wall_time_s;
-                reset_peak_rss();
-                let t = Instant::now();
-                let sol = solve_scene(&s, &mut NoObserver);
-                let wall = t.elapsed().as_secs_f64();
-                let peak = peak_rss_bytes();
-                let error_m = match &reference {
-                    Reference::FinestStatic(r) => distance_to(&sol, r),
-                    Reference::Elastica(e) => e.distance(&sol),
-                };
-                log(&format!(
-                    "{} {n} tol {tol:.0e} {kind:?}: {} {wall:.4} s, error {error_m:.2e} m",
-                    scene.name,
-                    sol.report.status.as_str(),
-                ));
-                rows.push(BenchRow {
-                    scene: scene.name.clone(),
-                    n,
-                    solver: kind,
-                    tol,
-                    status: sol.report.status.as_str().into(),
-                    wall_time_s: wall,
-                    iterations: sol.report.iterations,
-                    linear_solves: sol.report.linear_solves,
-                    factorizations: sol.report.factorizations,
-                    factor_time_s: sol.report.factor_time_s,
-                    sim_time_s: sol.report.sim_time_s,
-                    error_m: error_m.is_finite().then_some(error_m),
-                    peak_rss_bytes: peak,
-                });
+                for &mode in &limits.self_contact {
+                    let mut s = bench_scene(scene, n, kind, tol);
+                    s.solver.dynamic.max_wall_time_s = limits.max_wall_time_s;
+                    s.contact.self_contact = mode;
+                    rows.push(bench_point(&s, &reference, &mut log));
+                }
             }
         }
     }
     rows
+}
+
+/// One point of [`bench_rows`]: `s` solved, timed and measured against `reference`.
+fn bench_point(s: &Scene, reference: &Reference, log: &mut impl FnMut(&str)) -> BenchRow {
+    let (n, kind, tol) = (s.cloth.nx, s.solver.kind, s.solver.static_.residual_tol_rel);
+    reset_peak_rss();
+    let t = Instant::now();
+    let sol = solve_scene(s, &mut NoObserver);
+    let wall = t.elapsed().as_secs_f64();
+    let peak = peak_rss_bytes();
+    let error_m = match reference {
+        Reference::FinestStatic(r) => distance_to(&sol, r),
+        Reference::Elastica(e) => e.distance(&sol),
+    };
+    log(&format!(
+        "{} {n} tol {tol:.0e} {kind:?} self {:?}: {} {wall:.4} s, error {error_m:.2e} m",
+        s.name,
+        s.contact.self_contact,
+        sol.report.status.as_str(),
+    ));
+    let sc = (!sol.x.is_empty())
+        .then(|| crate::simulate::self_contact_summary(s, &sol.grid, &sol.model, &sol.x));
+    BenchRow {
+        scene: s.name.clone(),
+        n,
+        solver: kind,
+        tol,
+        status: sol.report.status.as_str().into(),
+        wall_time_s: wall,
+        iterations: sol.report.iterations,
+        linear_solves: sol.report.linear_solves,
+        factorizations: sol.report.factorizations,
+        factor_time_s: sol.report.factor_time_s,
+        sim_time_s: sol.report.sim_time_s,
+        error_m: error_m.is_finite().then_some(error_m),
+        peak_rss_bytes: peak,
+        self_contact: s.contact.self_contact,
+        self_contact_time_s: sc.as_ref().map_or(0.0, |c| c.time_s),
+        self_contact_pairs: sc.as_ref().map_or(0, |c| c.active_pairs),
+        crossing_edges: sc.as_ref().map_or(0, |c| c.crossing_edges),
+    }
 }
 
 /// Largest distance between `sol` and `reference` at the grid points they share (the coarse grid's
@@ -273,6 +300,7 @@ pub fn hang4_rows(
             max_implicit_size,
             exact_elastica: false,
             max_wall_time_s: None,
+            self_contact: vec![crate::scene::SelfContactMode::Auto],
         },
         log,
     )
@@ -281,11 +309,11 @@ pub fn hang4_rows(
 /// The rows as a Markdown table.
 pub fn markdown_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| scene | particles | solver | tolerance | status | wall time (ms) | iterations/steps | linear solves | factorizations | factorization time (ms) | error vs finest static (m) | peak RSS (MB) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| scene | particles | solver | tolerance | status | wall time (ms) | iterations/steps | linear solves | factorizations | factorization time (ms) | error vs finest static (m) | peak RSS (MB) | self-contact | self-contact time (ms) | crossing edges |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s += &format!(
-            "| {} | {n}×{n} | {:?} | {:.0e} | {} | {:.3} | {} | {} | {} | {:.3} | {:.2e} | {} |\n",
+            "| {} | {n}×{n} | {:?} | {:.0e} | {} | {:.3} | {} | {} | {} | {:.3} | {:.2e} | {} | {:?} | {:.3} | {} |\n",
             r.scene,
             r.solver,
             r.tol,
@@ -298,6 +326,9 @@ pub fn markdown_table(rows: &[BenchRow]) -> String {
             r.error_m.unwrap_or(f64::NAN),
             r.peak_rss_bytes
                 .map_or("–".into(), |b| format!("{:.1}", b as f64 / 1e6)),
+            r.self_contact,
+            r.self_contact_time_s * 1e3,
+            r.crossing_edges,
             n = r.n
         );
     }

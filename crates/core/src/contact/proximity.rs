@@ -282,37 +282,91 @@ fn primitive_boxes(topo: &MeshTopology, vbox: &[Aabb], r: f64) -> (Vec<Aabb>, Ve
     (tboxes, eboxes)
 }
 
-/// The spatial hash: (cell key, kind, index) for every cell each box overlaps (kind 0 a vertex's box,
-/// 1 a triangle's, 2 an edge's), sorted by cell; cells as large as the median triangle box.
-fn hash_entries(boxes: [(&[Aabb], &[u32]); 3]) -> Vec<(u64, u8, u32)> {
+/// The spatial hash: for every cell each box overlaps (kind 0 a vertex's box, 1 a triangle's, 2 an
+/// edge's), an entry (bucket, kind, index), grouped by bucket (the cell's key hashed into a table of
+/// about twice as many buckets as entries; counting sort, then each bucket sorted by kind and index);
+/// cells as large as the median triangle box, or an eighth of the largest box of any kind (so that no
+/// box spans more than 9³ cells). Returns the entries, the cell size and the bucket count.
+fn hash_entries(boxes: [(&[Aabb], &[u32]); 3]) -> (Vec<(u64, u8, u32)>, f64, u64) {
     let mut extents: Vec<f64> = boxes[1].0.iter().map(|b| (b.hi - b.lo).max()).collect();
     if extents.is_empty() {
-        return Vec::new();
+        return (Vec::new(), 1.0, 1);
     }
     let mid = extents.len() / 2;
-    let cell = extents.select_nth_unstable_by(mid, f64::total_cmp).1.max(1e-9);
-    let mut entries: Vec<(u64, u8, u32)> = Vec::new();
+    let median = *extents.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let largest = boxes
+        .iter()
+        .flat_map(|(list, _)| list.iter())
+        .map(|b| (b.hi - b.lo).max())
+        .fold(0.0, f64::max);
+    let cell = median.max(largest / 8.0).max(1e-9);
+    let span = |b: &Aabb| {
+        let lo = (b.lo / cell).map(|v| v.floor() as i64);
+        let hi = (b.hi / cell).map(|v| v.floor() as i64);
+        (lo, hi)
+    };
+    let count: usize = boxes
+        .iter()
+        .flat_map(|(list, _)| list.iter())
+        .map(|b| {
+            let (lo, hi) = span(b);
+            ((hi - lo).map(|d| d as usize + 1)).product()
+        })
+        .sum();
+    let buckets = (2 * count).next_power_of_two().max(2) as u64;
+    let mut raw: Vec<(u64, u8, u32)> = Vec::with_capacity(count);
     for (kind, (list, ids)) in boxes.iter().enumerate() {
         for (b, &id) in list.iter().zip(ids.iter()) {
-            let lo = (b.lo / cell).map(|v| v.floor() as i64);
-            let hi = (b.hi / cell).map(|v| v.floor() as i64);
+            let (lo, hi) = span(b);
             for i in lo.x..=hi.x {
                 for j in lo.y..=hi.y {
                     for k in lo.z..=hi.z {
-                        let key = ((i as u64 & 0x1F_FFFF) << 42)
-                            | ((j as u64 & 0x1F_FFFF) << 21)
-                            | (k as u64 & 0x1F_FFFF);
-                        entries.push((key, kind as u8, id));
+                        raw.push((bucket_of(cell_key(i, j, k), buckets), kind as u8, id));
                     }
                 }
             }
         }
     }
-    entries.sort_unstable();
-    entries
+    // Counting sort by bucket, then each bucket by (kind, index).
+    let mut start = vec![0usize; buckets as usize + 1];
+    for e in &raw {
+        start[e.0 as usize + 1] += 1;
+    }
+    for k in 0..buckets as usize {
+        start[k + 1] += start[k];
+    }
+    let mut entries = vec![(0u64, 0u8, 0u32); raw.len()];
+    let mut fill = start.clone();
+    for e in raw {
+        entries[fill[e.0 as usize]] = e;
+        fill[e.0 as usize] += 1;
+    }
+    for k in 0..buckets as usize {
+        if start[k + 1] - start[k] > 1 {
+            entries[start[k]..start[k + 1]].sort_unstable();
+        }
+    }
+    (entries, cell, buckets)
 }
 
-/// Calls `f` with the entries of each cell of the sorted hash.
+fn cell_key(i: i64, j: i64, k: i64) -> u64 {
+    ((i as u64 & 0x1F_FFFF) << 42) | ((j as u64 & 0x1F_FFFF) << 21) | (k as u64 & 0x1F_FFFF)
+}
+
+/// The bucket of a cell key (Fibonacci hashing into `buckets`, a power of two).
+fn bucket_of(key: u64, buckets: u64) -> u64 {
+    (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) & (buckets - 1)
+}
+
+/// The one bucket that handles a pair of overlapping boxes: that of the cell of the lower corner of
+/// their overlap, which both boxes were inserted into (so each pair is met once, barring two of their
+/// shared cells falling into one bucket, which the caller's dedup removes).
+fn owner_bucket(a: &Aabb, b: &Aabb, cell: f64, buckets: u64) -> u64 {
+    let c = (a.lo.sup(&b.lo) / cell).map(|v| v.floor() as i64);
+    bucket_of(cell_key(c.x, c.y, c.z), buckets)
+}
+
+/// Calls `f` with the entries of each bucket of the hash.
 fn for_each_cell(entries: &[(u64, u8, u32)], mut f: impl FnMut(&[(u64, u8, u32)])) {
     let mut start = 0;
     while start < entries.len() {
@@ -323,10 +377,15 @@ fn for_each_cell(entries: &[(u64, u8, u32)], mut f: impl FnMut(&[(u64, u8, u32)]
     }
 }
 
-/// Every pair of primitives that share no vertex and whose boxes, each the union of its vertices'
-/// boxes `vbox` grown by `r`, overlap: the broad phase, a spatial hash. Sorted, without duplicates
-/// (deterministic).
-pub fn candidate_pairs(topo: &MeshTopology, vbox: &[Aabb], r: f64) -> Vec<Pair> {
+/// Every pair of primitives that share no vertex, whose boxes, each the union of its vertices'
+/// boxes `vbox` grown by `r`, overlap, and that `keep` accepts: the broad phase, a spatial hash.
+/// Sorted, without duplicates (deterministic).
+pub fn candidate_pairs(
+    topo: &MeshTopology,
+    vbox: &[Aabb],
+    r: f64,
+    keep: impl Fn(Pair) -> bool,
+) -> Vec<Pair> {
     let (tboxes, eboxes) = primitive_boxes(topo, vbox, r);
     let vboxes: Vec<Aabb> = topo
         .vertices
@@ -337,48 +396,81 @@ pub fn candidate_pairs(topo: &MeshTopology, vbox: &[Aabb], r: f64) -> Vec<Pair> 
         (0..tboxes.len() as u32).collect(),
         (0..eboxes.len() as u32).collect(),
     );
-    let entries = hash_entries([
+    let (entries, size, buckets) = hash_entries([
         (&vboxes, &topo.vertices),
         (&tboxes, &tids),
         (&eboxes, &eids),
     ]);
     let mut pairs = Vec::new();
     for_each_cell(&entries, |cell| {
-        cell_pairs(topo, vbox, (&tboxes, &eboxes), r, cell, &mut pairs)
+        let found = CellPairs {
+            topo,
+            vbox,
+            boxes: (&tboxes, &eboxes),
+            r,
+            size,
+            buckets,
+        };
+        found.collect(cell, &keep, &mut pairs)
     });
     pairs.sort_unstable();
     pairs.dedup();
     pairs
 }
 
-/// The pairs of one hash cell (its entries sorted by kind).
-fn cell_pairs(
-    topo: &MeshTopology,
-    vbox: &[Aabb],
-    (tboxes, eboxes): (&[Aabb], &[Aabb]),
+/// What [`CellPairs::collect`] needs of the hash.
+struct CellPairs<'a> {
+    topo: &'a MeshTopology,
+    vbox: &'a [Aabb],
+    boxes: (&'a [Aabb], &'a [Aabb]),
     r: f64,
-    cell: &[(u64, u8, u32)],
-    out: &mut Vec<Pair>,
-) {
-    let of = |kind: u8| cell.iter().filter(move |e| e.1 == kind).map(|e| e.2);
-    for v in of(0) {
-        let vb = vbox[v as usize].inflate(r);
-        for t in of(1) {
-            if !topo.triangles[t as usize].contains(&v) && vb.overlaps(&tboxes[t as usize]) {
-                out.push(Pair::PointTriangle(v, t));
+    size: f64,
+    buckets: u64,
+}
+
+impl CellPairs<'_> {
+    /// The pairs of one hash cell (its entries sorted by kind) that this cell owns and `keep`
+    /// accepts.
+    fn collect(&self, cell: &[(u64, u8, u32)], keep: &impl Fn(Pair) -> bool, out: &mut Vec<Pair>) {
+        let (topo, (tboxes, eboxes)) = (self.topo, self.boxes);
+        let key = cell[0].0;
+        // The entries are sorted by kind within the cell: vertices, triangles, edges.
+        let (a, b) = (
+            cell.partition_point(|e| e.1 < 1),
+            cell.partition_point(|e| e.1 < 2),
+        );
+        let (verts, tris, edges) = (&cell[..a], &cell[a..b], &cell[b..]);
+        for &(_, _, v) in verts {
+            let vb = self.vbox[v as usize].inflate(self.r);
+            for &(_, _, t) in tris {
+                let tb = &tboxes[t as usize];
+                let pair = Pair::PointTriangle(v, t);
+                if !topo.triangles[t as usize].contains(&v)
+                    && vb.overlaps(tb)
+                    && owner_bucket(&vb, tb, self.size, self.buckets) == key
+                    && keep(pair)
+                {
+                    out.push(pair);
+                }
             }
         }
-    }
-    let edges: Vec<u32> = of(2).collect();
-    for (k, &a) in edges.iter().enumerate() {
-        let ea = topo.edges[a as usize];
-        for &b in &edges[k + 1..] {
-            let eb = topo.edges[b as usize];
-            if ea.iter().any(|v| eb.contains(v)) || !eboxes[a as usize].overlaps(&eboxes[b as usize])
-            {
-                continue;
+        for (k, &(_, _, a)) in edges.iter().enumerate() {
+            let ea = topo.edges[a as usize];
+            let ab = &eboxes[a as usize];
+            for &(_, _, b) in &edges[k + 1..] {
+                let eb = topo.edges[b as usize];
+                let bb = &eboxes[b as usize];
+                if ea.iter().any(|v| eb.contains(v))
+                    || !ab.overlaps(bb)
+                    || owner_bucket(ab, bb, self.size, self.buckets) != key
+                {
+                    continue;
+                }
+                let pair = Pair::EdgeEdge(a.min(b), a.max(b));
+                if keep(pair) {
+                    out.push(pair);
+                }
             }
-            out.push(Pair::EdgeEdge(a.min(b), a.max(b)));
         }
     }
 }
@@ -392,7 +484,7 @@ pub fn edge_triangle_crossings(topo: &MeshTopology, x: &[V3]) -> Vec<(u32, u32)>
         (0..tboxes.len() as u32).collect(),
         (0..eboxes.len() as u32).collect(),
     );
-    let entries = hash_entries([(&[], &[]), (&tboxes, &tids), (&eboxes, &eids)]);
+    let (entries, size, buckets) = hash_entries([(&[], &[]), (&tboxes, &tids), (&eboxes, &eids)]);
     let mut out = Vec::new();
     for_each_cell(&entries, |cell| {
         for e in cell.iter().filter(|c| c.1 == 2).map(|c| c.2) {
@@ -403,7 +495,9 @@ pub fn edge_triangle_crossings(topo: &MeshTopology, x: &[V3]) -> Vec<(u32, u32)>
                     continue;
                 }
                 let [a, b, c] = tr.map(|k| x[k as usize]);
-                if eboxes[e as usize].overlaps(&tboxes[t as usize])
+                let (eb, tb) = (&eboxes[e as usize], &tboxes[t as usize]);
+                if eb.overlaps(tb)
+                    && owner_bucket(eb, tb, size, buckets) == cell[0].0
                     && segment_crosses_triangle(&x[ed[0] as usize], &x[ed[1] as usize], &a, &b, &c)
                 {
                     out.push((e, t));
@@ -521,7 +615,7 @@ mod tests {
         }
         let topo = MeshTopology::from_triangles(tris);
         let boxes: Vec<Aabb> = x.iter().map(Aabb::point).collect();
-        let pairs = candidate_pairs(&topo, &boxes, 1e-3);
+        let pairs = candidate_pairs(&topo, &boxes, 1e-3, |_| true);
         let mut brute = 0;
         for &vtx in &topo.vertices {
             for (t, tri) in topo.triangles.iter().enumerate() {

@@ -54,6 +54,8 @@ pub struct SelfContact {
     /// Barrier stiffness κ, J.
     pub kappa_J: f64,
     margin_m: f64,
+    /// The longest vertex move checked with one broad phase, m: four of the longest rest edge.
+    piece_m: f64,
     cache: Mutex<Cache>,
 }
 
@@ -74,6 +76,11 @@ impl SelfContact {
             .iter()
             .map(|e| (x0[e[0] as usize] - x0[e[1] as usize]).norm())
             .fold(f64::INFINITY, f64::min);
+        let longest = topo
+            .edges
+            .iter()
+            .map(|e| (x0[e[0] as usize] - x0[e[1] as usize]).norm())
+            .fold(0.0, f64::max);
         let margin_m = if shortest.is_finite() {
             (0.1 * shortest).max(0.25 * (thickness_m + band_m))
         } else {
@@ -85,6 +92,7 @@ impl SelfContact {
             band_m,
             kappa_J: super::BarrierContact::kappa_for_weight(weight_N, band_m),
             margin_m,
+            piece_m: (4.0 * longest).max(margin_m),
             cache: Mutex::new(Cache::default()),
         }
     }
@@ -132,19 +140,16 @@ impl SelfContact {
             .collect();
         let act = self.activation_m();
         let topo = &self.topo;
-        c.pairs = candidate_pairs(topo, &c.region, 0.5 * act)
-            .into_iter()
-            .filter(|&pair| {
-                let idx = pair.vertices(topo);
-                let reach = |k: std::ops::Range<usize>| k.map(|i| rho[idx[i]]).fold(0.0, f64::max);
-                let (a, b) = if pair.is_point_triangle() {
-                    (reach(0..1), reach(1..4))
-                } else {
-                    (reach(0..2), reach(2..4))
-                };
-                pair_distance(pair.is_point_triangle(), &idx.map(|k| x[k])).0 - a - b < act
-            })
-            .collect();
+        c.pairs = candidate_pairs(topo, &c.region, 0.5 * act, |pair| {
+            let idx = pair.vertices(topo);
+            let reach = |k: std::ops::Range<usize>| k.map(|i| rho[idx[i]]).fold(0.0, f64::max);
+            let (a, b) = if pair.is_point_triangle() {
+                (reach(0..1), reach(1..4))
+            } else {
+                (reach(0..2), reach(2..4))
+            };
+            pair_distance(pair.is_point_triangle(), &idx.map(|k| x[k])).0 - a - b < act
+        });
         c.valid = true;
         c.broad_phases += 1;
     }
@@ -176,13 +181,14 @@ impl SelfContact {
             .map(|e| (x[e[0] as usize] - x[e[1] as usize]).norm())
             .fold(0.0, f64::max);
         let boxes: Vec<Aabb> = x.iter().map(Aabb::point).collect();
-        let min_distance_m = candidate_pairs(&self.topo, &boxes, 0.5 * longest)
-            .into_iter()
-            .map(|p| {
-                let idx = p.vertices(&self.topo);
-                pair_distance(p.is_point_triangle(), &idx.map(|k| x[k])).0
-            })
-            .fold(f64::INFINITY, f64::min);
+        let min_distance_m = std::cell::Cell::new(f64::INFINITY);
+        candidate_pairs(&self.topo, &boxes, 0.5 * longest, |p| {
+            let idx = p.vertices(&self.topo);
+            let d = pair_distance(p.is_point_triangle(), &idx.map(|k| x[k])).0;
+            min_distance_m.set(min_distance_m.get().min(d));
+            false
+        });
+        let min_distance_m = min_distance_m.get();
         let mut active_pairs = 0;
         self.each_active(x, |_, _, _| active_pairs += 1);
         let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
@@ -229,25 +235,53 @@ impl EnergyTerm for SelfContact {
             h.push_outer(&idx, &coef, &k);
         });
     }
+    /// Additive CCD over every candidate pair. A long step (far from equilibrium Newton may propose
+    /// a vertex move of a metre) is checked in pieces of at most `piece_m` per vertex, each
+    /// with its own broad phase, so that no swept box spans the sheet; the first piece with an
+    /// impact gives the bound.
     fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
         let start = Instant::now();
         let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        self.ensure(&mut c, x, Some(dx));
-        let mut alpha = f64::INFINITY;
-        for &pair in &c.pairs {
-            let idx = pair.vertices(&self.topo);
-            let toi = additive_ccd(
-                pair.is_point_triangle(),
-                &idx.map(|k| x[k]),
-                &idx.map(|k| dx[k]),
-                self.thickness_m,
-                0.1,
-                1.0,
-            );
-            alpha = alpha.min(toi);
+        let longest = self
+            .topo
+            .vertices
+            .iter()
+            .map(|&v| dx[v as usize].norm())
+            .fold(0.0, f64::max);
+        let pieces = (longest / self.piece_m).ceil().clamp(1.0, 10_000.0) as usize;
+        let share = 1.0 / pieces as f64;
+        let seg: Vec<Vector3<f64>> = dx.iter().map(|d| d * share).collect();
+        let mut xk = x.to_vec();
+        let mut bound = f64::INFINITY;
+        for k in 0..pieces {
+            if k > 0 {
+                for (p, d) in xk.iter_mut().zip(&seg) {
+                    *p += d;
+                }
+            }
+            self.ensure(&mut c, &xk, Some(&seg));
+            let toi = c
+                .pairs
+                .iter()
+                .map(|&pair| {
+                    let idx = pair.vertices(&self.topo);
+                    additive_ccd(
+                        pair.is_point_triangle(),
+                        &idx.map(|k| xk[k]),
+                        &idx.map(|k| seg[k]),
+                        self.thickness_m,
+                        0.1,
+                        1.0,
+                    )
+                })
+                .fold(f64::INFINITY, f64::min);
+            if toi.is_finite() {
+                bound = (k as f64 + toi) * share;
+                break;
+            }
         }
         c.time_s += start.elapsed().as_secs_f64();
-        alpha
+        bound
     }
     fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {
         Some(self.state(x))

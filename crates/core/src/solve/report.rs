@@ -58,6 +58,9 @@ pub enum StopReason {
     ContactTooStiff,
     /// The implicit integrator's adaptive step fell below its minimum without Newton converging.
     StepTooSmall,
+    /// The solve met its tolerance but the sheet passes through itself (self-contact off, or a
+    /// solver without it): the state is not a drape. `contact.self = "auto"` prevents it.
+    PassesThroughItself,
 }
 
 impl StopReason {
@@ -72,9 +75,10 @@ impl StopReason {
             | StopReason::ContactRounds
             | StopReason::StepTooSmall => Status::MaxIterations,
             StopReason::Diverged => Status::Diverged,
-            StopReason::Invalid | StopReason::Observer | StopReason::ContactTooStiff => {
-                Status::Invalid
-            }
+            StopReason::Invalid
+            | StopReason::Observer
+            | StopReason::ContactTooStiff
+            | StopReason::PassesThroughItself => Status::Invalid,
         }
     }
 }
