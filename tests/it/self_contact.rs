@@ -17,7 +17,12 @@ fn mesh(nx: usize, ny: usize, present: &[bool]) -> (Vec<[usize; 3]>, Vec<[usize;
     let mut tris = Vec::new();
     for j in 0..ny - 1 {
         for i in 0..nx - 1 {
-            let (a, b, c, d) = (j * nx + i, j * nx + i + 1, (j + 1) * nx + i, (j + 1) * nx + i + 1);
+            let (a, b, c, d) = (
+                j * nx + i,
+                j * nx + i + 1,
+                (j + 1) * nx + i,
+                (j + 1) * nx + i + 1,
+            );
             for t in [[a, b, d], [a, d, c]] {
                 if t.iter().all(|&v| present[v]) {
                     tris.push(t);
@@ -67,7 +72,9 @@ fn point_triangle(p: &V, a: &V, b: &V, c: &V) -> f64 {
             return h.abs();
         }
     }
-    seg_point(p, a, b).min(seg_point(p, b, c)).min(seg_point(p, c, a))
+    seg_point(p, a, b)
+        .min(seg_point(p, b, c))
+        .min(seg_point(p, c, a))
 }
 
 /// Distance between segments: the interior critical point where it exists, else the four
@@ -106,7 +113,10 @@ fn near(a: &(V, V), b: &(V, V), r: f64) -> bool {
 /// (edge–triangle crossings, smallest vertex–triangle or edge–edge distance within `reach`) of the
 /// sheet at `x`, over primitives that share no vertex.
 fn self_check(x: &[V], tris: &[[usize; 3]], edges: &[[usize; 2]], reach: f64) -> (usize, f64) {
-    let tb: Vec<(V, V)> = tris.iter().map(|t| bbox(&[&x[t[0]], &x[t[1]], &x[t[2]]])).collect();
+    let tb: Vec<(V, V)> = tris
+        .iter()
+        .map(|t| bbox(&[&x[t[0]], &x[t[1]], &x[t[2]]]))
+        .collect();
     let eb: Vec<(V, V)> = edges.iter().map(|e| bbox(&[&x[e[0]], &x[e[1]]])).collect();
     let (mut crossings, mut dmin) = (0, f64::INFINITY);
     for (e, ebox) in edges.iter().zip(&eb) {
@@ -152,14 +162,26 @@ fn the_independent_checks_see_a_sheet_folded_through_itself() {
     }
     for j in 0..3 {
         for i in 0..3 {
-            x.push(V::new(0.5 + 0.1 * j as f64, i as f64 - 1.0, 0.7 - 0.5 * j as f64));
+            x.push(V::new(
+                0.5 + 0.1 * j as f64,
+                i as f64 - 1.0,
+                0.7 - 0.5 * j as f64,
+            ));
         }
     }
     let present = vec![true; 9];
     let (t1, e1) = mesh(3, 3, &present);
     let shift = |v: usize| v + 9;
-    let tris: Vec<[usize; 3]> = t1.iter().copied().chain(t1.iter().map(|t| t.map(shift))).collect();
-    let edges: Vec<[usize; 2]> = e1.iter().copied().chain(e1.iter().map(|e| e.map(shift))).collect();
+    let tris: Vec<[usize; 3]> = t1
+        .iter()
+        .copied()
+        .chain(t1.iter().map(|t| t.map(shift)))
+        .collect();
+    let edges: Vec<[usize; 2]> = e1
+        .iter()
+        .copied()
+        .chain(e1.iter().map(|e| e.map(shift)))
+        .collect();
     let (c, d) = self_check(&x, &tris, &edges, 0.1);
     assert!(c > 0 && d < 1e-12, "{c} {d}");
     // Apart by 2 mm: none, and the distance is the gap.
@@ -196,8 +218,16 @@ fn every_bundled_scene_converges_without_passing_through_itself() {
         let (crossings, dmin) = check_solution(&s, &sol);
         let xi = drapelab::build::self_thickness_m(&s);
         assert_eq!(crossings, 0, "{name} passes through itself");
-        assert!(dmin >= xi, "{name}: parts {dmin:.3e} m apart, under half of 2ξ = {}", 2.0 * xi);
-        let active = sol.model.self_contact(&sol.x).expect("modelled").active_pairs;
+        assert!(
+            dmin >= xi,
+            "{name}: parts {dmin:.3e} m apart, under half of 2ξ = {}",
+            2.0 * xi
+        );
+        let active = sol
+            .model
+            .self_contact(&sol.x)
+            .expect("modelled")
+            .active_pairs;
         if s.obstacles.is_empty() && active == 0 {
             let off = solve_scene(&scene(name, &["contact.self=\"off\""]), &mut NoObserver);
             let moved = sol
@@ -206,9 +236,14 @@ fn every_bundled_scene_converges_without_passing_through_itself() {
                 .zip(&off.x)
                 .map(|(a, b)| (a - b).norm())
                 .fold(0.0, f64::max);
-            assert!(moved <= 1e-6, "{name}: self-contact moved the equilibrium {moved:.2e} m");
+            assert!(
+                moved <= 1e-6,
+                "{name}: self-contact moved the equilibrium {moved:.2e} m"
+            );
         }
-        lines.push(format!("{name}: {active} active pairs, closest {dmin:.2e} m"));
+        lines.push(format!(
+            "{name}: {active} active pairs, closest {dmin:.2e} m"
+        ));
     }
     eprintln!("{}", lines.join("\n"));
 }
@@ -220,9 +255,21 @@ fn every_bundled_scene_converges_without_passing_through_itself() {
 fn without_self_contact_the_limp_drape_passes_through_itself_and_is_not_a_result() {
     let s = scene("table_limp_hanging.toml", &["contact.self=\"off\""]);
     let sol = solve_scene(&s, &mut NoObserver);
-    assert_eq!(sol.report.stop, drapelab::solve::StopReason::PassesThroughItself);
-    assert_eq!(sol.report.status.as_str(), "invalid", "{}", sol.report.message);
-    assert!(sol.report.message.contains("passes through itself"), "{}", sol.report.message);
+    assert_eq!(
+        sol.report.stop,
+        drapelab::solve::StopReason::PassesThroughItself
+    );
+    assert_eq!(
+        sol.report.status.as_str(),
+        "invalid",
+        "{}",
+        sol.report.message
+    );
+    assert!(
+        sol.report.message.contains("passes through itself"),
+        "{}",
+        sol.report.message
+    );
     let (crossings, _) = check_solution(&s, &sol);
     assert!(crossings > 10, "{crossings}");
 }
@@ -284,7 +331,7 @@ fn a_sheet_folding_onto_itself_stays_apart_at_every_accepted_step_and_is_recorde
     let path = tmp.path().join("fold.toml");
     std::fs::write(&path, FOLD).unwrap();
     let s = Scene::load(&path, &[]).unwrap().scene.into_inner();
-    let (tris, edges) = mesh(7, 13, &vec![true; 7 * 13]);
+    let (tris, edges) = mesh(7, 13, &[true; 7 * 13]);
     let xi = drapelab::build::self_thickness_m(&s);
     let mut obs = EveryStep {
         tris,
@@ -295,22 +342,43 @@ fn a_sheet_folding_onto_itself_stays_apart_at_every_accepted_step_and_is_recorde
         worst: (0, f64::INFINITY),
     };
     let sol = solve_scene(&s, &mut obs);
-    assert!(!sol.report.status.as_str().contains("diverged"), "{}", sol.report.message);
+    assert!(
+        !sol.report.status.as_str().contains("diverged"),
+        "{}",
+        sol.report.message
+    );
     assert!(obs.steps > 20, "{} steps", obs.steps);
     assert_eq!(obs.worst.0, 0, "a step passed through the sheet");
-    assert!(obs.worst.1 >= xi, "closest {:.3e} m under ξ = {xi}", obs.worst.1);
+    assert!(
+        obs.worst.1 >= xi,
+        "closest {:.3e} m under ξ = {xi}",
+        obs.worst.1
+    );
     // The halves did meet: pairs within the activation distance at the end.
     let state = sol.model.self_contact(&sol.x).expect("modelled");
     assert!(state.active_pairs > 0, "the halves never met");
     // Without self-contact the same fall folds the halves through each other.
-    let off = Scene::load(&path, &[drapelab::config::parse_override("contact.self=\"off\"").unwrap()])
-        .unwrap()
-        .scene
-        .into_inner();
-    let (tris, edges) = mesh(7, 13, &vec![true; 7 * 13]);
-    let mut obs_off = EveryStep { tris, edges, reach: 2.0 * xi, n: 7 * 13, steps: 0, worst: (0, f64::INFINITY) };
+    let off = Scene::load(
+        &path,
+        &[drapelab::config::parse_override("contact.self=\"off\"").unwrap()],
+    )
+    .unwrap()
+    .scene
+    .into_inner();
+    let (tris, edges) = mesh(7, 13, &[true; 7 * 13]);
+    let mut obs_off = EveryStep {
+        tris,
+        edges,
+        reach: 2.0 * xi,
+        n: 7 * 13,
+        steps: 0,
+        worst: (0, f64::INFINITY),
+    };
     solve_scene(&off, &mut obs_off);
-    assert!(obs_off.worst.0 > 0, "the halves never crossed without self-contact");
+    assert!(
+        obs_off.worst.0 > 0,
+        "the halves never crossed without self-contact"
+    );
     // Recorded: the CLI's timeline.mcap, read by the Python mcap reader, holds every accepted step,
     // each without crossings by the checks here; drape.rrd loads in rerun.
     let out = tmp.path().join("o");
@@ -319,13 +387,23 @@ fn a_sheet_folding_onto_itself_stays_apart_at_every_accepted_step_and_is_recorde
         .arg(&path)
         .arg("--out")
         .arg(&out)
-        .args(["--set", "record.timeline=true", "--set", "record.rerun=true"])
+        .args([
+            "--set",
+            "record.timeline=true",
+            "--set",
+            "record.rerun=true",
+        ])
         .output()
         .unwrap();
     // Half a second of the fall is recorded; the sheet still swings (status max-iterations, exit 1).
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
-    assert_eq!(run["status"], "max-iterations", "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        run["status"],
+        "max-iterations",
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert_eq!(run["self_contact"]["crossing_edges"], 0);
     let frames = run_python(
         r#"
@@ -342,8 +420,13 @@ print(json.dumps(frames))
         &[&out.join("timeline.mcap")],
     );
     let frames: Vec<Vec<[f64; 3]>> = serde_json::from_str(frames.trim()).unwrap();
-    assert!(frames.len() + 1 >= obs.steps, "{} frames for {} steps", frames.len(), obs.steps);
-    let (tris, edges) = mesh(7, 13, &vec![true; 7 * 13]);
+    assert!(
+        frames.len() + 1 >= obs.steps,
+        "{} frames for {} steps",
+        frames.len(),
+        obs.steps
+    );
+    let (tris, edges) = mesh(7, 13, &[true; 7 * 13]);
     for (k, f) in frames.iter().enumerate() {
         let x: Vec<V> = f.iter().map(|p| V::new(p[0], p[1], p[2])).collect();
         let (c, _) = self_check(&x, &tris, &edges, 2.0 * xi);
@@ -362,5 +445,42 @@ print(rows)
         &[&out.join("drape.rrd")],
     );
     let rows: usize = rrd.trim().parse().unwrap();
-    assert!(rows + 1 >= obs.steps, "{rows} rerun rows for {} steps", obs.steps);
+    assert!(
+        rows + 1 >= obs.steps,
+        "{rows} rerun rows for {} steps",
+        obs.steps
+    );
+}
+
+/// Bad self-contact settings are input errors naming the file and key (exit 2, nothing written):
+/// "on" with an integrator that cannot bound its steps, a thickness the flat sheet already exceeds,
+/// an unknown mode.
+#[test]
+fn bad_self_contact_settings_name_the_key() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = root().join("datasets/scenes/hang4.toml");
+    for (sets, key) in [
+        (
+            vec!["solver.kind=\"explicit-euler\"", "contact.self=\"on\""],
+            "contact.self",
+        ),
+        (
+            vec!["contact.self_thickness_m=0.02"],
+            "contact.self_thickness_m",
+        ),
+        (
+            vec!["contact.self_thickness_m=-1e-3"],
+            "contact.self_thickness_m",
+        ),
+        (vec!["contact.self=\"sometimes\""], "contact.self"),
+    ] {
+        let out = tmp.path().join("o");
+        let mut args: Vec<String> = vec!["simulate".into(), scene.display().to_string()];
+        for s in &sets {
+            args.extend(["--set".to_string(), s.to_string()]);
+        }
+        args.extend(["--out".to_string(), out.display().to_string()]);
+        crate::support::assert_bad_input(&args, &["hang4.toml", key]);
+        assert!(!out.exists(), "{sets:?} left {}", out.display());
+    }
 }

@@ -767,7 +767,8 @@ would already touch itself; use a coarser grid or a thinner sheet"
                 );
             }
         }
-        if self.contact.self_contact == SelfContactMode::On && !self.solver.kind.supports_self_contact()
+        if self.contact.self_contact == SelfContactMode::On
+            && !self.solver.kind.supports_self_contact()
         {
             return ck.err(
                 "contact.self",

@@ -162,7 +162,8 @@ pub fn self_contact_summary(
         modelled: state.is_some(),
         thickness_m: xi,
         activation_distance_m: xi.map(|t| 2.0 * t),
-        min_distance_m: state.and_then(|s| s.min_distance_m.is_finite().then_some(s.min_distance_m)),
+        min_distance_m: state
+            .and_then(|s| s.min_distance_m.is_finite().then_some(s.min_distance_m)),
         active_pairs: state.map_or(0, |s| s.active_pairs),
         broad_phases: state.map_or(0, |s| s.broad_phases),
         time_s: state.map_or(0.0, |s| s.time_s),

@@ -545,7 +545,12 @@ mod tests {
     #[test]
     fn distances_match_brute_force_sampling() {
         let (a, b, c) = (v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0));
-        for p in [v(0.2, 0.2, 0.5), v(2.0, -1.0, 0.3), v(-1.0, -1.0, 0.0), v(0.6, 0.6, -0.2)] {
+        for p in [
+            v(0.2, 0.2, 0.5),
+            v(2.0, -1.0, 0.3),
+            v(-1.0, -1.0, 0.0),
+            v(0.6, 0.6, -0.2),
+        ] {
             let (d, w) = point_triangle_distance(&p, &a, &b, &c);
             let mut best = f64::INFINITY;
             for i in 0..=200 {
@@ -576,7 +581,12 @@ mod tests {
 
     #[test]
     fn additive_ccd_stops_a_point_short_of_a_triangle_it_would_cross() {
-        let x = [v(0.2, 0.2, 0.1), v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
+        let x = [
+            v(0.2, 0.2, 0.1),
+            v(0.0, 0.0, 0.0),
+            v(1.0, 0.0, 0.0),
+            v(0.0, 1.0, 0.0),
+        ];
         let dx = [v(0.0, 0.0, -0.3), V3::zeros(), V3::zeros(), V3::zeros()];
         let t = additive_ccd(true, &x, &dx, 0.0, 0.1, 1.0);
         // It would touch at t = 1/3; it stops before, within the last 10 % of the gap.
@@ -585,8 +595,18 @@ mod tests {
         let slide = [v(0.3, 0.0, 0.0), V3::zeros(), V3::zeros(), V3::zeros()];
         assert!(additive_ccd(true, &x, &slide, 0.0, 0.1, 1.0).is_infinite());
         // Two edges crossing through each other.
-        let e = [v(0.0, 0.0, 0.1), v(1.0, 0.0, 0.1), v(0.5, -1.0, 0.0), v(0.5, 1.0, 0.0)];
-        let de = [v(0.0, 0.0, -0.2), v(0.0, 0.0, -0.2), V3::zeros(), V3::zeros()];
+        let e = [
+            v(0.0, 0.0, 0.1),
+            v(1.0, 0.0, 0.1),
+            v(0.5, -1.0, 0.0),
+            v(0.5, 1.0, 0.0),
+        ];
+        let de = [
+            v(0.0, 0.0, -0.2),
+            v(0.0, 0.0, -0.2),
+            V3::zeros(),
+            V3::zeros(),
+        ];
         let t = additive_ccd(false, &e, &de, 0.0, 0.1, 1.0);
         assert!(t < 0.5 && t > 0.4, "{t}");
     }
@@ -619,7 +639,12 @@ mod tests {
         let mut brute = 0;
         for &vtx in &topo.vertices {
             for (t, tri) in topo.triangles.iter().enumerate() {
-                let idx = [vtx as usize, tri[0] as usize, tri[1] as usize, tri[2] as usize];
+                let idx = [
+                    vtx as usize,
+                    tri[0] as usize,
+                    tri[1] as usize,
+                    tri[2] as usize,
+                ];
                 let y = idx.map(|k| x[k]);
                 if !tri.contains(&vtx) && pair_distance(true, &y).0 < 1.5e-3 {
                     brute += 1;

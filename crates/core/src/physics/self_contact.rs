@@ -308,9 +308,17 @@ mod tests {
                 }
             }
         }
-        (x, crate::cloth::cell_triangles(3, 3).into_iter().chain(
-            crate::cloth::cell_triangles(3, 3).into_iter().map(|t| t.map(|v| v + 9)),
-        ).collect())
+        (
+            x,
+            crate::cloth::cell_triangles(3, 3)
+                .into_iter()
+                .chain(
+                    crate::cloth::cell_triangles(3, 3)
+                        .into_iter()
+                        .map(|t| t.map(|v| v + 9)),
+                )
+                .collect(),
+        )
     }
 
     #[test]
