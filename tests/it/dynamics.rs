@@ -162,6 +162,7 @@ fn over_the_stress_box_implicit_euler_settles_on_static_equilibria() {
     let axes = drapelab::optim::latin_hypercube(50, 6, 19);
     let lerp = |u: f64, lo: f64, hi: f64| lo + u * (hi - lo);
     let (mut settled, mut minima, mut same, mut worst) = (0, 0, 0, 0.0f64);
+    let mut crossed = 0;
     for i in 0..50 {
         let u: Vec<f64> = axes.iter().map(|a| a[i]).collect();
         let topology = ["a", "b", "c"][((u[4] * 3.0) as usize).min(2)];
@@ -189,9 +190,18 @@ fn over_the_stress_box_implicit_euler_settles_on_static_equilibria() {
             ),
             "cloth.nx=14".into(),
             "cloth.ny=14".into(),
+            // Solver agreement on seed 000's net as it was built (without self-contact: 50 falls with
+            // it take 4–22 s each here, ten times longer; the crossing check still applies).
+            "contact.self=\"off\"".into(),
         ];
         let sets: Vec<&str> = g.iter().map(String::as_str).collect();
         let dynamic = fall("hang4.toml", &sets, &mut NoObserver);
+        // Without self-contact a slack net can settle folded through itself: that state is not a
+        // result (invalid, PassesThroughItself), and no other invalid ending is allowed.
+        if dynamic.report.stop == drapelab::solve::StopReason::PassesThroughItself {
+            crossed += 1;
+            continue;
+        }
         assert_ne!(dynamic.report.status, Status::Invalid, "{sets:?}");
         if dynamic.report.status != Status::Converged {
             assert!(
@@ -217,7 +227,7 @@ fn over_the_stress_box_implicit_euler_settles_on_static_equilibria() {
         same += usize::from(d < 1e-4);
     }
     eprintln!(
-        "{settled} of 50 settled, {minima} of them on a minimum, {same} within 1e-4 m of Newton's static drape (the farthest {worst:.2e} m)"
+        "{settled} of 50 settled, {minima} of them on a minimum, {same} within 1e-4 m of Newton's static drape (the farthest {worst:.2e} m); {crossed} settled through themselves"
     );
     assert!(minima >= 40, "{minima} minima");
     assert!(settled >= 45, "{settled} of 50 settled");

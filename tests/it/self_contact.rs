@@ -313,6 +313,21 @@ struct EveryStep {
     worst: (usize, f64),
 }
 
+impl EveryStep {
+    /// For the 7 × 13 sheet of [`FOLD`] of thickness `xi`.
+    fn of_fold(xi: f64) -> Self {
+        let (tris, edges) = mesh(7, 13, &[true; 7 * 13]);
+        Self {
+            tris,
+            edges,
+            reach: 2.0 * xi,
+            n: 7 * 13,
+            steps: 0,
+            worst: (0, f64::INFINITY),
+        }
+    }
+}
+
 impl Observer for EveryStep {
     fn wants(&self, _index: usize) -> bool {
         true
@@ -331,16 +346,8 @@ fn a_sheet_folding_onto_itself_stays_apart_at_every_accepted_step_and_is_recorde
     let path = tmp.path().join("fold.toml");
     std::fs::write(&path, FOLD).unwrap();
     let s = Scene::load(&path, &[]).unwrap().scene.into_inner();
-    let (tris, edges) = mesh(7, 13, &[true; 7 * 13]);
     let xi = drapelab::build::self_thickness_m(&s);
-    let mut obs = EveryStep {
-        tris,
-        edges,
-        reach: 2.0 * xi,
-        n: 7 * 13,
-        steps: 0,
-        worst: (0, f64::INFINITY),
-    };
+    let mut obs = EveryStep::of_fold(xi);
     let sol = solve_scene(&s, &mut obs);
     assert!(
         !sol.report.status.as_str().contains("diverged"),
@@ -365,15 +372,7 @@ fn a_sheet_folding_onto_itself_stays_apart_at_every_accepted_step_and_is_recorde
     .unwrap()
     .scene
     .into_inner();
-    let (tris, edges) = mesh(7, 13, &[true; 7 * 13]);
-    let mut obs_off = EveryStep {
-        tris,
-        edges,
-        reach: 2.0 * xi,
-        n: 7 * 13,
-        steps: 0,
-        worst: (0, f64::INFINITY),
-    };
+    let mut obs_off = EveryStep::of_fold(xi);
     solve_scene(&off, &mut obs_off);
     assert!(
         obs_off.worst.0 > 0,

@@ -308,17 +308,18 @@ mod tests {
                 }
             }
         }
-        (
-            x,
-            crate::cloth::cell_triangles(3, 3)
-                .into_iter()
-                .chain(
-                    crate::cloth::cell_triangles(3, 3)
-                        .into_iter()
-                        .map(|t| t.map(|v| v + 9)),
-                )
-                .collect(),
-        )
+        // Two triangles per cell of each 3 × 3 layer.
+        let mut tris = Vec::new();
+        for layer in 0..2u32 {
+            for j in 0..2u32 {
+                for i in 0..2u32 {
+                    let p = layer * 9 + j * 3 + i;
+                    tris.push([p, p + 1, p + 4]);
+                    tris.push([p, p + 4, p + 3]);
+                }
+            }
+        }
+        (x, tris)
     }
 
     #[test]
