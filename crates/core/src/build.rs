@@ -316,6 +316,14 @@ pub fn self_thickness_m(scene: &Scene) -> f64 {
     })
 }
 
+/// The triangles of the grid whose three particles are all present (not `absent`).
+pub fn sheet_triangles(grid: &Grid, absent: &[bool]) -> Vec<[u32; 3]> {
+    crate::cloth::grid_triangles(grid)
+        .into_iter()
+        .filter(|t| t.iter().all(|&v| !absent[v as usize]))
+        .collect()
+}
+
 /// The sheet's self-contact term (when the scene's `contact.self` and solver ask for it): the grid
 /// triangulated over its present particles, thickness ξ ([`self_thickness_m`]), band ξ, κ from the
 /// mean particle weight.
@@ -329,10 +337,7 @@ fn self_contact(
     if !scene.solver.kind.self_contact(scene.contact.self_contact) {
         return None;
     }
-    let triangles: Vec<[u32; 3]> = crate::cloth::grid_triangles(grid)
-        .into_iter()
-        .filter(|t| t.iter().all(|&v| !absent[v as usize]))
-        .collect();
+    let triangles = sheet_triangles(grid, absent);
     let heavy: Vec<f64> = masses[..grid.len()]
         .iter()
         .copied()

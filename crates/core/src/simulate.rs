@@ -114,7 +114,7 @@ pub fn check_crossings(
     x: &[Vector3<f64>],
     report: &mut SolveReport,
 ) {
-    if !report.is_converged() || model.self_contact(x).is_some() || x.len() < grid.len() {
+    if !report.is_converged() || model.models_self_contact() || x.len() < grid.len() {
         return;
     }
     let n = crossing_edges(scene, grid, x);
@@ -134,12 +134,13 @@ pub fn check_crossings(
 
 /// Mesh edges of the triangulated grid at `x` that cross a triangle sharing no vertex with them.
 fn crossing_edges(scene: &Scene, grid: &Grid, x: &[Vector3<f64>]) -> usize {
-    let present = crate::build::present_particles(scene);
-    let triangles: Vec<[u32; 3]> = crate::cloth::grid_triangles(grid)
-        .into_iter()
-        .filter(|t| t.iter().all(|&v| present[v as usize]))
+    let absent: Vec<bool> = crate::build::present_particles(scene)
+        .iter()
+        .map(|p| !p)
         .collect();
-    let topo = crate::contact::proximity::MeshTopology::from_triangles(triangles);
+    let topo = crate::contact::proximity::MeshTopology::from_triangles(
+        crate::build::sheet_triangles(grid, &absent),
+    );
     crate::contact::proximity::edge_triangle_crossings(&topo, x)
         .iter()
         .map(|c| c.0)

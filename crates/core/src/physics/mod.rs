@@ -119,6 +119,10 @@ pub trait EnergyTerm: Send + Sync {
     fn self_contact(&self, _x: &Vecs) -> Option<SelfContactState> {
         None
     }
+    /// Whether this is the sheet's self-contact term.
+    fn is_self_contact(&self) -> bool {
+        false
+    }
 }
 
 /// The assembled model: masses, pins and energy terms.
@@ -249,6 +253,10 @@ impl Model {
             .iter()
             .map(|t| t.max_strain(x))
             .fold(0.0, f64::max)
+    }
+    /// Whether the model has the sheet's self-contact term (cheap: no state is computed).
+    pub fn models_self_contact(&self) -> bool {
+        self.terms.iter().any(|t| t.is_self_contact())
     }
     /// The state of the sheet's self-contact at `x`, when the model has the term.
     pub fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {

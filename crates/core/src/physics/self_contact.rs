@@ -286,6 +286,9 @@ impl EnergyTerm for SelfContact {
     fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {
         Some(self.state(x))
     }
+    fn is_self_contact(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]
