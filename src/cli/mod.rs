@@ -115,6 +115,10 @@ pub enum Command {
         /// a filesystem shared with the nodes; README "Running on a Slurm cluster").
         #[arg(long, value_enum)]
         executor: Option<ExecutorArg>,
+        /// When another `drapelab run` holds this pipeline's run folder, wait for it to finish
+        /// instead of exiting with 2.
+        #[arg(long)]
+        wait: bool,
     },
     /// Compute some items of a stage, as one Slurm array task does (`drapelab run --executor slurm`
     /// writes the task list and calls this; not needed by hand).
@@ -394,6 +398,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             jobs,
             dry_run,
             executor,
+            wait,
         } => run_pipeline_command(
             &pipeline,
             crate::pipeline::RunOptions {
@@ -402,6 +407,11 @@ pub fn run(cli: Cli) -> Result<i32> {
                 jobs,
                 dry_run,
                 executor: executor.map(Into::into),
+                wait: if wait {
+                    crate::pipeline::LockWait::Yes
+                } else {
+                    crate::pipeline::LockWait::No
+                },
             },
         ),
         Command::Worker {
@@ -537,11 +547,14 @@ fn status(pipeline: &Path, check: bool) -> Result<i32> {
     let plan = crate::pipeline::load_plan(pipeline, &crate::stages::registry())?;
     let mut stale = 0;
     for (name, state) in crate::pipeline::stage_states(&plan) {
+        let last = crate::pipeline::Manifest::read(&crate::pipeline::manifest_path(&plan, &name))
+            .map(|m| format!(" [last run {:.1} s]", m.wall_time_s))
+            .unwrap_or_default();
         match state {
-            crate::pipeline::StageState::UpToDate => println!("{name}: up to date"),
+            crate::pipeline::StageState::UpToDate => println!("{name}: up to date{last}"),
             crate::pipeline::StageState::Stale(why) => {
                 stale += 1;
-                println!("{name}: stale ({why})")
+                println!("{name}: stale ({why}){last}")
             }
         }
     }

@@ -441,7 +441,7 @@ fn a_panicking_stage_fails_alone_and_the_run_exits_1() {
             &std::fs::read(tmp.path().join(format!("runs/t/.manifests/{done}.json"))).unwrap(),
         )
         .unwrap();
-        assert_eq!(m["status"], "ok", "{done}");
+        assert_eq!(m["status"]["outcome"], "ok", "{done}");
     }
     assert!(!tmp.path().join("reports/ab.md").exists());
 }

@@ -177,7 +177,7 @@ pub enum SolverKind {
 
 impl SolverKind {
     /// The name as written in scenes.
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             SolverKind::Static => "static",
             SolverKind::ExplicitEuler => "explicit-euler",

@@ -2,10 +2,11 @@
 //! (written atomically by the stage kind), the parts folder is kept while the stage's key (inputs,
 //! parameters, version, build) holds, so a rerun after a kill computes only the missing parts, and
 //! the outputs are the gather of every part. The local executor runs the missing items on this
-//! process's threads; [`crate::slurm`] runs them as array tasks.
+//! process's threads ([`Local`]); the Slurm executor runs them as array tasks. The runner chooses
+//! the [`Executor`].
 
-use crate::executor::{ExecutorKind, ExecutorSettings};
-use crate::stage::StageContext;
+use crate::files::remove_partials;
+use crate::stage::{Stage, StageContext};
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -53,49 +54,69 @@ pub fn without_part(dir: &Path, items: impl IntoIterator<Item = usize>) -> Vec<u
         .collect()
 }
 
-/// Computes `items` on this process's threads (the current rayon pool), one part each. Every item
-/// is tried; the first failure (by item) is returned after the others finished, so that their
-/// parts are kept.
-pub fn compute_local(ctx: &StageContext<'_>, items: &[usize], dir: &Path) -> Result<()> {
-    let kind = ctx.stage.kind.as_ref();
-    let mut failures: Vec<(usize, anyhow::Error)> = items
-        .par_iter()
-        .filter_map(|&i| {
-            let r = kind.compute_item(ctx, i, &part_path(dir, i));
-            ctx.progress.item_done(&ctx.stage.name);
-            r.err().map(|e| (i, e))
-        })
-        .collect();
-    failures.sort_by_key(|(i, _)| *i);
-    match failures.into_iter().next() {
-        Some((i, e)) => Err(e.context(format!("item {i}"))),
-        None => Ok(()),
+/// Where the missing items of a stage are computed.
+pub trait Executor: Sync {
+    /// Computes `items` of stage kind `kind` (context `ctx`), one part each in `dir`; returns once
+    /// every item has a part or has failed.
+    fn compute(
+        &self,
+        kind: &dyn Stage,
+        ctx: &StageContext<'_>,
+        items: &[usize],
+        dir: &Path,
+    ) -> Result<()>;
+}
+
+/// The local executor: the items on this process's threads (the current rayon pool).
+pub struct Local;
+
+impl Executor for Local {
+    /// Every item is tried; the first failure (by item) is returned after the others finished, so
+    /// that their parts are kept.
+    fn compute(
+        &self,
+        kind: &dyn Stage,
+        ctx: &StageContext<'_>,
+        items: &[usize],
+        dir: &Path,
+    ) -> Result<()> {
+        let mut failures: Vec<(usize, anyhow::Error)> = items
+            .par_iter()
+            .filter_map(|&i| {
+                let r = kind.compute_item(ctx, i, &part_path(dir, i));
+                ctx.item_done();
+                r.err().map(|e| (i, e))
+            })
+            .collect();
+        failures.sort_by_key(|(i, _)| *i);
+        match failures.into_iter().next() {
+            Some((i, e)) => Err(e.context(format!("item {i}"))),
+            None => Ok(()),
+        }
     }
 }
 
-/// Runs a stage of `n` items under `key`: the parts folder is prepared, the missing items are
-/// computed by the executor, and the parts are gathered into the outputs.
+/// Runs stage kind `kind` of `n` items under `key`: the parts folder is prepared, the missing items
+/// are computed by `executor`, and the parts are gathered into the outputs.
 pub fn run_by_items(
+    kind: &dyn Stage,
     ctx: &StageContext<'_>,
     n: usize,
     key: &str,
-    executor: &ExecutorSettings,
+    executor: &dyn Executor,
 ) -> Result<()> {
-    let dir = parts_dir(&ctx.plan.run_dir(), &ctx.stage.name);
+    let dir = parts_dir(&ctx.run_dir, &ctx.stage);
     prepare_parts(&dir, key)?;
-    crate::runner::remove_partials(&dir);
+    remove_partials(&dir);
     let missing = without_part(&dir, 0..n);
-    ctx.progress.stage_started(&ctx.stage.name, n as u64);
+    ctx.started(n);
     for _ in 0..n - missing.len() {
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
     }
-    tracing::debug!(stage = %ctx.stage.name, items = n, missing = missing.len(), "parts");
+    tracing::debug!(stage = %ctx.stage, items = n, missing = missing.len(), "parts");
     if !missing.is_empty() {
-        match executor.kind {
-            ExecutorKind::Local => compute_local(ctx, &missing, &dir)?,
-            ExecutorKind::Slurm => crate::slurm::compute_slurm(ctx, &missing, &dir, executor)?,
-        }
+        executor.compute(kind, ctx, &missing, &dir)?;
     }
     let parts: Vec<PathBuf> = (0..n).map(|i| part_path(&dir, i)).collect();
-    ctx.stage.kind.gather(ctx, &parts)
+    kind.gather(ctx, &parts)
 }

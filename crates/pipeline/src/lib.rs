@@ -7,8 +7,11 @@
 //! that stage a dependency.
 
 mod executor;
+mod files;
 mod items;
+mod lock;
 mod manifest;
+mod outcome;
 mod plan;
 mod progress;
 mod runner;
@@ -16,8 +19,10 @@ mod slurm;
 mod stage;
 
 pub use executor::{ExecutorKind, ExecutorSettings};
-pub use items::{part_path, parts_dir};
+pub use items::{Executor, Local, part_path, parts_dir};
+pub use lock::{Holder, LockWait, RunLock};
 pub use manifest::{Manifest, hash_file};
+pub use outcome::{FailureCause, StageOutcome, StaleReason};
 pub use plan::{Paths, Plan, PlannedStage, StageSpec, load_plan};
 pub use progress::{LogProgress, MultiBarProgress, Progress, progress_for_terminal};
 pub use runner::{

@@ -1,6 +1,7 @@
 //! Stage manifests: what a finished stage read, with which parameters, what it wrote and how it
 //! ended. Written last and atomically, so a stage without a matching manifest is not finished.
 
+use crate::outcome::StageOutcome;
 use anyhow::Result;
 use drapelab_core::atomic::write_atomic;
 use serde::{Deserialize, Serialize};
@@ -22,8 +23,8 @@ pub struct Manifest {
     pub params: serde_json::Value,
     /// Each output's size in bytes, by path.
     pub outputs: BTreeMap<String, u64>,
-    /// "ok" or "failed: ...".
-    pub status: String,
+    /// How the stage ended.
+    pub status: StageOutcome,
     /// Wall time of the stage in s.
     pub wall_time_s: f64,
     /// The command line that ran it.

@@ -2,6 +2,7 @@
 //! On a terminal, an indicatif MultiProgress with one bar per running stage; otherwise log lines
 //! through `tracing` (level info; `-q` or `RUST_LOG=warn` silences them).
 
+use crate::outcome::StageOutcome;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::HashMap;
 use std::io::IsTerminal;
@@ -14,8 +15,8 @@ pub trait Progress: Sync {
     fn stage_started(&self, stage: &str, items: u64);
     /// One item of a stage finished.
     fn item_done(&self, stage: &str);
-    /// A stage finished ("ok" or "failed: ..."), after `wall_s` seconds.
-    fn stage_finished(&self, stage: &str, outcome: &str, wall_s: f64);
+    /// A stage finished, after `wall_s` seconds.
+    fn stage_finished(&self, stage: &str, outcome: &StageOutcome, wall_s: f64);
     /// A stage was skipped, and why.
     fn stage_skipped(&self, stage: &str, why: &str);
 }
@@ -58,8 +59,8 @@ impl Progress for LogProgress {
             }
         }
     }
-    fn stage_finished(&self, stage: &str, outcome: &str, wall_s: f64) {
-        if outcome == "ok" {
+    fn stage_finished(&self, stage: &str, outcome: &StageOutcome, wall_s: f64) {
+        if outcome.is_ok() {
             tracing::info!("[{stage}] {outcome} in {wall_s:.2} s");
         } else {
             tracing::error!("[{stage}] {outcome} in {wall_s:.2} s");
@@ -103,7 +104,7 @@ impl Progress for MultiBarProgress {
             b.inc(1);
         }
     }
-    fn stage_finished(&self, stage: &str, outcome: &str, wall_s: f64) {
+    fn stage_finished(&self, stage: &str, outcome: &StageOutcome, wall_s: f64) {
         if let Some(b) = self.bars.lock().expect("lock").remove(stage) {
             b.finish_and_clear();
         }

@@ -1,10 +1,15 @@
 //! Running a plan make-style: a stage runs when it is stale (or forced), otherwise it is skipped
 //! in milliseconds. Outputs are written atomically by the stages; the manifest is written last.
 
-use crate::executor::{ExecutorKind, ExecutorSettings};
+use crate::executor::ExecutorKind;
+use crate::files::{rel, remove_partials};
+use crate::items::{Executor, Local, parts_dir, run_by_items};
+use crate::lock::{LockWait, RunLock};
 use crate::manifest::{Manifest, build_id, hash_file, stage_key};
+use crate::outcome::{FailureCause, StageOutcome, StaleReason};
 use crate::plan::{Plan, PlannedStage};
 use crate::progress::Progress;
+use crate::slurm::Slurm;
 use crate::stage::StageContext;
 use anyhow::Result;
 use drapelab_core::error::InputError;
@@ -25,6 +30,8 @@ pub struct RunOptions {
     pub dry_run: bool,
     /// The executor of items, overriding the pipeline's `[executor]` kind (`--executor`).
     pub executor: Option<ExecutorKind>,
+    /// Whether to wait for a run folder that another run holds (`--wait`) or refuse at once.
+    pub wait: LockWait,
 }
 
 /// Whether a stage is up to date, and if not, why.
@@ -32,8 +39,8 @@ pub struct RunOptions {
 pub enum StageState {
     /// Inputs, parameters, version and outputs match the manifest.
     UpToDate,
-    /// Must run; the reason in words.
-    Stale(String),
+    /// Must run, and why.
+    Stale(StaleReason),
 }
 
 /// What a run did.
@@ -43,17 +50,10 @@ pub struct RunSummary {
     pub ran: Vec<String>,
     /// Stages skipped as up to date.
     pub skipped: Vec<String>,
-    /// Stages that failed, with why.
-    pub failed: Vec<(String, String)>,
-    /// Stages that would run (dry run).
-    pub would_run: Vec<(String, String)>,
-}
-
-fn rel(root: &Path, p: &Path) -> String {
-    p.strip_prefix(root)
-        .unwrap_or(p)
-        .to_string_lossy()
-        .replace('\\', "/")
+    /// Stages that failed, with how.
+    pub failed: Vec<(String, StageOutcome)>,
+    /// Stages that would run (dry run), with why.
+    pub would_run: Vec<(String, StaleReason)>,
 }
 
 /// The manifest path of a stage.
@@ -118,82 +118,75 @@ fn hashed(
         .collect()
 }
 
+/// Why stage `s` must run, if it must: upstream stages that will run, then its manifest against
+/// its parameters, inputs, outputs and build.
 fn check(plan: &Plan, s: &PlannedStage, upstream_stale: &BTreeSet<String>) -> StageState {
     if let Some(d) = s.deps.iter().find(|d| upstream_stale.contains(*d)) {
-        return StageState::Stale(format!("upstream stage `{d}` will run"));
+        return StageState::Stale(StaleReason::UpstreamWillRun(d.clone()));
     }
     let Some(m) = Manifest::read(&manifest_path(plan, &s.name)) else {
-        return StageState::Stale("never completed (no manifest)".into());
+        return StageState::Stale(StaleReason::NeverRun);
     };
-    if m.status != "ok" {
-        return StageState::Stale(format!("last run {}", m.status));
+    match stale_reason(plan, s, &m) {
+        Some(r) => StageState::Stale(r),
+        None => StageState::UpToDate,
+    }
+}
+
+/// Why the manifest `m` of stage `s` no longer holds, if it does not.
+fn stale_reason(plan: &Plan, s: &PlannedStage, m: &Manifest) -> Option<StaleReason> {
+    if let StageOutcome::Failed { message, .. } = &m.status {
+        return Some(StaleReason::LastRunFailed(message.clone()));
     }
     if m.drapelab_version != drapelab_core::VERSION {
-        return StageState::Stale(format!(
-            "drapelab version changed ({} → {})",
-            m.drapelab_version,
-            drapelab_core::VERSION
-        ));
+        return Some(StaleReason::VersionChanged {
+            from: m.drapelab_version.clone(),
+            to: drapelab_core::VERSION.into(),
+        });
     }
-    let params = &s.params;
-    if m.params != *params {
+    if m.params != s.params {
         let mut changed = Vec::new();
-        if let (Some(a), Some(b)) = (m.params.as_object(), params.as_object()) {
+        if let (Some(a), Some(b)) = (m.params.as_object(), s.params.as_object()) {
             for k in a.keys().chain(b.keys()).collect::<BTreeSet<_>>() {
                 if a.get(k) != b.get(k) {
                     changed.push(k.clone());
                 }
             }
         }
-        return StageState::Stale(format!("parameter changed: {}", changed.join(", ")));
+        return Some(StaleReason::ParamsChanged(changed));
     }
     let now = current_inputs(plan, s);
     for (p, h) in &now {
         match (h, m.inputs.get(p)) {
-            (None, _) => return StageState::Stale(format!("input `{p}` is missing")),
-            (Some(_), None) => return StageState::Stale(format!("new input `{p}`")),
-            (Some(a), Some(b)) if a != b => {
-                return StageState::Stale(format!("input `{p}` changed"));
-            }
+            (None, _) => return Some(StaleReason::InputMissing(p.clone())),
+            (Some(_), None) => return Some(StaleReason::InputAdded(p.clone())),
+            (Some(a), Some(b)) if a != b => return Some(StaleReason::InputChanged(p.clone())),
             _ => {}
         }
     }
     if let Some(p) = m.inputs.keys().find(|p| !now.contains_key(*p)) {
-        return StageState::Stale(format!("input `{p}` removed"));
+        return Some(StaleReason::InputRemoved(p.clone()));
     }
     for o in s.outputs.values() {
         let size = std::fs::metadata(plan.root.join(o)).map(|m| m.len()).ok();
         if size.is_none() || size != m.outputs.get(&o.to_string_lossy().to_string()).copied() {
-            return StageState::Stale(format!("output `{}` missing or altered", o.display()));
+            return Some(StaleReason::OutputAltered(o.display().to_string()));
         }
     }
-    if m.key != stage_key(s.kind.kind(), params, &m.inputs) {
-        return StageState::Stale("manifest key mismatch".into());
+    if m.key != stage_key(s.kind.kind(), &s.params, &m.inputs) {
+        return Some(StaleReason::KeyMismatch);
     }
     if m.build != build_id() {
-        return StageState::Stale(format!(
-            "drapelab was rebuilt (build {} → {})",
-            if m.build.is_empty() {
-                "unknown"
+        return Some(StaleReason::Rebuilt {
+            from: if m.build.is_empty() {
+                "unknown".into()
             } else {
-                &m.build
+                m.build.clone()
             },
-            build_id()
-        ));
+            to: build_id().into(),
+        });
     }
-    StageState::UpToDate
-}
-
-/// Removes temporary files left in `dir` by a killed run (`.NAME.*.partial`).
-pub(crate) fn remove_partials(dir: &Path) {
-    if let Ok(entries) = std::fs::read_dir(dir) {
-        for e in entries.flatten() {
-            let name = e.file_name().to_string_lossy().to_string();
-            if name.starts_with('.') && name.ends_with(".partial") {
-                std::fs::remove_file(e.path()).ok();
-            }
-        }
-    }
+    None
 }
 
 /// The state of every stage, as `drapelab status` prints it (stale stages make their dependents stale).
@@ -210,8 +203,8 @@ pub fn stage_states(plan: &Plan) -> Vec<(String, StageState)> {
     out
 }
 
-/// Runs the plan; stage failures are in the summary, bad input is an error.
-pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> Result<RunSummary> {
+/// Refuses `--until`/`--force` names that are not stages of the plan.
+fn check_stage_names(plan: &Plan, opts: &RunOptions) -> Result<(), InputError> {
     for name in opts.until.iter().chain(&opts.force) {
         if plan.stage(name).is_none() {
             let known: Vec<&str> = plan.stages.iter().map(|s| s.name.as_str()).collect();
@@ -219,17 +212,32 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
                 &plan.file,
                 "stages",
                 format!("no stage named `{name}` (stages: {})", known.join(", ")),
-            )
-            .into());
+            ));
         }
     }
-    let mut executor = plan.executor.clone();
+    Ok(())
+}
+
+/// Runs the plan; stage failures are in the summary, bad input is an error. A real run holds the
+/// run folder's lock ([`RunLock`]) throughout: a second run of the pipeline is refused (or waits).
+pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> Result<RunSummary> {
+    check_stage_names(plan, opts)?;
+    let mut settings = plan.executor.clone();
     if let Some(kind) = opts.executor {
-        executor.kind = kind;
+        settings.kind = kind;
     }
-    if executor.kind == ExecutorKind::Slurm && !opts.dry_run {
-        crate::slurm::preflight(&executor, &plan.file)?;
+    if settings.kind == ExecutorKind::Slurm && !opts.dry_run {
+        crate::slurm::preflight(&settings, &plan.file)?;
     }
+    let _lock = if opts.dry_run {
+        None
+    } else {
+        Some(RunLock::acquire(&plan.run_dir(), opts.wait)?)
+    };
+    let executor: Box<dyn Executor> = match settings.kind {
+        ExecutorKind::Local => Box::new(Local),
+        ExecutorKind::Slurm => Box::new(Slurm(&settings)),
+    };
     let selected: BTreeSet<String> = match &opts.until {
         Some(u) => plan.ancestors(u),
         None => plan.stages.iter().map(|s| s.name.clone()).collect(),
@@ -239,9 +247,6 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
         .iter()
         .flat_map(|f| plan.descendants(f))
         .collect();
-    let mut summary = RunSummary::default();
-    let mut will_run: BTreeSet<String> = BTreeSet::new();
-    let mut failed: BTreeSet<String> = BTreeSet::new();
     let jobs = if opts.jobs == 0 {
         std::thread::available_parallelism()
             .map(|n| n.get())
@@ -250,15 +255,16 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
         opts.jobs
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
-    for s in &plan.stages {
-        if !selected.contains(&s.name) {
-            continue;
-        }
-        if let Some(d) = s.deps.iter().find(|d| failed.contains(*d)) {
-            let why = format!("upstream stage `{d}` failed");
-            progress.stage_skipped(&s.name, &why);
-            failed.insert(s.name.clone());
-            summary.failed.push((s.name.clone(), why));
+    let mut summary = RunSummary::default();
+    let mut will_run: BTreeSet<String> = BTreeSet::new();
+    for s in plan.stages.iter().filter(|s| selected.contains(&s.name)) {
+        if let Some(d) = s.deps.iter().find(|d| summary.has_failed(d)) {
+            let outcome = StageOutcome::failed(
+                FailureCause::Upstream,
+                format!("upstream stage `{d}` failed"),
+            );
+            progress.stage_skipped(&s.name, &outcome.to_string());
+            summary.failed.push((s.name.clone(), outcome));
             continue;
         }
         let upstream = if opts.dry_run {
@@ -267,7 +273,7 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
             BTreeSet::new()
         };
         let state = if forced.contains(&s.name) {
-            StageState::Stale("forced".into())
+            StageState::Stale(StaleReason::Forced)
         } else {
             check(plan, s, &upstream)
         };
@@ -284,26 +290,30 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
         }
         if forced.contains(&s.name) {
             // Forced: computed afresh, parts included.
-            let parts = crate::items::parts_dir(&plan.run_dir(), &s.name);
+            let parts = parts_dir(&plan.run_dir(), &s.name);
             if parts.exists() {
                 std::fs::remove_dir_all(&parts)?;
             }
         }
-        let status = run_stage(plan, s, &pool, &executor, progress)?;
-        if status == "ok" {
-            summary.ran.push(s.name.clone());
-        } else {
-            failed.insert(s.name.clone());
-            summary.failed.push((s.name.clone(), status));
+        match run_stage(plan, s, &pool, executor.as_ref(), progress)? {
+            StageOutcome::Ok => summary.ran.push(s.name.clone()),
+            failed => summary.failed.push((s.name.clone(), failed)),
         }
     }
     Ok(summary)
 }
 
+impl RunSummary {
+    /// Whether stage `name` failed (or did not run because one above it failed).
+    pub fn has_failed(&self, name: &str) -> bool {
+        self.failed.iter().any(|(s, _)| s == name)
+    }
+}
+
 /// The context of stage `s` now (its input files by slot, its outputs) and its input hashes.
 fn stage_context<'a>(
-    plan: &'a Plan,
-    s: &'a PlannedStage,
+    plan: &Plan,
+    s: &PlannedStage,
     progress: &'a dyn Progress,
 ) -> (StageContext<'a>, BTreeMap<String, String>) {
     let slots = slot_inputs(plan, s);
@@ -312,8 +322,16 @@ fn stage_context<'a>(
         .map(|(p, h)| (p, h.unwrap_or_default()))
         .collect();
     let ctx = StageContext {
-        plan,
-        stage: s,
+        pipeline: plan.name.clone(),
+        pipeline_file: plan
+            .file
+            .strip_prefix(&plan.root)
+            .unwrap_or(&plan.file)
+            .to_path_buf(),
+        stage: s.name.clone(),
+        root: plan.root.clone(),
+        run_dir: plan.run_dir(),
+        params: s.spec.params.clone(),
         inputs: slots
             .into_iter()
             .map(|(k, files)| (k, files.iter().map(|p| plan.root.join(p)).collect()))
@@ -340,13 +358,15 @@ fn parts_key(s: &PlannedStage, inputs: &BTreeMap<String, String>) -> String {
 
 /// Runs a stage: by items through the executor when its kind has items, else in one piece.
 fn run_whole_or_items(
+    s: &PlannedStage,
     ctx: &StageContext<'_>,
     inputs: &BTreeMap<String, String>,
-    executor: &ExecutorSettings,
+    executor: &dyn Executor,
 ) -> Result<()> {
-    match ctx.stage.kind.items(ctx)? {
-        Some(n) => crate::items::run_by_items(ctx, n, &parts_key(ctx.stage, inputs), executor),
-        None => ctx.stage.kind.run(ctx),
+    let kind = s.kind.as_ref();
+    match kind.items(ctx)? {
+        Some(n) => run_by_items(kind, ctx, n, &parts_key(s, inputs), executor),
+        None => kind.run(ctx),
     }
 }
 
@@ -359,26 +379,27 @@ pub fn run_worker(plan: &Plan, stage: &str, items: &[usize]) -> Result<()> {
     })?;
     let progress = crate::progress::LogProgress::default();
     let (ctx, inputs) = stage_context(plan, s, &progress);
-    let dir = crate::items::parts_dir(&plan.run_dir(), stage);
+    let dir = parts_dir(&plan.run_dir(), stage);
     if !crate::items::parts_match(&dir, &parts_key(s, &inputs)) {
         anyhow::bail!(
-            "{}: the parts folder is not that of stage `{stage}` with its current inputs,              parameters and build (they changed since `drapelab run` submitted the work); run it again",
+            "{}: the parts folder is not that of stage `{stage}` with its current inputs, \
+             parameters and build (they changed since `drapelab run` submitted the work); run it again",
             dir.display()
         );
     }
     let todo = crate::items::without_part(&dir, items.iter().copied());
-    crate::items::compute_local(&ctx, &todo, &dir)
+    Local.compute(s.kind.as_ref(), &ctx, &todo, &dir)
 }
 
-/// Runs one stale stage in `pool` and writes its manifest: its status, "ok" or "failed: …" (an
-/// error, a panic, or an output not written). Bad input is returned as an error.
+/// Runs one stale stage in `pool` and writes its manifest: its outcome (an error, a panic, or an
+/// output not written is a failure). Bad input is returned as an error.
 fn run_stage(
     plan: &Plan,
     s: &PlannedStage,
     pool: &rayon::ThreadPool,
-    executor: &ExecutorSettings,
+    executor: &dyn Executor,
     progress: &dyn Progress,
-) -> Result<String> {
+) -> Result<StageOutcome> {
     let start = Instant::now();
     let (ctx, inputs) = stage_context(plan, s, progress);
     for o in ctx.outputs.values() {
@@ -387,20 +408,25 @@ fn run_stage(
             remove_partials(d);
         }
     }
-    let outputs = ctx.outputs.clone();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        pool.install(|| run_whole_or_items(&ctx, &inputs, executor))
+        pool.install(|| run_whole_or_items(s, &ctx, &inputs, executor))
     }));
     let status = match result {
-        Ok(Ok(())) => match outputs.values().find(|o| !o.exists()) {
-            Some(o) => format!("failed: did not write {}", rel(&plan.root, o)),
-            None => "ok".to_string(),
+        Ok(Ok(())) => match ctx.outputs.values().find(|o| !o.exists()) {
+            Some(o) => StageOutcome::failed(
+                FailureCause::MissingOutput,
+                format!("did not write {}", rel(&plan.root, o)),
+            ),
+            None => StageOutcome::Ok,
         },
         Ok(Err(e)) if e.chain().any(|c| c.is::<InputError>()) => return Err(e),
-        Ok(Err(e)) => format!("failed: {}", format!("{e:#}").replace('\n', " ")),
-        Err(panic) => format!(
-            "failed: the stage panicked ({}); this is a bug in drapelab, please report it",
-            panic_message(panic.as_ref())
+        Ok(Err(e)) => StageOutcome::failed(FailureCause::Error, format!("{e:#}")),
+        Err(panic) => StageOutcome::failed(
+            FailureCause::Panic,
+            format!(
+                "the stage panicked ({}); this is a bug in drapelab, please report it",
+                panic_message(panic.as_ref())
+            ),
         ),
     };
     let wall = start.elapsed().as_secs_f64();
@@ -414,12 +440,8 @@ fn run_stage(
             .outputs
             .values()
             .map(|o| {
-                (
-                    o.to_string_lossy().to_string(),
-                    std::fs::metadata(plan.root.join(o))
-                        .map(|m| m.len())
-                        .unwrap_or(0),
-                )
+                let size = std::fs::metadata(plan.root.join(o)).map_or(0, |m| m.len());
+                (o.to_string_lossy().to_string(), size)
             })
             .collect(),
         status: status.clone(),

@@ -5,8 +5,8 @@
 //! stage gathers the parts. Needs only a filesystem that the nodes share with this process.
 
 use crate::executor::ExecutorSettings;
-use crate::items::without_part;
-use crate::stage::StageContext;
+use crate::items::{Executor, without_part};
+use crate::stage::{Stage, StageContext};
 use anyhow::{Context, Result, bail};
 use drapelab_core::error::InputError;
 use std::path::{Path, PathBuf};
@@ -69,13 +69,10 @@ fn script(
     logs: &Path,
 ) -> Result<String> {
     let exe = std::env::current_exe().context("cannot locate the drapelab executable")?;
-    let pipeline = std::fs::canonicalize(&ctx.plan.file)?;
+    let pipeline = std::fs::canonicalize(ctx.root.join(&ctx.pipeline_file))?;
     let mut lines = vec![
         "#!/bin/bash".to_string(),
-        format!(
-            "#SBATCH --job-name=drapelab-{}-{}",
-            ctx.plan.name, ctx.stage.name
-        ),
+        format!("#SBATCH --job-name=drapelab-{}-{}", ctx.pipeline, ctx.stage),
         format!(
             "#SBATCH --array=0-{}{}",
             n_tasks - 1,
@@ -100,13 +97,13 @@ fn script(
     lines.push(format!("export RAYON_NUM_THREADS={}", s.cpus_per_task));
     lines.push(format!(
         "cd '{}'",
-        std::fs::canonicalize(&ctx.plan.root)?.display()
+        std::fs::canonicalize(&ctx.root)?.display()
     ));
     lines.push(format!(
         "exec '{}' -q worker '{}' --stage '{}' --tasks '{}' --task \"$SLURM_ARRAY_TASK_ID\"",
         exe.display(),
         pipeline.display(),
-        ctx.stage.name,
+        ctx.stage,
         tasks.display()
     ));
     Ok(lines.join("\n") + "\n")
@@ -146,7 +143,7 @@ fn submit(
         .to_string();
     tracing::info!(
         "[{}] submitted array job {id}: {} task(s) for {} item(s)",
-        ctx.stage.name,
+        ctx.stage,
         chunks.len(),
         items.len()
     );
@@ -160,8 +157,24 @@ fn in_queue(id: &str) -> Result<bool> {
     Ok(out.status.success() && !String::from_utf8_lossy(&out.stdout).trim().is_empty())
 }
 
+/// The Slurm executor with its settings.
+pub struct Slurm<'a>(pub &'a ExecutorSettings);
+
+impl Executor for Slurm<'_> {
+    /// The items as Slurm array tasks (each runs `drapelab worker`), resubmitting what is missing.
+    fn compute(
+        &self,
+        _kind: &dyn Stage,
+        ctx: &StageContext<'_>,
+        items: &[usize],
+        dir: &Path,
+    ) -> Result<()> {
+        compute_slurm(ctx, items, dir, self.0)
+    }
+}
+
 /// Computes `items` of the stage in `ctx` as Slurm array tasks, resubmitting what is missing.
-pub fn compute_slurm(
+fn compute_slurm(
     ctx: &StageContext<'_>,
     items: &[usize],
     dir: &Path,
@@ -175,7 +188,7 @@ pub fn compute_slurm(
         loop {
             let left = wanted(dir).len();
             for _ in reported..items.len() - left {
-                ctx.progress.item_done(&ctx.stage.name);
+                ctx.item_done();
             }
             reported = reported.max(items.len() - left);
             if !in_queue(&id)? {
@@ -189,7 +202,7 @@ pub fn compute_slurm(
         }
         tracing::warn!(
             "[{}] array job {id} left {} item(s) without a part{}",
-            ctx.stage.name,
+            ctx.stage,
             todo.len(),
             if attempt < s.max_resubmissions {
                 "; resubmitting them"

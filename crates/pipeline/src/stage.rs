@@ -5,7 +5,6 @@
 //! sees kinds as `dyn` [`Stage`] through a [`Registry`]; adding a kind is one file and one line in the
 //! registry that the binary builds.
 
-use crate::plan::{Plan, PlannedStage};
 use crate::progress::Progress;
 use anyhow::Result;
 use serde::Serialize;
@@ -109,12 +108,12 @@ pub trait Stage: Send + Sync {
     /// Computes item `item` and writes its part at `part` (last, atomically; side files beside it).
     fn compute_item(&self, ctx: &StageContext<'_>, item: usize, part: &Path) -> Result<()> {
         let _ = (item, part);
-        anyhow::bail!("stage `{}` does not run by items", ctx.stage.name)
+        anyhow::bail!("stage `{}` does not run by items", ctx.stage)
     }
     /// Writes the stage's outputs from the parts of every item, in item order.
     fn gather(&self, ctx: &StageContext<'_>, parts: &[PathBuf]) -> Result<()> {
         let _ = parts;
-        anyhow::bail!("stage `{}` does not run by items", ctx.stage.name)
+        anyhow::bail!("stage `{}` does not run by items", ctx.stage)
     }
 }
 
@@ -136,11 +135,7 @@ pub trait StageKind: Send + Sync + 'static {
     }
     /// Runs the stage with its parameters (not called for an [`ItemKind`]).
     fn run(ctx: &StageContext<'_>, _params: &Self::Params) -> Result<()> {
-        anyhow::bail!(
-            "stage `{}` of kind {} runs by items",
-            ctx.stage.name,
-            Self::KIND
-        )
+        anyhow::bail!("stage `{}` of kind {} runs by items", ctx.stage, Self::KIND)
     }
 }
 
@@ -185,8 +180,7 @@ struct ItemTyped<K>(PhantomData<K>);
 
 /// The parameters of the stage in `ctx`, typed.
 fn params_of<K: StageKind>(ctx: &StageContext<'_>) -> Result<K::Params> {
-    typed_params(&ctx.stage.spec.params)
-        .map_err(|e| anyhow::anyhow!("params.{}: {}", e.key, e.message))
+    typed_params(&ctx.params).map_err(|e| anyhow::anyhow!("params.{}: {}", e.key, e.message))
 }
 
 /// The [`Stage`] methods every typed kind shares: its metadata, its parameters and `run`.
@@ -273,12 +267,22 @@ impl Registry {
     }
 }
 
-/// What a stage gets to run: its files by slot, absolute.
+/// What a stage gets to run, as plain data: where it is, its parameters as written, its files by
+/// slot (absolute) and where to report progress. A stage sees nothing of the plan but this, so
+/// everything it reads is a declared input.
 pub struct StageContext<'a> {
-    /// The plan (for the root and run folder).
-    pub plan: &'a Plan,
-    /// The stage.
-    pub stage: &'a PlannedStage,
+    /// The pipeline's name.
+    pub pipeline: String,
+    /// The pipeline file, relative to the root where it lies inside it.
+    pub pipeline_file: PathBuf,
+    /// The stage's name.
+    pub stage: String,
+    /// The project root (absolute or as given) that the pipeline's paths are relative to.
+    pub root: PathBuf,
+    /// The run folder, `runs/<pipeline>` under the root.
+    pub run_dir: PathBuf,
+    /// The `params` table as written (defaults are filled in by the kind's typed parameters).
+    pub params: toml::Table,
     /// Input files of each given slot, absolute, sorted within a slot (globs expanded).
     pub inputs: BTreeMap<String, Vec<PathBuf>>,
     /// Output files of each given slot, absolute.
@@ -290,12 +294,23 @@ pub struct StageContext<'a> {
 impl StageContext<'_> {
     /// "Made by `drapelab run PIPELINE` (drapelab VERSION)": the provenance line of every report.
     pub fn made_by(&self) -> String {
-        let file = &self.plan.file;
         format!(
             "Made by `drapelab run {}` (drapelab {})",
-            file.strip_prefix(&self.plan.root).unwrap_or(file).display(),
+            self.pipeline_file.display(),
             drapelab_core::VERSION
         )
+    }
+    /// Reports that the stage has `items` items of work.
+    pub fn started(&self, items: usize) {
+        self.progress.stage_started(&self.stage, items as u64);
+    }
+    /// Reports one item done.
+    pub fn item_done(&self) {
+        self.progress.item_done(&self.stage);
+    }
+    /// `path` relative to the project root, for tables and reports.
+    pub fn relative<'p>(&self, path: &'p Path) -> &'p Path {
+        path.strip_prefix(&self.root).unwrap_or(path)
     }
     /// The one file of input slot `slot` (a required slot is always there once the plan loaded).
     pub fn input(&self, slot: &str) -> Result<&Path> {
@@ -303,12 +318,12 @@ impl StageContext<'_> {
             Some([one]) => Ok(one),
             Some(many) => anyhow::bail!(
                 "input `{slot}` of stage `{}` matched {} files; it takes one",
-                self.stage.name,
+                self.stage,
                 many.len()
             ),
             None => anyhow::bail!(
                 "stage `{}` needs input `{slot}`: add `inputs.{slot} = \"PATH\"`",
-                self.stage.name
+                self.stage
             ),
         }
     }
@@ -329,7 +344,7 @@ impl StageContext<'_> {
         self.optional_output(slot).ok_or_else(|| {
             anyhow::anyhow!(
                 "stage `{}` needs output `{slot}`: add `outputs.{slot} = \"PATH\"`",
-                self.stage.name
+                self.stage
             )
         })
     }

@@ -96,8 +96,7 @@ fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
     if scenes.is_empty() {
         bail!("a benchmark needs at least one scene file as input");
     }
-    ctx.progress
-        .stage_started(&ctx.stage.name, scenes.len() as u64);
+    ctx.started(scenes.len());
     let limits = BenchLimits {
         solvers: p
             .solvers
@@ -114,7 +113,7 @@ fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
     for s in &scenes {
         let sizes = p.sizes.get(&s.name).unwrap_or(&p.default_sizes);
         rows.extend(bench_rows(s, sizes, &p.tolerances, &limits, |_| {}));
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
     }
     write_table(ctx.output("table")?, &rows)?;
     if p.slack_net_population > 0 {

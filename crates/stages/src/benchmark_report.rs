@@ -5,12 +5,18 @@
 use crate::report::{Panels, markdown, plot_panels};
 use anyhow::{Context, Result};
 use drapelab_core::benchmark::{fitted_exponent, pareto_front};
+use drapelab_core::scene::SolverKind;
+use drapelab_core::solve::Status;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::write_text;
 use polars::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
+
+/// The names the benchmark table writes for a converged solve and the static solver.
+const CONVERGED: &str = Status::Converged.as_str();
+const STATIC: &str = SolverKind::Static.name();
 
 /// Parameters of a benchmark-report stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -63,7 +69,7 @@ impl StageKind for BenchmarkReport {
 }
 
 fn run(ctx: &StageContext<'_>, p: &BenchmarkReportParams) -> Result<()> {
-    ctx.progress.stage_started(&ctx.stage.name, 1);
+    ctx.started(1);
     let mut bench: Option<DataFrame> = None;
     for f in ctx.input_files("bench") {
         let df = read(f)?;
@@ -87,7 +93,7 @@ point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
     md += &newton_work_section(&bench)?;
     md += &settling_section(&c, &bench)?;
     if let Some(pop) = ctx.optional_input("population")? {
-        md += &population_section(&read(pop)?)?;
+        md += &population_section(&drapelab_record::read_table(pop)?);
     }
     if let Some(sc) = ctx.optional_input("self_contact")? {
         md += &self_contact_section(&read(sc)?)?;
@@ -108,7 +114,7 @@ equilibrium.\n";
     }
     write_text(ctx.output("markdown")?, &md)?;
     write_text(ctx.output("plot")?, &svg)?;
-    ctx.progress.item_done(&ctx.stage.name);
+    ctx.item_done();
     Ok(())
 }
 
@@ -160,7 +166,7 @@ fn pareto_section(c: &BenchCols) -> Result<(String, String)> {
         else {
             continue;
         };
-        if status.get(r) != Some("converged") || e <= 0.0 {
+        if status.get(r) != Some(CONVERGED) || e <= 0.0 {
             continue;
         }
         let pt = (t.log10(), e.log10());
@@ -237,16 +243,16 @@ squares on the logarithms.\n\n| scene | solver | sides | fitted exponent of wall
         ) else {
             continue;
         };
-        if status.get(r) != Some("converged") || (tl / scaling_tolerance - 1.0).abs() > 1e-9 {
+        if status.get(r) != Some(CONVERGED) || (tl / scaling_tolerance - 1.0).abs() > 1e-9 {
             continue;
         }
         let particles = (k * k) as f64;
-        if sv == "static" {
+        if sv == STATIC {
             series
                 .entry((s.into(), "static (whole solve)".into()))
                 .or_default()
                 .push((particles, t));
-        } else if sv == "explicit-euler" && it > 0 {
+        } else if sv == SolverKind::ExplicitEuler.name() && it > 0 {
             series
                 .entry((s.into(), "explicit Euler (one step)".into()))
                 .or_default()
@@ -331,7 +337,7 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
         col("factor_time_s")?,
     );
     for r in 0..bench.height() {
-        if solver.str()?.get(r) != Some("static")
+        if solver.str()?.get(r) != Some(STATIC)
             || tol
                 .f64()?
                 .get(r)
@@ -430,12 +436,12 @@ another local minimum than the static one (folds on the rod and the pedestal): i
         )
     };
     let static_wall: BTreeMap<_, f64> = (0..c.rows)
-        .filter(|&r| solver.get(r) == Some("static"))
+        .filter(|&r| solver.get(r) == Some(STATIC))
         .filter_map(|r| Some((key(r), wall.get(r)?)))
         .collect();
     for r in 0..c.rows {
         let sv = solver.get(r).unwrap_or("");
-        if sv == "static" || status.get(r) != Some("converged") {
+        if sv == STATIC || status.get(r) != Some(CONVERGED) {
             continue;
         }
         let st = static_wall.get(&key(r)).copied();
@@ -456,54 +462,12 @@ another local minimum than the static one (folds on the rod and the pedestal): i
 }
 
 /// The slack-net population's iterations, factorizations and times per solve (min / median / max).
-fn population_section(pop: &DataFrame) -> Result<String> {
-    let f = |c: &str| -> Result<Vec<f64>> {
-        let s = pop
-            .column(c)?
-            .as_materialized_series()
-            .cast(&polars::prelude::DataType::Float64)?;
-        let ca = s.f64()?;
-        Ok((0..ca.len())
-            .map(|i| ca.get(i).unwrap_or(f64::NAN))
-            .collect())
-    };
-    let strings = |c: &str| -> Result<Vec<String>> {
-        let ca = pop.column(c)?.str()?.clone();
-        Ok((0..ca.len())
-            .map(|i| ca.get(i).unwrap_or("").to_string())
-            .collect())
-    };
-    let status = strings("status")?;
-    let (k, l, d, it, fa, w, ft) = (
-        f("stiffness_N_per_m")?,
-        f("natural_length_m")?,
-        f("areal_density_kg_per_m2")?,
-        f("iterations")?,
-        f("factorizations")?,
-        f("wall_time_s")?,
-        f("factor_time_s")?,
-    );
-    let topology = strings("topology")?;
-    let start = strings("start")?;
-    let rows: Vec<drapelab_core::benchmark::PopulationRow> = (0..pop.height())
-        .map(|r| drapelab_core::benchmark::PopulationRow {
-            start: start[r].clone(),
-            stiffness_N_per_m: k[r],
-            natural_length_m: l[r],
-            topology: topology[r].clone(),
-            areal_density_kg_per_m2: d[r],
-            status: status[r].clone(),
-            iterations: it[r] as usize,
-            factorizations: fa[r] as usize,
-            wall_time_s: w[r],
-            factor_time_s: ft[r],
-        })
-        .collect();
+fn population_section(rows: &[drapelab_core::benchmark::PopulationRow]) -> String {
     let of = |which: &str| -> Vec<drapelab_core::benchmark::PopulationRow> {
         rows.iter().filter(|r| r.start == which).cloned().collect()
     };
     let (sagged, lattice) = (of("sagged"), of("lattice"));
-    Ok(format!(
+    format!(
         "\n## Seed 000's slack-net population\n\nhang4 on the 14 × 14 net, static, at {} points of a Latin \
 hypercube over Table 3's stiffness and natural length, the three topologies and Table 2's densities (what a \
 calibration asks thousands of times), from the sagged start: {}\nThe same net as the calibration solves it: \
@@ -513,5 +477,5 @@ the calibration's warm-start lattice (`calibrate::StartLattice`): {}",
         drapelab_core::benchmark::population_table(&sagged),
         lattice.len(),
         drapelab_core::benchmark::population_table(&lattice)
-    ))
+    )
 }

@@ -85,7 +85,7 @@ impl StageKind for CalibrationReport {
 
 fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
     let find = |slot: &str| ctx.input(slot);
-    ctx.progress.stage_started(&ctx.stage.name, 1);
+    ctx.started(1);
     let md = ctx.output("markdown")?;
     let (conv_svg, effects_svg) = (
         ctx.optional_output("convergence_plot"),
@@ -133,9 +133,9 @@ fn run(ctx: &StageContext<'_>, p: &CalibrationReportParams) -> Result<()> {
         rel(conv_svg),
         rel(effects_svg),
         markdown(&cmp)
-    ) + &run_time_section(ctx, &res, &cmp)?;
+    ) + &run_time_section(&res, &cmp)?;
     write_text(md, &text)?;
-    ctx.progress.item_done(&ctx.stage.name);
+    ctx.item_done();
     Ok(())
 }
 
@@ -286,22 +286,10 @@ fn fig_10(me: &DataFrame) -> Result<String> {
     )
 }
 
-/// The wall time of every other stage of the plan (from its manifest, when it has run) and the
-/// number of hang simulations of the calibration (cache misses: ICA, polish, identifiability and
-/// the CMA-ES baseline's evaluations).
-fn run_time_section(ctx: &StageContext<'_>, res: &DataFrame, cmp: &DataFrame) -> Result<String> {
-    let mut rows = String::new();
-    let mut total = 0.0;
-    for st in &ctx.plan.stages {
-        if st.name == ctx.stage.name {
-            continue;
-        }
-        let path = drapelab_pipeline::manifest_path(ctx.plan, &st.name);
-        if let Some(m) = drapelab_pipeline::Manifest::read(&path) {
-            total += m.wall_time_s;
-            rows += &format!("| {} | {} | {:.1} |\n", st.name, m.kind, m.wall_time_s);
-        }
-    }
+/// The number of hang simulations of the calibration (cache misses: ICA, polish, identifiability
+/// and the CMA-ES baseline's evaluations). Stage wall times are not read here (other stages'
+/// manifests are not this stage's inputs): `drapelab status` lists them.
+fn run_time_section(res: &DataFrame, cmp: &DataFrame) -> Result<String> {
     let sims_col = res.column("simulations")?.cast(&DataType::UInt64)?;
     let sims_ca = sims_col.u64()?;
     let sims: u64 = (0..sims_ca.len()).filter_map(|i| sims_ca.get(i)).sum();
@@ -316,9 +304,8 @@ fn run_time_section(ctx: &StageContext<'_>, res: &DataFrame, cmp: &DataFrame) ->
         .get(0)
         .unwrap_or(0.0);
     Ok(format!(
-        "\n## Run time\n\nWall time of each stage of this run (the last time it ran; an up-to-date stage keeps \
-its time), on this machine:\n\n| stage | kind | wall time s |\n|---|---|---|\n{rows}| all of the above | | {total:.1} |\n\n\
-Simulations of the 4-corner hang in the calibration: {sims} (ICA, polish and identifiability, distinct \
+        "\n## Run time\n\nThe wall time of each stage's last run: `drapelab status PIPELINE` (from the \
+stages' manifests).\n\nSimulations of the 4-corner hang in the calibration: {sims} (ICA, polish and identifiability, distinct \
 parameter vectors) and {cmaes:.0} for the CMA-ES baseline.\n"
     ))
 }

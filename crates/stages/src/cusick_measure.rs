@@ -92,10 +92,8 @@ impl StageKind for CusickMeasure {
     fn run(ctx: &StageContext<'_>, p: &CusickMeasureParams) -> Result<()> {
         let index = ctx.input("index")?;
         let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
-        ctx.progress
-            .stage_started(&ctx.stage.name, data.captures.len() as u64);
-        let measured =
-            measure_dataset(&data, &p.scale, &|| ctx.progress.item_done(&ctx.stage.name))?;
+        ctx.started(data.captures.len());
+        let measured = measure_dataset(&data, &p.scale, &|| ctx.item_done())?;
         let outlines: Vec<OutlineRow> = measured
             .iter()
             .flat_map(|(r, outline)| photo_outline(r, outline))

@@ -126,8 +126,7 @@ impl StageKind for CusickPredict {
                 .map(|c| c.key())
                 .collect(),
         };
-        ctx.progress
-            .stage_started(&ctx.stage.name, data.fabrics.len() as u64);
+        ctx.started(data.fabrics.len());
         let fabrics: Vec<FabricPrediction> = data
             .fabrics
             .par_iter()
@@ -144,7 +143,7 @@ impl StageKind for CusickPredict {
                 };
                 let density_known = f.areal_density_kg_per_m2.is_some();
                 let out = predict_fabric(f.fabric, density_known, &rows, &measured, mesh, &q);
-                ctx.progress.item_done(&ctx.stage.name);
+                ctx.item_done();
                 out
             })
             .collect();

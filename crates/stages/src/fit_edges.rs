@@ -59,8 +59,7 @@ fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
     if photos.is_empty() {
         bail!("no photo (.png, .jpg) in input `photos`");
     }
-    ctx.progress
-        .stage_started(&ctx.stage.name, photos.len() as u64);
+    ctx.started(photos.len());
     let fits: Vec<Result<Vec<(String, EdgeFit)>>> = photos
         .par_iter()
         .map(|photo| {
@@ -76,11 +75,11 @@ fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
             };
             let fit = with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?;
             let sample = dir
-                .strip_prefix(&ctx.plan.root)
+                .strip_prefix(&ctx.root)
                 .unwrap_or(dir)
                 .to_string_lossy()
                 .replace('\\', "/");
-            ctx.progress.item_done(&ctx.stage.name);
+            ctx.item_done();
             Ok(fit.edges.into_iter().map(|e| (sample.clone(), e)).collect())
         })
         .collect();

@@ -97,7 +97,7 @@ fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
         .optional_input("cholmod_newton")?
         .map(std::fs::canonicalize)
         .transpose()?;
-    let python = std::path::absolute(ctx.plan.root.join(&p.python))?;
+    let python = std::path::absolute(ctx.root.join(&p.python))?;
     let has = |py: &std::path::Path| {
         std::process::Command::new(py)
             .args(["-c", "import numpy, scipy, cvxopt"])
@@ -146,7 +146,7 @@ fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
         Ok(serde_json::from_slice(&o.stdout)?)
     };
     let total = p.static_sizes.len() + p.explicit_sizes.len();
-    ctx.progress.stage_started(&ctx.stage.name, total as u64);
+    ctx.started(total);
     // (comparison, n, peer time, drapelab time, peer centre z, drapelab centre z)
     let mut rows: Vec<(&str, usize, f64, f64, f64, f64)> = Vec::new();
     for &n in &p.static_sizes {
@@ -172,7 +172,7 @@ fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
                 sol.at(n / 2, n / 2).z,
             ));
         }
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
     }
     for &n in &p.explicit_sizes {
         let peer = run_py(&explicit, &[n.to_string(), p.explicit_steps.to_string()])?;
@@ -200,7 +200,7 @@ fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
             f64::NAN,
             f64::NAN,
         ));
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
     }
     let opt = |v: f64| v.is_finite().then_some(v);
     let rows: Vec<PeerRow> = rows

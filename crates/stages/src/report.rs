@@ -121,7 +121,7 @@ impl StageKind for Report {
 fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
     let md = ctx.output("markdown")?;
     let svg = ctx.output("plot")?;
-    ctx.progress.stage_started(&ctx.stage.name, 2);
+    ctx.started(2);
     let lf = scan_all(ctx.input_files("tables"))?;
     let group: Vec<Expr> = p.group_by.iter().map(|c| col(c.as_str())).collect();
     let summary = lf
@@ -129,7 +129,10 @@ fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         .group_by(group.clone())
         .agg([
             len().alias("points"),
-            col("status").eq(lit("converged")).sum().alias("converged"),
+            col("status")
+                .eq(lit(drapelab_core::solve::Status::Converged.as_str()))
+                .sum()
+                .alias("converged"),
             (col("wall_time_s") * lit(1000.0))
                 .mean()
                 .alias("mean_wall_time_ms"),
@@ -139,7 +142,7 @@ fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         ])
         .sort(p.group_by.clone(), SortMultipleOptions::default())
         .collect()?;
-    ctx.progress.item_done(&ctx.stage.name);
+    ctx.item_done();
     let series = if p.series.is_empty() {
         p.group_by.clone()
     } else {
@@ -155,7 +158,7 @@ fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
     cols.push(col(p.x.as_str()).cast(DataType::Float64).alias("__x"));
     cols.push(col(p.y.as_str()).cast(DataType::Float64).alias("__y"));
     let pts = lf
-        .filter(col("status").eq(lit("converged")))
+        .filter(col("status").eq(lit(drapelab_core::solve::Status::Converged.as_str())))
         .select(cols)
         .sort(["__x"], SortMultipleOptions::default())
         .collect()?;
@@ -201,10 +204,7 @@ fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
     }
     text += &format!("{} from:\n\n", ctx.made_by());
     for i in ctx.input_files("tables") {
-        text += &format!(
-            "- `{}`\n",
-            i.strip_prefix(&ctx.plan.root).unwrap_or(i).display()
-        );
+        text += &format!("- `{}`\n", i.strip_prefix(&ctx.root).unwrap_or(i).display());
     }
     text += &format!(
         "\n## Summary by {}\n\n{}\n",
@@ -216,7 +216,7 @@ fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         p.y, p.x, p.y, p.x
     );
     write_text(md, &text)?;
-    ctx.progress.item_done(&ctx.stage.name);
+    ctx.item_done();
     Ok(())
 }
 

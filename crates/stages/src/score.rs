@@ -49,13 +49,12 @@ fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
     if truths.is_empty() {
         bail!("input `simulated` matched no file");
     }
-    ctx.progress
-        .stage_started(&ctx.stage.name, truths.len() as u64);
+    ctx.started(truths.len());
     let mut rows = Vec::new();
     for t in truths {
         let dir = t.parent().unwrap_or(std::path::Path::new("."));
         let sample = dir
-            .strip_prefix(&ctx.plan.root)
+            .strip_prefix(&ctx.root)
             .unwrap_or(dir)
             .to_string_lossy()
             .replace('\\', "/");
@@ -69,7 +68,7 @@ fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
             .cloned()
             .collect();
         rows.extend(score_edges(&real, &sim, p.side_cm));
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
     }
     write_table(ctx.output("score")?, &rows)
 }

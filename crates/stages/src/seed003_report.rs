@@ -133,13 +133,12 @@ fn run(ctx: &StageContext<'_>, p: &Seed003ReportParams) -> Result<()> {
         .iter()
         .map(|f| load(f))
         .collect::<Result<_>>()?;
-    ctx.progress
-        .stage_started(&ctx.stage.name, scenes.len() as u64 + 1);
+    ctx.started(scenes.len() + 1);
     let solved: Vec<Solved> = scenes
         .par_iter()
         .map(|s| {
             let r = solve_pair(s);
-            ctx.progress.item_done(&ctx.stage.name);
+            ctx.item_done();
             r
         })
         .collect();
@@ -178,7 +177,7 @@ fn run(ctx: &StageContext<'_>, p: &Seed003ReportParams) -> Result<()> {
     }
     md += &surfaces_section(ctx)?;
     write_outputs(ctx, md, &solved, &load_svg)?;
-    ctx.progress.item_done(&ctx.stage.name);
+    ctx.item_done();
     Ok(())
 }
 

@@ -47,9 +47,9 @@ impl StageKind for Simulate {
         let overrides: Vec<(String, toml::Value)> =
             p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
         let loaded = Scene::load(ctx.input("scene")?, &overrides)?;
-        ctx.progress.stage_started(&ctx.stage.name, 1);
+        ctx.started(1);
         let report = simulate_to_dir(&loaded, &dir, &mut NoObserver)?;
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
         if report.status != Status::Converged {
             bail!(
                 "{}: {} ({})",

@@ -48,8 +48,8 @@ fn run(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
         Ok(Scene::load(ctx.input(slot)?, &[])?.scene.into_inner())
     };
     let (full, quarter, hang) = (load("full")?, load("quarter")?, load("hang")?);
-    ctx.progress.stage_started(&ctx.stage.name, 6);
-    let done = || ctx.progress.item_done(&ctx.stage.name);
+    ctx.started(6);
+    let done = || ctx.item_done();
     let mut rows = vec![skip_symmetry(&full, &quarter)];
     done();
     rows.push(skip_recording(&hang, ctx.input("hang")?)?);
@@ -127,6 +127,6 @@ struct Silent;
 impl drapelab_pipeline::Progress for Silent {
     fn stage_started(&self, _: &str, _: u64) {}
     fn item_done(&self, _: &str) {}
-    fn stage_finished(&self, _: &str, _: &str, _: f64) {}
+    fn stage_finished(&self, _: &str, _: &drapelab_pipeline::StageOutcome, _: f64) {}
     fn stage_skipped(&self, _: &str, _: &str) {}
 }

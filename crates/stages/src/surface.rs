@@ -372,7 +372,7 @@ impl StageKind for Surface {
         let path = ctx.input("drape")?;
         let texture_path = ctx.optional_input("texture")?;
         let texture = load_texture(texture_path, "inputs.texture")?;
-        ctx.progress.stage_started(&ctx.stage.name, 1);
+        ctx.started(1);
         let drape = if path.extension().is_some_and(|e| e == "toml") {
             solve_drape(&Scene::load(path, &[])?, &mut NoObserver)?
         } else {
@@ -388,7 +388,7 @@ impl StageKind for Surface {
             t.display().to_string()
         });
         make_surface(&drape, p, &texture, &name, &out)?;
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
         Ok(())
     }
 }

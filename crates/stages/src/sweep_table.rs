@@ -38,7 +38,7 @@ pub struct SweepOutcome {
     /// Solver that ran.
     pub solver: String,
     /// Solve status (converged, max-iterations, diverged, …).
-    pub status: String,
+    pub status: Status,
     /// Newton iterations or time steps.
     pub iterations: u64,
     /// Linear solves.
@@ -110,7 +110,7 @@ impl SweepOutcome {
         SweepOutcome {
             particles: g.len() as u32,
             solver: r.solver.clone(),
-            status: r.status.as_str().to_string(),
+            status: r.status,
             iterations: r.iterations as u64,
             linear_solves: r.linear_solves as u64,
             wall_time_s: r.wall_time_s,

@@ -207,8 +207,7 @@ fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
         .iter()
         .map(|r| COLUMNS.iter().map(|&c| r[c]).collect())
         .collect();
-    ctx.progress
-        .stage_started(&ctx.stage.name, rows.len() as u64);
+    ctx.started(rows.len());
     let mut sn = Vec::new();
     let mut costs = Vec::new();
     for l in &rows {
@@ -224,7 +223,7 @@ fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
             .collect();
         sn.push(sn_smaller_the_better(&finals));
         costs.push(finals.iter().sum::<f64>() / finals.len() as f64);
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
     }
     let effects = main_effects(&rows, &sn);
     let best_levels: Vec<u8> = effects

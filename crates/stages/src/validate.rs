@@ -108,8 +108,7 @@ fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
     for (s, e) in read_edges(edges_file)? {
         by_sample.entry(s.clone()).or_default().push((s, e));
     }
-    ctx.progress
-        .stage_started(&ctx.stage.name, by_sample.len() as u64);
+    ctx.started(by_sample.len());
     let (mut names, mut eq5, mut dist) = (Vec::new(), Vec::new(), Vec::new());
     for (sample, measured) in &by_sample {
         let n = sample_number(sample)
@@ -152,7 +151,7 @@ fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
         names.push(sample.clone());
         eq5.push(mean(rows.iter().map(|r| r.objective_pct).collect()));
         dist.push(mean(rows.iter().map(|r| r.curve_distance_pct).collect()));
-        ctx.progress.item_done(&ctx.stage.name);
+        ctx.item_done();
     }
     let opt = |x: f64| x.is_finite().then_some(x);
     let rows: Vec<ValidationRow> = names

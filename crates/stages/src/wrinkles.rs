@@ -300,8 +300,7 @@ impl StageKind for Wrinkles {
     ];
     fn run(ctx: &StageContext<'_>, p: &WrinklesParams) -> Result<()> {
         let cfg = load_config(ctx.input("config")?)?;
-        ctx.progress
-            .stage_started(&ctx.stage.name, cfg.cases.len() as u64);
+        ctx.started(cfg.cases.len());
         let out = |slot: &str| ctx.optional_output(slot).map(Path::to_path_buf);
         let outputs = WrinkleOutputs {
             table: out("table"),
@@ -311,7 +310,7 @@ impl StageKind for Wrinkles {
         };
         write_wrinkles(&cfg, &outputs, p)?;
         for _ in &cfg.cases {
-            ctx.progress.item_done(&ctx.stage.name);
+            ctx.item_done();
         }
         Ok(())
     }

@@ -27,7 +27,7 @@ pub struct BenchRow {
     #[serde(rename = "tolerance_rel")]
     pub tol: f64,
     /// Solver status.
-    pub status: String,
+    pub status: crate::solve::Status,
     /// Wall time in s (whole solve including assembly).
     pub wall_time_s: f64,
     /// Newton iterations or time steps.
@@ -242,7 +242,7 @@ fn bench_point(s: &Scene, reference: &Reference, log: &mut impl FnMut(&str)) -> 
         n,
         solver: kind,
         tol,
-        status: sol.report.status.as_str().into(),
+        status: sol.report.status,
         wall_time_s: wall,
         iterations: sol.report.iterations,
         linear_solves: sol.report.linear_solves,
@@ -349,7 +349,7 @@ pub struct PopulationRow {
     /// Areal density, kg/m².
     pub areal_density_kg_per_m2: f64,
     /// Solver status.
-    pub status: String,
+    pub status: crate::solve::Status,
     /// Newton iterations.
     pub iterations: usize,
     /// Numeric factorizations attempted.
@@ -382,7 +382,7 @@ impl PopulationRow {
             natural_length_m,
             topology: format!("{topology:?}").to_lowercase(),
             areal_density_kg_per_m2,
-            status: report.status.as_str().into(),
+            status: report.status,
             iterations: report.iterations,
             factorizations: report.factorizations,
             wall_time_s,
@@ -488,7 +488,10 @@ pub fn min_median_max(v: &[f64]) -> (f64, f64, f64) {
 /// The population as a Markdown summary: converged count, then min / median / max of iterations,
 /// factorizations, wall time and factorization time per solve.
 pub fn population_table(rows: &[PopulationRow]) -> String {
-    let conv: Vec<&PopulationRow> = rows.iter().filter(|r| r.status == "converged").collect();
+    let conv: Vec<&PopulationRow> = rows
+        .iter()
+        .filter(|r| r.status == crate::solve::Status::Converged)
+        .collect();
     let stat = |f: &dyn Fn(&PopulationRow) -> f64| {
         min_median_max(&conv.iter().map(|r| f(r)).collect::<Vec<_>>())
     };

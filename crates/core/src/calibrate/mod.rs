@@ -82,7 +82,7 @@ pub struct Evaluation {
     /// Cost: curve distance in % of the side, or the penalty.
     pub cost: f64,
     /// The solver's status.
-    pub status: &'static str,
+    pub status: crate::solve::Status,
     /// Wall time of the simulation, s.
     pub simulation_time_s: f64,
 }
@@ -218,7 +218,7 @@ impl Problem {
         };
         let e = Evaluation {
             cost,
-            status: sol.report.status.as_str(),
+            status: sol.report.status,
             simulation_time_s: sol.report.wall_time_s,
         };
         self.cache.lock().expect("cache").insert(key, e);

@@ -365,6 +365,7 @@ pub fn solve_dynamic(
     report.energy_J = model.energy(x, 1.0);
     report.wall_time_s = start.elapsed().as_secs_f64();
     if stepper.cut_steps > 0 && integrator == Integrator::BaraffWitkin {
+        report.contact_cut_steps = stepper.cut_steps;
         report.message = format!(
             "{} ({} steps cut short by contact)",
             report.message, stepper.cut_steps

@@ -18,13 +18,19 @@ pub enum Status {
 
 impl Status {
     /// The name written into outputs.
-    pub fn as_str(self) -> &'static str {
+    pub const fn as_str(self) -> &'static str {
         match self {
             Status::Converged => "converged",
             Status::MaxIterations => "max-iterations",
             Status::Diverged => "diverged",
             Status::Invalid => "invalid",
         }
+    }
+}
+
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
     }
 }
 
@@ -172,6 +178,10 @@ pub struct SolveReport {
     /// For a converged solve of a scene (static, or dynamic once settled): whether the equilibrium is
     /// a minimum of the energy ([`super::is_minimum`]). None when not checked (no convergence).
     pub minimum: Option<bool>,
+    /// Steps of an explicit or linearised integrator cut short where they would have carried a
+    /// particle into an obstacle (Baraff–Witkin); 0 for other solvers.
+    #[serde(default)]
+    pub contact_cut_steps: usize,
 }
 
 impl SolveReport {
@@ -196,6 +206,7 @@ impl SolveReport {
             divergence: None,
             message: String::new(),
             minimum: None,
+            contact_cut_steps: 0,
         }
     }
     /// Whether the final state is an equilibrium that may be written as a result.
