@@ -1,6 +1,7 @@
 //! The command line: clap arguments become one validated configuration, once (ripgrep's habit);
 //! [`run`] returns the process exit code.
 
+mod args;
 mod bench;
 pub mod edges;
 mod progress;
@@ -174,6 +175,7 @@ pub enum Command {
     /// straight from the particles).
     ///
     /// Example: drapelab render datasets/scenes/hang4.toml --out runs/photo --px-per-cm 8 --markers --noise 4
+    #[command(allow_negative_numbers = true)]
     Render {
         /// The scene (4 or 2 pinned corners).
         scene: PathBuf,
@@ -183,26 +185,26 @@ pub enum Command {
         /// Scene overrides, as for simulate.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// Scale in the plane of the fixed corners, px per cm.
-        #[arg(long, default_value_t = 8.0)]
+        /// Scale in the plane of the fixed corners, px per cm (> 0, ≤ 200).
+        #[arg(long, default_value_t = 8.0, value_parser = args::px_per_cm)]
         px_per_cm: f64,
         /// Pinhole camera at this distance (m) in front of the corners' plane; default orthographic.
-        #[arg(long)]
+        #[arg(long, value_parser = args::positive)]
         pinhole_distance_m: Option<f64>,
         /// Draw red markers at the two fixed corners.
         #[arg(long)]
         markers: bool,
-        /// Gaussian noise, grey levels (σ).
-        #[arg(long, default_value_t = 0.0)]
+        /// Gaussian noise, grey levels (σ ≥ 0).
+        #[arg(long, default_value_t = 0.0, value_parser = args::non_negative)]
         noise: f64,
-        /// Gaussian blur, px (σ).
-        #[arg(long, default_value_t = 0.0)]
+        /// Gaussian blur, px (σ ≥ 0).
+        #[arg(long, default_value_t = 0.0, value_parser = args::non_negative)]
         blur_px: f64,
-        /// Camera rotation about its axis, degrees.
-        #[arg(long, default_value_t = 0.0)]
+        /// Camera rotation about its axis, degrees (negative: clockwise).
+        #[arg(long, default_value_t = 0.0, value_parser = args::finite)]
         rotate_deg: f64,
-        /// Save as JPEG with this quality (1..100) instead of PNG.
-        #[arg(long)]
+        /// Save as JPEG with this quality (1..=100) instead of PNG.
+        #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
         jpeg_quality: Option<u8>,
         /// Seed of the noise.
         #[arg(long, default_value_t = 1)]
@@ -221,7 +223,7 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
         /// Scale in the plane of the fixed corners, px per cm.
-        #[arg(long)]
+        #[arg(long, value_parser = args::positive)]
         px_per_cm: Option<f64>,
         /// Pixel positions of the two fixed corners: x1,y1,x2,y2 (pixel centres at integers, as
         /// image viewers and OpenCV number them).
@@ -231,7 +233,7 @@ pub enum Command {
         #[arg(long)]
         markers: bool,
         /// Distance between the fixed corners, cm (with --markers).
-        #[arg(long)]
+        #[arg(long, value_parser = args::positive)]
         side_cm: Option<f64>,
         /// A camera.json: view, side_cm, the scale (px_per_cm or a pinhole) and the corners
         /// (corners_px or markers); `render`'s own settings are optional.
@@ -240,8 +242,8 @@ pub enum Command {
         /// Which hang the photo shows (ignored with --camera-json, which names it).
         #[arg(long, value_enum, default_value_t = ViewArg::Hang4)]
         view: ViewArg,
-        /// Polynomial degree.
-        #[arg(long, default_value_t = 4)]
+        /// Polynomial degree (1..=8).
+        #[arg(long, default_value_t = 4, value_parser = args::degree())]
         degree: usize,
     },
     /// Score simulated edges against measured ones (seed 000 Eq. 5).
@@ -254,7 +256,7 @@ pub enum Command {
         /// Simulated edges.parquet.
         sim: PathBuf,
         /// Side of the sample, cm.
-        #[arg(long, default_value_t = 50.0)]
+        #[arg(long, default_value_t = 50.0, value_parser = args::positive)]
         side_cm: f64,
     },
     /// Tension-field wrinkles of vertically hung fabric (seed 002).
@@ -271,7 +273,7 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
         /// Points per row and rows of the deformed grid.
-        #[arg(long, num_args = 2, value_names = ["NX", "NY"], default_values_t = [41, 81])]
+        #[arg(long, num_args = 2, value_names = ["NX", "NY"], default_values_t = [41, 81], value_parser = args::mesh_side())]
         mesh: Vec<usize>,
     },
     /// Time to equilibrium of hang4 against error, every solver.
@@ -282,8 +284,8 @@ pub enum Command {
         /// The hang4 scene to benchmark.
         #[arg(long, default_value = "datasets/scenes/hang4.toml")]
         scene: PathBuf,
-        /// Particles per side to run (comma-separated).
-        #[arg(long, value_delimiter = ',', default_value = "11,21,41,81")]
+        /// Particles per side to run (comma-separated, each 3..=1001).
+        #[arg(long, value_delimiter = ',', default_value = "11,21,41,81", value_parser = args::grid_side())]
         sizes: Vec<usize>,
         /// Largest size at which the explicit and symplectic integrators are run (they are slow).
         #[arg(long, default_value_t = 21)]
@@ -291,8 +293,8 @@ pub enum Command {
         /// Largest size at which implicit Euler is run.
         #[arg(long, default_value_t = 41)]
         max_implicit_size: usize,
-        /// Force tolerance of every solver, relative to the lightest particle's weight.
-        #[arg(long, default_value_t = 1e-6)]
+        /// Force tolerance of every solver, relative to the lightest particle's weight (> 0).
+        #[arg(long, default_value_t = 1e-6, value_parser = args::positive)]
         tol: f64,
         /// Static solves of seed 000's slack-net population (14 × 14 over Table 3's box) to run
         /// after the hang4 table, for its iterations and factorizations per solve (0: none).
@@ -371,14 +373,9 @@ pub fn load_scene(path: &Path, sets: &[String]) -> Result<LoadedScene, InputErro
         .map(|s| parse_override(s))
         .collect::<Result<Vec<_>, InputError>>()?;
     Scene::load(path, &overrides).map_err(|e| {
-        let culprit = sets.iter().zip(&overrides).find(|(_, (k, _))| {
-            e.key == *k
-                || e.key.starts_with(&format!("{k}."))
-                || k.starts_with(&format!("{}.", e.key))
-        });
-        match culprit {
-            Some((flag, _)) => InputError::new(
-                format!("--set {flag} (over {})", path.display()),
+        match crate::config::override_culprit(&e.key, &overrides) {
+            Some(i) => InputError::new(
+                format!("--set {} (over {})", sets[i], path.display()),
                 e.key,
                 e.message,
             ),
@@ -453,6 +450,7 @@ pub fn run(cli: Cli) -> Result<i32> {
                 rotate_deg,
                 seed,
             )?;
+            args::out_dir(&out)?;
             let path = crate::io::render_scene(&loaded, &out, &opts, jpeg_quality, 4)?;
             eprintln!("rendered {} → {}", loaded.scene.name, path.display());
             Ok(EXIT_OK)
@@ -521,6 +519,7 @@ pub fn run(cli: Cli) -> Result<i32> {
 /// `drapelab simulate`.
 fn simulate(scene: &Path, out: &Path, set: &[String]) -> Result<i32> {
     let loaded = load_scene(scene, set)?;
+    args::out_dir(out)?;
     let mut progress = SolveProgress::new(&loaded.scene.name);
     let report = crate::io::simulate_to_dir(&loaded, out, &mut progress)?;
     progress.done(&report);
@@ -595,30 +594,11 @@ fn render_options(
     rotate_deg: f64,
     seed: u64,
 ) -> Result<crate::edges::RenderOptions, InputError> {
+    // The numbers were checked by their value parsers (args.rs).
     let camera = match pinhole_distance_m {
-        Some(d) if d.is_finite() && d > 0.0 => crate::edges::Camera::Pinhole { distance_m: d },
-        Some(d) => {
-            return Err(InputError::new(
-                "--pinhole-distance-m",
-                "",
-                format!("must be > 0, got {d}"),
-            ));
-        }
+        Some(d) => crate::edges::Camera::Pinhole { distance_m: d },
         None => crate::edges::Camera::Orthographic,
     };
-    for (k, v) in [
-        ("--px-per-cm", px_per_cm),
-        ("--noise", noise + 1.0),
-        ("--blur-px", blur_px + 1.0),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(InputError::new(
-                k,
-                "",
-                "must be a finite number ≥ 0 (> 0 for the scale)",
-            ));
-        }
-    }
     Ok(crate::edges::RenderOptions {
         camera,
         px_per_cm,
@@ -673,9 +653,6 @@ fn fit_edges(
             corners: edges::parse_corners(&corners)?,
         }
     };
-    if !(1..=8).contains(&degree) {
-        return Err(InputError::new("--degree", "", "must be in 1..=8").into());
-    }
     let fits = crate::io::fit_photo(
         photo,
         out,
@@ -698,10 +675,7 @@ fn fit_edges(
 /// `drapelab wrinkles`.
 fn wrinkles(config: &Path, out: &Path, mesh: &[usize]) -> Result<i32> {
     let cfg = crate::wrinkles::load_config(config)?;
-    if mesh.iter().any(|&m| m < 2) {
-        return Err(InputError::new("--mesh", "", "NX and NY must be ≥ 2").into());
-    }
-    std::fs::create_dir_all(out)?;
+    args::out_dir(out)?;
     let outputs = crate::stages::WrinkleOutputs {
         table: Some(out.join("wrinkles.parquet")),
         mesh: Some(out.join("mesh.parquet")),

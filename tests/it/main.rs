@@ -13,6 +13,7 @@ mod layering;
 mod loads;
 mod pipeline;
 mod recordings;
+mod runs;
 mod self_contact;
 mod slurm;
 mod stress;

@@ -4,7 +4,7 @@
 
 use crate::support::{drapelab, run_python, temp_project};
 use drapelab::pipeline::{
-    LogProgress, RunOptions, StageState, load_plan, run_pipeline, stage_states,
+    LogProgress, RunOptions, StageState, StaleReason, load_plan, run_pipeline, stage_states,
 };
 use std::path::{Path, PathBuf};
 
@@ -39,7 +39,7 @@ params = { title = "t", x = "material.mass_spring.stiffness_N_per_m", group_by =
 "#;
 
 /// A temporary project with the bundled scenes and a pipeline file.
-fn project(pipeline: &str) -> (tempfile::TempDir, PathBuf) {
+pub(crate) fn project(pipeline: &str) -> (tempfile::TempDir, PathBuf) {
     temp_project(
         &["datasets/scenes/hang4.toml", "datasets/scenes/hang2.toml"],
         "t.toml",
@@ -81,7 +81,10 @@ fn second_run_skips_everything_and_a_changed_input_reruns_only_its_dependents() 
     let states = stage_states(&plan);
     let why = |n: &str| states.iter().find(|(s, _)| s == n).unwrap().1.clone();
     assert_eq!(why("a4"), StageState::UpToDate);
-    assert!(matches!(why("a2"), StageState::Stale(w) if w.contains("hang2.toml")));
+    assert!(matches!(
+        why("a2"),
+        StageState::Stale(StaleReason::InputChanged(w)) if w.contains("hang2.toml")
+    ));
     let third = run(&file, RunOptions::default());
     assert_eq!(sorted(third.ran), ["a2", "report", "sweep2"]);
     assert_eq!(third.skipped, ["a4"]);
@@ -143,7 +146,7 @@ fn force_reruns_the_stage_and_its_dependents_and_a_changed_parameter_is_reported
     let states = stage_states(&plan);
     let a4 = &states.iter().find(|(s, _)| s == "a4").unwrap().1;
     assert!(
-        matches!(a4, StageState::Stale(w) if w.contains("parameter changed: set")),
+        matches!(a4, StageState::Stale(StaleReason::ParamsChanged(k)) if k == &["set"]),
         "{a4:?}"
     );
     let out = drapelab().arg("status").arg(&file).output().unwrap();
@@ -156,7 +159,7 @@ fn force_reruns_the_stage_and_its_dependents_and_a_changed_parameter_is_reported
 }
 
 /// Heavier than PIPELINE (about 2 s on 2 cores) so that kills land inside stages.
-const SLOW_PIPELINE: &str = r#"
+pub(crate) const SLOW_PIPELINE: &str = r#"
 name = "t"
 [stages.a4]
 kind = "simulate"
@@ -430,10 +433,13 @@ fn a_panicking_stage_fails_alone_and_the_run_exits_1() {
         &std::fs::read(tmp.path().join("runs/t/.manifests/bad.json")).unwrap(),
     )
     .unwrap();
-    let status = manifest["status"].as_str().unwrap();
+    let status = &manifest["status"];
+    assert_eq!(status["outcome"], "failed", "{status}");
+    assert_eq!(status["cause"], "panic", "{status}");
+    let message = status["message"].as_str().unwrap();
     assert!(
-        status.starts_with("failed") && status.contains("panicked") && status.contains("buggy"),
-        "{status}"
+        message.contains("panicked") && message.contains("buggy"),
+        "{message}"
     );
     // The stages that do not depend on it ran; its dependent did not.
     for done in ["a4", "a2", "sweep2", "report"] {

@@ -26,6 +26,15 @@ pub fn parse_override(s: &str) -> Result<(String, toml::Value), InputError> {
 }
 
 /// Sets `key` (dotted path) in `table`, creating tables on the way.
+/// Which of `overrides` (dotted key, value) caused an error at `key`: the override of that key, of
+/// a table above it, or of a key inside it.
+pub fn override_culprit(key: &str, overrides: &[(String, toml::Value)]) -> Option<usize> {
+    overrides.iter().position(|(k, _)| {
+        key == k || key.starts_with(&format!("{k}.")) || k.starts_with(&format!("{key}."))
+    })
+}
+
+/// Sets `key` (dotted) in `table`.
 pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
     let parts: Vec<&str> = key.split('.').collect();
     let (last, path) = parts.split_last().ok_or("empty key")?;

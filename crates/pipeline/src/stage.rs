@@ -308,6 +308,19 @@ impl StageContext<'_> {
     pub fn item_done(&self) {
         self.progress.item_done(&self.stage);
     }
+    /// A bad value in this stage's `params` (found when it runs): an input error naming the
+    /// pipeline file and `stages.STAGE.params.KEY` (exit 2).
+    pub fn param_error(
+        &self,
+        key: &str,
+        message: impl Into<String>,
+    ) -> drapelab_core::error::InputError {
+        drapelab_core::error::InputError::new(
+            self.root.join(&self.pipeline_file),
+            format!("stages.{}.params.{key}", self.stage),
+            message,
+        )
+    }
     /// `path` relative to the project root, for tables and reports.
     pub fn relative<'p>(&self, path: &'p Path) -> &'p Path {
         path.strip_prefix(&self.root).unwrap_or(path)

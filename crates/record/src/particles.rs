@@ -1,4 +1,6 @@
-//! `particles.parquet`: one row per particle, columns `i`, `j` (u32), `x_m`, `y_m`, `z_m` (f64).
+//! `particles.parquet`: one row per particle, columns `i`, `j` (u32), `x_m`, `y_m`, `z_m` (f64),
+//! `present` (bool: false for a particle outside a disc sheet, which is not part of the fabric and
+//! keeps its flat start position).
 
 use crate::table::{Table, read_table, table_batch, write_parquet};
 use anyhow::Result;
@@ -20,6 +22,10 @@ pub struct ParticleRow {
     pub y_m: f64,
     /// Position (height), m.
     pub z_m: f64,
+    /// Whether the particle is part of the fabric: false outside a disc sheet's circle (such a
+    /// particle is in no energy term and stays at its flat start position; leave it out of any
+    /// measure).
+    pub present: bool,
 }
 
 impl Table for ParticleRow {
@@ -27,11 +33,13 @@ impl Table for ParticleRow {
     const ROW: &'static str = "One grid particle of a solved sheet (also `last_state.parquet` of a solve that did not converge); key-value metadata `status`, `solver`, `scene`.";
 }
 
-/// Writes the grid particles' positions, with key-value metadata (status, solver, ...).
+/// Writes the grid particles' positions (flagged absent where `absent` says so; an empty slice:
+/// all present), with key-value metadata (status, solver, ...).
 pub fn write_particles(
     path: &Path,
     grid: &Grid,
     x: &[Vector3<f64>],
+    absent: &[bool],
     metadata: &[(&str, String)],
 ) -> Result<()> {
     let rows: Vec<ParticleRow> = (0..grid.len())
@@ -41,6 +49,7 @@ pub fn write_particles(
             x_m: x[p].x,
             y_m: x[p].y,
             z_m: x[p].z,
+            present: !absent.get(p).copied().unwrap_or(false),
         })
         .collect();
     let kv = metadata

@@ -11,7 +11,7 @@ use drapelab_core::edges::{
 use drapelab_core::error::InputError;
 use drapelab_core::scene::LoadedScene;
 use drapelab_core::simulate::solve_scene;
-use drapelab_core::solve::NoObserver;
+use drapelab_core::solve::{NoObserver, Status};
 use std::path::{Path, PathBuf};
 
 /// Solves a scene, renders it, and writes photo, camera.json, particles.parquet and the direct
@@ -82,8 +82,9 @@ pub fn render_scene(
         &out.join("particles.parquet"),
         &sol.grid,
         &sol.x,
+        &[],
         &[
-            ("status", "converged".into()),
+            ("status", Status::Converged.as_str().into()),
             ("scene", scene.name.clone()),
         ],
     )?;

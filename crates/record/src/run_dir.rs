@@ -20,7 +20,7 @@ struct RunRecord<'a> {
     report: &'a SolveReport,
     terms: &'a [String],
     particles: usize,
-    outputs: Vec<&'a str>,
+    outputs: Vec<&'static str>,
     /// Drape coefficient, folds and penetration, for a converged scene with obstacles.
     drape: Option<drapelab_core::measure::DrapeMeasures>,
     /// The sheet's self-contact at the end: smallest distance, active pairs, crossings.
@@ -28,21 +28,83 @@ struct RunRecord<'a> {
     scene: &'a Scene,
 }
 
+/// Every file `simulate` may write into its folder.
+pub const SIMULATE_FILES: [&str; 5] = [
+    "run.json",
+    "particles.parquet",
+    "last_state.parquet",
+    "timeline.mcap",
+    "drape.rrd",
+];
+
 /// Solves `loaded` and writes its outputs into `out` (created if needed). Returns the report; a
 /// solve that did not converge writes `run.json` with its status and `last_state.parquet`, never
 /// `particles.parquet`.
+///
+/// The outputs are written into a fresh folder inside `out` and moved in when the solve is done,
+/// `run.json` last; the files of an earlier run that this one does not write are removed first. So
+/// `out` never holds a result beside a `run.json` that contradicts it, and a run that fails with an
+/// error leaves the earlier result whole. Other files in `out` are left alone.
 pub fn simulate_to_dir(
     loaded: &LoadedScene,
     out: &Path,
     progress: &mut dyn Observer,
 ) -> Result<SolveReport> {
-    let scene = &loaded.scene;
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    remove_stale_staging(out);
+    let staging = tempfile::Builder::new()
+        .prefix(".simulate.")
+        .suffix(".partial")
+        .tempdir_in(out)
+        .with_context(|| format!("cannot write into {}", out.display()))?;
+    let (report, written) = simulate_into(loaded, staging.path(), progress)?;
+    publish(staging.path(), out, &written)?;
+    Ok(report)
+}
+
+/// Removes staging folders that a killed run left in `out`.
+fn remove_stale_staging(out: &Path) {
+    for e in std::fs::read_dir(out).into_iter().flatten().flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.starts_with(".simulate.") && name.ends_with(".partial") {
+            std::fs::remove_dir_all(e.path()).ok();
+        }
+    }
+}
+
+/// Moves the files `written` from `staging` into `out`, `run.json` last, after removing the
+/// simulate files of an earlier run that are not among them.
+fn publish(staging: &Path, out: &Path, written: &[&str]) -> Result<()> {
+    for f in SIMULATE_FILES.iter().filter(|f| !written.contains(f)) {
+        let old = out.join(f);
+        if old.exists() {
+            std::fs::remove_file(&old)
+                .with_context(|| format!("cannot remove the earlier {}", old.display()))?;
+        }
+    }
+    let mut order: Vec<&&str> = written.iter().filter(|f| **f != "run.json").collect();
+    order.extend(written.iter().filter(|f| **f == "run.json"));
+    for f in order {
+        std::fs::rename(staging.join(f), out.join(f))
+            .with_context(|| format!("cannot move {f} into {}", out.display()))?;
+    }
+    Ok(())
+}
+
+/// Solves `loaded` and writes its outputs into the empty folder `out`; the report and the files
+/// written.
+fn simulate_into(
+    loaded: &LoadedScene,
+    out: &Path,
+    progress: &mut dyn Observer,
+) -> Result<(SolveReport, Vec<&'static str>)> {
+    let scene = &loaded.scene;
     let BuiltScene {
         grid,
         mut model,
         x0,
     } = build_scene(scene);
+    let absent = drapelab_core::build::absent_particles(scene, &x0);
     let pins: Vec<usize> = (0..grid.len()).filter(|&p| model.fixed[p]).collect();
     let every = scene.record.every;
     let mut timeline = if scene.record.timeline {
@@ -110,10 +172,10 @@ pub fn simulate_to_dir(
         ("scene", scene.name.clone()),
     ];
     if report.status == Status::Converged {
-        write_particles(&out.join("particles.parquet"), &grid, &x, &meta)?;
+        write_particles(&out.join("particles.parquet"), &grid, &x, &absent, &meta)?;
         outputs.push("particles.parquet");
     } else if finite && report.status != Status::Diverged {
-        write_particles(&out.join("last_state.parquet"), &grid, &x, &meta)?;
+        write_particles(&out.join("last_state.parquet"), &grid, &x, &absent, &meta)?;
         outputs.push("last_state.parquet");
     }
     let terms = model.term_names();
@@ -132,10 +194,11 @@ pub fn simulate_to_dir(
         scene,
     };
     let json = serde_json::to_string_pretty(&record)?;
+    let written = record.outputs.clone();
     write_atomic(&out.join("run.json"), |f| {
         use std::io::Write;
         f.write_all(json.as_bytes())?;
         Ok(())
     })?;
-    Ok(report)
+    Ok((report, written))
 }

@@ -1,7 +1,7 @@
 //! One Arrow record batch to a Parquet file, atomically, zstd-compressed.
 
 use crate::write_atomic;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use arrow::array::RecordBatch;
 use parquet::arrow::ArrowWriter;
 use parquet::basic::{Compression, ZstdLevel};
@@ -93,15 +93,26 @@ pub fn table_markdown<T: Table>() -> Result<String> {
     Ok(s)
 }
 
-/// Reads the rows of a table of `T`'s schema back, every batch in file order.
+/// Reads the rows of a table of `T`'s schema back, every batch in file order. A file that cannot
+/// be opened, is not Parquet, or does not hold `T`'s columns is an
+/// [`InputError`](drapelab_core::error::InputError) naming it (exit 2).
 pub fn read_table<T: Table>(path: &Path) -> Result<Vec<T>> {
-    let f = std::fs::File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    use drapelab_core::error::InputError;
+    let bad = |what: String| InputError::new(path, "", what);
+    let f = std::fs::File::open(path).map_err(|e| bad(format!("cannot open: {e}")))?;
+    let reader = parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(f)
+        .and_then(|b| b.build())
+        .map_err(|e| {
+            bad(format!(
+                "not a readable Parquet file ({e}); expected {}",
+                T::FILE
+            ))
+        })?;
     let mut out = Vec::new();
-    for batch in
-        parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(f)?.build()?
-    {
-        let rows: Vec<T> = serde_arrow::from_record_batch(&batch?)
-            .with_context(|| format!("{}: not a {} table", path.display(), T::FILE))?;
+    for batch in reader {
+        let batch = batch.map_err(|e| bad(format!("corrupt Parquet data: {e}")))?;
+        let rows: Vec<T> = serde_arrow::from_record_batch(&batch)
+            .map_err(|e| bad(format!("not a {} table: {e}", T::FILE)))?;
         out.extend(rows);
     }
     Ok(out)

@@ -68,6 +68,28 @@ const SAMPLES_SLOT: Slot = Slot::one("samples", "Table 2's densities (knitted_sa
 /// The hang scene of the calibration stages.
 const SCENE_SLOT: Slot = Slot::one("scene", "the hang scene each sample is simulated in");
 
+/// Loads scene `file` with the overrides a stage's parameters make; an error an override causes
+/// names the pipeline, the stage and the parameter (`param_key` of the override's scene key), and
+/// the scene.
+pub(crate) fn load_scene(
+    ctx: &drapelab_pipeline::StageContext<'_>,
+    file: &std::path::Path,
+    overrides: &[(String, toml::Value)],
+    param_key: impl Fn(&str) -> String,
+) -> anyhow::Result<drapelab_core::scene::LoadedScene> {
+    drapelab_core::scene::Scene::load(file, overrides).map_err(|e| {
+        match drapelab_core::config::override_culprit(&e.key, overrides) {
+            Some(i) => ctx
+                .param_error(
+                    &param_key(&overrides[i].0),
+                    format!("{} (scene {}, key `{}`)", e.message, file.display(), e.key),
+                )
+                .into(),
+            None => e.into(),
+        }
+    })
+}
+
 /// Every stage kind drapelab knows.
 pub fn registry() -> Registry {
     Registry::new()

@@ -37,6 +37,46 @@ pub struct ReportParams {
     pub notes: String,
 }
 
+impl ReportParams {
+    /// Every column the parameters name, with its key.
+    fn columns(&self) -> Vec<(String, &str)> {
+        let mut v: Vec<(String, &str)> = Vec::new();
+        for (i, c) in self.group_by.iter().enumerate() {
+            v.push((format!("group_by[{i}]"), c));
+        }
+        for (i, c) in self.series.iter().enumerate() {
+            v.push((format!("series[{i}]"), c));
+        }
+        v.push(("x".into(), &self.x));
+        v.push(("y".into(), &self.y));
+        if let Some(f) = &self.facet {
+            v.push(("facet".into(), f));
+        }
+        v
+    }
+}
+
+/// Refuses, before any query runs, a named column that the tables do not have: an input error
+/// naming the pipeline, `stages.STAGE.params.KEY`, the column and the tables' columns (exit 2).
+fn check_schema(ctx: &StageContext<'_>, lf: &mut LazyFrame, p: &ReportParams) -> Result<()> {
+    let schema = lf.collect_schema()?;
+    for (key, c) in p.columns() {
+        if schema.get(c).is_none() {
+            let names: Vec<String> = schema.iter_names().map(|n| n.to_string()).collect();
+            return Err(ctx
+                .param_error(
+                    &key,
+                    format!(
+                        "the tables have no column `{c}` (they have: {})",
+                        names.join(", ")
+                    ),
+                )
+                .into());
+        }
+    }
+    Ok(())
+}
+
 /// Points of each series (by label) on one panel.
 pub type Lines = BTreeMap<String, Vec<(f64, f64)>>;
 /// Panels by facet value.
@@ -122,7 +162,8 @@ fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
     let md = ctx.output("markdown")?;
     let svg = ctx.output("plot")?;
     ctx.started(2);
-    let lf = scan_all(ctx.input_files("tables"))?;
+    let mut lf = scan_all(ctx.input_files("tables"))?;
+    check_schema(ctx, &mut lf, p)?;
     let group: Vec<Expr> = p.group_by.iter().map(|c| col(c.as_str())).collect();
     let summary = lf
         .clone()

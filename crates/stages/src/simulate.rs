@@ -1,7 +1,6 @@
 //! `simulate`: one scene with overrides, solved into the folder of its outputs.
 
 use anyhow::{Result, bail};
-use drapelab_core::scene::Scene;
 use drapelab_core::solve::{NoObserver, Status};
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use drapelab_record::simulate_to_dir;
@@ -46,7 +45,8 @@ impl StageKind for Simulate {
         }
         let overrides: Vec<(String, toml::Value)> =
             p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
-        let loaded = Scene::load(ctx.input("scene")?, &overrides)?;
+        let loaded =
+            crate::load_scene(ctx, ctx.input("scene")?, &overrides, |k| format!("set.{k}"))?;
         ctx.started(1);
         let report = simulate_to_dir(&loaded, &dir, &mut NoObserver)?;
         ctx.item_done();

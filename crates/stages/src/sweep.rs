@@ -160,6 +160,7 @@ pub fn sweep_points(p: &SweepParams) -> Vec<Vec<toml::Value>> {
 /// The scene of item `k`: scene file `k / points`, design point `k % points`, with the sweep's keys
 /// set (recording off).
 fn item_scene(
+    ctx: &StageContext<'_>,
     files: &[std::path::PathBuf],
     p: &SweepParams,
     points: &[Vec<toml::Value>],
@@ -173,7 +174,13 @@ fn item_scene(
             overrides.push((sub.trim().to_string(), v.clone()));
         }
     }
-    let mut scene = Scene::load(file, &overrides)?.scene.into_inner();
+    let param_key = |k: &str| match p.axes.keys().find(|a| a.split(',').any(|s| s.trim() == k)) {
+        Some(axis) => format!("axes.\"{axis}\""),
+        None => format!("set.\"{k}\""),
+    };
+    let mut scene = crate::load_scene(ctx, file, &overrides, param_key)?
+        .scene
+        .into_inner();
     scene.record.timeline = false;
     scene.record.rerun = false;
     Ok((i as u32, scene))
@@ -226,13 +233,13 @@ impl ItemKind for Sweep {
         let points = sweep_points(p);
         let n = files.len() * points.len();
         for k in 0..n {
-            item_scene(files, p, &points, k)?;
+            item_scene(ctx, files, p, &points, k)?;
         }
         Ok(n)
     }
     fn compute(ctx: &StageContext<'_>, p: &SweepParams, item: usize, part: &Path) -> Result<()> {
         let points = sweep_points(p);
-        let (i, scene) = item_scene(scene_files(ctx)?, p, &points, item)?;
+        let (i, scene) = item_scene(ctx, scene_files(ctx)?, p, &points, item)?;
         let keys: Vec<&String> = p.axes.keys().collect();
         write_sweep(part, &[solve_point(&scene, i)], &points, &keys)
     }
