@@ -122,10 +122,11 @@ pub enum Command {
         wait: bool,
     },
     /// Compute some items of a stage, as one Slurm array task does (`drapelab run --executor slurm`
-    /// writes the task list and calls this; not needed by hand).
+    /// writes the task list and calls this; not needed by hand, so hidden from --help).
     ///
     /// Reads line TASK (0-based) of the task list: the items to compute. Items that already have a
     /// part are skipped; the parts folder must be that of the stage's current inputs.
+    #[command(hide = true)]
     Worker {
         /// The pipeline file.
         pipeline: PathBuf,
@@ -149,8 +150,15 @@ pub enum Command {
         #[arg(long)]
         check: bool,
     },
-    /// List the stage kinds a pipeline may use, with their input and output slots.
+    /// List the stage kinds a pipeline may use, with their input and output slots and their
+    /// parameters' defaults (units are in the names).
     Kinds,
+    /// Print a shell completion script, e.g. `drapelab completions bash > ~/.local/share/bash-completion/completions/drapelab`.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
     /// List every Parquet table drapelab writes: its columns (units in the names), types, nullability.
     ///
     /// The listing is traced from the tables' row types, the one place each schema is written; the
@@ -418,6 +426,16 @@ pub fn run(cli: Cli) -> Result<i32> {
             task,
         } => worker(&pipeline, &stage, &tasks, task),
         Command::Status { pipeline, check } => status(&pipeline, check),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            clap_complete::generate(
+                shell,
+                &mut Cli::command(),
+                "drapelab",
+                &mut std::io::stdout(),
+            );
+            Ok(EXIT_OK)
+        }
         Command::Kinds => {
             print!("{}", kinds_text());
             Ok(EXIT_OK)
@@ -564,7 +582,8 @@ fn status(pipeline: &Path, check: bool) -> Result<i32> {
     })
 }
 
-/// `drapelab kinds`: every stage kind with its slots.
+/// `drapelab kinds`: every stage kind with its slots and its parameters' defaults (units are in
+/// the names); docs/src/reference/kinds.md is this output.
 pub fn kinds_text() -> String {
     let mut s = String::new();
     for k in crate::stages::registry().kinds() {
@@ -580,6 +599,68 @@ pub fn kinds_text() -> String {
                 );
             }
         }
+        s += &params_text(k);
+    }
+    s
+}
+
+/// The parameters of a kind: each default (the resolved parameters of an empty table), or the
+/// first key a pipeline must give.
+fn params_text(k: &dyn crate::pipeline::Stage) -> String {
+    match k.resolve(&toml::Table::new()) {
+        Ok(serde_json::Value::Object(map)) => map
+            .iter()
+            .map(|(key, v)| format!("  params.{key} = {v} (default)\n"))
+            .collect(),
+        Ok(_) => String::new(),
+        Err(e) => {
+            let missing = e
+                .message
+                .strip_prefix("missing field `")
+                .and_then(|m| m.split('`').next());
+            match (e.key.is_empty(), missing) {
+                (true, Some(field)) => format!(
+                    "  params.{field}: required (no default); the kind's documentation lists the rest\n"
+                ),
+                _ => format!(
+                    "  params.{}: required ({}); the kind's documentation lists the rest\n",
+                    e.key, e.message
+                ),
+            }
+        }
+    }
+}
+
+/// The command-line reference (docs/src/reference/cli.md): every visible subcommand with its
+/// description and options, from the clap definitions.
+pub fn cli_reference() -> String {
+    use clap::CommandFactory;
+    let cli = Cli::command();
+    let mut s = String::new();
+    for sub in cli.get_subcommands().filter(|c| !c.is_hide_set()) {
+        s += &format!("## `drapelab {}`\n\n", sub.get_name());
+        if let Some(about) = sub.get_long_about().or(sub.get_about()) {
+            s += &format!("{}\n\n", about.to_string().trim());
+        }
+        for a in sub.get_arguments().filter(|a| !a.is_hide_set()) {
+            let name = match (a.get_long(), a.is_positional()) {
+                (Some(l), _) => format!("--{l}"),
+                (None, _) => a.get_id().as_str().to_uppercase(),
+            };
+            let help = a.get_help().map(|h| h.to_string()).unwrap_or_default();
+            let defaults: Vec<String> = a
+                .get_default_values()
+                .iter()
+                .map(|v| v.to_string_lossy().to_string())
+                .collect();
+            let default = if defaults.is_empty() {
+                String::new()
+            } else {
+                format!(" Default: `{}`.", defaults.join(" "))
+            };
+            s += &format!("- `{name}`: {}{default}\n", help.replace('\n', " "));
+        }
+        s += "\n";
     }
     s
 }

@@ -5,6 +5,7 @@ mod calibrate;
 mod cli;
 mod contact;
 mod cusick;
+mod docs;
 mod dynamics;
 mod edges;
 mod engine;
