@@ -441,7 +441,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             Ok(EXIT_OK)
         }
         Command::Tables => {
-            print!("{}", crate::stages::tables_markdown()?);
+            print!("{}", crate::app::tables_markdown()?);
             Ok(EXIT_OK)
         }
         Command::Surface(args) => surface::surface(args),
@@ -757,18 +757,18 @@ fn fit_edges(
 fn wrinkles(config: &Path, out: &Path, mesh: &[usize]) -> Result<i32> {
     let cfg = crate::wrinkles::load_config(config)?;
     args::out_dir(out)?;
-    let outputs = crate::stages::WrinkleOutputs {
+    let outputs = crate::app::wrinkles::WrinkleOutputs {
         table: Some(out.join("wrinkles.parquet")),
         mesh: Some(out.join("mesh.parquet")),
         recording: Some(out.join("wrinkles.rrd")),
         markdown: Some(out.join("wrinkles.md")),
     };
-    let params = crate::stages::WrinklesParams {
+    let params = crate::app::wrinkles::WrinklesParams {
         mesh_nx: mesh[0],
         mesh_ny: mesh[1],
     };
-    let solved = crate::stages::write_wrinkles(&cfg, &outputs, &params)?;
-    print!("{}", crate::stages::report_markdown(&cfg, &solved));
+    let solved = crate::app::wrinkles::write_wrinkles(&cfg, &outputs, &params)?;
+    print!("{}", crate::app::wrinkles::report_markdown(&cfg, &solved));
     Ok(if solved.iter().all(|s| s.result.converged) {
         EXIT_OK
     } else {

@@ -1,10 +1,10 @@
 //! `drapelab surface`: a drape dressed as a smooth textured surface (seed 003 §10.8).
 
 use super::progress::SolveProgress;
-use crate::error::{EXIT_OK, InputError};
-use crate::stages::{
+use crate::app::surface::{
     SurfaceOutputs, SurfaceParams, load_run, load_texture, make_surface, solve_drape,
 };
+use crate::error::{EXIT_OK, InputError};
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 

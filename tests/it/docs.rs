@@ -35,7 +35,7 @@ fn generated(page: &str, now: &str) {
 
 #[test]
 fn the_reference_pages_match_the_code() {
-    generated("tables.md", &drapelab::stages::tables_markdown().unwrap());
+    generated("tables.md", &drapelab::app::tables_markdown().unwrap());
     generated("kinds.md", &drapelab::cli::kinds_text());
     generated("cli.md", &drapelab::cli::cli_reference());
 }

@@ -40,6 +40,25 @@ impl fmt::Display for InputError {
 
 impl std::error::Error for InputError {}
 
+/// A bad stage parameter: the key under `params.` (empty for the whole table) and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamError {
+    /// Dotted key under `params.`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl ParamError {
+    /// A new parameter error.
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}
+
 /// Exit code for success.
 pub const EXIT_OK: i32 = 0;
 /// Exit code when a run or stage failed (I/O, a solver status that the caller treats as failure).

@@ -66,24 +66,7 @@ impl Slot {
     }
 }
 
-/// A bad parameter: the key under `params.` (empty for the whole table) and what is wrong.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParamError {
-    /// Dotted key under `params.`.
-    pub key: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl ParamError {
-    /// A new parameter error.
-    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
-        Self {
-            key: key.into(),
-            message: message.into(),
-        }
-    }
-}
+pub use drapelab_core::error::ParamError;
 
 /// The interface the engine knows a stage kind by (object safe).
 pub trait Stage: Send + Sync {

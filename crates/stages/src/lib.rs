@@ -1,7 +1,6 @@
-//! drapelab-stages: the stage kinds of drapelab's pipelines, one file each, glue over the library
-//! (`drapelab-core` for the science, `drapelab-record` for the files), and the report helpers
-//! (Markdown tables from polars, plots with plotters). [`registry`] lists every kind: adding one is
-//! a file here and a line there.
+//! drapelab-stages: the stage kinds of drapelab's pipelines, one adapter file each: the kind's slots
+//! and parameters, and a call of its workflow (`drapelab-app`) or report (`drapelab-reports`) with
+//! the stage's files. [`registry`] lists every kind: adding one is a file here and a line there.
 
 #![allow(non_snake_case)]
 
@@ -9,14 +8,10 @@ mod benchmark;
 mod benchmark_report;
 mod calibrate;
 mod calibration_report;
-mod calibration_tables;
 mod cusick_measure;
-mod cusick_plots;
 mod cusick_predict;
 mod cusick_report;
-mod cusick_tables;
 mod fit_edges;
-mod montage;
 mod peers;
 pub mod report;
 mod score;
@@ -25,7 +20,6 @@ mod simulate;
 mod skips;
 mod surface;
 mod sweep;
-mod sweep_table;
 mod tune;
 mod validate;
 mod wrinkles;
@@ -37,7 +31,7 @@ pub use calibration_report::{CalibrationReport, CalibrationReportParams};
 pub use cusick_measure::{CusickMeasure, CusickMeasureParams, ShadowRow, measure_dataset};
 pub use cusick_predict::{CusickPredict, CusickPredictParams};
 pub use cusick_report::{CusickReport, CusickReportParams, dc_within, nodes_within};
-pub use cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
+pub use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 pub use fit_edges::{FitEdges, FitEdgesParams};
 pub use peers::{Peers, PeersParams};
 pub use report::{Report, ReportParams};
@@ -68,26 +62,29 @@ const SAMPLES_SLOT: Slot = Slot::one("samples", "Table 2's densities (knitted_sa
 /// The hang scene of the calibration stages.
 const SCENE_SLOT: Slot = Slot::one("scene", "the hang scene each sample is simulated in");
 
-/// Loads scene `file` with the overrides a stage's parameters make; an error an override causes
-/// names the pipeline, the stage and the parameter (`param_key` of the override's scene key), and
-/// the scene.
-pub(crate) fn load_scene(
-    ctx: &drapelab_pipeline::StageContext<'_>,
-    file: &std::path::Path,
-    overrides: &[(String, toml::Value)],
-    param_key: impl Fn(&str) -> String,
-) -> anyhow::Result<drapelab_core::scene::LoadedScene> {
-    drapelab_core::scene::Scene::load(file, overrides).map_err(|e| {
-        match drapelab_core::config::override_culprit(&e.key, overrides) {
-            Some(i) => ctx
-                .param_error(
-                    &param_key(&overrides[i].0),
-                    format!("{} (scene {}, key `{}`)", e.message, file.display(), e.key),
-                )
-                .into(),
-            None => e.into(),
-        }
-    })
+/// The workflow's view of a stage's context: its files, its name, and progress forwarded to the
+/// engine's display.
+pub(crate) fn job<'c>(ctx: &'c drapelab_pipeline::StageContext<'_>) -> drapelab_app::Job<'c> {
+    drapelab_app::Job {
+        stage: ctx.stage.clone(),
+        source: ctx.pipeline_file.clone(),
+        root: ctx.root.clone(),
+        inputs: ctx.inputs.clone(),
+        outputs: ctx.outputs.clone(),
+        progress: Box::new(Forward(ctx)),
+    }
+}
+
+/// Progress of a workflow, forwarded to the stage's.
+struct Forward<'c, 'p>(&'c drapelab_pipeline::StageContext<'p>);
+
+impl drapelab_app::Progress for Forward<'_, '_> {
+    fn started(&self, items: usize) {
+        self.0.started(items);
+    }
+    fn item_done(&self) {
+        self.0.item_done();
+    }
 }
 
 /// Every stage kind drapelab knows.
@@ -112,34 +109,4 @@ pub fn registry() -> Registry {
         .with::<CusickPredict>()
         .with::<CusickReport>()
         .with::<Surface>()
-}
-
-/// Every Parquet table drapelab writes, each traced from its row type, as the Markdown the README's
-/// "Tables" section holds (`drapelab tables` prints it).
-pub fn tables_markdown() -> anyhow::Result<String> {
-    use drapelab_record::table_markdown as md;
-    let sections = [
-        md::<drapelab_record::ParticleRow>()?,
-        md::<drapelab_record::EdgeRow>()?,
-        md::<sweep_table::SweepPoint>()?,
-        md::<sweep_table::SweepOutcome>()?,
-        md::<drapelab_core::edges::ScoreRow>()?,
-        md::<calibration_tables::ResultRow>()?,
-        md::<calibration_tables::ComparisonRow>()?,
-        md::<calibration_tables::EvaluationRow>()?,
-        md::<validate::ValidationRow>()?,
-        md::<tune::TuneRow>()?,
-        md::<tune::MainEffectRow>()?,
-        md::<wrinkles::WrinkleRow>()?,
-        md::<wrinkles::WrinkleMeshRow>()?,
-        md::<drapelab_core::benchmark::BenchRow>()?,
-        md::<drapelab_core::benchmark::PopulationRow>()?,
-        md::<drapelab_core::benchmark::SkipRow>()?,
-        md::<peers::PeerRow>()?,
-        md::<cusick_measure::ShadowRow>()?,
-        md::<cusick_tables::PredictionRow>()?,
-        md::<cusick_tables::OutlineRow>()?,
-        md::<cusick_tables::ProfileRow>()?,
-    ];
-    Ok(sections.join("\n"))
 }

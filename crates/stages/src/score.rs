@@ -1,24 +1,9 @@
-//! `score`: measured edges (a fit-edges table) against simulated ones (`edges_truth.parquet` files, one
-//! per sample folder), per sample and edge: seed 000 Eq. 5 and the curve distance, into `score.parquet`.
+//! The stage kind over [`drapelab_app::score`]: its slots and parameters checked when the plan loads,
+//! and a call of the workflow with the stage's files.
 
-use anyhow::{Context, Result, bail};
-use drapelab_core::edges::score_edges;
+use anyhow::Result;
+pub use drapelab_app::score::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::{read_edges, write_table};
-use serde::{Deserialize, Serialize};
-
-/// Parameters of a score stage.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ScoreParams {
-    /// Side of the samples, cm (normalises Eq. 5). Default 50.
-    #[serde(default = "default_side")]
-    pub side_cm: f64,
-}
-
-fn default_side() -> f64 {
-    50.0
-}
 
 /// The `score` stage kind.
 pub struct Score;
@@ -37,38 +22,7 @@ impl StageKind for Score {
     ];
     const OUTPUTS: &'static [Slot] = &[Slot::one("score", "score.parquet")];
     fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
+        let ctx = &crate::job(ctx);
         run(ctx, p)
     }
-}
-
-fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
-    let measured_path = ctx.input("measured")?;
-    let measured = read_edges(measured_path)
-        .with_context(|| format!("measured edges {}", measured_path.display()))?;
-    let truths = ctx.input_files("simulated");
-    if truths.is_empty() {
-        bail!("input `simulated` matched no file");
-    }
-    ctx.started(truths.len());
-    let mut rows = Vec::new();
-    for t in truths {
-        let dir = t.parent().unwrap_or(std::path::Path::new("."));
-        let sample = dir
-            .strip_prefix(&ctx.root)
-            .unwrap_or(dir)
-            .to_string_lossy()
-            .replace('\\', "/");
-        let sim: Vec<_> = read_edges(t)?
-            .into_iter()
-            .map(|(_, e)| (sample.clone(), e))
-            .collect();
-        let real: Vec<_> = measured
-            .iter()
-            .filter(|(s, _)| *s == sample)
-            .cloned()
-            .collect();
-        rows.extend(score_edges(&real, &sim, p.side_cm));
-        ctx.item_done();
-    }
-    write_table(ctx.output("score")?, &rows)
 }

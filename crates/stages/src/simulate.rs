@@ -1,20 +1,9 @@
-//! `simulate`: one scene with overrides, solved into the folder of its outputs.
+//! The stage kind over [`drapelab_app::simulate`]: its slots and parameters checked when the plan loads,
+//! and a call of the workflow with the stage's files.
 
-use anyhow::{Result, bail};
-use drapelab_core::solve::{NoObserver, Status};
+use anyhow::Result;
+pub use drapelab_app::simulate::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::simulate_to_dir;
-use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
-
-/// Parameters of a simulate stage.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-pub struct SimulateParams {
-    /// Scene keys to override by dotted path, e.g. { "cloth.nx" = 21 }.
-    #[serde(default)]
-    pub set: BTreeMap<String, toml::Value>,
-}
 
 /// The `simulate` stage kind.
 pub struct Simulate;
@@ -31,33 +20,7 @@ impl StageKind for Simulate {
         Slot::optional("recording", "drape.rrd, when record.rerun is set"),
     ];
     fn run(ctx: &StageContext<'_>, p: &SimulateParams) -> Result<()> {
-        let dir = ctx
-            .output("run")?
-            .parent()
-            .expect("output has a folder")
-            .to_path_buf();
-        if ctx
-            .outputs
-            .values()
-            .any(|o| o.parent() != Some(dir.as_path()))
-        {
-            bail!("all outputs of a simulate stage must lie in one folder");
-        }
-        let overrides: Vec<(String, toml::Value)> =
-            p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
-        let loaded =
-            crate::load_scene(ctx, ctx.input("scene")?, &overrides, |k| format!("set.{k}"))?;
-        ctx.started(1);
-        let report = simulate_to_dir(&loaded, &dir, &mut NoObserver)?;
-        ctx.item_done();
-        if report.status != Status::Converged {
-            bail!(
-                "{}: {} ({})",
-                loaded.scene.name,
-                report.status.as_str(),
-                report.message
-            );
-        }
-        Ok(())
+        let ctx = &crate::job(ctx);
+        run(ctx, p)
     }
 }

@@ -1,22 +1,12 @@
-//! `skips`: each skip the engine makes, measured on and off in the same run.
+//! `skips`: each skip the engine makes, measured on and off in the same run; the workflow is
+//! [`drapelab_app::skips`], and the skip of an up-to-date stage is measured here, with the engine.
 
 use anyhow::Result;
-use drapelab_core::benchmark::{
-    SkipRow, skip_cost_cache, skip_second_thread, skip_symmetry, skip_unneeded_terms,
-};
-use drapelab_core::scene::{LoadedScene, Scene};
-use drapelab_core::solve::NoObserver;
+pub use drapelab_app::skips::*;
+use drapelab_core::benchmark::SkipRow;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
-use drapelab_record::simulate_to_dir;
-use drapelab_record::write_table;
-use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
-
-/// Parameters of a skips stage.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-pub struct SkipsParams {}
 
 /// The `skips` stage kind.
 pub struct Skips;
@@ -35,62 +25,8 @@ impl StageKind for Skips {
     ];
     const OUTPUTS: &'static [Slot] = &[Slot::one("table", "skips.parquet")];
     fn run(ctx: &StageContext<'_>, p: &SkipsParams) -> Result<()> {
-        run(ctx, p)
+        run(&crate::job(ctx), p, skip_up_to_date_stage)
     }
-}
-
-/// Runs a skips stage: each skip the engine makes (a quarter model, recording off, the cost cache, an
-/// up-to-date stage, a contact term a scene does not need), and the second thread of a calibration
-/// population, measured on and off in the same run, into a Parquet table (`skip`, `scene`,
-/// `time_with_skip_s`, `time_without_skip_s`, `saved_fraction`).
-fn run(ctx: &StageContext<'_>, _p: &SkipsParams) -> Result<()> {
-    let load = |slot: &str| -> Result<Scene> {
-        Ok(Scene::load(ctx.input(slot)?, &[])?.scene.into_inner())
-    };
-    let (full, quarter, hang) = (load("full")?, load("quarter")?, load("hang")?);
-    ctx.started(6);
-    let done = || ctx.item_done();
-    let mut rows = vec![skip_symmetry(&full, &quarter)];
-    done();
-    rows.push(skip_recording(&hang, ctx.input("hang")?)?);
-    done();
-    rows.push(skip_cost_cache(&hang)?);
-    done();
-    rows.push(skip_up_to_date_stage(ctx.input("hang")?, &hang.name)?);
-    done();
-    rows.push(skip_unneeded_terms(&hang));
-    done();
-    rows.push(skip_second_thread(&hang)?);
-    done();
-    write_table(ctx.output("table")?, &rows)
-}
-
-/// Recording off: simulate at 21 × 21 with the timeline and the rerun recording off and on.
-fn skip_recording(hang: &Scene, path: &Path) -> Result<SkipRow> {
-    let mut hang4 = hang.clone();
-    hang4.cloth.nx = 21;
-    hang4.cloth.ny = 21;
-    let tmp = tempfile::tempdir()?;
-    let mut with_rec = hang4.clone();
-    with_rec.record.timeline = true;
-    with_rec.record.rerun = true;
-    let mut times = Vec::new();
-    for (k, s) in [&hang4, &with_rec].iter().enumerate() {
-        let loaded = LoadedScene {
-            scene: (*s).clone().validated()?,
-            path: path.to_path_buf(),
-        };
-        let out = tmp.path().join(format!("r{k}"));
-        let t = Instant::now();
-        simulate_to_dir(&loaded, &out, &mut NoObserver)?;
-        times.push(t.elapsed().as_secs_f64());
-    }
-    Ok(SkipRow::new(
-        "timeline and rerun recording off",
-        hang4.name.clone(),
-        times[0],
-        times[1],
-    ))
 }
 
 /// Up-to-date stages: a one-stage pipeline run from scratch, then again (nothing to do).

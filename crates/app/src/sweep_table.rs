@@ -142,7 +142,7 @@ impl SweepOutcome {
 /// One swept key's values at every row, as the narrowest column that holds every value of the
 /// design `all` (integers, then floats, then strings; so that one row's part has the whole table's
 /// type); named by its first key.
-fn axis_column(key: &str, vals: &[&toml::Value], all: &[&toml::Value]) -> (Field, ArrayRef) {
+pub fn axis_column(key: &str, vals: &[&toml::Value], all: &[&toml::Value]) -> (Field, ArrayRef) {
     let name = key.split(',').next().unwrap_or(key).trim().to_string();
     if all.iter().all(|v| v.is_integer()) {
         let a = Int64Array::from_iter_values(vals.iter().map(|v| v.as_integer().unwrap_or(0)));
@@ -161,7 +161,7 @@ fn axis_column(key: &str, vals: &[&toml::Value], all: &[&toml::Value]) -> (Field
 }
 
 /// A TOML number as f64 (integers too).
-pub(crate) fn as_f64(v: &toml::Value) -> Option<f64> {
+pub fn as_f64(v: &toml::Value) -> Option<f64> {
     v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
 }
 

@@ -22,11 +22,11 @@ pub struct Tile<'a> {
 }
 
 /// Side of a tile, px.
-const TILE_PX: u32 = 350;
+pub const TILE_PX: u32 = 350;
 /// Height of a tile's label band, px.
-const LABEL_PX: u32 = 40;
+pub const LABEL_PX: u32 = 40;
 /// The cloth's colour in the montage.
-const CLOTH: [f64; 3] = [214.0, 178.0, 140.0];
+pub const CLOTH: [f64; 3] = [214.0, 178.0, 140.0];
 
 /// Writes `text` in `img` at (x, y) with the 8 × 8 font scaled `scale` times (ASCII; other characters
 /// as '?'), clipped to the image.
@@ -58,7 +58,7 @@ pub fn draw_text(img: &mut RgbImage, text: &str, (x, y): (u32, u32), scale: u32,
 
 /// A drape's picture for a tile: its smooth surface, or the flat-shaded grid where it cannot be
 /// interpolated.
-fn picture(t: &Tile<'_>, view: View, size: (u32, u32)) -> RgbImage {
+pub fn picture(t: &Tile<'_>, view: View, size: (u32, u32)) -> RgbImage {
     match DrapeSurface::new(t.grid, t.x, &t.present, Parametrization::Uniform) {
         Some(s) => render_surface(&s.tessellate(120), &Paint::Plain(CLOTH), view, size, 12),
         None => drapelab_core::edges::render_view(

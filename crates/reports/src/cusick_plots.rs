@@ -2,16 +2,16 @@
 //! predicted specimens beside the simulated ones (outlines r(θ) seen from above, with the pedestal
 //! and the flat specimen), and the measured against the simulated height profile z(r).
 
-use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use anyhow::Result;
+use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 
 /// Panels: two per row.
-const COLS: usize = 2;
+pub const COLS: usize = 2;
 
 /// One fabric's panel: caption, axes in mm with their names, `y.2` labels on y, no grid.
-fn panel<'a, 'b>(
+pub fn panel<'a, 'b>(
     area: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
     caption: &str,
     x: (std::ops::Range<f64>, &str),
@@ -43,7 +43,7 @@ fn panel<'a, 'b>(
 }
 
 /// A closed polyline (mm) of one outline's points.
-fn closed_mm(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+pub fn closed_mm(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     let mut v: Vec<(f64, f64)> = points
         .iter()
         .map(|&(t, r)| (1e3 * r * t.cos(), 1e3 * r * t.sin()))
@@ -54,7 +54,7 @@ fn closed_mm(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     v
 }
 
-fn circle_mm(radius_m: f64) -> Vec<(f64, f64)> {
+pub fn circle_mm(radius_m: f64) -> Vec<(f64, f64)> {
     let pts: Vec<(f64, f64)> = (0..=180)
         .map(|i| (i as f64 / 180.0 * std::f64::consts::TAU, radius_m))
         .collect();
@@ -63,12 +63,16 @@ fn circle_mm(radius_m: f64) -> Vec<(f64, f64)> {
 
 /// The outlines of each fabric grouped by source: photos (of specimens other than the
 /// calibration's) and simulated seeds, each a list of (θ, r) points.
-type Outlines = BTreeMap<i32, (Vec<Points>, Vec<Points>)>;
+pub type Outlines = BTreeMap<i32, (Vec<Points>, Vec<Points>)>;
 
 /// The (θ in rad, r in m) points of one outline.
-type Points = Vec<(f64, f64)>;
+pub type Points = Vec<(f64, f64)>;
 
-fn group_outlines(rows: &[PredictionRow], photos: &[OutlineRow], model: &[OutlineRow]) -> Outlines {
+pub fn group_outlines(
+    rows: &[PredictionRow],
+    photos: &[OutlineRow],
+    model: &[OutlineRow],
+) -> Outlines {
     let calib: BTreeMap<i32, i32> = rows
         .iter()
         .map(|r| (r.fabric, r.calibration_sample))

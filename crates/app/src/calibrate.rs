@@ -1,0 +1,280 @@
+//! `calibrate`: for each sample of a fit-edges table, ICA runs over Table 3's box against the sample's
+//! measured 4-corner edges (the scene input with the sample's Table 2 density); the best run is kept.
+//! Writes `results.parquet` (one row per sample, with the runs' spread and each parameter's
+//! identifiability) and `evaluations.parquet` (every country of every decade of every run). Each
+//! sample is an item: one part per sample, run by the pipeline's executor, then gathered.
+
+use crate::calibration_tables::{ComparisonRow, EvaluationRow, ResultRow};
+use crate::job::Job;
+use anyhow::{Context, Result, bail};
+use drapelab_core::calibrate::{
+    Noise, Problem, SampleSettings, calibrate_sample, read_sample_densities, sample_scene,
+};
+use drapelab_core::edges::{EdgeFit, EdgeSource};
+use drapelab_core::optim::{DecadeEvent, IcaSettings};
+use drapelab_record::{
+    CalibrationRecorder, gather_parquet, merge_recordings, read_edges, write_table,
+};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Parameters of a calibrate stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrateParams {
+    /// Independent ICA runs per sample (seeds seed, seed+1, ...). Default 10 (seed 000).
+    #[serde(default = "default_runs")]
+    pub runs: usize,
+    /// ICA settings (seed is the first run's); or set `ica_from_input`.
+    #[serde(default)]
+    pub ica: Option<IcaSettings>,
+    /// Read ICA's settings from the `ica` input (a tune stage's `best_ica.json`) instead of `ica`.
+    #[serde(default)]
+    pub ica_from_input: bool,
+    /// Particles per side of the simulated net. Default 14.
+    #[serde(default = "default_grid")]
+    pub grid: usize,
+    /// Side of the samples, cm. Default 50.
+    #[serde(default = "default_side")]
+    pub side_cm: f64,
+    /// Which curve of a simulated drape stands for its edges: "silhouette" (of its triangles, as a
+    /// photo shows it; default) or "particles" (the polyline through the edge particles).
+    #[serde(default)]
+    pub edge_source: EdgeSource,
+    /// Measurement error of the photos in the cost's unit (curve distance, % of the side), for the
+    /// identifiability analysis: a worst-case bound (0.03 is the photo-to-particle gap of the bundled
+    /// dataset, README "Edges from photos"). Default: none, the standard error of least squares
+    /// estimated from the residual at the optimum ([`drapelab_core::calibrate::Noise`]).
+    #[serde(default)]
+    pub measurement_noise_pct: Option<f64>,
+    /// A parameter is identifiable when the photos pin it to within this fraction of its value (the
+    /// half-width over which the cost stays within the noise). Default 0.05.
+    #[serde(default = "default_ident")]
+    pub identifiable_rel: f64,
+    /// Half-width of the window swept around the optimum for each parameter, as a fraction of its
+    /// Table 3 range. Default 0.1.
+    #[serde(default = "default_window")]
+    pub identifiability_window: f64,
+    /// Add the photos' systematic uncertainty (the `systematic_pct` of their edges: corners, scale,
+    /// blur and light perturbed) to the residual's in the identifiability intervals. Default true.
+    #[serde(default = "default_true")]
+    pub include_systematic: bool,
+    /// Nelder–Mead iterations that polish the best ICA optimum over stiffness and natural length
+    /// ([`drapelab_core::calibrate::Problem::polish`]); 0 keeps seed 000's ICA alone. Default 60.
+    #[serde(default = "default_polish")]
+    pub polish_iterations: u64,
+    /// Also run CMA-ES with the same number of cost evaluations as each ICA run (the baseline), into
+    /// the `comparison.parquet` output. Default false.
+    #[serde(default)]
+    pub baseline_cmaes: bool,
+}
+
+pub fn default_true() -> bool {
+    true
+}
+pub fn default_runs() -> usize {
+    10
+}
+pub fn default_grid() -> usize {
+    14
+}
+pub fn default_side() -> f64 {
+    50.0
+}
+pub fn default_ident() -> f64 {
+    0.05
+}
+pub fn default_polish() -> u64 {
+    60
+}
+pub fn default_window() -> f64 {
+    0.1
+}
+
+impl CalibrateParams {
+    /// Checks the parameters: Err((key, message)).
+    pub fn check(&self) -> Result<(), (String, String)> {
+        match (&self.ica, self.ica_from_input) {
+            (Some(ica), false) => ica.check().map_err(|(k, m)| (format!("ica.{k}"), m))?,
+            (None, true) => {}
+            _ => {
+                return Err((
+                    "ica".into(),
+                    "give exactly one of `ica` (settings) and `ica_from_input = true` (the `ica` input)"
+                        .into(),
+                ));
+            }
+        }
+        if self.runs == 0 {
+            return Err(("runs".into(), "must be ≥ 1".into()));
+        }
+        if self.grid < 3 {
+            return Err(("grid".into(), "must be ≥ 3".into()));
+        }
+        for (key, v, lo, hi) in [
+            (
+                "measurement_noise_pct",
+                self.measurement_noise_pct.unwrap_or(1.0),
+                0.0,
+                100.0,
+            ),
+            ("identifiable_rel", self.identifiable_rel, 0.0, 1.0),
+            (
+                "identifiability_window",
+                self.identifiability_window,
+                0.0,
+                1.0,
+            ),
+        ] {
+            if !(v.is_finite() && v > lo && v <= hi) {
+                return Err((key.into(), format!("must be in ({lo}, {hi}], got {v}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The ICA settings: given, or read from the `ica` input.
+pub fn ica_settings(ctx: &Job<'_>, p: &CalibrateParams) -> Result<IcaSettings> {
+    if let Some(ica) = &p.ica {
+        return Ok(ica.clone());
+    }
+    let path = ctx.input("ica")?;
+    let ica: IcaSettings = serde_json::from_slice(
+        &std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?,
+    )?;
+    ica.check()
+        .map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", path.display()))?;
+    Ok(ica)
+}
+
+/// The measured edges of every sample of the `edges` input, by sample (the items, in this order).
+pub fn edges_by_sample(ctx: &Job<'_>) -> Result<BTreeMap<String, Vec<EdgeFit>>> {
+    let edges_file = ctx.input("edges")?;
+    let mut by_sample: BTreeMap<String, Vec<EdgeFit>> = BTreeMap::new();
+    for (s, e) in read_edges(edges_file)? {
+        by_sample.entry(s).or_default().push(e);
+    }
+    if by_sample.is_empty() {
+        bail!("{}: no edges", edges_file.display());
+    }
+    Ok(by_sample)
+}
+
+/// A side file of a sample's part: `part-00003.NAME`.
+pub fn side(part: &Path, name: &str) -> PathBuf {
+    part.with_extension(name)
+}
+
+/// Calibrates sample `item` (in sample order) and writes its part: the results row at `part` (last),
+/// its evaluations, CMA-ES comparison and recording beside it when the stage writes them.
+pub fn compute(ctx: &Job<'_>, p: &CalibrateParams, item: usize, part: &Path) -> Result<()> {
+    let by_sample = edges_by_sample(ctx)?;
+    let Some((sample, measured)) = by_sample.iter().nth(item) else {
+        bail!("no sample {item} in {}", ctx.input("edges")?.display());
+    };
+    let densities = read_sample_densities(ctx.input("samples")?)?;
+    let scene = sample_scene(ctx.input("scene")?, &densities, sample, p.grid)?;
+    let settings = SampleSettings {
+        runs: p.runs,
+        ica: ica_settings(ctx, p)?,
+        side_cm: p.side_cm,
+        polish_iterations: p.polish_iterations,
+        noise: Noise::for_edges(p.measurement_noise_pct, measured, p.include_systematic),
+        identifiable_rel: p.identifiable_rel,
+        identifiability_window: p.identifiability_window,
+        baseline_cmaes: p.baseline_cmaes,
+    };
+    let recorder = match ctx.optional_output("recording") {
+        Some(_) => Some(CalibrationRecorder::new(&side(part, "rrd"))?),
+        None => None,
+    };
+    let mut problem = Problem::new(scene, measured.clone(), p.side_cm);
+    problem.edge_source = p.edge_source;
+    let mut observe = |r: usize, ev: &DecadeEvent<'_>| -> Result<()> {
+        match &recorder {
+            Some(rec) => record_decade(rec, &problem, sample, r, ev, measured, p.side_cm)
+                .context("writing the calibration recording"),
+            None => Ok(()),
+        }
+    };
+    let found = calibrate_sample(&problem, measured, &settings, &mut observe, &|| {})?;
+    if let Some(rec) = recorder {
+        rec.finish()?;
+    }
+    if ctx.optional_output("evaluations").is_some() {
+        let rows: Vec<EvaluationRow> = found
+            .evaluations
+            .iter()
+            .map(|e| EvaluationRow::new(sample, e))
+            .collect();
+        write_table(&side(part, "evaluations.parquet"), &rows)?;
+    }
+    if ctx.optional_output("comparison").is_some() {
+        let rows: Vec<ComparisonRow> = found
+            .runs
+            .iter()
+            .map(|r| ComparisonRow::new(sample, r))
+            .collect();
+        write_table(&side(part, "comparison.parquet"), &rows)?;
+    }
+    write_table(part, &[ResultRow::new(sample, &found, p.runs)])
+}
+
+/// `results.parquet`, and `evaluations.parquet`, `comparison.parquet` and `calibration.rrd` when
+/// asked, from the samples' parts.
+pub fn gather(ctx: &Job<'_>, parts: &[PathBuf]) -> Result<()> {
+    gather_parquet(parts, ctx.output("results")?)?;
+    let sides = |name: &str| -> Vec<PathBuf> { parts.iter().map(|p| side(p, name)).collect() };
+    if let Some(out) = ctx.optional_output("evaluations") {
+        gather_parquet(&sides("evaluations.parquet"), out)?;
+    }
+    if let Some(out) = ctx.optional_output("comparison") {
+        gather_parquet(&sides("comparison.parquet"), out)?;
+    }
+    if let Some(out) = ctx.optional_output("recording") {
+        merge_recordings(&sides("rrd"), out, "drapelab_calibration")?;
+    }
+    Ok(())
+}
+
+/// Logs a decade: the empires and the drape of the best imperialist.
+pub fn record_decade(
+    rec: &CalibrationRecorder,
+    problem: &Problem,
+    sample: &str,
+    run: usize,
+    ev: &DecadeEvent<'_>,
+    measured: &[EdgeFit],
+    side_cm: f64,
+) -> Result<()> {
+    let best = ev
+        .empires
+        .iter()
+        .map(|e| &e.imperialist)
+        .min_by(|a, b| a.cost.total_cmp(&b.cost));
+    let drape = best
+        .map(|b| problem.drape(&b.x))
+        .and_then(|(s, e)| Some((s, e?)));
+    let origin = drape.as_ref().map(|(s, _)| s.x[0]).unwrap_or_default();
+    rec.decade(
+        sample,
+        run,
+        ev,
+        |x| [x[0] as f32, x[3] as f32, x[4] as f32],
+        drape
+            .as_ref()
+            .map(|(s, e)| (&s.grid, s.x.as_slice(), e.as_slice())),
+        measured,
+        origin,
+        side_cm,
+    )
+}
+
+/// The `count` of the stage kind over this workflow.
+pub fn count(ctx: &Job<'_>, p: &CalibrateParams) -> Result<usize> {
+    ica_settings(ctx, p)?;
+    read_sample_densities(ctx.input("samples")?)?;
+    Ok(edges_by_sample(ctx)?.len())
+}

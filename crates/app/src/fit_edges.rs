@@ -1,0 +1,68 @@
+//! `fit-edges`: every input photo (PNG or JPEG) fitted with edge polynomials, calibrated by the
+//! `camera.json` in its folder (as `drapelab render` writes it); one `edges.parquet` for all photos,
+//! each row's `sample` being the photo's folder relative to the project root.
+
+use crate::job::Job;
+use anyhow::{Result, bail};
+use drapelab_core::edges::{
+    EdgeFit, FitImageOptions, fit_image, read_camera, read_gray, with_systematics,
+};
+use drapelab_record::write_edges;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Parameters of a fit-edges stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitEdgesParams {
+    /// Polynomial degree. Default 4 (seed 000).
+    #[serde(default = "default_degree")]
+    pub degree: usize,
+}
+
+pub fn default_degree() -> usize {
+    4
+}
+
+pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<()> {
+    let photos: Vec<_> = ctx
+        .input_files("photos")
+        .iter()
+        .filter(|f| {
+            f.extension()
+                .is_some_and(|e| e == "png" || e == "jpg" || e == "jpeg")
+        })
+        .collect();
+    if photos.is_empty() {
+        bail!("no photo (.png, .jpg) in input `photos`");
+    }
+    ctx.started(photos.len());
+    let fits: Vec<Result<Vec<(String, EdgeFit)>>> = photos
+        .par_iter()
+        .map(|photo| {
+            let dir = photo.parent().unwrap_or(std::path::Path::new("."));
+            let camera = dir.join("camera.json");
+            let cam = read_camera(&camera)?;
+            let img = read_gray(photo)?;
+            let opts = FitImageOptions {
+                view: cam.view,
+                degree: p.degree,
+                calibration: cam.calibration(&camera)?,
+                pinhole: cam.pinhole,
+            };
+            let fit = with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?;
+            let sample = dir
+                .strip_prefix(&ctx.root)
+                .unwrap_or(dir)
+                .to_string_lossy()
+                .replace('\\', "/");
+            ctx.item_done();
+            Ok(fit.edges.into_iter().map(|e| (sample.clone(), e)).collect())
+        })
+        .collect();
+    let mut rows = Vec::new();
+    for f in fits {
+        rows.extend(f?);
+    }
+    write_edges(ctx.output("edges")?, &rows)
+}

@@ -1,0 +1,59 @@
+//! drapelab's workflows, each a function over a [`Job`] (its files by name, its progress) with
+//! typed parameters: simulate to a folder, fit photos and score them, tune and run the ICA
+//! calibration, validate it, sweep scenes, measure and predict Cusick drapes, the benchmark grids,
+//! seed 002's wrinkles and §10.8's surfaces. The pipeline's stages, the command line, the tests
+//! and the Python package call them; the report stack (polars, plotters) is not here.
+
+#![allow(non_snake_case)]
+
+pub mod job;
+
+pub mod benchmark;
+pub mod calibrate;
+pub mod calibration_tables;
+pub mod cusick_measure;
+pub mod cusick_predict;
+pub mod cusick_tables;
+pub mod fit_edges;
+pub mod peers;
+pub mod score;
+pub mod simulate;
+pub mod skips;
+pub mod surface;
+pub mod sweep;
+pub mod sweep_table;
+pub mod tune;
+pub mod validate;
+pub mod wrinkles;
+
+pub use job::{Job, Progress, Quiet};
+
+/// Every Parquet table drapelab writes, each traced from its row type, as the Markdown of the
+/// book's Tables page (`drapelab tables` prints it).
+pub fn tables_markdown() -> anyhow::Result<String> {
+    use drapelab_record::table_markdown as md;
+    let sections = [
+        md::<drapelab_record::ParticleRow>()?,
+        md::<drapelab_record::EdgeRow>()?,
+        md::<crate::sweep_table::SweepPoint>()?,
+        md::<crate::sweep_table::SweepOutcome>()?,
+        md::<drapelab_core::edges::ScoreRow>()?,
+        md::<crate::calibration_tables::ResultRow>()?,
+        md::<crate::calibration_tables::ComparisonRow>()?,
+        md::<crate::calibration_tables::EvaluationRow>()?,
+        md::<crate::validate::ValidationRow>()?,
+        md::<crate::tune::TuneRow>()?,
+        md::<crate::tune::MainEffectRow>()?,
+        md::<crate::wrinkles::WrinkleRow>()?,
+        md::<crate::wrinkles::WrinkleMeshRow>()?,
+        md::<drapelab_core::benchmark::BenchRow>()?,
+        md::<drapelab_core::benchmark::PopulationRow>()?,
+        md::<drapelab_core::benchmark::SkipRow>()?,
+        md::<crate::peers::PeerRow>()?,
+        md::<crate::cusick_measure::ShadowRow>()?,
+        md::<crate::cusick_tables::PredictionRow>()?,
+        md::<crate::cusick_tables::OutlineRow>()?,
+        md::<crate::cusick_tables::ProfileRow>()?,
+    ];
+    Ok(sections.join("\n"))
+}

@@ -1,0 +1,12 @@
+//! drapelab's reports: polars queries over the pipelines' tables, plotters figures, Markdown and
+//! pictures (the seed 003 montage), each a function over a [`drapelab_app::Job`].
+
+#![allow(non_snake_case)]
+
+pub mod benchmark_report;
+pub mod calibration_report;
+pub mod cusick_plots;
+pub mod cusick_report;
+pub mod montage;
+pub mod report;
+pub mod seed003_report;
