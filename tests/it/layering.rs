@@ -1,19 +1,32 @@
-//! The layering written down in the README's module map, checked: crates depend only on crates
-//! below them, the core crate pulls in no I/O stack (not even transitively), no module of the core
-//! imports a module above it, and no function outside tests runs over 150 lines.
+//! The layering written down in the module map (docs/src/reference/modules.md), checked: crates
+//! depend only on crates below them, the core crate pulls in no I/O stack (not even transitively)
+//! and the application layer no report stack, no module of the core imports a module above it, no
+//! crate's modules import each other in a cycle, a stage file is an adapter (at most 100 lines of
+//! code), and no function outside tests runs over 150 lines.
 
 use crate::support::root;
 use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Each workspace crate and the workspace crates it may depend on.
-const CRATES: [(&str, &[&str]); 5] = [
+const CRATES: [(&str, &[&str]); 7] = [
     ("drapelab-core", &[]),
     ("drapelab-record", &["drapelab-core"]),
     ("drapelab-pipeline", &["drapelab-core"]),
+    ("drapelab-app", &["drapelab-core", "drapelab-record"]),
+    (
+        "drapelab-reports",
+        &["drapelab-core", "drapelab-record", "drapelab-app"],
+    ),
     (
         "drapelab-stages",
-        &["drapelab-core", "drapelab-record", "drapelab-pipeline"],
+        &[
+            "drapelab-core",
+            "drapelab-record",
+            "drapelab-pipeline",
+            "drapelab-app",
+            "drapelab-reports",
+        ],
     ),
     (
         "drapelab",
@@ -21,10 +34,14 @@ const CRATES: [(&str, &[&str]); 5] = [
             "drapelab-core",
             "drapelab-record",
             "drapelab-pipeline",
+            "drapelab-app",
             "drapelab-stages",
         ],
     ),
 ];
+
+/// Crates the application layer must not depend on: the report stack and the engine's display.
+const NOT_IN_APP: [&str; 5] = ["polars", "plotters", "clap", "indicatif", "drapelab-pipeline"];
 
 /// Crates the core must not reach, directly or through another crate.
 const NOT_IN_CORE: [&str; 8] = [
@@ -113,6 +130,9 @@ fn crates_depend_only_downwards() {
                     !NOT_IN_CORE.contains(&dep),
                     "drapelab-core depends on {dep}"
                 );
+            }
+            if name == "drapelab-app" {
+                assert!(!NOT_IN_APP.contains(&dep), "drapelab-app depends on {dep}");
             }
         }
     }
@@ -229,6 +249,110 @@ fn no_core_module_imports_one_above_it() {
         }
     }
     assert_eq!(seen.len(), CORE_RANKS.len(), "modules: {seen:?}");
+}
+
+/// The modules of the crate whose sources lie in `src` and the modules each imports (`crate::X`).
+fn module_graph(src: &Path) -> BTreeMap<String, std::collections::BTreeSet<String>> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    let mut graph: BTreeMap<String, std::collections::BTreeSet<String>> = BTreeMap::new();
+    for f in &files {
+        let m = module_of(f.strip_prefix(src).unwrap());
+        let deps = graph.entry(m.clone()).or_default();
+        for d in crate_refs(&std::fs::read_to_string(f).unwrap()) {
+            if d != m {
+                deps.insert(d);
+            }
+        }
+    }
+    graph
+}
+
+/// A cycle among the modules of `graph`, if any (depth-first search).
+fn find_cycle(graph: &BTreeMap<String, std::collections::BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        g: &BTreeMap<String, std::collections::BTreeSet<String>>,
+        m: &str,
+        path: &mut Vec<String>,
+        done: &mut std::collections::BTreeSet<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(i) = path.iter().position(|p| p == m) {
+            return Some(path[i..].to_vec());
+        }
+        if done.contains(m) {
+            return None;
+        }
+        path.push(m.to_string());
+        for d in g.get(m).into_iter().flatten() {
+            if let Some(c) = visit(g, d, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        done.insert(m.to_string());
+        None
+    }
+    let mut done = std::collections::BTreeSet::new();
+    graph
+        .keys()
+        .find_map(|m| visit(graph, m, &mut Vec::new(), &mut done))
+}
+
+#[test]
+fn no_crate_has_an_import_cycle_among_its_modules() {
+    let mut srcs = vec![root().join("src")];
+    for e in std::fs::read_dir(root().join("crates")).unwrap() {
+        srcs.push(e.unwrap().path().join("src"));
+    }
+    for src in srcs {
+        let graph = module_graph(&src);
+        assert!(graph.len() > 1, "{}: no modules found", src.display());
+        if let Some(cycle) = find_cycle(&graph) {
+            panic!("{}: modules import each other: {}", src.display(), cycle.join(" → "));
+        }
+    }
+}
+
+#[test]
+fn the_cycle_check_sees_a_cycle() {
+    let g: BTreeMap<String, std::collections::BTreeSet<String>> = [
+        ("a", &["b"][..]),
+        ("b", &["c"][..]),
+        ("c", &["a"][..]),
+        ("d", &[][..]),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v.iter().map(|s| s.to_string()).collect()))
+    .collect();
+    assert_eq!(find_cycle(&g).map(|c| c.len()), Some(3));
+}
+
+/// Lines of code of a Rust text outside `#[cfg(test)]`: not blank, not a comment.
+fn code_lines(text: &str) -> usize {
+    text.lines()
+        .take_while(|l| !l.trim_start().starts_with("#[cfg(test)]"))
+        .filter(|l| {
+            let t = l.trim();
+            !t.is_empty() && !t.starts_with("//")
+        })
+        .count()
+}
+
+#[test]
+fn a_stage_file_is_an_adapter() {
+    let src = root().join("crates/stages/src");
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        if p.file_name().is_some_and(|n| n == "lib.rs") {
+            continue;
+        }
+        let n = code_lines(&std::fs::read_to_string(&p).unwrap());
+        assert!(
+            n <= 100,
+            "{}: {n} lines of code; a stage file is slots, parameters and a workflow call: move the work into drapelab-app or drapelab-reports",
+            p.display()
+        );
+    }
 }
 
 /// Lengths of the functions of a Rust file outside `#[cfg(test)]` modules, by brace matching
