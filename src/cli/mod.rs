@@ -184,76 +184,14 @@ pub enum Command {
     ///
     /// Example: drapelab render datasets/scenes/hang4.toml --out runs/photo --px-per-cm 8 --markers --noise 4
     #[command(allow_negative_numbers = true)]
-    Render {
-        /// The scene (4 or 2 pinned corners).
-        scene: PathBuf,
-        /// Output folder.
-        #[arg(long)]
-        out: PathBuf,
-        /// Scene overrides, as for simulate.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Scale in the plane of the fixed corners, px per cm (> 0, ≤ 200).
-        #[arg(long, default_value_t = 8.0, value_parser = args::px_per_cm)]
-        px_per_cm: f64,
-        /// Pinhole camera at this distance (m) in front of the corners' plane; default orthographic.
-        #[arg(long, value_parser = args::positive)]
-        pinhole_distance_m: Option<f64>,
-        /// Draw red markers at the two fixed corners.
-        #[arg(long)]
-        markers: bool,
-        /// Gaussian noise, grey levels (σ ≥ 0).
-        #[arg(long, default_value_t = 0.0, value_parser = args::non_negative)]
-        noise: f64,
-        /// Gaussian blur, px (σ ≥ 0).
-        #[arg(long, default_value_t = 0.0, value_parser = args::non_negative)]
-        blur_px: f64,
-        /// Camera rotation about its axis, degrees (negative: clockwise).
-        #[arg(long, default_value_t = 0.0, value_parser = args::finite)]
-        rotate_deg: f64,
-        /// Save as JPEG with this quality (1..=100) instead of PNG.
-        #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
-        jpeg_quality: Option<u8>,
-        /// Seed of the noise.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-    },
+    Render(RenderArgs),
     /// Fit the edges of a photo of a hanging sheet with polynomials (seed 000).
     ///
     /// Seed 000 Figs 3, 11, 12. Writes DIR/edges.parquet (edge, power, coefficient of x^power in cm,
     /// RMS residual, points) and DIR/overlay.png (fitted curves red, reference line blue). Calibrate
     /// with --px-per-cm and --corners, or --markers and --side-cm, or --camera-json (a camera file
     /// as the README's "Camera files" describes it, or the one `render` writes).
-    FitEdges {
-        /// The photo (PNG or JPEG).
-        photo: PathBuf,
-        /// Output folder.
-        #[arg(long)]
-        out: PathBuf,
-        /// Scale in the plane of the fixed corners, px per cm.
-        #[arg(long, value_parser = args::positive)]
-        px_per_cm: Option<f64>,
-        /// Pixel positions of the two fixed corners: x1,y1,x2,y2 (pixel centres at integers, as
-        /// image viewers and OpenCV number them).
-        #[arg(long)]
-        corners: Option<String>,
-        /// Find the corners from two red markers (needs --side-cm).
-        #[arg(long)]
-        markers: bool,
-        /// Distance between the fixed corners, cm (with --markers).
-        #[arg(long, value_parser = args::positive)]
-        side_cm: Option<f64>,
-        /// A camera.json: view, side_cm, the scale (px_per_cm or a pinhole) and the corners
-        /// (corners_px or markers); `render`'s own settings are optional.
-        #[arg(long)]
-        camera_json: Option<PathBuf>,
-        /// Which hang the photo shows (ignored with --camera-json, which names it).
-        #[arg(long, value_enum, default_value_t = ViewArg::Hang4)]
-        view: ViewArg,
-        /// Polynomial degree (1..=8).
-        #[arg(long, default_value_t = 4, value_parser = args::degree())]
-        degree: usize,
-    },
+    FitEdges(FitEdgesArgs),
     /// Score simulated edges against measured ones (seed 000 Eq. 5).
     ///
     /// Per edge: Eq. 5 (coefficients in coordinates centred on the edge, in %) and the RMS distance
@@ -288,32 +226,106 @@ pub enum Command {
     ///
     /// Each resolution with every solver, and each result's distance to the finest static solution;
     /// prints a Markdown table.
-    Bench {
-        /// The hang4 scene to benchmark.
-        #[arg(long, default_value = "datasets/scenes/hang4.toml")]
-        scene: PathBuf,
-        /// Particles per side to run (comma-separated, each 3..=1001).
-        #[arg(long, value_delimiter = ',', default_value = "11,21,41,81", value_parser = args::grid_side())]
-        sizes: Vec<usize>,
-        /// Largest size at which the explicit and symplectic integrators are run (they are slow).
-        #[arg(long, default_value_t = 21)]
-        max_explicit_size: usize,
-        /// Largest size at which implicit Euler is run.
-        #[arg(long, default_value_t = 41)]
-        max_implicit_size: usize,
-        /// Force tolerance of every solver, relative to the lightest particle's weight (> 0).
-        #[arg(long, default_value_t = 1e-6, value_parser = args::positive)]
-        tol: f64,
-        /// Static solves of seed 000's slack-net population (14 × 14 over Table 3's box) to run
-        /// after the hang4 table, for its iterations and factorizations per solve (0: none).
-        #[arg(long, default_value_t = 50)]
-        population: usize,
-        /// Run the whole benchmark pipeline instead (pipelines/benchmark.toml: every reference scene,
-        /// solver, size and tolerance, the scipy/numpy peers, the skips, reports/benchmark.md; only
-        /// stale stages run).
-        #[arg(long)]
-        all: bool,
-    },
+    Bench(BenchArgs),
+}
+
+/// The flags of `drapelab render`.
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// The scene (4 or 2 pinned corners).
+    pub scene: PathBuf,
+    /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Scene overrides, as for simulate.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Scale in the plane of the fixed corners, px per cm (> 0, ≤ 200).
+    #[arg(long, default_value_t = 8.0, value_parser = args::px_per_cm)]
+    pub px_per_cm: f64,
+    /// Pinhole camera at this distance (m) in front of the corners' plane; default orthographic.
+    #[arg(long, value_parser = args::positive)]
+    pub pinhole_distance_m: Option<f64>,
+    /// Draw red markers at the two fixed corners.
+    #[arg(long)]
+    pub markers: bool,
+    /// Gaussian noise, grey levels (σ ≥ 0).
+    #[arg(long, default_value_t = 0.0, value_parser = args::non_negative)]
+    pub noise: f64,
+    /// Gaussian blur, px (σ ≥ 0).
+    #[arg(long, default_value_t = 0.0, value_parser = args::non_negative)]
+    pub blur_px: f64,
+    /// Camera rotation about its axis, degrees (negative: clockwise).
+    #[arg(long, default_value_t = 0.0, value_parser = args::finite)]
+    pub rotate_deg: f64,
+    /// Save as JPEG with this quality (1..=100) instead of PNG.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub jpeg_quality: Option<u8>,
+    /// Seed of the noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+/// The flags of `drapelab fit-edges`.
+#[derive(Debug, clap::Args)]
+pub struct FitEdgesArgs {
+    /// The photo (PNG or JPEG).
+    pub photo: PathBuf,
+    /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Scale in the plane of the fixed corners, px per cm.
+    #[arg(long, value_parser = args::positive)]
+    pub px_per_cm: Option<f64>,
+    /// Pixel positions of the two fixed corners: x1,y1,x2,y2 (pixel centres at integers, as
+    /// image viewers and OpenCV number them).
+    #[arg(long)]
+    pub corners: Option<String>,
+    /// Find the corners from two red markers (needs --side-cm).
+    #[arg(long)]
+    pub markers: bool,
+    /// Distance between the fixed corners, cm (with --markers).
+    #[arg(long, value_parser = args::positive)]
+    pub side_cm: Option<f64>,
+    /// A camera.json: view, side_cm, the scale (px_per_cm or a pinhole) and the corners
+    /// (corners_px or markers); `render`'s own settings are optional.
+    #[arg(long)]
+    pub camera_json: Option<PathBuf>,
+    /// Which hang the photo shows (ignored with --camera-json, which names it).
+    #[arg(long, value_enum, default_value_t = ViewArg::Hang4)]
+    pub view: ViewArg,
+    /// Polynomial degree (1..=8).
+    #[arg(long, default_value_t = 4, value_parser = args::degree())]
+    pub degree: usize,
+}
+
+/// The flags of `drapelab bench`.
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// The hang4 scene to benchmark.
+    #[arg(long, default_value = "datasets/scenes/hang4.toml")]
+    pub scene: PathBuf,
+    /// Particles per side to run (comma-separated, each 3..=1001).
+    #[arg(long, value_delimiter = ',', default_value = "11,21,41,81", value_parser = args::grid_side())]
+    pub sizes: Vec<usize>,
+    /// Largest size at which the explicit and symplectic integrators are run (they are slow).
+    #[arg(long, default_value_t = 21)]
+    pub max_explicit_size: usize,
+    /// Largest size at which implicit Euler is run.
+    #[arg(long, default_value_t = 41)]
+    pub max_implicit_size: usize,
+    /// Force tolerance of every solver, relative to the lightest particle's weight (> 0).
+    #[arg(long, default_value_t = 1e-6, value_parser = args::positive)]
+    pub tol: f64,
+    /// Static solves of seed 000's slack-net population (14 × 14 over Table 3's box) to run
+    /// after the hang4 table, for its iterations and factorizations per solve (0: none).
+    #[arg(long, default_value_t = 50)]
+    pub population: usize,
+    /// Run the whole benchmark pipeline instead (pipelines/benchmark.toml: every reference scene,
+    /// solver, size and tolerance, the scipy/numpy peers, the skips, reports/benchmark.md; only
+    /// stale stages run).
+    #[arg(long)]
+    pub all: bool,
 }
 
 /// `drapelab run`: runs a pipeline make-style with a progress display; returns the exit code.
@@ -428,12 +440,8 @@ pub fn run(cli: Cli) -> Result<i32> {
         Command::Status { pipeline, check } => status(&pipeline, check),
         Command::Completions { shell } => {
             use clap::CommandFactory;
-            clap_complete::generate(
-                shell,
-                &mut Cli::command(),
-                "drapelab",
-                &mut std::io::stdout(),
-            );
+            let mut out = std::io::stdout();
+            clap_complete::generate(shell, &mut Cli::command(), "drapelab", &mut out);
             Ok(EXIT_OK)
         }
         Command::Kinds => {
@@ -445,93 +453,72 @@ pub fn run(cli: Cli) -> Result<i32> {
             Ok(EXIT_OK)
         }
         Command::Surface(args) => surface::surface(args),
-        Command::Render {
-            scene,
-            out,
-            set,
-            px_per_cm,
-            pinhole_distance_m,
-            markers,
-            noise,
-            blur_px,
-            rotate_deg,
-            jpeg_quality,
-            seed,
-        } => {
-            let loaded = load_scene(&scene, &set)?;
-            let opts = render_options(
-                px_per_cm,
-                pinhole_distance_m,
-                markers,
-                noise,
-                blur_px,
-                rotate_deg,
-                seed,
-            )?;
-            args::out_dir(&out)?;
-            let path = crate::io::render_scene(&loaded, &out, &opts, jpeg_quality, 4)?;
-            eprintln!("rendered {} → {}", loaded.scene.name, path.display());
-            Ok(EXIT_OK)
-        }
-        Command::FitEdges {
-            photo,
-            out,
-            px_per_cm,
-            corners,
-            markers,
-            side_cm,
-            camera_json,
-            view,
-            degree,
-        } => {
-            let calibration = FitCalibration {
-                px_per_cm,
-                corners,
-                markers,
-                side_cm,
-                camera_json,
-            };
-            fit_edges(&photo, &out, calibration, view, degree)
-        }
+        Command::Render(a) => render(a),
+        Command::FitEdges(a) => fit_edges_command(a),
         Command::Wrinkles { config, out, mesh } => wrinkles(&config, &out, &mesh),
-        Command::Score { real, sim, side_cm } => {
-            let rows = crate::io::score_files(&real, &sim, side_cm)?;
-            println!(
-                "| edge | objective (Eq. 5) % | Eq. 5 uncentred % | curve distance % of side |\n|---|---|---|---|"
-            );
-            for r in &rows {
-                println!(
-                    "| {} | {:.4} | {:.4} | {:.4} |",
-                    r.edge, r.objective_pct, r.objective_uncentred_pct, r.curve_distance_pct
-                );
-            }
-            Ok(EXIT_OK)
-        }
-        Command::Bench {
-            scene,
-            sizes,
-            max_explicit_size,
-            max_implicit_size,
-            tol,
-            population,
-            all,
-        } => {
-            if all {
-                return run_pipeline_command(
-                    Path::new("pipelines/benchmark.toml"),
-                    Default::default(),
-                );
-            }
-            bench::run_bench(
-                &scene,
-                &sizes,
-                (max_explicit_size, max_implicit_size),
-                tol,
-                population,
-            )?;
-            Ok(EXIT_OK)
-        }
+        Command::Score { real, sim, side_cm } => score(&real, &sim, side_cm),
+        Command::Bench(a) => bench_command(a),
     }
+}
+
+/// `drapelab render`: solve a hang and render it as a photo.
+fn render(a: RenderArgs) -> Result<i32> {
+    let loaded = load_scene(&a.scene, &a.set)?;
+    let opts = render_options(
+        a.px_per_cm,
+        a.pinhole_distance_m,
+        a.markers,
+        a.noise,
+        a.blur_px,
+        a.rotate_deg,
+        a.seed,
+    )?;
+    args::out_dir(&a.out)?;
+    let path = crate::io::render_scene(&loaded, &a.out, &opts, a.jpeg_quality, 4)?;
+    eprintln!("rendered {} → {}", loaded.scene.name, path.display());
+    Ok(EXIT_OK)
+}
+
+/// `drapelab fit-edges`: the flags into a calibration, then the fit.
+fn fit_edges_command(a: FitEdgesArgs) -> Result<i32> {
+    let calibration = FitCalibration {
+        px_per_cm: a.px_per_cm,
+        corners: a.corners,
+        markers: a.markers,
+        side_cm: a.side_cm,
+        camera_json: a.camera_json,
+    };
+    fit_edges(&a.photo, &a.out, calibration, a.view, a.degree)
+}
+
+/// `drapelab score`: Eq. 5 and the curve distance per edge, as a Markdown table.
+fn score(real: &Path, sim: &Path, side_cm: f64) -> Result<i32> {
+    let rows = crate::io::score_files(real, sim, side_cm)?;
+    println!(
+        "| edge | objective (Eq. 5) % | Eq. 5 uncentred % | curve distance % of side |\n|---|---|---|---|"
+    );
+    for r in &rows {
+        println!(
+            "| {} | {:.4} | {:.4} | {:.4} |",
+            r.edge, r.objective_pct, r.objective_uncentred_pct, r.curve_distance_pct
+        );
+    }
+    Ok(EXIT_OK)
+}
+
+/// `drapelab bench`: the hang4 table, or the whole benchmark pipeline with `--all`.
+fn bench_command(a: BenchArgs) -> Result<i32> {
+    if a.all {
+        return run_pipeline_command(Path::new("pipelines/benchmark.toml"), Default::default());
+    }
+    bench::run_bench(
+        &a.scene,
+        &a.sizes,
+        (a.max_explicit_size, a.max_implicit_size),
+        a.tol,
+        a.population,
+    )?;
+    Ok(EXIT_OK)
 }
 
 /// `drapelab simulate`.

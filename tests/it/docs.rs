@@ -1,6 +1,6 @@
 //! The documentation (README.md and the mdBook under docs/) kept true: every generated reference
-//! page equals what the code generates now (the tables' schemas, the stage kinds with their slots
-//! and parameter defaults, the command line), every relative link resolves, every page is in the
+//! page equals what the code generates now (the tables' schemas, the scene keys, the stage kinds
+//! with their slots and parameter defaults, the command line), every relative link resolves, every page is in the
 //! book's summary, and the README stays short. `DRAPELAB_BLESS=1 cargo test --release --test it --
 //! docs` rewrites the generated pages.
 
@@ -38,6 +38,16 @@ fn the_reference_pages_match_the_code() {
     generated("tables.md", &drapelab::app::tables_markdown().unwrap());
     generated("kinds.md", &drapelab::cli::kinds_text());
     generated("cli.md", &drapelab::cli::cli_reference());
+    let mut scenes: Vec<PathBuf> =
+        glob::glob(&root().join("datasets/scenes/*.toml").to_string_lossy())
+            .unwrap()
+            .map(Result::unwrap)
+            .collect();
+    scenes.sort();
+    generated(
+        "scene-keys.md",
+        &drapelab::app::scene_keys::scene_keys_markdown(&scenes).unwrap(),
+    );
 }
 
 /// Every Markdown file of the README and the book.

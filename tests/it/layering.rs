@@ -2,7 +2,7 @@
 //! depend only on crates below them, the core crate pulls in no I/O stack (not even transitively)
 //! and the application layer no report stack, no module of the core imports a module above it, no
 //! crate's modules import each other in a cycle, a stage file is an adapter (at most 100 lines of
-//! code), and no function outside tests runs over 150 lines.
+//! code), and no function outside tests runs over 100 lines.
 
 use crate::support::root;
 use std::collections::BTreeMap;
@@ -41,7 +41,13 @@ const CRATES: [(&str, &[&str]); 7] = [
 ];
 
 /// Crates the application layer must not depend on: the report stack and the engine's display.
-const NOT_IN_APP: [&str; 5] = ["polars", "plotters", "clap", "indicatif", "drapelab-pipeline"];
+const NOT_IN_APP: [&str; 5] = [
+    "polars",
+    "plotters",
+    "clap",
+    "indicatif",
+    "drapelab-pipeline",
+];
 
 /// Crates the core must not reach, directly or through another crate.
 const NOT_IN_CORE: [&str; 8] = [
@@ -308,7 +314,11 @@ fn no_crate_has_an_import_cycle_among_its_modules() {
         let graph = module_graph(&src);
         assert!(graph.len() > 1, "{}: no modules found", src.display());
         if let Some(cycle) = find_cycle(&graph) {
-            panic!("{}: modules import each other: {}", src.display(), cycle.join(" → "));
+            panic!(
+                "{}: modules import each other: {}",
+                src.display(),
+                cycle.join(" → ")
+            );
         }
     }
 }
@@ -411,7 +421,7 @@ fn long_functions(text: &str, limit: usize) -> Vec<(String, usize)> {
 }
 
 #[test]
-fn no_function_is_over_150_lines() {
+fn no_function_is_over_100_lines() {
     let mut files = Vec::new();
     for dir in ["crates", "src"] {
         rust_files(&root().join(dir), &mut files);
@@ -419,7 +429,7 @@ fn no_function_is_over_150_lines() {
     let mut long = Vec::new();
     for f in &files {
         let text = std::fs::read_to_string(f).unwrap();
-        for (name, len) in long_functions(&text, 150) {
+        for (name, len) in long_functions(&text, 100) {
             long.push(format!(
                 "{}: {name} ({len} lines)",
                 f.strip_prefix(root()).unwrap().display()
@@ -428,7 +438,7 @@ fn no_function_is_over_150_lines() {
     }
     assert!(
         long.is_empty(),
-        "functions over 150 lines:\n{}",
+        "functions over 100 lines:\n{}",
         long.join("\n")
     );
 }

@@ -416,7 +416,7 @@ fn a_panicking_stage_fails_alone_and_the_run_exits_1() {
         + "\n[stages.bad]\nkind = \"panics\"\noutputs.out = \"{run}/bad/out.json\"\n\
            \n[stages.after_bad]\nkind = \"report\"\ninputs.tables = [\"{run}/bad/out.json\"]\n\
            outputs.markdown = \"reports/ab.md\"\noutputs.plot = \"reports/ab.svg\"\n\
-           params = { title = \"t\", x = \"a\" }\n";
+           params = { title = \"t\", x = \"cloth.nx\" }\n";
     let (tmp, file) = project(&text);
     let registry = drapelab::stages::registry().with::<Panics>();
     let code = drapelab::cli::run_pipeline_with(

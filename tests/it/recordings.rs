@@ -111,7 +111,8 @@ fn pyarrow_reads_particles_with_documented_columns() {
         r#"
 import sys, pyarrow.parquet as pq, pyarrow as pa
 t = pq.read_table(sys.argv[1])
-assert t.schema.names == ["i", "j", "x_m", "y_m", "z_m"], t.schema
+assert t.schema.names == ["i", "j", "x_m", "y_m", "z_m", "present"], t.schema
+assert t.schema.field("present").type == pa.bool_() and all(t.column("present").to_pylist())
 assert t.schema.field("i").type == pa.uint32() and t.schema.field("z_m").type == pa.float64()
 assert t.num_rows == 121
 assert pq.read_metadata(sys.argv[1]).metadata[b"status"] == b"converged"

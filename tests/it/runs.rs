@@ -239,8 +239,8 @@ fn one_stage(kind: &str, rest: &str) -> String {
 }
 
 #[test]
-fn a_bad_set_in_a_pipeline_names_the_pipeline_and_stage_and_a_bad_report_column_is_refused_at_load()
-{
+fn a_bad_set_in_a_pipeline_names_the_pipeline_and_stage_and_a_bad_report_column_is_refused_before_work()
+ {
     let (_tmp, file) = project(&one_stage(
         "simulate",
         "inputs.scene = \"datasets/scenes/hang2.toml\"\noutputs.particles = \"{run}/p.parquet\"\n\

@@ -33,10 +33,10 @@ pub struct CalibrateParams {
     #[serde(default)]
     pub ica_from_input: bool,
     /// Particles per side of the simulated net. Default 14.
-    #[serde(default = "default_grid")]
+    #[serde(default = "crate::defaults::grid")]
     pub grid: usize,
     /// Side of the samples, cm. Default 50.
-    #[serde(default = "default_side")]
+    #[serde(default = "crate::defaults::side_cm")]
     pub side_cm: f64,
     /// Which curve of a simulated drape stands for its edges: "silhouette" (of its triangles, as a
     /// photo shows it; default) or "particles" (the polyline through the edge particles).
@@ -75,12 +75,6 @@ pub fn default_true() -> bool {
 }
 pub fn default_runs() -> usize {
     10
-}
-pub fn default_grid() -> usize {
-    14
-}
-pub fn default_side() -> f64 {
-    50.0
 }
 pub fn default_ident() -> f64 {
     0.05

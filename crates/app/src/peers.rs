@@ -65,6 +65,66 @@ pub fn default_steps() -> usize {
     2000
 }
 
+/// Runs peer `script` with `args` under `python` in the script's folder; its JSON on stdout.
+fn run_peer(
+    python: &std::path::Path,
+    script: &std::path::Path,
+    args: &[String],
+) -> Result<serde_json::Value> {
+    let o = std::process::Command::new(python)
+        .arg(script)
+        .args(args)
+        .current_dir(script.parent().unwrap_or(std::path::Path::new(".")))
+        .output()?;
+    if !o.status.success() {
+        bail!(
+            "{}: {}",
+            script.display(),
+            String::from_utf8_lossy(&o.stderr)
+                .lines()
+                .last()
+                .unwrap_or("failed")
+        );
+    }
+    Ok(serde_json::from_slice(&o.stdout)?)
+}
+
+/// Makes sure `python` (inside a virtual environment) can import numpy, scipy and cvxopt, creating
+/// the environment and installing them from PyPI when it cannot.
+fn ensure_peer_python(python: &std::path::Path) -> Result<()> {
+    let has = |py: &std::path::Path| {
+        std::process::Command::new(py)
+            .args(["-c", "import numpy, scipy, cvxopt"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if has(python) {
+        return Ok(());
+    }
+    let venv = python
+        .parent()
+        .and_then(|b| b.parent())
+        .context("python is not inside a virtual environment")?;
+    if !python.exists() {
+        std::process::Command::new("python3")
+            .args(["-m", "venv"])
+            .arg(venv)
+            .status()
+            .context("python3 -m venv")?;
+    }
+    let ok = std::process::Command::new(python)
+        .args(["-m", "pip", "install", "-q", "numpy", "scipy", "cvxopt"])
+        .status()
+        .context("pip install numpy scipy cvxopt")?;
+    if !ok.success() || !has(python) {
+        bail!(
+            "{}: cannot install numpy, scipy and cvxopt",
+            python.display()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(ctx: &Job<'_>, p: &PeersParams) -> Result<()> {
     let scene = Scene::load(ctx.input("scene")?, &[])?.scene;
     let script =
@@ -75,53 +135,8 @@ pub fn run(ctx: &Job<'_>, p: &PeersParams) -> Result<()> {
         .map(std::fs::canonicalize)
         .transpose()?;
     let python = std::path::absolute(ctx.root.join(&p.python))?;
-    let has = |py: &std::path::Path| {
-        std::process::Command::new(py)
-            .args(["-c", "import numpy, scipy, cvxopt"])
-            .output()
-            .is_ok_and(|o| o.status.success())
-    };
-    if !has(&python) {
-        let venv = python
-            .parent()
-            .and_then(|b| b.parent())
-            .context("python is not inside a virtual environment")?;
-        if !python.exists() {
-            std::process::Command::new("python3")
-                .args(["-m", "venv"])
-                .arg(venv)
-                .status()
-                .context("python3 -m venv")?;
-        }
-        let ok = std::process::Command::new(&python)
-            .args(["-m", "pip", "install", "-q", "numpy", "scipy", "cvxopt"])
-            .status()
-            .context("pip install numpy scipy cvxopt")?;
-        if !ok.success() || !has(&python) {
-            bail!(
-                "{}: cannot install numpy, scipy and cvxopt",
-                python.display()
-            );
-        }
-    }
-    let run_py = |script: &std::path::Path, args: &[String]| -> Result<serde_json::Value> {
-        let o = std::process::Command::new(&python)
-            .arg(script)
-            .args(args)
-            .current_dir(script.parent().unwrap_or(std::path::Path::new(".")))
-            .output()?;
-        if !o.status.success() {
-            bail!(
-                "{}: {}",
-                script.display(),
-                String::from_utf8_lossy(&o.stderr)
-                    .lines()
-                    .last()
-                    .unwrap_or("failed")
-            );
-        }
-        Ok(serde_json::from_slice(&o.stdout)?)
-    };
+    ensure_peer_python(&python)?;
+    let run_py = |script: &std::path::Path, args: &[String]| run_peer(&python, script, args);
     let total = p.static_sizes.len() + p.explicit_sizes.len();
     ctx.started(total);
     // (comparison, n, peer time, drapelab time, peer centre z, drapelab centre z)

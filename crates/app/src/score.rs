@@ -12,12 +12,8 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct ScoreParams {
     /// Side of the samples, cm (normalises Eq. 5). Default 50.
-    #[serde(default = "default_side")]
+    #[serde(default = "crate::defaults::side_cm")]
     pub side_cm: f64,
-}
-
-pub fn default_side() -> f64 {
-    50.0
 }
 
 pub fn run(ctx: &Job<'_>, p: &ScoreParams) -> Result<()> {

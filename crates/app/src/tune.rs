@@ -63,23 +63,16 @@ pub struct TuneParams {
     #[serde(default)]
     pub levels: Levels,
     /// Particles per side. Default 14.
-    #[serde(default = "default_grid")]
+    #[serde(default = "crate::defaults::grid")]
     pub grid: usize,
     /// Side of the samples, cm. Default 50.
-    #[serde(default = "default_side")]
+    #[serde(default = "crate::defaults::side_cm")]
     pub side_cm: f64,
 }
 
 pub fn one() -> usize {
     1
 }
-pub fn default_grid() -> usize {
-    14
-}
-pub fn default_side() -> f64 {
-    50.0
-}
-
 /// L27 columns used for the factors A..G (any seven columns of L27 are pairwise orthogonal).
 pub const COLUMNS: [usize; 7] = [0, 1, 4, 2, 5, 7, 8];
 pub const FACTORS: [&str; 7] = [

@@ -20,22 +20,15 @@ use std::collections::BTreeMap;
 #[serde(deny_unknown_fields)]
 pub struct ValidateParams {
     /// Particles per side of the simulated net. Default 14.
-    #[serde(default = "default_grid")]
+    #[serde(default = "crate::defaults::grid")]
     pub grid: usize,
     /// Side of the samples, cm. Default 50.
-    #[serde(default = "default_side")]
+    #[serde(default = "crate::defaults::side_cm")]
     pub side_cm: f64,
     /// Which curve of a simulated drape stands for its edges: "silhouette" (of its triangles, as a
     /// photo shows it; default) or "particles" (the polyline through the edge particles).
     #[serde(default)]
     pub edge_source: EdgeSource,
-}
-
-pub fn default_grid() -> usize {
-    14
-}
-pub fn default_side() -> f64 {
-    50.0
 }
 
 /// Calibrated parameters by sample number from a results table.

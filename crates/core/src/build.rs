@@ -58,7 +58,6 @@ pub fn initial_positions(scene: &Scene) -> Vec<Vector3<f64>> {
 pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
     let c = &scene.cloth;
     let grid = scene.grid();
-    let flat = grid.flat_positions();
     let mut x0 = initial_positions(scene);
     let mut masses = grid.lumped_masses(c.areal_density_kg_per_m2);
     let mut fixed = vec![false; grid.len()];
@@ -84,65 +83,7 @@ pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
         None => (0.0, None),
     };
     if let Some(ms) = &scene.material.mass_spring {
-        for edge in &scene.boundary.clamp_edges {
-            // A mass-spring net has no rotational degrees of freedom: clamp = pin the edge and the next line.
-            let (on, next) = edge.lines(&grid);
-            for p in on.into_iter().chain(next) {
-                fixed[p] = true;
-            }
-        }
-        let rest = |a: usize, b: usize, factor: f64| match ms.natural_length_m {
-            Some(l0) => l0 * factor,
-            None => (flat[b] - flat[a]).norm(),
-        };
-        let mut family = |fam: SpringFamily, k: f64, offsets: &[(usize, usize)], factor: f64| {
-            let mut pairs = Vec::new();
-            for j in 0..grid.ny {
-                for i in 0..grid.nx {
-                    for &(di, dj) in offsets {
-                        if i + di < grid.nx && j + dj < grid.ny {
-                            let (a, b) = (grid.index(i, j), grid.index(i + di, j + dj));
-                            if !absent[a] && !absent[b] {
-                                pairs.push((a, b));
-                            }
-                        }
-                    }
-                }
-            }
-            // The anti-diagonal of each cell for shear springs.
-            if fam == SpringFamily::Shear {
-                for j in 0..grid.ny - 1 {
-                    for i in 0..grid.nx - 1 {
-                        let (a, b) = (grid.index(i + 1, j), grid.index(i, j + 1));
-                        if !absent[a] && !absent[b] {
-                            pairs.push((a, b));
-                        }
-                    }
-                }
-            }
-            let rests: Vec<f64> = pairs.iter().map(|&(a, b)| rest(a, b, factor)).collect();
-            let n = pairs.len();
-            if n > 0 {
-                terms.push(Box::new(Springs::new(fam, pairs, rests, vec![k; n])));
-            }
-        };
-        family(
-            SpringFamily::Structural,
-            ms.structural(),
-            &[(1, 0), (0, 1)],
-            1.0,
-        );
-        if ms.topology.has_shear() {
-            family(
-                SpringFamily::Shear,
-                ms.shear(),
-                &[(1, 1)],
-                std::f64::consts::SQRT_2,
-            );
-        }
-        if ms.topology.has_bend() {
-            family(SpringFamily::Bend, ms.bend(), &[(2, 0), (0, 2)], 2.0);
-        }
+        mass_spring_terms(scene, ms, &grid, &absent, &mut fixed, &mut terms);
     }
     let mut held = Vec::new();
     if let Some(cont) = &scene.material.continuum {
@@ -186,6 +127,79 @@ pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
         elongation_rate: elongation,
     };
     BuiltScene { grid, model, x0 }
+}
+
+/// Seed 000's mass-spring net (§3, Table 3): structural, shear and bend springs of the present
+/// particles, with the scene's natural length or the flat grid's; a clamped edge pins its line and
+/// the next (a net has no rotational degrees of freedom).
+fn mass_spring_terms(
+    scene: &ValidatedScene,
+    ms: &crate::material::MassSpring,
+    grid: &Grid,
+    absent: &[bool],
+    fixed: &mut [bool],
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    let flat = grid.flat_positions();
+    for edge in &scene.boundary.clamp_edges {
+        // A mass-spring net has no rotational degrees of freedom: clamp = pin the edge and the next line.
+        let (on, next) = edge.lines(grid);
+        for p in on.into_iter().chain(next) {
+            fixed[p] = true;
+        }
+    }
+    let rest = |a: usize, b: usize, factor: f64| match ms.natural_length_m {
+        Some(l0) => l0 * factor,
+        None => (flat[b] - flat[a]).norm(),
+    };
+    let mut family = |fam: SpringFamily, k: f64, offsets: &[(usize, usize)], factor: f64| {
+        let mut pairs = Vec::new();
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                for &(di, dj) in offsets {
+                    if i + di < grid.nx && j + dj < grid.ny {
+                        let (a, b) = (grid.index(i, j), grid.index(i + di, j + dj));
+                        if !absent[a] && !absent[b] {
+                            pairs.push((a, b));
+                        }
+                    }
+                }
+            }
+        }
+        // The anti-diagonal of each cell for shear springs.
+        if fam == SpringFamily::Shear {
+            for j in 0..grid.ny - 1 {
+                for i in 0..grid.nx - 1 {
+                    let (a, b) = (grid.index(i + 1, j), grid.index(i, j + 1));
+                    if !absent[a] && !absent[b] {
+                        pairs.push((a, b));
+                    }
+                }
+            }
+        }
+        let rests: Vec<f64> = pairs.iter().map(|&(a, b)| rest(a, b, factor)).collect();
+        let n = pairs.len();
+        if n > 0 {
+            terms.push(Box::new(Springs::new(fam, pairs, rests, vec![k; n])));
+        }
+    };
+    family(
+        SpringFamily::Structural,
+        ms.structural(),
+        &[(1, 0), (0, 1)],
+        1.0,
+    );
+    if ms.topology.has_shear() {
+        family(
+            SpringFamily::Shear,
+            ms.shear(),
+            &[(1, 1)],
+            std::f64::consts::SQRT_2,
+        );
+    }
+    if ms.topology.has_bend() {
+        family(SpringFamily::Bend, ms.bend(), &[(2, 0), (0, 2)], 2.0);
+    }
 }
 
 /// The scene's `[[loads]]` as one term (only when it has some): a load given by position goes to the
@@ -420,24 +434,12 @@ fn present_cells(grid: &Grid, absent: &[bool]) -> (Vec<[usize; 4]>, Vec<(f64, f6
     (cells, sides)
 }
 
-/// The continuum model on the grid: tensile springs along grid lines (k = E·w/h), cell shear (G) and
-/// quadratic bending along grid lines (k = D·w/h̄) and cell twist (D_t). A clamped edge pins its particles and adds
-/// virtual fixed points mirrored across it, so the bending term sees a zero slope at the edge.
-#[allow(clippy::needless_range_loop, clippy::too_many_arguments)] // grid loops index several parallel arrays
-fn continuum_terms(
-    grid: &Grid,
-    r: &Rigidities,
-    absent: &[bool],
-    clamps: &[crate::cloth::Edge],
-    fixed: &mut Vec<bool>,
-    masses: &mut Vec<f64>,
-    x0: &mut Vec<Vector3<f64>>,
-    terms: &mut Vec<Box<dyn EnergyTerm>>,
-) {
+/// The continuum sheet's tensile springs (seed 003 §10.3): one per grid segment of present
+/// particles, its stiffness the tensile rigidity times the tributary width over the length.
+fn tensile_springs(grid: &Grid, r: &Rigidities, absent: &[bool]) -> Springs {
     let (nx, ny) = (grid.nx, grid.ny);
     let wx = tributary_lengths(&grid.xs);
     let wy = tributary_lengths(&grid.ys);
-    // Tensile springs.
     let mut pairs = Vec::new();
     let mut rest = Vec::new();
     let mut k = Vec::new();
@@ -457,12 +459,27 @@ fn continuum_terms(
             }
         }
     }
-    terms.push(Box::new(Springs::new(
-        SpringFamily::Tensile,
-        pairs,
-        rest,
-        k,
-    )));
+    Springs::new(SpringFamily::Tensile, pairs, rest, k)
+}
+
+/// The continuum model on the grid: tensile springs along grid lines (k = E·w/h), cell shear (G) and
+/// quadratic bending along grid lines (k = D·w/h̄) and cell twist (D_t). A clamped edge pins its particles and adds
+/// virtual fixed points mirrored across it, so the bending term sees a zero slope at the edge.
+#[allow(clippy::needless_range_loop, clippy::too_many_arguments)] // grid loops index several parallel arrays
+fn continuum_terms(
+    grid: &Grid,
+    r: &Rigidities,
+    absent: &[bool],
+    clamps: &[crate::cloth::Edge],
+    fixed: &mut Vec<bool>,
+    masses: &mut Vec<f64>,
+    x0: &mut Vec<Vector3<f64>>,
+    terms: &mut Vec<Box<dyn EnergyTerm>>,
+) {
+    let (nx, ny) = (grid.nx, grid.ny);
+    let wx = tributary_lengths(&grid.xs);
+    let wy = tributary_lengths(&grid.ys);
+    terms.push(Box::new(tensile_springs(grid, r, absent)));
     // Shear.
     if r.shear_N_per_m > 0.0 {
         let (cells, sides) = present_cells(grid, absent);

@@ -700,6 +700,34 @@ impl Scene {
                 );
             }
         }
+        self.check_loads(ck)?;
+        if !self.boundary.clamp_edges.is_empty() && (c.nx < 3 || c.ny < 3) {
+            return ck.err(
+                "boundary.clamp_edges",
+                "a clamp needs at least 3 particles along each side".into(),
+            );
+        }
+        if self.boundary.pin_corners.is_empty()
+            && self.boundary.pin_particles.is_empty()
+            && self.boundary.clamp_edges.is_empty()
+            && self.boundary.holds.is_empty()
+            && (!self.contact.fix_supported || self.obstacles.is_empty())
+        {
+            return ck.err(
+                "boundary",
+                "nothing is pinned or clamped: the sheet would fall freely".into(),
+            );
+        }
+        if c.origin_m.iter().any(|v| !v.is_finite()) {
+            return ck.err("cloth.origin_m", "must be finite".into());
+        }
+        self.check_contact(ck)
+    }
+
+    /// Each `[[loads]]` entry: one particle on the grid or a finite position, a magnitude ≥ 0 N and
+    /// a finite non-zero direction.
+    fn check_loads(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        let c = &self.cloth;
         for (k, l) in self.loads.iter().enumerate() {
             let key = |f: &str| format!("loads[{k}].{f}");
             match (l.particle, l.at_m) {
@@ -729,26 +757,11 @@ impl Scene {
                 return ck.err(&key("direction"), "must be finite and not zero".into());
             }
         }
-        if !self.boundary.clamp_edges.is_empty() && (c.nx < 3 || c.ny < 3) {
-            return ck.err(
-                "boundary.clamp_edges",
-                "a clamp needs at least 3 particles along each side".into(),
-            );
-        }
-        if self.boundary.pin_corners.is_empty()
-            && self.boundary.pin_particles.is_empty()
-            && self.boundary.clamp_edges.is_empty()
-            && self.boundary.holds.is_empty()
-            && (!self.contact.fix_supported || self.obstacles.is_empty())
-        {
-            return ck.err(
-                "boundary",
-                "nothing is pinned or clamped: the sheet would fall freely".into(),
-            );
-        }
-        if c.origin_m.iter().any(|v| !v.is_finite()) {
-            return ck.err("cloth.origin_m", "must be finite".into());
-        }
+        Ok(())
+    }
+
+    /// The `[contact]` table: distances, friction and self-contact settings.
+    fn check_contact(&self, ck: &Check<'_>) -> Result<(), InputError> {
         ck.pos("contact.distance_m", self.contact.distance_m)?;
         ck.nonneg(
             "contact.friction_coefficient",

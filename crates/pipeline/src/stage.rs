@@ -252,7 +252,8 @@ impl Registry {
 
 /// What a stage gets to run, as plain data: where it is, its parameters as written, its files by
 /// slot (absolute) and where to report progress. A stage sees nothing of the plan but this, so
-/// everything it reads is a declared input.
+/// everything it reads is a declared input. Stage kinds hand it to their workflow as a
+/// `drapelab_app::Job` (the files' accessors live there).
 pub struct StageContext<'a> {
     /// The pipeline's name.
     pub pipeline: String,
@@ -275,14 +276,6 @@ pub struct StageContext<'a> {
 }
 
 impl StageContext<'_> {
-    /// "Made by `drapelab run PIPELINE` (drapelab VERSION)": the provenance line of every report.
-    pub fn made_by(&self) -> String {
-        format!(
-            "Made by `drapelab run {}` (drapelab {})",
-            self.pipeline_file.display(),
-            drapelab_core::VERSION
-        )
-    }
     /// Reports that the stage has `items` items of work.
     pub fn started(&self, items: usize) {
         self.progress.stage_started(&self.stage, items as u64);
@@ -290,62 +283,5 @@ impl StageContext<'_> {
     /// Reports one item done.
     pub fn item_done(&self) {
         self.progress.item_done(&self.stage);
-    }
-    /// A bad value in this stage's `params` (found when it runs): an input error naming the
-    /// pipeline file and `stages.STAGE.params.KEY` (exit 2).
-    pub fn param_error(
-        &self,
-        key: &str,
-        message: impl Into<String>,
-    ) -> drapelab_core::error::InputError {
-        drapelab_core::error::InputError::new(
-            self.root.join(&self.pipeline_file),
-            format!("stages.{}.params.{key}", self.stage),
-            message,
-        )
-    }
-    /// `path` relative to the project root, for tables and reports.
-    pub fn relative<'p>(&self, path: &'p Path) -> &'p Path {
-        path.strip_prefix(&self.root).unwrap_or(path)
-    }
-    /// The one file of input slot `slot` (a required slot is always there once the plan loaded).
-    pub fn input(&self, slot: &str) -> Result<&Path> {
-        match self.inputs.get(slot).map(Vec::as_slice) {
-            Some([one]) => Ok(one),
-            Some(many) => anyhow::bail!(
-                "input `{slot}` of stage `{}` matched {} files; it takes one",
-                self.stage,
-                many.len()
-            ),
-            None => anyhow::bail!(
-                "stage `{}` needs input `{slot}`: add `inputs.{slot} = \"PATH\"`",
-                self.stage
-            ),
-        }
-    }
-    /// The file of an optional input slot, if given.
-    pub fn optional_input(&self, slot: &str) -> Result<Option<&Path>> {
-        if self.inputs.contains_key(slot) {
-            self.input(slot).map(Some)
-        } else {
-            Ok(None)
-        }
-    }
-    /// The files of input slot `slot` (empty when an optional slot is not given).
-    pub fn input_files(&self, slot: &str) -> &[PathBuf] {
-        self.inputs.get(slot).map_or(&[], Vec::as_slice)
-    }
-    /// The path of output slot `slot` (a required slot is always there once the plan loaded).
-    pub fn output(&self, slot: &str) -> Result<&Path> {
-        self.optional_output(slot).ok_or_else(|| {
-            anyhow::anyhow!(
-                "stage `{}` needs output `{slot}`: add `outputs.{slot} = \"PATH\"`",
-                self.stage
-            )
-        })
-    }
-    /// The path of an optional output slot, if given.
-    pub fn optional_output(&self, slot: &str) -> Option<&Path> {
-        self.outputs.get(slot).map(PathBuf::as_path)
     }
 }

@@ -159,7 +159,9 @@ pub struct CusickDataset {
     pub captures: Vec<CaptureLabel>,
 }
 
-fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, InputError> {
+/// The rows of a CSV file with a header line (`#` lines are comments), each deserialized as `T`; a
+/// file that cannot be read or a row that does not fit is an [`InputError`] naming the file and row.
+pub fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, InputError> {
     let mut r = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .from_path(path)

@@ -21,6 +21,7 @@ mod timeline;
 mod wrinkles_rrd;
 
 pub use calibration_rrd::CalibrationRecorder;
+pub use cusick::read_csv;
 pub use cusick_rrd::{FABRIC_SPACING_M, NamedMesh, write_cusick_drapes};
 pub use drapelab_core::atomic::{Staged, write_atomic, write_text};
 pub use edges_table::EdgeRow;

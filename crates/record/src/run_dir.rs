@@ -1,7 +1,7 @@
 //! One scene solved into a folder: `particles.parquet` (or `last_state.parquet`), `run.json` and,
 //! when the scene asks, `timeline.mcap` and `drape.rrd`.
 
-use crate::{RerunRecorder, TimelineRecorder, write_particles};
+use crate::{RerunRecorder, Sampled, TimelineRecorder, write_particles};
 use anyhow::{Context, Result};
 use drapelab_core::atomic::write_atomic;
 use drapelab_core::build::{BuiltScene, build_scene};
@@ -91,6 +91,41 @@ fn publish(staging: &Path, out: &Path, written: &[&str]) -> Result<()> {
     Ok(())
 }
 
+/// The timeline (MCAP) and rerun recorders of a solve, each when the scene asks for it.
+type Recorders = (
+    Option<Sampled<TimelineRecorder>>,
+    Option<Sampled<RerunRecorder>>,
+);
+
+/// The recorders a scene asks for (`record.timeline`, `record.rerun`), writing into `out`.
+fn recorders(
+    scene: &Scene,
+    out: &Path,
+    grid: &drapelab_core::cloth::Grid,
+    model: &drapelab_core::physics::Model,
+    x0: &[nalgebra::Vector3<f64>],
+) -> Result<Recorders> {
+    let pins: Vec<usize> = (0..grid.len()).filter(|&p| model.fixed[p]).collect();
+    let every = scene.record.every;
+    let timeline = if scene.record.timeline {
+        Some(
+            TimelineRecorder::new(&out.join("timeline.mcap"), grid, every)?
+                .at_frame_rate(scene.record.frame_rate_hz),
+        )
+    } else {
+        None
+    };
+    let rrd = if scene.record.rerun {
+        Some(
+            RerunRecorder::new(&out.join("drape.rrd"), &scene.name, grid, x0, &pins, every)?
+                .at_frame_rate(scene.record.frame_rate_hz),
+        )
+    } else {
+        None
+    };
+    Ok((timeline, rrd))
+}
+
 /// Solves `loaded` and writes its outputs into the empty folder `out`; the report and the files
 /// written.
 fn simulate_into(
@@ -105,31 +140,7 @@ fn simulate_into(
         x0,
     } = build_scene(scene);
     let absent = drapelab_core::build::absent_particles(scene, &x0);
-    let pins: Vec<usize> = (0..grid.len()).filter(|&p| model.fixed[p]).collect();
-    let every = scene.record.every;
-    let mut timeline = if scene.record.timeline {
-        Some(
-            TimelineRecorder::new(&out.join("timeline.mcap"), &grid, every)?
-                .at_frame_rate(scene.record.frame_rate_hz),
-        )
-    } else {
-        None
-    };
-    let mut rrd = if scene.record.rerun {
-        Some(
-            RerunRecorder::new(
-                &out.join("drape.rrd"),
-                &scene.name,
-                &grid,
-                &x0,
-                &pins,
-                every,
-            )?
-            .at_frame_rate(scene.record.frame_rate_hz),
-        )
-    } else {
-        None
-    };
+    let (mut timeline, mut rrd) = recorders(scene, out, &grid, &model, &x0)?;
     let mut x = x0;
     let report = {
         let mut obs: Vec<&mut dyn Observer> = vec![progress];

@@ -133,7 +133,13 @@ pub fn glb_bytes(surface: &TexturedSurface<'_>) -> Result<Vec<u8>> {
                         view(3, Some(ELEMENT_ARRAY_BUFFER)), view(4, None)],
         "buffers": [{"byteLength": bin.len()}],
     });
-    let mut js = serde_json::to_vec(&doc)?;
+    glb_container(&serde_json::to_vec(&doc)?, &bin)
+}
+
+/// The binary glTF container (glTF 2.0 §4.4): a 12-byte header, the JSON chunk padded with spaces
+/// and the binary chunk (already padded to 4 bytes).
+fn glb_container(json: &[u8], bin: &[u8]) -> Result<Vec<u8>> {
+    let mut js = json.to_vec();
     while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
@@ -147,7 +153,7 @@ pub fn glb_bytes(surface: &TexturedSurface<'_>) -> Result<Vec<u8>> {
     out.extend_from_slice(&js);
     out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
     out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
+    out.extend_from_slice(bin);
     Ok(out)
 }
 

@@ -273,10 +273,10 @@ dynamic point).\n\n| scene | solver | converged | max-iterations | diverged | in
         let _ = writeln!(
             md,
             "| {s} | {sv} | {} | {} | {} | {} |",
-            c("converged"),
-            c("max-iterations"),
-            c("diverged"),
-            c("invalid")
+            c(Status::Converged.as_str()),
+            c(Status::MaxIterations.as_str()),
+            c(Status::Diverged.as_str()),
+            c(Status::Invalid.as_str())
         );
     }
     md

@@ -29,25 +29,7 @@ pub fn scan(p: &Path) -> Result<LazyFrame> {
 
 /// Rows of a seed CSV (comment lines skipped) as maps of column → value.
 pub fn read_csv(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
-    let text = std::fs::read_to_string(path)?;
-    let mut lines = text
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.trim().is_empty());
-    let header: Vec<String> = lines
-        .next()
-        .unwrap_or_default()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    Ok(lines
-        .map(|l| {
-            header
-                .iter()
-                .cloned()
-                .zip(l.split(',').map(str::to_string))
-                .collect()
-        })
-        .collect())
+    Ok(drapelab_record::read_csv(path)?)
 }
 
 pub fn run(ctx: &Job<'_>, p: &CalibrationReportParams) -> Result<()> {

@@ -4,6 +4,7 @@
 
 use anyhow::{Result, bail};
 use drapelab_app::Job;
+use drapelab_core::error::ParamError;
 use drapelab_record::write_text;
 use plotters::prelude::*;
 use polars::prelude::*;
@@ -54,6 +55,38 @@ impl ReportParams {
         }
         v
     }
+}
+
+/// The columns every `sweep.parquet` has (its first and last row types); between them are the
+/// swept keys, dotted scene keys.
+fn sweep_columns() -> Vec<String> {
+    let mut names = Vec::new();
+    for fields in [
+        drapelab_record::table_fields::<drapelab_app::sweep_table::SweepPoint>(),
+        drapelab_record::table_fields::<drapelab_app::sweep_table::SweepOutcome>(),
+    ] {
+        names.extend(fields.into_iter().flatten().map(|f| f.name().clone()));
+    }
+    names
+}
+
+/// Refuses, when the plan loads, a column that is neither a column of `sweep.parquet` nor a swept
+/// scene key (a dotted path such as `cloth.nx`): a report summarises sweep tables.
+pub fn check(p: &ReportParams) -> Result<(), ParamError> {
+    let known = sweep_columns();
+    for (key, c) in p.columns() {
+        if !c.contains('.') && !known.iter().any(|k| k == c) {
+            return Err(ParamError::new(
+                key,
+                format!(
+                    "unknown column `{c}`: name a column of sweep.parquet ({}) or a swept scene key \
+                     such as `cloth.nx`",
+                    known.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Refuses, before any query runs, a named column that the tables do not have: an input error
@@ -183,35 +216,7 @@ pub fn run(ctx: &Job<'_>, p: &ReportParams) -> Result<()> {
         .select(cols)
         .sort(["__x"], SortMultipleOptions::default())
         .collect()?;
-    let mut panels: Panels = BTreeMap::new();
-    let xs = pts.column("__x")?.f64()?.clone();
-    let ys = pts.column("__y")?.f64()?.clone();
-    let text = |name: &str, r: usize| {
-        pts.column(name)
-            .ok()
-            .and_then(|s| s.str().ok().and_then(|s| s.get(r).map(str::to_string)))
-            .unwrap_or_default()
-    };
-    for r in 0..pts.height() {
-        let label = series
-            .iter()
-            .map(|k| format!("{}={}", k.rsplit('.').next().unwrap_or(k), text(k, r)))
-            .collect::<Vec<_>>()
-            .join(", ");
-        let panel = if p.facet.is_some() {
-            text("__facet", r)
-        } else {
-            String::new()
-        };
-        if let (Some(x), Some(y)) = (xs.get(r), ys.get(r)) {
-            panels
-                .entry(panel)
-                .or_default()
-                .entry(label)
-                .or_default()
-                .push((x, y));
-        }
-    }
+    let panels = panels_of(&pts, &series, p.facet.is_some())?;
     let svg_text = plot_panels(&panels, &p.x, &p.y, p.facet.as_deref())?;
     write_text(svg, &svg_text)?;
     let svg_rel = svg
@@ -239,6 +244,41 @@ pub fn run(ctx: &Job<'_>, p: &ReportParams) -> Result<()> {
     write_text(md, &text)?;
     ctx.item_done();
     Ok(())
+}
+
+/// The plot's points by panel (facet value) and line (series values), from the columns `__x`,
+/// `__y` and `__facet` of `pts`.
+fn panels_of(pts: &DataFrame, series: &[String], faceted: bool) -> Result<Panels> {
+    let mut panels: Panels = BTreeMap::new();
+    let xs = pts.column("__x")?.f64()?.clone();
+    let ys = pts.column("__y")?.f64()?.clone();
+    let text = |name: &str, r: usize| {
+        pts.column(name)
+            .ok()
+            .and_then(|s| s.str().ok().and_then(|s| s.get(r).map(str::to_string)))
+            .unwrap_or_default()
+    };
+    for r in 0..pts.height() {
+        let label = series
+            .iter()
+            .map(|k| format!("{}={}", k.rsplit('.').next().unwrap_or(k), text(k, r)))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let panel = if faceted {
+            text("__facet", r)
+        } else {
+            String::new()
+        };
+        if let (Some(x), Some(y)) = (xs.get(r), ys.get(r)) {
+            panels
+                .entry(panel)
+                .or_default()
+                .entry(label)
+                .or_default()
+                .push((x, y));
+        }
+    }
+    Ok(panels)
 }
 
 /// Draws one panel per facet value (stacked), each with one line per series, to an SVG string;

@@ -2,7 +2,7 @@
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-use drapelab_pipeline::{Slot, StageContext, StageKind};
+use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
 pub use drapelab_reports::report::*;
 
 /// The `report` stage kind.
@@ -11,15 +11,18 @@ pub struct Report;
 impl StageKind for Report {
     type Params = ReportParams;
     const KIND: &'static str = "report";
-    const SUMMARY: &'static str = "Summaries and a plot over Parquet tables, as Markdown";
+    const SUMMARY: &'static str = "Summaries and a plot over sweep tables, as Markdown";
     const INPUTS: &'static [Slot] = &[Slot::many(
         "tables",
-        "Parquet tables (e.g. sweep.parquet) with a status column",
+        "sweep tables (a sweep stage's sweep.parquet)",
     )];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("markdown", "the report, .md"),
         Slot::one("plot", "the plot, .svg"),
     ];
+    fn check(p: &ReportParams) -> Result<(), ParamError> {
+        check(p)
+    }
     fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
         let ctx = &crate::job(ctx);
         run(ctx, p)

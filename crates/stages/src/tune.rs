@@ -31,8 +31,9 @@ impl StageKind for Tune {
         }
     }
     fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
-        let outcome = run(&crate::job(ctx), p)?;
-        if let Some(svg) = ctx.optional_output("plot") {
+        let job = crate::job(ctx);
+        let outcome = run(&job, p)?;
+        if let Some(svg) = job.optional_output("plot") {
             let text = drapelab_reports::report::plot_panels(
                 &outcome.main_effects,
                 "factor level (1..3)",

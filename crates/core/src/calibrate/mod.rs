@@ -405,7 +405,9 @@ impl Problem {
 /// Areal density (kg/m²) of each sample of seed 000 Table 2, read from `knitted_samples.csv`
 /// (`sample` and `weight_g_per_m2` columns; `#` lines are comments).
 pub fn read_sample_densities(path: &std::path::Path) -> anyhow::Result<HashMap<u32, f64>> {
-    let text = std::fs::read_to_string(path)?;
+    use crate::error::InputError;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
     let mut lines = text
         .lines()
         .filter(|l| !l.starts_with('#') && !l.trim().is_empty());
@@ -414,13 +416,25 @@ pub fn read_sample_densities(path: &std::path::Path) -> anyhow::Result<HashMap<u
         header
             .iter()
             .position(|h| *h == name)
-            .ok_or_else(|| anyhow::anyhow!("{}: no column {name}", path.display()))
+            .ok_or_else(|| InputError::new(path, name, "no such column in the header line"))
     };
     let (cs, cw) = (col("sample")?, col("weight_g_per_m2")?);
     let mut out = HashMap::new();
-    for l in lines {
-        let f: Vec<&str> = l.split(',').collect();
-        out.insert(f[cs].trim().parse()?, f[cw].trim().parse::<f64>()? / 1000.0);
+    for (k, l) in lines.enumerate() {
+        let f: Vec<&str> = l.split(',').map(str::trim).collect();
+        let bad = || {
+            InputError::new(
+                path,
+                format!("row {}", k + 1),
+                format!("`{l}`: needs an integer `sample` and a number `weight_g_per_m2`"),
+            )
+        };
+        let sample = f.get(cs).and_then(|v| v.parse().ok()).ok_or_else(bad)?;
+        let grams = f
+            .get(cw)
+            .and_then(|v| v.parse::<f64>().ok())
+            .ok_or_else(bad)?;
+        out.insert(sample, grams / 1000.0);
     }
     Ok(out)
 }
@@ -548,30 +562,7 @@ pub fn identifiability(
     let noise_pct = 0.5 * delta.sqrt();
     let reach: Vec<f64> = joint
         .iter()
-        .map(|&d| {
-            let rise = |h: f64| {
-                [-h, h]
-                    .iter()
-                    .map(|&t| {
-                        let mut u = best_u.to_vec();
-                        u[d] = (best_u[d] + t).clamp(0.0, 1.0);
-                        problem.cost(&u) - c0
-                    })
-                    .fold(f64::NEG_INFINITY, f64::max)
-            };
-            let mut h = window / 8.0;
-            for _ in 0..12 {
-                let r = rise(h);
-                if r < 3.0 * noise_pct && h < window {
-                    h = (2.0 * h).min(window);
-                } else if r > 30.0 * noise_pct {
-                    h *= 0.5;
-                } else {
-                    break;
-                }
-            }
-            h / window
-        })
+        .map(|&d| quadratic_reach(problem, best_u, d, window, noise_pct))
         .collect();
     let grid2: Vec<Vec<f64>> = offsets
         .iter()
@@ -600,17 +591,61 @@ pub fn identifiability(
             }
         })
         .collect();
+    out.push(topology_identifiability(problem, best_u, delta));
+    out
+}
+
+/// The topology is identified when every other topology (the best point otherwise) costs more than
+/// the best by the noise `delta` (in squared cost).
+fn topology_identifiability(problem: &Problem, best_u: &[f64], delta: f64) -> Identifiability {
+    let b = &problem.bounds;
+    let best = b.decode(best_u);
+    let c0 = problem.cost(best_u);
     let others_cost_more = (0..3).all(|k| {
         let mut u = best_u.to_vec();
         u[4] = (k as f64 + 0.5) / 3.0;
         b.decode(&u).topology == best.topology || problem.cost(&u).powi(2) > c0 * c0 + delta
     });
-    out.push(Identifiability {
+    Identifiability {
         name: "topology",
         uncertainty: if others_cost_more { 0.0 } else { f64::INFINITY },
         identifiable: others_cost_more,
-    });
-    out
+    }
+}
+
+/// Along axis `d` of the unit box, a step (as a fraction of `window`) over which the cost rises
+/// by 3–30 times the noise `noise_pct` from `best_u`: the quadratic model holds there, and a fit sees
+/// curvature rather than round-off.
+fn quadratic_reach(
+    problem: &Problem,
+    best_u: &[f64],
+    d: usize,
+    window: f64,
+    noise_pct: f64,
+) -> f64 {
+    let c0 = problem.cost(best_u);
+    let rise = |h: f64| {
+        [-h, h]
+            .iter()
+            .map(|&t| {
+                let mut u = best_u.to_vec();
+                u[d] = (best_u[d] + t).clamp(0.0, 1.0);
+                problem.cost(&u) - c0
+            })
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let mut h = window / 8.0;
+    for _ in 0..12 {
+        let r = rise(h);
+        if r < 3.0 * noise_pct && h < window {
+            h = (2.0 * h).min(window);
+        } else if r > 30.0 * noise_pct {
+            h *= 0.5;
+        } else {
+            break;
+        }
+    }
+    h / window
 }
 
 /// Fits y ≈ a + gᵀt + ½ tᵀHt to `pts` (t ∈ ℝⁿ, squared cost y) and returns, per coordinate, the

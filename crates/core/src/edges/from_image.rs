@@ -389,21 +389,7 @@ pub fn fit_image(
     let mask = |u: i64, v: i64| {
         u >= 0 && v >= 0 && u < w as i64 && v < h as i64 && seg.fabric_at(u as u32, v as u32)
     };
-    for c in &corners {
-        let r = guard as i64 + 3;
-        let (cu, cv) = (c.0 as i64, c.1 as i64);
-        let touches = (-r..=r).any(|dv| (-r..=r).any(|du| mask(cu + du, cv + dv)));
-        if !touches {
-            return Err(InputError::new(
-                file,
-                "--corners",
-                format!(
-                    "the fabric touches no corner at ({:.1}, {:.1}): check the corner positions or markers",
-                    c.0, c.1
-                ),
-            ));
-        }
-    }
+    corners_touch_fabric(&corners, guard, &mask, file)?;
     let [c0, c1] = corners;
     let len = ((c1.0 - c0.0).powi(2) + (c1.1 - c0.1).powi(2)).sqrt();
     let tdir = ((c1.0 - c0.0) / len, (c1.1 - c0.1) / len);
@@ -465,31 +451,7 @@ pub fn fit_image(
                 }
             }
         }
-        // The bottom edge's depth at each side bounds the side edges.
-        let bottom_depth = |x: f64| {
-            edges
-                .iter()
-                .find(|e: &&EdgeFit| e.edge == "bottom")
-                .map(|e| -e.eval(x))
-                .unwrap_or(f64::INFINITY)
-        };
-        let side_depth = if name == "right" {
-            bottom_depth(span_cm)
-        } else {
-            bottom_depth(0.0)
-        };
-        let pts = super::trim_edge(name, pts, span_cm, side_depth);
-        let Some(fit) = EdgeFit::from_points(name, &pts, opts.degree) else {
-            return Err(InputError::new(
-                file,
-                "",
-                format!(
-                    "too few points on the {name} edge ({}) to fit degree {}",
-                    pts.len(),
-                    opts.degree
-                ),
-            ));
-        };
+        let (fit, pts) = fit_edge(name, pts, &edges, span_cm, opts.degree, file)?;
         edges.push(fit);
         points_cm.push(pts);
     }
@@ -507,6 +469,67 @@ pub fn fit_image(
         corners,
         px_per_cm: s,
     })
+}
+
+/// Refuses a calibration whose corners the fabric does not touch (within the guard and 3 px).
+fn corners_touch_fabric(
+    corners: &[(f64, f64); 2],
+    guard: f64,
+    mask: &dyn Fn(i64, i64) -> bool,
+    file: &Path,
+) -> Result<(), InputError> {
+    for c in corners {
+        let r = guard as i64 + 3;
+        let (cu, cv) = (c.0 as i64, c.1 as i64);
+        let touches = (-r..=r).any(|dv| (-r..=r).any(|du| mask(cu + du, cv + dv)));
+        if !touches {
+            return Err(InputError::new(
+                file,
+                "--corners",
+                format!(
+                    "the fabric touches no corner at ({:.1}, {:.1}): check the corner positions or markers",
+                    c.0, c.1
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The polynomial of edge `name` through its traced points `pts` (cm), trimmed where a side edge
+/// runs past the bottom edge's depth at its side (seed 000 Fig. 3); the fit and the points kept.
+fn fit_edge(
+    name: &str,
+    pts: Vec<(f64, f64)>,
+    edges: &[EdgeFit],
+    span_cm: f64,
+    degree: usize,
+    file: &Path,
+) -> Result<(EdgeFit, Vec<(f64, f64)>), InputError> {
+    let bottom_depth = |x: f64| {
+        edges
+            .iter()
+            .find(|e| e.edge == "bottom")
+            .map(|e| -e.eval(x))
+            .unwrap_or(f64::INFINITY)
+    };
+    let side_depth = if name == "right" {
+        bottom_depth(span_cm)
+    } else {
+        bottom_depth(0.0)
+    };
+    let pts = super::trim_edge(name, pts, span_cm, side_depth);
+    let Some(fit) = EdgeFit::from_points(name, &pts, degree) else {
+        return Err(InputError::new(
+            file,
+            "",
+            format!(
+                "too few points on the {name} edge ({}) to fit degree {degree}",
+                pts.len()
+            ),
+        ));
+    };
+    Ok((fit, pts))
 }
 
 /// Half-width of the window over which [`subpixel_edge`] sums coverages, px: wide enough for a

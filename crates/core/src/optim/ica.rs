@@ -243,68 +243,14 @@ impl Ica {
         countries.sort_by(|a, b| a.cost.total_cmp(&b.cost));
         let mut colonies: Vec<Country> = countries.split_off(s.imperialists);
         colonies.shuffle(&mut rng);
-        // Initial colonies shared by normalised imperialist power.
-        let max = countries
-            .iter()
-            .map(|c| c.cost)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let norm: Vec<f64> = countries.iter().map(|c| max - c.cost).collect();
-        let sum: f64 = norm.iter().sum();
-        let ncol = colonies.len();
-        let mut shares: Vec<usize> = norm
-            .iter()
-            .map(|v| {
-                if sum > 0.0 {
-                    (v / sum * ncol as f64).round() as usize
-                } else {
-                    ncol / countries.len()
-                }
-            })
-            .collect();
-        let mut assigned: usize = shares.iter().sum();
-        while assigned > ncol {
-            let k = shares
-                .iter()
-                .enumerate()
-                .rev()
-                .find(|(_, v)| **v > 0)
-                .map(|(k, _)| k)
-                .unwrap_or(0);
-            shares[k] -= 1;
-            assigned -= 1;
-        }
-        shares[0] += ncol - assigned;
-        let mut empires: Vec<Empire> = countries
-            .into_iter()
-            .zip(&shares)
-            .map(|(imp, &n)| Empire {
-                imperialist: imp,
-                colonies: colonies.drain(..n.min(colonies.len())).collect(),
-            })
-            .collect();
-        let best = |empires: &[Empire]| {
-            empires
-                .iter()
-                .map(|e| &e.imperialist)
-                .min_by(|a, b| a.cost.total_cmp(&b.cost))
-                .cloned()
-        };
-        let mean = |empires: &[Empire]| {
-            let all: Vec<f64> = empires
-                .iter()
-                .flat_map(|e| {
-                    std::iter::once(e.imperialist.cost).chain(e.colonies.iter().map(|c| c.cost))
-                })
-                .collect();
-            all.iter().sum::<f64>() / all.len() as f64
-        };
-        let mut best_c = best(&empires).expect("at least one imperialist");
+        let mut empires = form_empires(countries, colonies);
+        let mut best_c = best_country(&empires).expect("at least one imperialist");
         let mut history = vec![best_c.cost];
         observe(&DecadeEvent {
             decade: 0,
             empires: &empires,
             best_cost: best_c.cost,
-            mean_cost: mean(&empires),
+            mean_cost: mean_cost(&empires),
             evaluations,
         });
         let mut decade = 0;
@@ -342,7 +288,7 @@ impl Ica {
                 }
             }
             compete(&mut empires, s.xi, &mut rng);
-            if let Some(b) = best(&empires)
+            if let Some(b) = best_country(&empires)
                 && b.cost < best_c.cost
             {
                 best_c = b;
@@ -352,7 +298,7 @@ impl Ica {
                 decade,
                 empires: &empires,
                 best_cost: best_c.cost,
-                mean_cost: mean(&empires),
+                mean_cost: mean_cost(&empires),
                 evaluations,
             });
             // Stop when one empire remains (a run started with one empire runs all its decades).
@@ -368,6 +314,68 @@ impl Ica {
             history,
         }
     }
+}
+
+/// The first empires (Atashpaz-Gargari & Lucas 2007): the colonies shared among the imperialists
+/// by normalised power (the best cost's distance from the worst), the rounding remainder to the
+/// strongest.
+fn form_empires(countries: Vec<Country>, mut colonies: Vec<Country>) -> Vec<Empire> {
+    let max = countries
+        .iter()
+        .map(|c| c.cost)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let norm: Vec<f64> = countries.iter().map(|c| max - c.cost).collect();
+    let sum: f64 = norm.iter().sum();
+    let ncol = colonies.len();
+    let mut shares: Vec<usize> = norm
+        .iter()
+        .map(|v| {
+            if sum > 0.0 {
+                (v / sum * ncol as f64).round() as usize
+            } else {
+                ncol / countries.len()
+            }
+        })
+        .collect();
+    let mut assigned: usize = shares.iter().sum();
+    while assigned > ncol {
+        let k = shares
+            .iter()
+            .enumerate()
+            .rev()
+            .find(|(_, v)| **v > 0)
+            .map(|(k, _)| k)
+            .unwrap_or(0);
+        shares[k] -= 1;
+        assigned -= 1;
+    }
+    shares[0] += ncol - assigned;
+    countries
+        .into_iter()
+        .zip(&shares)
+        .map(|(imp, &n)| Empire {
+            imperialist: imp,
+            colonies: colonies.drain(..n.min(colonies.len())).collect(),
+        })
+        .collect()
+}
+
+/// The best imperialist of all empires.
+fn best_country(empires: &[Empire]) -> Option<Country> {
+    empires
+        .iter()
+        .map(|e| &e.imperialist)
+        .min_by(|a, b| a.cost.total_cmp(&b.cost))
+        .cloned()
+}
+
+/// The mean cost over every country of every empire.
+fn mean_cost(empires: &[Empire]) -> f64 {
+    let all: Vec<f64> = empires
+        .iter()
+        .flat_map(|e| std::iter::once(e.imperialist.cost).chain(e.colonies.iter().map(|c| c.cost)))
+        .collect();
+    all.iter().sum::<f64>() / all.len() as f64
 }
 
 #[cfg(test)]

@@ -260,13 +260,7 @@ pub fn integrate_implicit(
         // Recording frames, the state is judged on frame times only (the last one recorded is the
         // final state).
         let on_frame = frame_s.is_none() || at_frame;
-        // Near the round-off floor of forces a soft mode keeps moving by floor/stiffness per step:
-        // there the speed criterion becomes "no particle moved more than 1e-7 of the drape's size".
-        // (Each step's Newton stops within 100 times the floor of its own, inertia-stiffened forces.)
-        let floor = 100.0 * model.roundoff_force(x);
-        let still = speed <= settle.speed_m_per_s
-            || (r <= floor && speed * last_dt <= 1e-7 * settle.extent_m);
-        if on_frame && r <= settle.residual_N.max(floor) && still {
+        if on_frame && settled(model, x, settle, (r, speed, last_dt)) {
             report.stop_for(StopReason::Converged);
             report.message = format!(
                 "settled at t = {t:.4} s after {steps} steps (largest residual {r:.2e} N, largest speed {speed:.2e} m/s, kinetic energy {:.2e} J; largest step {largest:.1e} s)",
@@ -274,16 +268,10 @@ pub fn integrate_implicit(
             );
             break;
         }
-        if t >= max_time_s * (1.0 - 1e-12) {
-            report.stop_for(StopReason::SimulatedTime);
-            report.message = format!(
-                "not settled within {max_time_s} s (residual {r:.3e} N, speed {speed:.3e} m/s)"
-            );
-            break;
-        }
-        if max_wall_s.is_some_and(|b| start.elapsed().as_secs_f64() > b) {
-            report.stop_for(StopReason::WallTime);
-            report.message = format!("wall-time budget spent at t = {t:.4} s (residual {r:.3e} N)");
+        if let Some((reason, message)) = out_of_budget(t, (max_time_s, max_wall_s), start, r, speed)
+        {
+            report.stop_for(reason);
+            report.message = message;
             break;
         }
         // The step: capped by the time budget and, when recording frames, landing on the next one.
@@ -304,19 +292,12 @@ pub fn integrate_implicit(
                     t = next_frame.unwrap_or(t);
                     frame += 1;
                 }
-                if landed || (frame_s.is_none() && observer.wants(steps)) {
-                    let ev = StateEvent {
-                        index: steps,
-                        time_s: Some(t),
-                        x,
-                        max_residual_N: r,
-                        energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
-                    };
-                    if let Err(e) = observer.observe(&ev) {
-                        report.stop_for(StopReason::Observer);
-                        report.message = format!("an observer failed at t = {t:.4} s: {e:#}");
-                        break;
-                    }
+                if (landed || (frame_s.is_none() && observer.wants(steps)))
+                    && let Err(e) = observe_state(observer, model, x, v, (steps, t, r))
+                {
+                    report.stop_for(StopReason::Observer);
+                    report.message = format!("an observer failed at t = {t:.4} s: {e:#}");
+                    break;
                 }
                 // A step shortened to land on a frame does not set the next one, and for three
                 // steps after a rejected one the step does not grow.
@@ -347,6 +328,67 @@ pub fn integrate_implicit(
     report.iterations = steps;
     report.sim_time_s = Some(t);
     report.dt_s = Some(if steps > 0 { largest } else { s.dt_s });
+}
+
+/// Whether a state with largest residual `r` N and speed m/s after a step of `last_dt` s has
+/// settled: forces and speed below the criterion. Near the round-off floor of forces a soft mode
+/// keeps moving by floor/stiffness per step: there the speed criterion becomes "no particle moved
+/// more than 1e-7 of the drape's size". (Each step's Newton stops within 100 times the floor of
+/// its own, inertia-stiffened forces.)
+fn settled(
+    model: &Model,
+    x: &[Vector3<f64>],
+    settle: &Settle,
+    (r, speed, last_dt): (f64, f64, f64),
+) -> bool {
+    let floor = 100.0 * model.roundoff_force(x);
+    let still =
+        speed <= settle.speed_m_per_s || (r <= floor && speed * last_dt <= 1e-7 * settle.extent_m);
+    r <= settle.residual_N.max(floor) && still
+}
+
+/// Why an implicit integration must stop for its budgets, if it must: the simulated time
+/// `max_time_s` reached, or the wall time `max_wall_s` spent since `start`.
+fn out_of_budget(
+    t: f64,
+    (max_time_s, max_wall_s): (f64, Option<f64>),
+    start: Instant,
+    r: f64,
+    speed: f64,
+) -> Option<(StopReason, String)> {
+    if t >= max_time_s * (1.0 - 1e-12) {
+        return Some((
+            StopReason::SimulatedTime,
+            format!(
+                "not settled within {max_time_s} s (residual {r:.3e} N, speed {speed:.3e} m/s)"
+            ),
+        ));
+    }
+    if max_wall_s.is_some_and(|b| start.elapsed().as_secs_f64() > b) {
+        return Some((
+            StopReason::WallTime,
+            format!("wall-time budget spent at t = {t:.4} s (residual {r:.3e} N)"),
+        ));
+    }
+    None
+}
+
+/// Hands the state after step `steps` (time `t`, residual `r` N) to `observer`, with its total
+/// (potential and kinetic) energy.
+fn observe_state(
+    observer: &mut dyn Observer,
+    model: &Model,
+    x: &[Vector3<f64>],
+    v: &[Vector3<f64>],
+    (steps, t, r): (usize, f64, f64),
+) -> anyhow::Result<()> {
+    observer.observe(&StateEvent {
+        index: steps,
+        time_s: Some(t),
+        x,
+        max_residual_N: r,
+        energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
+    })
 }
 
 /// Hands the initial state (t = 0) to `observer` when it records frames or wants step 0.

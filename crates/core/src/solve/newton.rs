@@ -328,15 +328,7 @@ pub fn solve_static_loads(
                 report.diverge(iter, None, DivergenceReason::NonFinite);
                 break 'load;
             }
-            if observer.wants(iter)
-                && let Err(err) = observer.observe(&StateEvent {
-                    index: iter,
-                    time_s: None,
-                    x,
-                    max_residual_N: r,
-                    energy_J: e,
-                })
-            {
+            if let Err(err) = observe_iterate(observer, iter, x, (r, e)) {
                 report.stop_for(StopReason::Observer);
                 report.message = format!("an observer failed at iteration {iter}: {err:#}");
                 break 'load;
@@ -389,11 +381,51 @@ pub fn solve_static_loads(
         }
     }
     let final_load = loads.last().copied().unwrap_or(1.0);
+    finish_report(
+        model,
+        x,
+        final_load,
+        &mut ws,
+        (iter, floor, start),
+        &mut report,
+    );
+    report
+}
+
+/// Hands Newton iterate `iter` (residual `r` N, energy `e` J) to `observer` when it wants it.
+fn observe_iterate(
+    observer: &mut dyn Observer,
+    iter: usize,
+    x: &[Vector3<f64>],
+    (r, e): (f64, f64),
+) -> anyhow::Result<()> {
+    if !observer.wants(iter) {
+        return Ok(());
+    }
+    observer.observe(&StateEvent {
+        index: iter,
+        time_s: None,
+        x,
+        max_residual_N: r,
+        energy_J: e,
+    })
+}
+
+/// The final numbers of a static solve (residual and energy at the final load, times) and, when it
+/// converged, its message: in how many iterations, and whether to the round-off floor of forces.
+fn finish_report(
+    model: &Model,
+    x: &[Vector3<f64>],
+    final_load: f64,
+    ws: &mut Workspace,
+    (iter, floor, start): (usize, bool, Instant),
+    report: &mut SolveReport,
+) {
     model.gradient(x, final_load, &mut ws.g);
     report.iterations = iter;
     report.factor_time_s = ws.spd.factor_time_s;
     report.max_residual_N = free_max_residual(model, &ws.g);
-    report.max_residual_rel = report.max_residual_N / w_ref;
+    report.max_residual_rel = report.max_residual_N / model.reference_weight();
     report.energy_J = model.energy(x, final_load);
     report.wall_time_s = start.elapsed().as_secs_f64();
     if report.status == Status::Converged {
@@ -406,7 +438,6 @@ pub fn solve_static_loads(
             format!("converged in {iter} iterations")
         };
     }
-    report
 }
 
 /// (first DOF, component) of every held component of the free particles.

@@ -110,32 +110,7 @@ pub fn solve_vertical_gap(
                 rejected = true;
                 break;
             }
-            let mut changed = false;
-            // Pull back the nodes that went in, and hold them.
-            for p in 0..model.n_grid {
-                if pinned[p] || held[p] {
-                    continue;
-                }
-                let deepest = obstacles
-                    .iter()
-                    .map(|o| o.signed_distance(&x[p]))
-                    .filter(|(d, _)| *d < 0.0)
-                    .min_by(|a, b| a.0.total_cmp(&b.0));
-                let Some((depth, normal)) = deepest else {
-                    continue;
-                };
-                match surface_below(obstacles, &x[p]) {
-                    // The seed's pull-back: vertically onto the upper surface, for a node that came
-                    // from above (the lift is not much more than its depth).
-                    Some(z) if z - x[p].z <= MAX_LIFT_OVER_DEPTH * -depth => x[p].z = z,
-                    // A node that entered from the side or from below would be lifted over the
-                    // obstacle (the sheet would fold over it): put it back out along the normal.
-                    _ => x[p] -= normal * depth,
-                }
-                held[p] = true;
-                model.fixed[p] = true;
-                changed = true;
-            }
+            let mut changed = pull_back(model, x, obstacles, &pinned, &mut held);
             // Let go of the held nodes that the obstacle no longer supports.
             if round < RELEASE_ROUNDS {
                 model.gradient(x, target, &mut g);
@@ -173,6 +148,44 @@ pub fn solve_vertical_gap(
         held.iter().filter(|h| **h).count(),
     );
     report
+}
+
+/// The seed's pull-back: every free node that went into an obstacle is put back on its surface
+/// (vertically onto the upper surface when it came from above, else along the normal) and held;
+/// whether any moved.
+fn pull_back(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    obstacles: &[Obstacle],
+    pinned: &[bool],
+    held: &mut [bool],
+) -> bool {
+    let mut changed = false;
+    for p in 0..model.n_grid {
+        if pinned[p] || held[p] {
+            continue;
+        }
+        let deepest = obstacles
+            .iter()
+            .map(|o| o.signed_distance(&x[p]))
+            .filter(|(d, _)| *d < 0.0)
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let Some((depth, normal)) = deepest else {
+            continue;
+        };
+        match surface_below(obstacles, &x[p]) {
+            // The seed's pull-back: vertically onto the upper surface, for a node that came
+            // from above (the lift is not much more than its depth).
+            Some(z) if z - x[p].z <= MAX_LIFT_OVER_DEPTH * -depth => x[p].z = z,
+            // A node that entered from the side or from below would be lifted over the
+            // obstacle (the sheet would fold over it): put it back out along the normal.
+            _ => x[p] -= normal * depth,
+        }
+        held[p] = true;
+        model.fixed[p] = true;
+        changed = true;
+    }
+    changed
 }
 
 /// Whether a free node's straight path from `from` to `to` enters an obstacle deeper than `limit`
