@@ -237,7 +237,7 @@ fn drapelab_tables_lists_the_documented_columns() {
     let listing = String::from_utf8(out.stdout).expect("utf-8");
     for (file, column) in [
         ("particles.parquet", "`z_m` | Float64 | no"),
-        ("benchmark.parquet", "`error_m` | Float64 | yes"),
+        ("bench.parquet", "`error_m` | Float64 | yes"),
         ("results.parquet", "`topology` | Utf8 | no"),
         ("sweep.parquet", "`max_residual_N` | Float64 | yes"),
         ("wrinkles.parquet", "`converged` | Boolean | no"),

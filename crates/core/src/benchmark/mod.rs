@@ -57,7 +57,7 @@ pub struct BenchRow {
 }
 
 impl Table for BenchRow {
-    const FILE: &'static str = "benchmark.parquet";
+    const FILE: &'static str = "bench.parquet";
     const ROW: &'static str =
         "One solve of the accuracy–speed benchmark: scene × size × tolerance × solver.";
 }
