@@ -65,7 +65,7 @@ pub fn default_explicit() -> usize {
     21
 }
 
-pub fn run(ctx: &Job<'_>, p: &BenchmarkParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &BenchmarkParams) -> Result<Vec<BenchRow>> {
     let scenes: Vec<Scene> = ctx
         .input_files("scenes")
         .iter()
@@ -98,13 +98,13 @@ pub fn run(ctx: &Job<'_>, p: &BenchmarkParams) -> Result<()> {
         let out = ctx
             .optional_output("population")
             .context("slack_net_population needs the output `population`")?;
-        let mut rows =
+        let mut population =
             drapelab_core::benchmark::slack_net_population(&scenes[0], p.slack_net_population, 8);
-        rows.extend(
+        population.extend(
             drapelab_core::benchmark::warm_start_population(&scenes[0], p.slack_net_population, 9)
                 .0,
         );
-        write_table(out, &rows)?;
+        write_table(out, &population)?;
     }
-    Ok(())
+    Ok(rows)
 }

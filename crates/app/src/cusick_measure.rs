@@ -160,7 +160,7 @@ pub fn row(
 }
 
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &CusickMeasureParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &CusickMeasureParams) -> Result<Vec<ShadowRow>> {
     let index = ctx.input("index")?;
     let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
     ctx.started(data.captures.len());
@@ -171,5 +171,6 @@ pub fn run(ctx: &Job<'_>, p: &CusickMeasureParams) -> Result<()> {
         .collect();
     let rows: Vec<ShadowRow> = measured.into_iter().map(|(r, _)| r).collect();
     write_table(ctx.output("table")?, &rows)?;
-    write_table(ctx.output("outlines")?, &outlines)
+    write_table(ctx.output("outlines")?, &outlines)?;
+    Ok(rows)
 }

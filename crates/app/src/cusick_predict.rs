@@ -422,7 +422,7 @@ pub fn simulated_outline(fabric: i32, seed: u64, outline_m: &[f64]) -> Vec<Outli
 }
 
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>> {
     let index = ctx.input("index")?;
     let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
     let shadows = read_table::<ShadowRow>(ctx.input("shadows")?)?;
@@ -491,5 +491,6 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<()> {
         ctx.output("recording")?,
         Tester::default().pedestal_radius_m,
         &overlay,
-    )
+    )?;
+    Ok(rows)
 }

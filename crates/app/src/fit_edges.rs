@@ -24,7 +24,7 @@ pub fn default_degree() -> usize {
     4
 }
 
-pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<Vec<(String, EdgeFit)>> {
     let photos: Vec<_> = ctx
         .input_files("photos")
         .iter()
@@ -64,5 +64,6 @@ pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<()> {
     for f in fits {
         rows.extend(f?);
     }
-    write_edges(ctx.output("edges")?, &rows)
+    write_edges(ctx.output("edges")?, &rows)?;
+    Ok(rows)
 }

@@ -1,8 +1,10 @@
 //! drapelab's workflows, each a function over a [`Job`] (its files by name, its progress) with
 //! typed parameters: simulate to a folder, fit photos and score them, tune and run the ICA
 //! calibration, validate it, sweep scenes, measure and predict Cusick drapes, the benchmark grids,
-//! seed 002's wrinkles and §10.8's surfaces. The pipeline's stages, the command line, the tests
-//! and the Python package call them; the report stack (polars, plotters) is not here.
+//! seed 002's wrinkles and §10.8's surfaces. Each returns what it found as typed values (the rows
+//! it wrote, a solve report, a tuning's main effects); bad input is an `InputError` naming the file
+//! or the stage's parameter. The pipeline's stages, the command line, the tests and the Python
+//! package call them; the report stack (polars, plotters) is not here.
 
 #![allow(non_snake_case)]
 

@@ -3,7 +3,7 @@
 
 use crate::job::Job;
 use anyhow::{Context, Result, bail};
-use drapelab_core::edges::score_edges;
+use drapelab_core::edges::{ScoreRow, score_edges};
 use drapelab_record::{read_edges, write_table};
 use serde::{Deserialize, Serialize};
 
@@ -16,7 +16,7 @@ pub struct ScoreParams {
     pub side_cm: f64,
 }
 
-pub fn run(ctx: &Job<'_>, p: &ScoreParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &ScoreParams) -> Result<Vec<ScoreRow>> {
     let measured_path = ctx.input("measured")?;
     let measured = read_edges(measured_path)
         .with_context(|| format!("measured edges {}", measured_path.display()))?;
@@ -45,5 +45,6 @@ pub fn run(ctx: &Job<'_>, p: &ScoreParams) -> Result<()> {
         rows.extend(score_edges(&real, &sim, p.side_cm));
         ctx.item_done();
     }
-    write_table(ctx.output("score")?, &rows)
+    write_table(ctx.output("score")?, &rows)?;
+    Ok(rows)
 }

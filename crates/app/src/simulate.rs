@@ -2,7 +2,7 @@
 
 use crate::job::Job;
 use anyhow::{Result, bail};
-use drapelab_core::solve::{NoObserver, Status};
+use drapelab_core::solve::{NoObserver, SolveReport, Status};
 use drapelab_record::simulate_to_dir;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -17,7 +17,7 @@ pub struct SimulateParams {
 }
 
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &SimulateParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &SimulateParams) -> Result<SolveReport> {
     let dir = ctx
         .output("run")?
         .parent()
@@ -44,5 +44,5 @@ pub fn run(ctx: &Job<'_>, p: &SimulateParams) -> Result<()> {
             report.message
         );
     }
-    Ok(())
+    Ok(report)
 }

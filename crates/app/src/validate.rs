@@ -66,7 +66,7 @@ impl Table for ValidationRow {
         "One sample's calibrated parameters validated on the 2-corner hang (seed 000 Table 6).";
 }
 
-pub fn run(ctx: &Job<'_>, p: &ValidateParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &ValidateParams) -> Result<Vec<ValidationRow>> {
     let densities = read_sample_densities(ctx.input("samples")?)?;
     let scene_file = ctx.input("scene")?;
     let results = read_results(ctx.input("calibration")?)?;
@@ -130,5 +130,6 @@ pub fn run(ctx: &Job<'_>, p: &ValidateParams) -> Result<()> {
             curve_distance_pct: opt(d),
         })
         .collect();
-    write_table(ctx.output("validation")?, &rows)
+    write_table(ctx.output("validation")?, &rows)?;
+    Ok(rows)
 }

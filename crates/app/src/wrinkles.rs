@@ -285,7 +285,7 @@ pub fn report_markdown(cfg: &WrinkleConfig, solved: &[SolvedCase]) -> String {
 }
 
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &WrinklesParams) -> Result<()> {
+pub fn run(ctx: &Job<'_>, p: &WrinklesParams) -> Result<Vec<SolvedCase>> {
     let cfg = load_config(ctx.input("config")?)?;
     ctx.started(cfg.cases.len());
     let out = |slot: &str| ctx.optional_output(slot).map(Path::to_path_buf);
@@ -295,9 +295,9 @@ pub fn run(ctx: &Job<'_>, p: &WrinklesParams) -> Result<()> {
         recording: out("recording"),
         markdown: out("markdown"),
     };
-    write_wrinkles(&cfg, &outputs, p)?;
+    let solved = write_wrinkles(&cfg, &outputs, p)?;
     for _ in &cfg.cases {
         ctx.item_done();
     }
-    Ok(())
+    Ok(solved)
 }

@@ -24,6 +24,6 @@ impl StageKind for Benchmark {
     ];
     fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }

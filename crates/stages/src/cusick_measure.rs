@@ -32,6 +32,6 @@ impl StageKind for CusickMeasure {
     ];
     fn run(ctx: &StageContext<'_>, p: &CusickMeasureParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }

@@ -41,6 +41,6 @@ impl StageKind for CusickPredict {
     ];
     fn run(ctx: &StageContext<'_>, p: &CusickPredictParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }

@@ -25,6 +25,6 @@ impl StageKind for FitEdges {
     const OUTPUTS: &'static [Slot] = &[Slot::one("edges", "edges.parquet of every photo")];
     fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }

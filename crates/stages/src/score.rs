@@ -23,6 +23,6 @@ impl StageKind for Score {
     const OUTPUTS: &'static [Slot] = &[Slot::one("score", "score.parquet")];
     fn run(ctx: &StageContext<'_>, p: &ScoreParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }

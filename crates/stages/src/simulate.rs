@@ -21,6 +21,6 @@ impl StageKind for Simulate {
     ];
     fn run(ctx: &StageContext<'_>, p: &SimulateParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }

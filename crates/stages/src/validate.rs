@@ -28,6 +28,6 @@ impl StageKind for Validate {
     )];
     fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }

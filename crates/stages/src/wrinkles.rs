@@ -21,6 +21,6 @@ impl StageKind for Wrinkles {
     ];
     fn run(ctx: &StageContext<'_>, p: &WrinklesParams) -> Result<()> {
         let ctx = &crate::job(ctx);
-        run(ctx, p)
+        run(ctx, p).map(drop)
     }
 }
