@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Newton iterations, factorizations and wall time of every bundled scene with its defaults
+# (issue 34's table): `drapelab simulate` each datasets/scenes/*.toml into a temporary folder and
+# print one CSV row per scene from its run.json. Run it alone (the times are wall times):
+#   bash benches/newton_iterations.sh [path/to/drapelab] > newton.csv
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin="${1:-${CARGO_TARGET_DIR:-target}/release/drapelab}"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+echo "scene,status,iterations,factorizations,wall_time_s,energy_J,minimum"
+for scene in datasets/scenes/*.toml; do
+  name="$(basename "$scene" .toml)"
+  "$bin" -q simulate "$scene" --out "$tmp/$name" >/dev/null 2>&1 || true
+  python3 - "$tmp/$name/run.json" "$name" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))["report"]
+print(f'{sys.argv[2]},{r["status"]},{r["iterations"]},{r["factorizations"]},{r["wall_time_s"]:.3f},{r["energy_J"]:.9e},{r["minimum"]}')
+PY
+done
