@@ -40,28 +40,6 @@ pub struct Job<'a> {
 }
 
 impl Job<'_> {
-    /// A job of `stage` with no files, quiet, relative to `root`.
-    pub fn new(stage: impl Into<String>, root: impl Into<PathBuf>) -> Self {
-        Self {
-            stage: stage.into(),
-            source: PathBuf::new(),
-            root: root.into(),
-            inputs: BTreeMap::new(),
-            outputs: BTreeMap::new(),
-            progress: Box::new(Quiet),
-        }
-    }
-    /// With input `name` = `files`.
-    pub fn with_input(mut self, name: &str, files: &[&Path]) -> Self {
-        self.inputs
-            .insert(name.into(), files.iter().map(|p| p.to_path_buf()).collect());
-        self
-    }
-    /// With output `name` = `file`.
-    pub fn with_output(mut self, name: &str, file: &Path) -> Self {
-        self.outputs.insert(name.into(), file.to_path_buf());
-        self
-    }
     /// "Made by `drapelab run SOURCE` (drapelab VERSION)": the provenance line of every report.
     pub fn made_by(&self) -> String {
         format!(

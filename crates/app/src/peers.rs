@@ -145,23 +145,23 @@ pub fn run(ctx: &Job<'_>, p: &PeersParams) -> Result<()> {
         let peer = run_py(&newton, &[n.to_string(), "1e-6".into()])?;
         let s = bench_scene(&scene, n, SolverKind::Static, 1e-6);
         let sol = solve_scene(&s, &mut NoObserver);
-        rows.push((
-            "static: scipy sparse Newton / drapelab",
-            n,
-            peer["wall_time_s"].as_f64().unwrap_or(f64::NAN),
-            sol.report.wall_time_s,
-            peer["centre_z_m"].as_f64().unwrap_or(f64::NAN),
-            sol.at(n / 2, n / 2).z,
-        ));
-        if let Some(script) = &cholmod {
-            let peer = run_py(script, &[n.to_string(), "1e-6".into()])?;
-            rows.push((
-                "static: CHOLMOD (cvxopt) Newton / drapelab",
+        // A static peer's row: its time and centre height against this solve's.
+        let static_row = |label, peer: &serde_json::Value| {
+            (
+                label,
                 n,
                 peer["wall_time_s"].as_f64().unwrap_or(f64::NAN),
                 sol.report.wall_time_s,
                 peer["centre_z_m"].as_f64().unwrap_or(f64::NAN),
                 sol.at(n / 2, n / 2).z,
+            )
+        };
+        rows.push(static_row("static: scipy sparse Newton / drapelab", &peer));
+        if let Some(script) = &cholmod {
+            let peer = run_py(script, &[n.to_string(), "1e-6".into()])?;
+            rows.push(static_row(
+                "static: CHOLMOD (cvxopt) Newton / drapelab",
+                &peer,
             ));
         }
         ctx.item_done();
