@@ -305,14 +305,12 @@ pub fn barrier_contact(
     } else {
         crate::STANDARD_GRAVITY_M_PER_S2
     };
-    let falling = scene.solver.kind.integrator() == Some(crate::solve::Integrator::ImplicitEuler);
     crate::physics::BarrierContact::for_particles(
         scene.obstacles.clone(),
         scene.contact.distance_m,
         masses,
         fixed,
         g,
-        if falling { 0.0 } else { 0.1 },
     )
 }
 

@@ -201,7 +201,6 @@ fn pedestal_contact(
         masses,
         fixed,
         p.gravity_m_per_s2,
-        0.0,
     )
 }
 

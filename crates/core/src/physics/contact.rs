@@ -2,8 +2,7 @@
 //! particle at distance d from an obstacle, E = κ b(d) with b(d) = −(d − d̂)² ln(d/d̂) for 0 < d < d̂ and
 //! 0 beyond. The energy grows without bound as d → 0, so a line search that keeps the energy finite
 //! keeps every particle outside every obstacle, in any direction; [`EnergyTerm::max_step`] caps each
-//! step so that no particle closes more than 90 % of its gap, counting its approach along the normal
-//! (and, for the static solve, a tenth of its motion overall; see [`BarrierContact::sliding_share`]);
+//! step so that no particle closes more than 90 % of its gap, counting its approach along the normal;
 //! the infinite energy inside an obstacle
 //! makes the line search reject any step that would still end inside.
 
@@ -19,11 +18,6 @@ pub struct BarrierContact {
     pub d_hat_m: f64,
     /// Per particle: κ (J), zero for fixed particles.
     pub kappa_J: Vec<f64>,
-    /// A share of a particle's whole motion counted as approach to a convex obstacle in the step
-    /// bound (0: the exact bound). The static solve keeps 0.1, the bound its equilibria (several on
-    /// folding drapes, which Newton's path picks) were found with; implicit Euler uses 0, so sliding
-    /// along an obstacle never slows it.
-    pub sliding_share: f64,
 }
 
 /// b(d), b'(d), b''(d) of the barrier (zero for d ≥ d̂; infinite energy for d ≤ 0).
@@ -59,7 +53,6 @@ impl BarrierContact {
         masses: &[f64],
         fixed: &[bool],
         g_m_per_s2: f64,
-        sliding_share: f64,
     ) -> Self {
         let kappa_J = masses
             .iter()
@@ -76,7 +69,6 @@ impl BarrierContact {
             obstacles,
             d_hat_m,
             kappa_J,
-            sliding_share,
         }
     }
 
@@ -150,7 +142,7 @@ impl EnergyTerm for BarrierContact {
                 continue;
             }
             for o in &self.obstacles {
-                alpha = alpha.min(gap_bound(o, xp, &dx[p], self.sliding_share));
+                alpha = alpha.min(gap_bound(o, xp, &dx[p]));
             }
         }
         alpha
@@ -173,24 +165,23 @@ impl BarrierContact {
 }
 
 /// The largest fraction of the step `dx` that a particle at `x` may take towards obstacle `o`: its
-/// approach along the outward normal (plus `sliding` times its whole motion) covers at most 90 % of
-/// its gap d. For a convex obstacle the bound with `sliding` = 0 is exact (the segment stays beyond
-/// the tangent plane at the closest point, which the whole obstacle lies behind), so sliding along the
-/// surface is never slowed. A non-convex one (a solid of revolution) may curve into the path: with
-/// `sliding` = 0 the bound is halved until four points along the step keep at least 10 % of the gap.
-fn gap_bound(o: &Obstacle, x: &Vector3<f64>, dx: &Vector3<f64>, sliding: f64) -> f64 {
+/// approach along the outward normal covers at most 90 % of its gap d. For a convex obstacle the
+/// bound is exact (the segment stays beyond the tangent plane at the closest point, which the whole
+/// obstacle lies behind), so sliding along the surface is never slowed. A non-convex one (a solid of
+/// revolution) may curve into the path: the bound is halved until four points along the step keep at
+/// least 10 % of the gap.
+fn gap_bound(o: &Obstacle, x: &Vector3<f64>, dx: &Vector3<f64>) -> f64 {
     let (d, n) = o.signed_distance(x);
     if d <= 0.0 {
         return 0.0;
     }
-    let approach = (-n.dot(dx)).max(0.0) + sliding * dx.norm();
+    let approach = (-n.dot(dx)).max(0.0);
     let mut a = if approach > 0.0 {
         0.9 * d / approach
     } else {
         f64::INFINITY
     };
-    // A share of the whole motion already covers a curved surface (the static solve's bound).
-    if o.is_convex() || sliding > 0.0 {
+    if o.is_convex() {
         return a;
     }
     a = a.min(1.0);

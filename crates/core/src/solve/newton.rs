@@ -4,11 +4,18 @@
 //!
 //! A flat net has no transverse stiffness at the start, so its Hessian is singular: the damping
 //! `μ` (added on the diagonal, scaled by the mean diagonal) keeps every system positive definite,
-//! grows when a factorization or line search fails and shrinks after each accepted step, so the
-//! last iterations are plain Newton with quadratic convergence.
+//! grows when a line search fails and shrinks after each whole step, so the last iterations are
+//! plain Newton with quadratic convergence. An indefinite exact Hessian (compressed springs, a sheet
+//! buckling into a fold) is shifted for that iteration only, up to `shift_max_rel`, then replaced by
+//! the projected one; the shift is not carried on as damping. A nearly inextensible sheet turning
+//! about its supports (a hang, an overhang swinging down) limits straight steps to a fraction of a
+//! spring's length: the step follows the curve x + α dx + ½ α² a, a the geodesic acceleration
+//! (Transtrum & Sethna 2012), which bends it along the arcs the springs allow.
 
 use super::linear::{DofMap, SparseSpd};
-use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
+use super::{
+    DivergenceReason, Globalization, Observer, SolveReport, StateEvent, Status, StopReason,
+};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -43,6 +50,18 @@ pub struct StaticOptions {
     /// instead of the flat one. Default true.
     #[serde(default = "default_true")]
     pub sag_start: bool,
+    /// Follow the curved path x + α dx + ½ α² a, a the step's geodesic acceleration, where a is at
+    /// most twice the step in length and the Hessian is the exact one. Default true.
+    #[serde(default = "default_true")]
+    pub curvilinear: bool,
+    /// The largest shift of an indefinite exact Hessian, relative to its mean diagonal, tried
+    /// (tenfold from 1e-8) before the projected Hessian is used. Default 1e-5.
+    #[serde(default = "default_shift_max")]
+    pub shift_max_rel: f64,
+}
+
+fn default_shift_max() -> f64 {
+    1e-5
 }
 
 fn default_true() -> bool {
@@ -75,6 +94,8 @@ impl Default for StaticOptions {
             strain_bound: default_strain(),
             coarse_start: true,
             sag_start: true,
+            curvilinear: true,
+            shift_max_rel: default_shift_max(),
         }
     }
 }
@@ -125,12 +146,24 @@ struct Workspace {
     dx: Vec<Vector3<f64>>,
     trial: Vec<Vector3<f64>>,
     g_trial: Vec<Vector3<f64>>,
+    g_back: Vec<Vector3<f64>>,
+    /// The step's geodesic acceleration (zero on a straight step).
+    acc: Vec<Vector3<f64>>,
     shift: Vec<f64>,
     /// Levenberg–Marquardt damping relative to the mean free diagonal of the Hessian.
     mu: f64,
-    /// The damping's initial value (it returns there when the Hessian is projected).
-    mu_initial: f64,
+    /// The largest shift of the exact Hessian ([`StaticOptions::shift_max_rel`]).
+    shift_max: f64,
+    /// Whether to take curved steps ([`StaticOptions::curvilinear`]).
+    curvilinear: bool,
+    /// What the globalization did so far.
+    stats: Globalization,
 }
+
+/// The largest geodesic acceleration taken, relative to the step: |½ a| ≤ |dx|.
+const ACCELERATION_MAX: f64 = 1.0;
+/// The finite-difference step (in units of dx) of the acceleration's second derivative.
+const ACCELERATION_FD: f64 = 0.1;
 
 /// Smallest damping used once damping is needed (relative to the mean diagonal).
 const MU_MIN: f64 = 1e-8;
@@ -150,17 +183,22 @@ impl Workspace {
             dx: vec![Vector3::zeros(); x.len()],
             trial: x.to_vec(),
             g_trial: Vec::new(),
+            g_back: Vec::new(),
+            acc: vec![Vector3::zeros(); x.len()],
             shift: vec![0.0; n],
             mu: opts.lm_damping_initial,
-            mu_initial: opts.lm_damping_initial,
+            shift_max: opts.shift_max_rel,
+            curvilinear: opts.curvilinear,
+            stats: Globalization::default(),
         }
     }
 
     /// Factorizes the Hessian in `h` (computed at `x`), shifted by the damping: the exact Hessian
     /// (quadratic convergence; projected Newton stalls on a hanging net whose compressed springs'
-    /// transverse stiffness it drops), its damping raised tenfold while it is indefinite, and the
-    /// projected Hessian (every term's indefinite part clamped), the damping back at its initial
-    /// value, once the shift would have to exceed 1e-3 of the diagonal. False when no damping helps.
+    /// transverse stiffness it drops), shifted further tenfold while it is indefinite up to
+    /// `shift_max` of the diagonal (for this iteration only), then the projected Hessian (every
+    /// term's indefinite part clamped) with the damping, raised tenfold while it fails. False when no
+    /// damping helps.
     fn factorize(
         &mut self,
         model: &Model,
@@ -169,8 +207,9 @@ impl Workspace {
         scale: f64,
         report: &mut SolveReport,
     ) -> bool {
+        let mut shift = self.mu;
         for _ in 0..40 {
-            self.shift.iter_mut().for_each(|s| *s = self.mu * scale);
+            self.shift.iter_mut().for_each(|s| *s = shift * scale);
             // Held components (symmetry planes): a diagonal far above the rest decouples them,
             // and their step is set to zero.
             for &(d, c) in &self.held {
@@ -182,14 +221,15 @@ impl Workspace {
                 report.linear_solves += 1;
                 return true;
             }
-            // Indefinite: shift the exact Hessian (Levenberg–Marquardt) first; only when a large
-            // shift would be needed, use the projected Hessian.
-            if !*projected && self.mu >= 1e-3 {
+            if !*projected && shift * 10.0 <= self.shift_max {
+                shift = (shift * 10.0).max(MU_MIN);
+            } else if !*projected {
                 *projected = true;
                 model.hessian(x, &mut self.h, true);
-                self.mu = self.mu_initial.min(self.mu);
+                shift = self.mu;
             } else {
-                self.mu = (self.mu * 10.0).max(MU_MIN);
+                shift = (shift * 10.0).max(MU_MIN);
+                self.mu = shift;
             }
         }
         false
@@ -198,11 +238,23 @@ impl Workspace {
     /// The Newton step −(H + μD)⁻¹ g into `dx` (zero on fixed particles and held components), and
     /// the directional derivative gᵀdx.
     fn step(&mut self, x_len: usize) -> f64 {
-        for (p, gp) in self.g.iter().enumerate() {
+        let mut dx = std::mem::take(&mut self.dx);
+        let g = std::mem::take(&mut self.g);
+        self.solve_for(&g, &mut dx);
+        let slope = (0..x_len).map(|p| g[p].dot(&dx[p])).sum();
+        self.g = g;
+        self.dx = dx;
+        slope
+    }
+
+    /// −(H + μD)⁻¹ f into `out` with the last factorization, zero on fixed particles and held
+    /// components.
+    fn solve_for(&mut self, f: &[Vector3<f64>], out: &mut [Vector3<f64>]) {
+        for (p, fp) in f.iter().enumerate() {
             if let Some(d) = self.dofs.dof(p) {
-                self.rhs[d] = -gp.x;
-                self.rhs[d + 1] = -gp.y;
-                self.rhs[d + 2] = -gp.z;
+                self.rhs[d] = -fp.x;
+                self.rhs[d + 1] = -fp.y;
+                self.rhs[d + 2] = -fp.z;
             }
         }
         for &(d, c) in &self.held {
@@ -212,15 +264,41 @@ impl Workspace {
         for &(d, c) in &self.held {
             self.rhs[d + c] = 0.0;
         }
-        let mut slope = 0.0;
-        for p in 0..x_len {
-            self.dx[p] = match self.dofs.dof(p) {
+        for (p, o) in out.iter_mut().enumerate() {
+            *o = match self.dofs.dof(p) {
                 Some(d) => Vector3::new(self.rhs[d], self.rhs[d + 1], self.rhs[d + 2]),
                 None => Vector3::zeros(),
             };
-            slope += self.g[p].dot(&self.dx[p]);
         }
-        slope
+    }
+
+    /// The step's geodesic acceleration into `acc` (Transtrum & Sethna 2012): a = −(H + μD)⁻¹ T, T
+    /// the second derivative of the gradient along dx by central differences, so that the path
+    /// x + α dx + ½ α² a also cancels the gradient's second-order change. False (and `acc` zero) when
+    /// that is not finite or |½ a| > [`ACCELERATION_MAX`] |dx|.
+    fn acceleration(&mut self, model: &Model, x: &[Vector3<f64>], load: f64) -> bool {
+        let h = ACCELERATION_FD;
+        for (p, xp) in x.iter().enumerate() {
+            self.trial[p] = xp + self.dx[p] * h;
+        }
+        model.gradient(&self.trial, load, &mut self.g_trial);
+        for (p, xp) in x.iter().enumerate() {
+            self.trial[p] = xp - self.dx[p] * h;
+        }
+        model.gradient(&self.trial, load, &mut self.g_back);
+        let t: Vec<Vector3<f64>> = (0..x.len())
+            .map(|p| (self.g_trial[p] - self.g[p] * 2.0 + self.g_back[p]) / (h * h))
+            .collect();
+        let mut acc = std::mem::take(&mut self.acc);
+        self.solve_for(&t, &mut acc);
+        self.acc = acc;
+        let norm = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
+        let (na, nd) = (norm(&self.acc), norm(&self.dx));
+        let ok = na.is_finite() && 0.5 * na <= ACCELERATION_MAX * nd;
+        if !ok {
+            self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
+        }
+        ok
     }
 
     /// Backtracking (Armijo) line search along `dx` from the step length `alpha` (below 1 where a
@@ -236,8 +314,9 @@ impl Workspace {
         (mut alpha, slope): (f64, f64),
     ) -> Option<f64> {
         for _ in 0..30 {
+            let half = 0.5 * alpha * alpha;
             for (p, xp) in x.iter().enumerate() {
-                self.trial[p] = xp + self.dx[p] * alpha;
+                self.trial[p] = xp + self.dx[p] * alpha + self.acc[p] * half;
             }
             let et = model.energy(&self.trial, load);
             let flat = (et - *e).abs() <= 1e-11 * e.abs().max(1e-300);
@@ -250,16 +329,15 @@ impl Workspace {
                 *e = et;
                 return Some(alpha);
             }
+            self.stats.rejected_trials += 1;
             alpha *= 0.5;
         }
         None
     }
 
-    /// One damped Newton iteration from `x`: factorize, step, line search, then adapt the damping
-    /// (divided by 4 after a full step, raised tenfold from 1e-8 when no step lowers the energy; the
-    /// schedule drapelab has kept since its first static solver: small steps, so that a drape whose equilibrium
-    /// depends on its path — folds on a pedestal, a sheet rolling off a rod, sticky contact —
-    /// follows a quasi-static path). False when no step lowers the energy.
+    /// One damped Newton iteration from `x`: factorize, step (curved where the acceleration is
+    /// small), line search, then adapt the damping (divided by 4 after a whole step, raised tenfold
+    /// from 1e-8 when no step lowers the energy). False when no step lowers the energy.
     fn iterate(
         &mut self,
         model: &Model,
@@ -278,9 +356,23 @@ impl Workspace {
                 return false;
             }
             let slope = self.step(x.len());
-            let bound = model.max_step(x, &self.dx);
+            let mut bound = model.max_step(x, &self.dx);
+            let curved = self.curvilinear && !projected && self.acceleration(model, x, load);
+            if curved {
+                // The bound of the chord to the curve's end as well as of the tangent.
+                let end: Vec<Vector3<f64>> = self
+                    .dx
+                    .iter()
+                    .zip(&self.acc)
+                    .map(|(d, a)| d + a * 0.5)
+                    .collect();
+                bound = bound.min(model.max_step(x, &end));
+            } else {
+                self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
+            }
             match self.line_search(model, x, load, (e, r), (bound.min(1.0), slope)) {
                 Some(alpha) => {
+                    self.count(alpha, bound, (curved, projected));
                     if alpha == 1.0 && bound >= 1.0 {
                         self.mu = if self.mu < 1e-12 { 0.0 } else { self.mu / 4.0 };
                     }
@@ -292,6 +384,20 @@ impl Workspace {
             }
         }
         false
+    }
+
+    /// Counts an accepted step of length `alpha` under the terms' `bound`.
+    fn count(&mut self, alpha: f64, bound: f64, (curved, projected): (bool, bool)) {
+        let s = &mut self.stats;
+        if alpha == 1.0 {
+            s.full_steps += 1;
+        } else if alpha == bound {
+            s.bounded_steps += 1;
+        } else {
+            s.shortened_steps += 1;
+        }
+        s.curved_steps += usize::from(curved);
+        s.projected_steps += usize::from(projected);
     }
 }
 
@@ -423,6 +529,7 @@ fn finish_report(
 ) {
     model.gradient(x, final_load, &mut ws.g);
     report.iterations = iter;
+    report.globalization = ws.stats;
     report.factor_time_s = ws.spd.factor_time_s;
     report.max_residual_N = free_max_residual(model, &ws.g);
     report.max_residual_rel = report.max_residual_N / model.reference_weight();

@@ -137,6 +137,36 @@ pub struct Divergence {
     pub reason: DivergenceReason,
 }
 
+/// What the static solver's globalization did: its Newton iterations by the step they took. Zero
+/// for the dynamic solvers (their Newton steps are counted in the implicit integrator's own report).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct Globalization {
+    /// Iterations whose step was taken whole (α = 1).
+    pub full_steps: usize,
+    /// Iterations whose step the line search shortened (backtracking from α = 1 or from the bound).
+    pub shortened_steps: usize,
+    /// Iterations whose step a term's bound cut first (contact: no particle closes more than 90 %
+    /// of its gap in one step).
+    pub bounded_steps: usize,
+    /// Iterations along the curved path x + α dx + ½ α² a (geodesic acceleration).
+    pub curved_steps: usize,
+    /// Iterations on the projected Hessian (the exact one indefinite beyond the largest shift).
+    pub projected_steps: usize,
+    /// Line-search trials rejected over the solve (an energy that did not fall enough).
+    pub rejected_trials: usize,
+}
+
+impl Globalization {
+    fn add(&mut self, o: &Globalization) {
+        self.full_steps += o.full_steps;
+        self.shortened_steps += o.shortened_steps;
+        self.bounded_steps += o.bounded_steps;
+        self.curved_steps += o.curved_steps;
+        self.projected_steps += o.projected_steps;
+        self.rejected_trials += o.rejected_trials;
+    }
+}
+
 /// The outcome of a solve.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SolveReport {
@@ -182,6 +212,9 @@ pub struct SolveReport {
     /// particle into an obstacle (Baraff–Witkin); 0 for other solvers.
     #[serde(default)]
     pub contact_cut_steps: usize,
+    /// What the static solver's globalization did (its iterations by step).
+    #[serde(default)]
+    pub globalization: Globalization,
 }
 
 impl SolveReport {
@@ -207,6 +240,7 @@ impl SolveReport {
             message: String::new(),
             minimum: None,
             contact_cut_steps: 0,
+            globalization: Globalization::default(),
         }
     }
     /// Whether the final state is an equilibrium that may be written as a result.
@@ -237,6 +271,7 @@ impl SolveReport {
                 t.factorizations += latest.factorizations;
                 t.factor_time_s += latest.factor_time_s;
                 t.wall_time_s += latest.wall_time_s;
+                t.globalization.add(&latest.globalization);
                 t.status = latest.status;
                 t.stop = latest.stop;
                 t.max_residual_N = latest.max_residual_N;
