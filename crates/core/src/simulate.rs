@@ -293,6 +293,7 @@ pub fn solve_model(
         report.factorizations += r.factorizations;
         report.factor_time_s += r.factor_time_s;
         report.wall_time_s += r.wall_time_s;
+        report.globalization.add(&r.globalization);
         report.message += &format!(
             " (from a {}×{} start)",
             grid.nx.div_ceil(2),

@@ -58,6 +58,12 @@ pub struct StaticOptions {
     /// (tenfold from 1e-8) before the projected Hessian is used. Default 1e-5.
     #[serde(default = "default_shift_max")]
     pub shift_max_rel: f64,
+    /// Carry the shift that made an indefinite exact Hessian positive definite on as the damping,
+    /// projecting once it reaches 1e-3 of the diagonal (drapelab's first schedule: a quasi-static
+    /// path of short steps after every indefinite point; the Cusick drape keeps it, its fold counts
+    /// converge with the mesh on that path). False: the shift is the iteration's own. Default false.
+    #[serde(default)]
+    pub carried_damping: bool,
 }
 
 fn default_shift_max() -> f64 {
@@ -95,6 +101,7 @@ impl Default for StaticOptions {
             coarse_start: true,
             sag_start: true,
             curvilinear: true,
+            carried_damping: false,
             shift_max_rel: default_shift_max(),
         }
     }
@@ -156,6 +163,10 @@ struct Workspace {
     shift_max: f64,
     /// Whether to take curved steps ([`StaticOptions::curvilinear`]).
     curvilinear: bool,
+    /// Whether the shift is carried on as damping ([`StaticOptions::carried_damping`]).
+    carried: bool,
+    /// The damping's initial value (where a carried damping returns when the Hessian is projected).
+    mu_initial: f64,
     /// What the globalization did so far.
     stats: Globalization,
 }
@@ -189,6 +200,8 @@ impl Workspace {
             mu: opts.lm_damping_initial,
             shift_max: opts.shift_max_rel,
             curvilinear: opts.curvilinear,
+            carried: opts.carried_damping,
+            mu_initial: opts.lm_damping_initial,
             stats: Globalization::default(),
         }
     }
@@ -221,7 +234,10 @@ impl Workspace {
                 report.linear_solves += 1;
                 return true;
             }
-            if !*projected && shift * 10.0 <= self.shift_max {
+            if self.carried {
+                self.carry_shift(model, x, projected);
+                shift = self.mu;
+            } else if !*projected && shift * 10.0 <= self.shift_max {
                 shift = (shift * 10.0).max(MU_MIN);
             } else if !*projected {
                 *projected = true;
@@ -233,6 +249,18 @@ impl Workspace {
             }
         }
         false
+    }
+
+    /// [`StaticOptions::carried_damping`]: the damping raised tenfold, or the projected Hessian
+    /// with the damping back at its initial value once it reaches 1e-3.
+    fn carry_shift(&mut self, model: &Model, x: &[Vector3<f64>], projected: &mut bool) {
+        if !*projected && self.mu >= 1e-3 {
+            *projected = true;
+            model.hessian(x, &mut self.h, true);
+            self.mu = self.mu_initial.min(self.mu);
+        } else {
+            self.mu = (self.mu * 10.0).max(MU_MIN);
+        }
     }
 
     /// The Newton step −(H + μD)⁻¹ g into `dx` (zero on fixed particles and held components), and

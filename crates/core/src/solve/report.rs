@@ -157,7 +157,8 @@ pub struct Globalization {
 }
 
 impl Globalization {
-    fn add(&mut self, o: &Globalization) {
+    /// Adds another solve's counts (a coarse start, a load increment).
+    pub fn add(&mut self, o: &Globalization) {
         self.full_steps += o.full_steps;
         self.shortened_steps += o.shortened_steps;
         self.bounded_steps += o.bounded_steps;
