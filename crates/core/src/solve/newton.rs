@@ -302,8 +302,8 @@ impl Workspace {
 
     /// The step's geodesic acceleration into `acc` (Transtrum & Sethna 2012): a = −(H + μD)⁻¹ T, T
     /// the second derivative of the gradient along dx by central differences, so that the path
-    /// x + α dx + ½ α² a also cancels the gradient's second-order change. False (and `acc` zero) when
-    /// that is not finite or |½ a| > [`ACCELERATION_MAX`] |dx|.
+    /// x + α dx + ½ α² a also cancels the gradient's second-order change. False when that is not
+    /// finite or |½ a| > [`ACCELERATION_MAX`] |dx|.
     fn acceleration(&mut self, model: &Model, x: &[Vector3<f64>], load: f64) -> bool {
         let h = ACCELERATION_FD;
         for (p, xp) in x.iter().enumerate() {
@@ -314,19 +314,19 @@ impl Workspace {
             self.trial[p] = xp - self.dx[p] * h;
         }
         model.gradient(&self.trial, load, &mut self.g_back);
-        let t: Vec<Vector3<f64>> = (0..x.len())
-            .map(|p| (self.g_trial[p] - self.g[p] * 2.0 + self.g_back[p]) / (h * h))
-            .collect();
-        let mut acc = std::mem::take(&mut self.acc);
-        self.solve_for(&t, &mut acc);
-        self.acc = acc;
-        let norm = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
-        let (na, nd) = (norm(&self.acc), norm(&self.dx));
-        let ok = na.is_finite() && 0.5 * na <= ACCELERATION_MAX * nd;
-        if !ok {
-            self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
+        // T into g_trial (its buffer, so nothing is allocated per iteration).
+        for ((t, g), b) in self.g_trial.iter_mut().zip(&self.g).zip(&self.g_back) {
+            *t = (*t - g * 2.0 + b) / (h * h);
         }
-        ok
+        let (t, mut acc) = (
+            std::mem::take(&mut self.g_trial),
+            std::mem::take(&mut self.acc),
+        );
+        self.solve_for(&t, &mut acc);
+        (self.g_trial, self.acc) = (t, acc);
+        let norm = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
+        let na = norm(&self.acc);
+        na.is_finite() && 0.5 * na <= ACCELERATION_MAX * norm(&self.dx)
     }
 
     /// Backtracking (Armijo) line search along `dx` from the step length `alpha` (below 1 where a
@@ -387,14 +387,12 @@ impl Workspace {
             let mut bound = model.max_step(x, &self.dx);
             let curved = self.curvilinear && !projected && self.acceleration(model, x, load);
             if curved {
-                // The bound of the chord to the curve's end as well as of the tangent.
-                let end: Vec<Vector3<f64>> = self
-                    .dx
-                    .iter()
-                    .zip(&self.acc)
-                    .map(|(d, a)| d + a * 0.5)
-                    .collect();
-                bound = bound.min(model.max_step(x, &end));
+                // The bound of the chord to the curve's end as well as of the tangent (the chord
+                // into g_back, free until the next acceleration).
+                for ((c, d), a) in self.g_back.iter_mut().zip(&self.dx).zip(&self.acc) {
+                    *c = d + a * 0.5;
+                }
+                bound = bound.min(model.max_step(x, &self.g_back));
             } else {
                 self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
             }
