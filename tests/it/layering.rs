@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Each workspace crate and the workspace crates it may depend on.
-const CRATES: [(&str, &[&str]); 7] = [
+const CRATES: [(&str, &[&str]); 8] = [
     ("drapelab-core", &[]),
     ("drapelab-record", &["drapelab-core"]),
     ("drapelab-pipeline", &["drapelab-core"]),
@@ -26,6 +26,16 @@ const CRATES: [(&str, &[&str]); 7] = [
             "drapelab-pipeline",
             "drapelab-app",
             "drapelab-reports",
+        ],
+    ),
+    (
+        "drapelab-python",
+        &[
+            "drapelab-core",
+            "drapelab-record",
+            "drapelab-pipeline",
+            "drapelab-app",
+            "drapelab-stages",
         ],
     ),
     (

@@ -168,24 +168,17 @@ pub fn compute(ctx: &Job<'_>, p: &CalibrateParams, item: usize, part: &Path) -> 
     let Some((sample, measured)) = by_sample.iter().nth(item) else {
         bail!("no sample {item} in {}", ctx.input("edges")?.display());
     };
-    let densities = read_sample_densities(ctx.input("samples")?)?;
-    let scene = sample_scene(ctx.input("scene")?, &densities, sample, p.grid)?;
-    let settings = SampleSettings {
-        runs: p.runs,
-        ica: ica_settings(ctx, p)?,
-        side_cm: p.side_cm,
-        polish_iterations: p.polish_iterations,
-        noise: Noise::for_edges(p.measurement_noise_pct, measured, p.include_systematic),
-        identifiable_rel: p.identifiable_rel,
-        identifiability_window: p.identifiability_window,
-        baseline_cmaes: p.baseline_cmaes,
-    };
+    let (problem, settings) = sample_setup(
+        (ctx.input("scene")?, ctx.input("samples")?),
+        sample,
+        measured,
+        p,
+        ica_settings(ctx, p)?,
+    )?;
     let recorder = match ctx.optional_output("recording") {
         Some(_) => Some(CalibrationRecorder::new(&side(part, "rrd"))?),
         None => None,
     };
-    let mut problem = Problem::new(scene, measured.clone(), p.side_cm);
-    problem.edge_source = p.edge_source;
     let mut observe = |r: usize, ev: &DecadeEvent<'_>| -> Result<()> {
         match &recorder {
             Some(rec) => record_decade(rec, &problem, sample, r, ev, measured, p.side_cm)
@@ -214,6 +207,56 @@ pub fn compute(ctx: &Job<'_>, p: &CalibrateParams, item: usize, part: &Path) -> 
         write_table(&side(part, "comparison.parquet"), &rows)?;
     }
     write_table(part, &[ResultRow::new(sample, &found, p.runs)])
+}
+
+/// The problem and settings of calibrating `sample` against its `measured` edges: the net of
+/// `scene` with the sample's density from the `samples` table (seed 000 Table 2), and `p`'s settings
+/// with ICA's `ica`.
+pub fn sample_setup(
+    (scene, samples): (&Path, &Path),
+    sample: &str,
+    measured: &[EdgeFit],
+    p: &CalibrateParams,
+    ica: IcaSettings,
+) -> Result<(Problem, SampleSettings)> {
+    let densities = read_sample_densities(samples)?;
+    let scene = sample_scene(scene, &densities, sample, p.grid)?;
+    let settings = SampleSettings {
+        runs: p.runs,
+        ica,
+        side_cm: p.side_cm,
+        polish_iterations: p.polish_iterations,
+        noise: Noise::for_edges(p.measurement_noise_pct, measured, p.include_systematic),
+        identifiable_rel: p.identifiable_rel,
+        identifiability_window: p.identifiability_window,
+        baseline_cmaes: p.baseline_cmaes,
+    };
+    let mut problem = Problem::new(scene, measured.to_vec(), p.side_cm);
+    problem.edge_source = p.edge_source;
+    Ok((problem, settings))
+}
+
+/// One sample of an `edges` table calibrated with `p` (which gives `ica`), without files written:
+/// the results row (the Python package's `calibrate`).
+pub fn calibrate_one(
+    (edges, samples, scene): (&Path, &Path, &Path),
+    sample: &str,
+    p: &CalibrateParams,
+) -> Result<ResultRow> {
+    let measured: Vec<EdgeFit> = read_edges(edges)?
+        .into_iter()
+        .filter(|(s, _)| s == sample)
+        .map(|(_, e)| e)
+        .collect();
+    if measured.is_empty() {
+        bail!("{}: no edges of sample `{sample}`", edges.display());
+    }
+    let Some(ica) = p.ica.clone() else {
+        bail!("calibrating one sample needs the ICA settings `ica`");
+    };
+    let (problem, settings) = sample_setup((scene, samples), sample, &measured, p, ica)?;
+    let found = calibrate_sample(&problem, &measured, &settings, &mut |_, _| Ok(()), &|| {})?;
+    Ok(ResultRow::new(sample, &found, p.runs))
 }
 
 /// `results.parquet`, and `evaluations.parquet`, `comparison.parquet` and `calibration.rrd` when

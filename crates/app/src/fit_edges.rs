@@ -24,6 +24,24 @@ pub fn default_degree() -> usize {
     4
 }
 
+/// The edges of one photo, calibrated by `camera` (as `drapelab render` writes it), fitted with
+/// polynomials of `degree` (seed 000 Figs 11-12), each with its systematic uncertainty.
+pub fn photo_edges(
+    photo: &std::path::Path,
+    camera: &std::path::Path,
+    degree: usize,
+) -> Result<Vec<EdgeFit>> {
+    let cam = read_camera(camera)?;
+    let img = read_gray(photo)?;
+    let opts = FitImageOptions {
+        view: cam.view,
+        degree,
+        calibration: cam.calibration(camera)?,
+        pinhole: cam.pinhole,
+    };
+    Ok(with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?.edges)
+}
+
 pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<Vec<(String, EdgeFit)>> {
     let photos: Vec<_> = ctx
         .input_files("photos")
@@ -41,23 +59,14 @@ pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<Vec<(String, EdgeFit)>> 
         .par_iter()
         .map(|photo| {
             let dir = photo.parent().unwrap_or(std::path::Path::new("."));
-            let camera = dir.join("camera.json");
-            let cam = read_camera(&camera)?;
-            let img = read_gray(photo)?;
-            let opts = FitImageOptions {
-                view: cam.view,
-                degree: p.degree,
-                calibration: cam.calibration(&camera)?,
-                pinhole: cam.pinhole,
-            };
-            let fit = with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?;
+            let edges = photo_edges(photo, &dir.join("camera.json"), p.degree)?;
             let sample = dir
                 .strip_prefix(&ctx.root)
                 .unwrap_or(dir)
                 .to_string_lossy()
                 .replace('\\', "/");
             ctx.item_done();
-            Ok(fit.edges.into_iter().map(|e| (sample.clone(), e)).collect())
+            Ok(edges.into_iter().map(|e| (sample.clone(), e)).collect())
         })
         .collect();
     let mut rows = Vec::new();

@@ -474,7 +474,16 @@ impl Scene {
         path: &Path,
         overrides: &[(String, toml::Value)],
     ) -> Result<LoadedScene, InputError> {
-        let file = read_toml_table(path)?;
+        Self::load_table(path, read_toml_table(path)?, overrides)
+    }
+
+    /// [`Scene::load`] of a scene already parsed into a TOML table (the Python package's dict
+    /// scenes); `path` names it in errors and resolves nothing.
+    pub fn load_table(
+        path: &Path,
+        file: toml::Table,
+        overrides: &[(String, toml::Value)],
+    ) -> Result<LoadedScene, InputError> {
         let is_grid = |k: &str| k == "cloth.nx" || k == "cloth.ny";
         let with = |keep: &dyn Fn(&str) -> bool| -> Result<Scene, InputError> {
             let mut table = file.clone();

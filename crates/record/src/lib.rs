@@ -30,7 +30,7 @@ pub use particles::{ParticleRow, read_particles, write_particles};
 pub use parts::{gather_parquet, merge_recordings};
 pub use photo::{fit_photo, render_scene, score_files};
 pub use rrd::RerunRecorder;
-pub use run_dir::simulate_to_dir;
+pub use run_dir::{Simulated, simulate_to_dir, simulate_to_dir_state};
 pub use sampled::{Sampled, StateSink};
 pub use surface_out::{TexturedSurface, glb_bytes, write_glb, write_surface_rrd};
 pub use table::{

@@ -59,7 +59,21 @@ pub fn write_particles(
     let props = crate::table::writer_properties()
         .set_key_value_metadata(Some(kv))
         .build();
-    write_parquet(path, &table_batch(&rows)?, Some(props))
+    // The run metadata also in the Arrow schema, which pyarrow's `read_table(...).schema.metadata`
+    // and polars' `read_parquet_schema`-style readers see (the Parquet key-value pairs alone are
+    // dropped by most dataframe readers).
+    let batch = table_batch(&rows)?;
+    let schema = batch.schema().as_ref().clone().with_metadata(
+        metadata
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.clone()))
+            .collect(),
+    );
+    write_parquet(
+        path,
+        &batch.with_schema(std::sync::Arc::new(schema))?,
+        Some(props),
+    )
 }
 
 /// Reads `particles.parquet` back as (i, j, position) rows.

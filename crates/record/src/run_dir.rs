@@ -50,6 +50,28 @@ pub fn simulate_to_dir(
     out: &Path,
     progress: &mut dyn Observer,
 ) -> Result<SolveReport> {
+    Ok(simulate_to_dir_state(loaded, out, progress)?.report)
+}
+
+/// A scene solved into a folder: its report and final state.
+#[derive(Debug, Clone)]
+pub struct Simulated {
+    /// The solve's report (its status first).
+    pub report: SolveReport,
+    /// The particles' final positions, m, in grid order `j * nx + i`.
+    pub x: Vec<nalgebra::Vector3<f64>>,
+    /// Whether each particle is outside the sheet's shape (a disc's corners).
+    pub absent: Vec<bool>,
+    /// The sheet's grid.
+    pub grid: drapelab_core::cloth::Grid,
+}
+
+/// [`simulate_to_dir`], also returning the final state (the Python package's `simulate`).
+pub fn simulate_to_dir_state(
+    loaded: &LoadedScene,
+    out: &Path,
+    progress: &mut dyn Observer,
+) -> Result<Simulated> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     remove_stale_staging(out);
     let staging = tempfile::Builder::new()
@@ -57,9 +79,9 @@ pub fn simulate_to_dir(
         .suffix(".partial")
         .tempdir_in(out)
         .with_context(|| format!("cannot write into {}", out.display()))?;
-    let (report, written) = simulate_into(loaded, staging.path(), progress)?;
+    let (simulated, written) = simulate_into(loaded, staging.path(), progress)?;
     publish(staging.path(), out, &written)?;
-    Ok(report)
+    Ok(simulated)
 }
 
 /// Removes staging folders that a killed run left in `out`.
@@ -132,7 +154,7 @@ fn simulate_into(
     loaded: &LoadedScene,
     out: &Path,
     progress: &mut dyn Observer,
-) -> Result<(SolveReport, Vec<&'static str>)> {
+) -> Result<(Simulated, Vec<&'static str>)> {
     let scene = &loaded.scene;
     let BuiltScene {
         grid,
@@ -211,5 +233,13 @@ fn simulate_into(
         f.write_all(json.as_bytes())?;
         Ok(())
     })?;
-    Ok((report, written))
+    Ok((
+        Simulated {
+            report,
+            x,
+            absent,
+            grid,
+        },
+        written,
+    ))
 }

@@ -1,0 +1,298 @@
+"""drapelab from Python: simulate how fabric drapes, measure drape, fit photo edges, calibrate, and
+run drapelab's pipelines, with NumPy arrays and dicts back.
+
+Units are SI throughout and named in every key (``energy_J``, ``max_residual_N``, ``z_m``).
+Positions are ``(n, 3)`` float64 arrays in metres in grid order ``j * nx + i``.
+
+Bad input raises :class:`InputError` (a ``ValueError``) whose message names the file or argument
+and the key, as the command line's exit code 2 does. A solve that does not converge is not an
+exception: its :attr:`Result.status` says so (``"max-iterations"``, ``"diverged"``, ...). Long solves
+release the GIL and stop on Ctrl-C (``KeyboardInterrupt``) within about 50 ms of an iteration.
+
+>>> import drapelab
+>>> r = drapelab.simulate("datasets/scenes/hang4.toml", set={"cloth.nx": 21, "cloth.ny": 21})
+>>> r.status, r.positions.shape
+('converged', (441, 3))
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+import shutil
+import tempfile
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _drapelab
+from ._drapelab import InputError
+
+__version__: str = _drapelab.version()
+
+__all__ = [
+    "InputError",
+    "Result",
+    "simulate",
+    "read_scene",
+    "measure_drape",
+    "measure_silhouette",
+    "fit_edges",
+    "calibrate",
+    "run_pipeline",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+#: Every file a simulation may write into its folder (``drapelab simulate --out``).
+SIMULATE_FILES = (
+    "run.json",
+    "particles.parquet",
+    "last_state.parquet",
+    "timeline.mcap",
+    "drape.rrd",
+)
+
+
+def _plain(v: Any) -> Any:
+    """JSON for values NumPy and pathlib hand out (numpy scalars and arrays, paths)."""
+    if isinstance(v, os.PathLike):
+        return os.fspath(v)
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    raise InputError(f"{v!r}: a {type(v).__name__} has no TOML form")
+
+
+def _json(v: Any) -> str:
+    return json.dumps(v, default=_plain)
+
+
+class Result:
+    """One solved scene: its status, final positions and report, and its files.
+
+    Attributes:
+        status: ``"converged"``, or why the solve stopped (``"max-iterations"``, ``"diverged"``,
+            ``"stalled"``, ...); the positions of a solve that did not converge are its last state,
+            never a result.
+        positions: ``(n, 3)`` float64 array, m, grid order ``j * nx + i``.
+        present: ``(n,)`` bool array: False for particles outside the sheet's shape (a disc's
+            corners), which take no part in the solve.
+        triangles: ``(m, 3)`` int64 array of the grid's triangles (indices into ``positions``).
+        nx, ny: particles along x and y.
+        report: the solve's report (dict): ``iterations``, ``energy_J``, ``max_residual_N``,
+            ``wall_time_s``, ``solver``, ``status``, ``globalization``, ...
+        run: the whole ``run.json`` (report, scene with defaults, drape measures, self-contact).
+        folder: where the files are until the result is garbage-collected; :meth:`save` keeps them.
+    """
+
+    def __init__(self, run_json: str, positions: bytes, present: bytes, triangles: bytes,
+                 nx: int, ny: int, native_time_s: float, tmp: tempfile.TemporaryDirectory) -> None:
+        self._tmp = tmp
+        #: Seconds the call spent in Rust: scene loaded, solved, files written, arrays made.
+        self.native_time_s = native_time_s
+        self.folder = pathlib.Path(tmp.name)
+        self.run: Dict[str, Any] = json.loads(run_json)
+        self.report: Dict[str, Any] = self.run["report"]
+        self.status: str = self.run["status"]
+        self.positions = np.frombuffer(positions, dtype="<f8").reshape(-1, 3).copy()
+        self.present = np.frombuffer(present, dtype=np.uint8).astype(bool)
+        self.triangles = np.frombuffer(triangles, dtype="<u4").reshape(-1, 3).astype(np.int64)
+        self.nx = nx
+        self.ny = ny
+
+    @property
+    def converged(self) -> bool:
+        """Whether the solve converged (``status == "converged"``)."""
+        return self.status == "converged"
+
+    @property
+    def scene(self) -> Dict[str, Any]:
+        """The scene as solved, every default filled in."""
+        return self.run["scene"]
+
+    def table_path(self) -> pathlib.Path:
+        """``particles.parquet`` (converged) or ``last_state.parquet`` (not converged)."""
+        name = "particles.parquet" if self.converged else "last_state.parquet"
+        path = self.folder / name
+        if not path.exists():
+            raise RuntimeError(f"no particle table: the solve ended {self.status}")
+        return path
+
+    def to_polars(self):
+        """The particles table (``i``, ``j``, ``x_m``, ``y_m``, ``z_m``, ``present``) as a polars
+        DataFrame (needs ``polars``)."""
+        import polars as pl
+
+        return pl.read_parquet(self.table_path())
+
+    def save(self, folder: PathLike) -> pathlib.Path:
+        """Writes the files ``drapelab simulate --out FOLDER`` writes (``run.json``,
+        ``particles.parquet`` or ``last_state.parquet``, and ``timeline.mcap`` / ``drape.rrd`` when
+        the scene records them) into ``folder``, ``run.json`` last; simulate files of an earlier run
+        that this one did not write are removed, other files left alone. Returns the folder."""
+        out = pathlib.Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        written = [f for f in SIMULATE_FILES if (self.folder / f).exists()]
+        for f in SIMULATE_FILES:
+            if f not in written and (out / f).exists():
+                (out / f).unlink()
+        for f in sorted(written, key=lambda f: f == "run.json"):
+            partial = out / f".{f}.partial"
+            shutil.copyfile(self.folder / f, partial)
+            os.replace(partial, out / f)
+        return out
+
+    def __repr__(self) -> str:
+        r = self.report
+        return (f"<drapelab.Result {self.run['scene'].get('name', '')!r}: {self.status}, "
+                f"{self.nx}×{self.ny} particles, {r.get('iterations')} iterations, "
+                f"residual {r.get('max_residual_N', float('nan')):.3g} N, "
+                f"{r.get('wall_time_s', float('nan')):.3g} s>")
+
+
+def read_scene(path: PathLike) -> Dict[str, Any]:
+    """A scene TOML file as a dict (edit it and pass it to :func:`simulate`)."""
+    return json.loads(_drapelab.read_scene(os.fspath(path)))
+
+
+def simulate(scene: Union[PathLike, Mapping[str, Any]],
+             set: Optional[Mapping[str, Any]] = None) -> Result:
+    """Solves a scene as ``drapelab simulate`` does.
+
+    Args:
+        scene: a scene TOML file's path, or a dict with the same keys (``read_scene`` gives one).
+        set: overrides by dotted key, e.g. ``{"cloth.nx": 21, "material.density_kg_per_m2": 0.2}``;
+            a grid override moves pins and holds to the same material points.
+
+    Returns:
+        The :class:`Result`, converged or not (see its ``status``).
+
+    Raises:
+        InputError: an unknown key, a bad value or an unreadable file, named in the message.
+        KeyboardInterrupt: Ctrl-C during the solve.
+    """
+    overrides = _json(dict(set or {}))
+    if isinstance(scene, Mapping):
+        path, table = None, _json(dict(scene))
+    else:
+        path, table = os.fspath(scene), None
+    tmp = tempfile.TemporaryDirectory(prefix="drapelab-")
+    try:
+        out = _drapelab.simulate(path, table, overrides, tmp.name)
+    except BaseException:
+        tmp.cleanup()
+        raise
+    return Result(*out, tmp=tmp)
+
+
+def _measures(text: str) -> Dict[str, Any]:
+    m = json.loads(text)
+    radii = np.asarray(m["outline_m"], dtype=float)
+    k = np.arange(radii.size)
+    return {
+        "drape_coefficient_pct": m["dc_pct"],
+        "nodes": m["nodes"],
+        "shadow_area_m2": m["area_m2"],
+        "outline_radius_m": radii,
+        "outline_angle_rad": (k + 0.5) * 2 * np.pi / max(radii.size, 1),
+    }
+
+
+def measure_drape(positions: Union[Result, np.ndarray],
+                  triangles: Optional[np.ndarray] = None) -> Dict[str, Any]:
+    """The Cusick drape tester's measures of a draped mesh's vertical projection: the drape
+    coefficient (BS 5058, %, over the tester's 18 cm pedestal and 30 cm specimen), the nodes of its
+    shadow's outline, the shadow's area (m²) and the smoothed outline r(θ) (m, 1° sectors).
+
+    Args:
+        positions: ``(n, 3)`` vertex positions in metres, centred on the pedestal's axis (z up), or a
+            :class:`Result` (its present particles and grid triangles).
+        triangles: ``(m, 3)`` vertex indices (not needed with a Result).
+    """
+    if isinstance(positions, Result):
+        r = positions
+        keep = r.present[r.triangles].all(axis=1)
+        positions, triangles = r.positions, r.triangles[keep]
+    if triangles is None:
+        raise InputError("triangles: give the mesh's (m, 3) triangles")
+    x = np.ascontiguousarray(positions, dtype="<f8")
+    t = np.ascontiguousarray(triangles, dtype="<u4")
+    if x.ndim != 2 or x.shape[1] != 3:
+        raise InputError(f"positions: an (n, 3) array, got shape {x.shape}")
+    return _measures(_drapelab.drape_of_mesh(x.tobytes(), t.tobytes()))
+
+
+def measure_silhouette(photo: PathLike, *, px_per_m: float = 723.2,
+                       centre_px: Sequence[float] = (126.95, 127.44),
+                       threshold: int = 128) -> Dict[str, Any]:
+    """The same measures of a Cusick silhouette photo (a dark shadow on a light ground).
+
+    Args:
+        photo: PNG or JPEG.
+        px_per_m: the photo's scale, pixels per metre (default: the BDP dataset's 256² photos).
+        centre_px: pixel (column, row) of the pedestal's centre.
+        threshold: grey level below which a pixel is shadow.
+    """
+    scale = {"px_per_m": px_per_m, "centre_px": list(centre_px), "threshold": threshold}
+    return _measures(_drapelab.drape_of_silhouette(os.fspath(photo), _json(scale)))
+
+
+def fit_edges(photo: PathLike, camera: Optional[PathLike] = None,
+              degree: int = 4) -> List[Dict[str, Any]]:
+    """The edges of a hanging-fabric photo fitted with polynomials (seed 000 Figs 11-12).
+
+    Args:
+        photo: PNG or JPEG.
+        camera: its ``camera.json`` (as ``drapelab render`` writes it); default: beside the photo.
+        degree: polynomial degree (seed 000: 4).
+
+    Returns:
+        One dict per edge: ``edge``, ``coefficients`` (of x⁰…x^degree, x and y in cm),
+        ``rms_residual_cm``, ``n_points``, ``x_min_cm``, ``x_max_cm``, ``systematic_pct``, ...
+    """
+    photo = pathlib.Path(photo)
+    cam = pathlib.Path(camera) if camera is not None else photo.parent / "camera.json"
+    return json.loads(_drapelab.fit_edges(str(photo), str(cam), degree))
+
+
+def calibrate(edges: PathLike, sample: str, *, samples: PathLike, scene: PathLike,
+              ica: Mapping[str, Any], **params: Any) -> Dict[str, Any]:
+    """One sample calibrated by ICA against its measured edges (seed 000), as a ``calibrate``
+    stage does for each sample, without writing files.
+
+    Args:
+        edges: a fit-edges table (``edges.parquet``).
+        sample: the sample's name in it (its photo's folder, e.g. ``"datasets/knitted/sample_03/hang4"``).
+        samples: the samples table with their densities (``datasets/knitted/knitted_samples.csv``).
+        scene: the net's scene (``datasets/scenes/hang4.toml``).
+        ica: ICA's settings (seed 000 Table 1): ``decades``, ``countries``, ``imperialists``,
+            ``beta``, ``gamma`` (rad), ``revolution_rate``, ``xi``, ``seed``.
+        params: the calibrate stage's other parameters (``runs``, ``grid``, ``side_cm``,
+            ``polish_iterations``, ...; ``drapelab kinds`` lists them with defaults).
+
+    Returns:
+        The results row: calibrated stiffnesses (N/m), natural lengths, the runs' spread and each
+        parameter's identifiability.
+    """
+    p = dict(params, ica=dict(ica))
+    return json.loads(_drapelab.calibrate(os.fspath(edges), os.fspath(samples),
+                                          os.fspath(scene), sample, _json(p)))
+
+
+def run_pipeline(path: PathLike, until: Optional[str] = None,
+                 force: Optional[Sequence[str]] = None) -> Dict[str, Any]:
+    """Runs a pipeline make-style, as ``drapelab run`` does: only stale stages run.
+
+    Args:
+        path: the pipeline file (``pipelines/main.toml``); paths in it are relative to the current
+            folder, as for the command line.
+        until: run only this stage and what it depends on.
+        force: rerun these stages and their dependents even when up to date.
+
+    Returns:
+        ``{"pipeline", "run_dir", "ran": [...], "up_to_date": [...], "failed": {stage: why}, "ok"}``.
+    """
+    return json.loads(_drapelab.run_pipeline(os.fspath(path), until, list(force or [])))

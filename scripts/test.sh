@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# The test suite (the README's test command; .ci/run runs exactly this): the Rust tests, then the
+# Python package built from source and tested with pytest (tests/python/run.sh). Extra arguments go to
+# `cargo test`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo test --release --workspace "$@"
+bash tests/python/run.sh

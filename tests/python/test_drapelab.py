@@ -1,0 +1,263 @@
+"""The Python package against the command line and against physics: run by tests/it/python.rs with the
+package installed (`pip install .`) into a virtual environment the tests make. DRAPELAB_BIN is the
+command line built by the same `cargo test`; the working folder is the repository root."""
+
+import json
+import math
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+try:
+    import tomllib
+except ImportError:  # Python < 3.11
+    tomllib = None
+
+import drapelab
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HANG4 = ROOT / "datasets/scenes/hang4.toml"
+BIN = os.environ["DRAPELAB_BIN"]
+
+
+def cli_simulate(tmp_path, scene, *sets):
+    out = tmp_path / "cli"
+    args = [BIN, "simulate", str(scene), "--out", str(out)]
+    for s in sets:
+        args += ["--set", s]
+    subprocess.run(args, check=True, capture_output=True)
+    return out
+
+
+def test_simulate_equals_the_command_line_to_1e_12_m(tmp_path):
+    r = drapelab.simulate(HANG4, set={"cloth.nx": 21, "cloth.ny": 21})
+    assert r.status == "converged" and r.converged
+    assert r.positions.shape == (441, 3) and r.positions.dtype == np.float64
+    assert r.present.all() and r.triangles.shape == (2 * 20 * 20, 3)
+    t = pq.read_table(cli_simulate(tmp_path, HANG4, "cloth.nx=21", "cloth.ny=21") / "particles.parquet")
+    cli = np.column_stack([t["x_m"].to_numpy(), t["y_m"].to_numpy(), t["z_m"].to_numpy()])
+    order = t["j"].to_numpy() * 21 + t["i"].to_numpy()
+    assert np.abs(r.positions[order] - cli).max() <= 1e-12
+    # Force balance, independently of the solver: the four corners carry the sheet's weight.
+    assert r.report["max_residual_N"] < 1e-6 * 0.045 * 0.25 * 9.80665
+    assert r.report["iterations"] > 0 and r.report["energy_J"] < 0
+
+
+def test_the_table_carries_its_run_metadata_in_the_arrow_schema(tmp_path):
+    r = drapelab.simulate(HANG4)
+    saved = r.save(tmp_path / "run")
+    meta = pq.read_table(saved / "particles.parquet").schema.metadata
+    assert meta[b"status"] == b"converged"
+    assert meta[b"scene"] == b"hang4"
+    assert meta[b"drapelab_version"] == drapelab.__version__.encode()
+    assert meta[b"solver"].decode() == r.report["solver"]
+    assert sorted(p.name for p in saved.iterdir()) == ["particles.parquet", "run.json"]
+    assert json.loads((saved / "run.json").read_text())["status"] == "converged"
+    df = r.to_polars()
+    assert df.columns == ["i", "j", "x_m", "y_m", "z_m", "present"]
+    assert np.allclose(df["z_m"].to_numpy(), r.positions[df["j"].to_numpy() * r.nx + df["i"].to_numpy(), 2], atol=0)
+
+
+@pytest.mark.skipif(tomllib is None, reason="tomllib needs Python 3.11")
+def test_a_dict_scene_equals_its_toml():
+    with open(HANG4, "rb") as f:
+        table = tomllib.load(f)
+    assert drapelab.read_scene(HANG4) == table
+    a = drapelab.simulate(table, set={"cloth.nx": 15, "cloth.ny": 15})
+    b = drapelab.simulate(HANG4, set={"cloth.nx": 15, "cloth.ny": 15})
+    assert a.status == b.status == "converged"
+    assert np.array_equal(a.positions, b.positions)
+    table["material"]["mass_spring"]["stiffness_N_per_m"] = 500.0
+    softer = drapelab.simulate(table, set={"cloth.nx": 15, "cloth.ny": 15})
+    # Softer springs sag further: the centre hangs lower.
+    c = 7 * 15 + 7
+    assert softer.positions[c, 2] < a.positions[c, 2]
+
+
+def test_input_errors_name_the_key():
+    with pytest.raises(drapelab.InputError, match=r"cloth\.nxx") as e:
+        drapelab.simulate(HANG4, set={"cloth.nxx": 5})
+    assert isinstance(e.value, ValueError)
+    with pytest.raises(drapelab.InputError, match=r"set\[\"cloth\.nx\"\].*cloth\.nx"):
+        drapelab.simulate(HANG4, set={"cloth.nx": -3})
+    with pytest.raises(drapelab.InputError, match=r"hang4\.toml.*solver\.static\.max_iterations"):
+        drapelab.simulate(HANG4, set={"solver.static.max_iterations": "many"})
+    table = drapelab.read_scene(HANG4)
+    table["cloth"]["size_x_mm"] = 500
+    with pytest.raises(drapelab.InputError, match=r"scene \(dict\).*size_x_mm"):
+        drapelab.simulate(table)
+    with pytest.raises(drapelab.InputError, match=r"no_such\.toml"):
+        drapelab.simulate("no_such.toml")
+
+
+def test_a_solve_that_does_not_converge_is_a_status_not_an_exception():
+    r = drapelab.simulate(HANG4, set={"cloth.nx": 21, "cloth.ny": 21, "solver.static.max_iterations": 2})
+    assert r.status == "max-iterations" and not r.converged
+    assert r.report["iterations"] == 2
+    assert r.table_path().name == "last_state.parquet"
+    assert np.isfinite(r.positions).all()
+
+
+def test_ctrl_c_stops_a_long_solve_within_a_second(tmp_path):
+    script = textwrap.dedent(f"""
+        import sys, drapelab
+        print("solving", flush=True)
+        try:
+            drapelab.simulate({str(HANG4)!r}, set={{
+                "cloth.nx": 31, "cloth.ny": 31, "solver.kind": "symplectic-euler",
+                "solver.dynamic.dt_s": 1e-5, "solver.dynamic.max_time_s": 1e4,
+                "solver.dynamic.speed_tol_m_per_s": 1e-30, "solver.dynamic.residual_tol_rel": 1e-30}})
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+            sys.exit(3)
+        print("finished", flush=True)
+    """)
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "solving"
+    time.sleep(2.0)
+    assert p.poll() is None, "the solve must still be running"
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=30)
+    waited = time.monotonic() - sent
+    assert p.returncode == 3, (out, err)
+    assert "interrupted" in out
+    assert waited < 1.0, f"stopped {waited:.2f} s after SIGINT"
+
+
+def disc(radius_m, rings=40, sectors=180):
+    """A flat disc mesh at z = 0, centred on the axis."""
+    pts = [(0.0, 0.0, 0.0)]
+    tris = []
+    for k in range(1, rings + 1):
+        r = radius_m * k / rings
+        pts += [(r * math.cos(2 * math.pi * s / sectors), r * math.sin(2 * math.pi * s / sectors), 0.0) for s in range(sectors)]
+    for s in range(sectors):
+        tris.append((0, 1 + s, 1 + (s + 1) % sectors))
+    for k in range(1, rings):
+        a, b = 1 + (k - 1) * sectors, 1 + k * sectors
+        for s in range(sectors):
+            s1 = (s + 1) % sectors
+            tris += [(a + s, b + s, b + s1), (a + s, b + s1, a + s1)]
+    return np.array(pts), np.array(tris)
+
+
+def test_drape_coefficient_of_flat_discs_is_exact():
+    # BS 5058: DC = (S - A_pedestal) / (A_specimen - A_pedestal); the tester's 9 cm pedestal, 15 cm specimen.
+    flat = drapelab.measure_drape(*disc(0.15))
+    assert flat["drape_coefficient_pct"] == pytest.approx(100.0, abs=0.5)
+    half = drapelab.measure_drape(*disc(0.12))
+    assert half["drape_coefficient_pct"] == pytest.approx(100 * (0.12**2 - 0.09**2) / (0.15**2 - 0.09**2), abs=0.5)
+    assert half["nodes"] == 0
+    assert np.allclose(half["outline_radius_m"], 0.12, atol=2e-3)
+
+
+def test_a_cusick_silhouette_and_its_registered_mesh_agree():
+    photo = ROOT / "datasets/cusick/fabric_01/silhouettes/sample_01_capture_1.jpg"
+    m = drapelab.measure_silhouette(photo)
+    assert 20 < m["drape_coefficient_pct"] < 95
+    assert 3 <= m["nodes"] <= 12
+    assert m["outline_radius_m"].shape == (360,)
+    with pytest.raises(drapelab.InputError, match="no_such.png"):
+        drapelab.measure_silhouette("no_such.png")
+
+
+def test_fit_edges_equals_the_command_line(tmp_path):
+    photo = ROOT / "datasets/knitted/sample_01/hang4/photo.png"
+    edges = drapelab.fit_edges(photo)
+    out = tmp_path / "fit"
+    subprocess.run([BIN, "fit-edges", str(photo), "--out", str(out), "--camera-json", str(photo.parent / "camera.json")],
+                   check=True, capture_output=True)
+    rows = pq.read_table(out / "edges.parquet").to_pylist()
+    assert sorted(e["edge"] for e in edges) == sorted({r["edge"] for r in rows}) and edges
+    for e in edges:
+        mine = [r for r in rows if r["edge"] == e["edge"]]
+        assert [r["coefficient"] for r in sorted(mine, key=lambda r: r["power"])] == e["coefficients"]
+        assert len(e["coefficients"]) == 5
+        # A rendered photo of a simulated hang: the polynomial follows the edge to a fraction of a pixel.
+        assert e["rms_residual_cm"] < 0.1 and e["n_points"] > 100
+    with pytest.raises(drapelab.InputError, match="camera.json"):
+        drapelab.fit_edges(photo, camera=tmp_path / "camera.json")
+
+
+@pytest.fixture(scope="module")
+def project(tmp_path_factory):
+    """A small project (one knitted sample's 4-corner photo, the samples table, hang4) whose pipeline
+    fits the photo's edges and solves hang4, run once through `drapelab.run_pipeline`."""
+    root = tmp_path_factory.mktemp("project")
+    for rel in ["datasets/knitted/sample_03/hang4/photo.png", "datasets/knitted/sample_03/hang4/camera.json",
+                "datasets/knitted/knitted_samples.csv", "datasets/scenes/hang4.toml"]:
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_bytes((ROOT / rel).read_bytes())
+    (root / "pipelines").mkdir()
+    (root / "pipelines/p.toml").write_text(textwrap.dedent("""
+        name = "p"
+        [stages.fit4]
+        kind = "fit-edges"
+        inputs.photos = ["datasets/knitted/*/hang4/photo.png"]
+        inputs.cameras = ["datasets/knitted/*/hang4/camera.json"]
+        outputs.edges = "{run}/fit4/edges.parquet"
+        [stages.sim]
+        kind = "simulate"
+        inputs.scene = "datasets/scenes/hang4.toml"
+        outputs.run = "{run}/sim/run.json"
+        outputs.particles = "{run}/sim/particles.parquet"
+        params.set = { "cloth.nx" = 13, "cloth.ny" = 13 }
+    """))
+    cwd = os.getcwd()
+    os.chdir(root)
+    try:
+        first = drapelab.run_pipeline("pipelines/p.toml")
+    finally:
+        os.chdir(cwd)
+    return root, first
+
+
+def test_run_pipeline_is_make_style(project, monkeypatch):
+    root, first = project
+    assert first["ok"] and sorted(first["ran"]) == ["fit4", "sim"], first
+    monkeypatch.chdir(root)
+    again = drapelab.run_pipeline("pipelines/p.toml")
+    assert again["ran"] == [] and sorted(again["up_to_date"]) == ["fit4", "sim"], again
+    forced = drapelab.run_pipeline("pipelines/p.toml", force=["sim"])
+    assert forced["ran"] == ["sim"] and forced["up_to_date"] == ["fit4"]
+    assert (root / "runs/p/sim/particles.parquet").exists()
+    with pytest.raises(drapelab.InputError, match="nope.toml"):
+        drapelab.run_pipeline("pipelines/nope.toml")
+
+
+ICA = {"decades": 4, "countries": 12, "imperialists": 3, "beta": 2.0, "gamma": 0.5,
+       "revolution_rate": 0.1, "xi": 0.1, "seed": 1}
+
+
+def test_calibrate_one_sample_returns_its_row(project, monkeypatch):
+    root, _ = project
+    monkeypatch.chdir(root)
+    edges = "runs/p/fit4/edges.parquet"
+    kw = dict(samples="datasets/knitted/knitted_samples.csv", scene="datasets/scenes/hang4.toml", ica=ICA)
+    row = drapelab.calibrate(edges, "datasets/knitted/sample_03/hang4", runs=1, grid=8, polish_iterations=0, **kw)
+    assert row["sample"] == "datasets/knitted/sample_03/hang4"
+    assert row["runs"] == 1 and row["simulations"] > 0
+    # Seed 000 Table 3's box: 500 to 1200 N/m.
+    assert 500 <= row["stiffness_N_per_m"] <= 1200 and math.isfinite(row["curve_distance_pct"])
+    with pytest.raises(drapelab.InputError, match="runs"):
+        drapelab.calibrate(edges, "datasets/knitted/sample_03/hang4", runs=0, **kw)
+    with pytest.raises(RuntimeError, match="no edges of sample"):
+        drapelab.calibrate(edges, "datasets/knitted/sample_99/hang4", runs=1, **kw)
+
+
+def test_the_example_runs(tmp_path):
+    env = dict(os.environ, MPLBACKEND="Agg", DRAPELAB_EXAMPLE_OUT=str(tmp_path))
+    out = subprocess.run([sys.executable, str(ROOT / "examples/python/sag_sweep.py")], cwd=ROOT, env=env,
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / "sag_vs_stiffness.png").stat().st_size > 1000
+    assert "drape coefficient" in out.stdout
