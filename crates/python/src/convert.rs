@@ -27,28 +27,26 @@ pub fn u32_bytes(v: &[u32]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 
+/// Values of `N` little-endian bytes each, decoded by `from`; `what` names the argument.
+fn from_le<const N: usize, T>(b: &[u8], what: &str, from: fn([u8; N]) -> T) -> PyResult<Vec<T>> {
+    if !b.len().is_multiple_of(N) {
+        return Err(InputError::new_err(format!(
+            "{what}: not a whole number of {N}-byte values"
+        )));
+    }
+    Ok(b.chunks(N)
+        .map(|c| from(c.try_into().expect("N bytes")))
+        .collect())
+}
+
 /// f64 values from little-endian bytes.
 pub fn bytes_f64(b: &[u8]) -> PyResult<Vec<f64>> {
-    if !b.len().is_multiple_of(8) {
-        return Err(InputError::new_err(
-            "positions: not a whole number of float64 values",
-        ));
-    }
-    Ok(b.chunks(8)
-        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-        .collect())
+    from_le(b, "positions", f64::from_le_bytes)
 }
 
 /// u32 values from little-endian bytes.
 pub fn bytes_to_u32(b: &[u8]) -> PyResult<Vec<u32>> {
-    if !b.len().is_multiple_of(4) {
-        return Err(InputError::new_err(
-            "triangles: not a whole number of uint32 values",
-        ));
-    }
-    Ok(b.chunks(4)
-        .map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")))
-        .collect())
+    from_le(b, "triangles", u32::from_le_bytes)
 }
 
 /// The overrides of `set` (a JSON object of dotted keys), in its order.

@@ -117,12 +117,13 @@ fn drape_of_mesh(positions: &[u8], triangles: &[u8]) -> PyResult<String> {
             "triangles: vertex {bad} of {n} positions"
         )));
     }
+    shadow(&drapelab_core::cusick::mesh_projection(&pts, &tris))
+}
+
+/// The tester's measures of a shadow as JSON text.
+fn shadow(p: &drapelab_core::measure::Projection) -> PyResult<String> {
     let tester = drapelab_core::cusick::Tester::default();
-    let m = drapelab_core::cusick::shadow_measures(
-        &drapelab_core::cusick::mesh_projection(&pts, &tris),
-        &tester,
-    );
-    json(&m)
+    json(&drapelab_core::cusick::shadow_measures(p, &tester))
 }
 
 /// The same measures of a silhouette photo (dark shadow on light), with its scale as JSON text
@@ -134,12 +135,7 @@ fn drape_of_silhouette(path: &str, scale_json: &str) -> PyResult<String> {
     let img = image::open(path)
         .map_err(|e| InputError::new_err(format!("{path}: cannot read the photo: {e}")))?
         .to_luma8();
-    let tester = drapelab_core::cusick::Tester::default();
-    let m = drapelab_core::cusick::shadow_measures(
-        &drapelab_core::cusick::silhouette_projection(&img, &scale),
-        &tester,
-    );
-    json(&m)
+    shadow(&drapelab_core::cusick::silhouette_projection(&img, &scale))
 }
 
 /// The edges of a photo (seed 000 Figs 11-12) calibrated by `camera` (camera.json); JSON text.
