@@ -20,6 +20,7 @@
 //! and n no longer changes (when Eq. 10 alternates between two values, n is held at the larger).
 
 mod config;
+pub mod full;
 mod mesh;
 
 pub use config::{Defaults, SeedResult, Sweep, WrinkleCase, WrinkleConfig, load_config};

@@ -1,0 +1,243 @@
+//! Seed 002's hung sheet as a full simulation (issue 36, in progress): the continuum sheet (membrane
+//! E·t both ways, shear E·t/(2(1 + ν)), bending and twist D = E t³/(12(1 − ν²))) of the case's L × h,
+//! hung by its two top corners l = L − 2d apart under gravity (−z), solved from a vertical start
+//! compressed along the supports with a seeded out-of-plane ripple; and the wrinkles measured on the
+//! solved sheet by the seed's definitions (the centre fibre, Fig. 3).
+
+use super::{WrinkleInputs, support_span_m};
+use crate::error::InputError;
+use crate::scene::{LoadedScene, Scene};
+use nalgebra::Vector3;
+use rand::{Rng, SeedableRng};
+use serde::Serialize;
+use std::path::Path;
+
+/// The continuum scene of a case on an `nx × ny` grid: the rest state is the flat L × h sheet (grid
+/// x along the supports, grid y up the sheet, the top row at y = h), its two top corners pinned.
+pub fn hung_sheet_scene(
+    inp: &WrinkleInputs,
+    nx: usize,
+    ny: usize,
+) -> Result<LoadedScene, InputError> {
+    let nu = inp.poisson_ratio;
+    let e_t = inp.youngs_modulus_Pa * inp.thickness_m;
+    let g_t = e_t / (2.0 * (1.0 + nu));
+    let d = inp.youngs_modulus_Pa * inp.thickness_m.powi(3) / (12.0 * (1.0 - nu * nu));
+    let rho = inp.weight_N_per_m2 / crate::STANDARD_GRAVITY_M_PER_S2;
+    let text = format!(
+        "name = \"wrinkles-full\"\n\
+         [cloth]\nsize_x_m = {L}\nsize_y_m = {h}\nnx = {nx}\nny = {ny}\n\
+         areal_density_kg_per_m2 = {rho}\n\
+         [material.continuum]\ntensile_warp_N_per_m = {e_t}\ntensile_weft_N_per_m = {e_t}\n\
+         shear_N_per_m = {g_t}\nbending_warp_N_m = {d}\nbending_weft_N_m = {d}\n\
+         bending_twist_N_m = {d}\nthickness_m = {t}\n\
+         [boundary]\npin_corners = [\"xmin_ymax\", \"xmax_ymax\"]\n\
+         [solver]\nkind = \"static\"\n[solver.static]\nmax_iterations = 3000\n",
+        L = inp.length_m,
+        h = inp.height_m,
+        t = inp.thickness_m,
+    );
+    let table: toml::Table = text
+        .parse()
+        .map_err(|e| InputError::new("wrinkles-full", "", format!("{e}")))?;
+    Scene::load_table(Path::new("wrinkles-full"), table, &[])
+}
+
+/// The start of a hung sheet: vertical (x along the supports, z up, the top row at z = 0), every
+/// row compressed to the supports' span l, and an out-of-plane ripple y of `amplitude_m` from
+/// six sine modes with seeded wavenumbers and phases (breaking the mirror symmetry as a real
+/// sheet's imperfections do). Grid order as `grid` (j · nx + i).
+pub fn hung_start(
+    inp: &WrinkleInputs,
+    grid: &crate::cloth::Grid,
+    amplitude_m: f64,
+    seed: u64,
+) -> Vec<Vector3<f64>> {
+    let (len, h, l) = (inp.length_m, inp.height_m, support_span_m(inp));
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let modes: Vec<[f64; 4]> = (0..6)
+        .map(|_| {
+            [
+                rng.random_range(1..=12) as f64,
+                rng.random_range(1..=3) as f64,
+                rng.random_range(0.0..std::f64::consts::TAU),
+                rng.random_range(-1.0..1.0),
+            ]
+        })
+        .collect();
+    let pi = std::f64::consts::PI;
+    grid.flat_positions()
+        .iter()
+        .map(|p| {
+            let (s, eta) = (p.x / len, (h - p.y) / h);
+            let y: f64 = modes
+                .iter()
+                .map(|[kv, ku, phase, a]| a * (pi * kv * eta + phase).sin() * (pi * ku * s).sin())
+                .sum::<f64>()
+                * amplitude_m
+                / modes.len() as f64;
+            Vector3::new((p.x - 0.5 * len) * l / len, y, p.y - h)
+        })
+        .collect()
+}
+
+/// A case solved on an `nx × ny` grid from [`hung_start`] (ripple `amplitude_m`, `seed`): the
+/// static equilibrium (or why there is none), the grid and the final positions.
+pub fn solve_hung(
+    inp: &WrinkleInputs,
+    (nx, ny): (usize, usize),
+    amplitude_m: f64,
+    seed: u64,
+) -> Result<crate::simulate::Solution, InputError> {
+    let loaded = hung_sheet_scene(inp, nx, ny)?;
+    let start = hung_start(inp, &loaded.scene.grid(), amplitude_m, seed);
+    Ok(crate::simulate::solve_scene_from(
+        &loaded.scene,
+        &start,
+        &mut crate::solve::NoObserver,
+    ))
+}
+
+/// The wrinkles of a solved hung sheet: its centre fibre (column nx/2, top to bottom; depth below
+/// the supports −z, out of plane y), lobes counted from `threshold_rel` of the largest |y|.
+pub fn sheet_wrinkles(
+    grid: &crate::cloth::Grid,
+    x: &[Vector3<f64>],
+    threshold_rel: f64,
+) -> FibreWrinkles {
+    let i = grid.nx / 2;
+    let fibre: Vec<&Vector3<f64>> = (0..grid.ny).rev().map(|j| &x[grid.index(i, j)]).collect();
+    let depth: Vec<f64> = fibre.iter().map(|p| -p.z).collect();
+    let y: Vec<f64> = fibre.iter().map(|p| p.y).collect();
+    fibre_wrinkles(&depth, &y, threshold_rel)
+}
+
+/// Wrinkles seen on the centre fibre of a hung sheet (seed 002 Fig. 3): the fibre crosses the n
+/// strips between wrinkle lines, each strip turning the sheet from one side to the other.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FibreWrinkles {
+    /// Number of wrinkles n: sign changes of the out-of-plane displacement down the fibre, counted
+    /// between excursions beyond the threshold (so noise near zero does not count).
+    pub n: usize,
+    /// Largest out-of-plane displacement |z| on the fibre, m.
+    pub zmax_m: f64,
+    /// Depth below the supports of each wrinkle line (the extremum of each lobe), top first, m.
+    pub line_depths_m: Vec<f64>,
+    /// The ratio Q = (a₀/a_n)^(1/n) of the deepest to the shallowest line depth (Eq. 5); None with
+    /// no wrinkle.
+    pub q: Option<f64>,
+}
+
+/// Wrinkles of a fibre sampled top to bottom: depths below the supports (m) and out-of-plane
+/// displacements (m); a lobe counts when it reaches `threshold_rel` of the largest |z|.
+pub fn fibre_wrinkles(depth_m: &[f64], z_m: &[f64], threshold_rel: f64) -> FibreWrinkles {
+    let zmax = z_m.iter().fold(0.0f64, |m, z| m.max(z.abs()));
+    let threshold = threshold_rel * zmax;
+    let mut lobes: Vec<(f64, f64)> = Vec::new(); // (sign, depth at the lobe's extremum)
+    let mut best = 0.0f64;
+    for (&d, &z) in depth_m.iter().zip(z_m) {
+        if z.abs() < threshold || zmax == 0.0 {
+            continue;
+        }
+        let s = z.signum();
+        match lobes.last_mut() {
+            Some((sign, at)) if *sign == s => {
+                if z.abs() > best {
+                    best = z.abs();
+                    *at = d;
+                }
+            }
+            _ => {
+                lobes.push((s, d));
+                best = z.abs();
+            }
+        }
+    }
+    let n = lobes.len().saturating_sub(1);
+    let line_depths_m: Vec<f64> = lobes.iter().map(|&(_, d)| d).collect();
+    let q = (n > 0).then(|| {
+        let (shallow, deep) = (line_depths_m[0].abs(), line_depths_m[n].abs());
+        (deep / shallow.max(f64::MIN_POSITIVE)).powf(1.0 / n as f64)
+    });
+    FibreWrinkles {
+        n,
+        zmax_m: zmax,
+        line_depths_m,
+        q,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A synthetic sheet whose centre fibre is a cosine of n half-waves: n sign changes, n + 1
+    /// lines at the half-waves' extrema, z_max its amplitude.
+    #[test]
+    fn a_cosine_fibre_of_known_n_is_counted_exactly() {
+        for n in 1..=17usize {
+            let m = 400;
+            let depth: Vec<f64> = (0..m).map(|k| 1.4 * k as f64 / (m - 1) as f64).collect();
+            let z: Vec<f64> = depth
+                .iter()
+                .map(|d| 0.05 * (std::f64::consts::PI * n as f64 * d / 1.4).cos())
+                .collect();
+            let w = fibre_wrinkles(&depth, &z, 0.1);
+            assert_eq!(w.n, n, "n = {n}");
+            assert!((w.zmax_m - 0.05).abs() < 1e-12);
+            assert_eq!(w.line_depths_m.len(), n + 1);
+            for (i, d) in w.line_depths_m.iter().enumerate() {
+                assert!((d - 1.4 * i as f64 / n as f64).abs() <= 1.4 / (m - 1) as f64);
+            }
+        }
+    }
+
+    #[test]
+    fn noise_below_the_threshold_adds_no_wrinkle_and_a_flat_fibre_has_none() {
+        let depth: Vec<f64> = (0..100).map(|k| k as f64 * 0.01).collect();
+        let z: Vec<f64> = depth
+            .iter()
+            .enumerate()
+            .map(|(k, d)| {
+                (std::f64::consts::PI * d).sin() * 0.02 + if k % 2 == 0 { 1e-4 } else { -1e-4 }
+            })
+            .collect();
+        assert_eq!(fibre_wrinkles(&depth, &z, 0.1).n, 0);
+        let flat = fibre_wrinkles(&depth, &vec![0.0; 100], 0.1);
+        assert_eq!((flat.n, flat.zmax_m, flat.q), (0, 0.0, None));
+    }
+
+    #[test]
+    fn the_hung_sheet_starts_vertical_between_its_supports_with_its_rest_state_flat() {
+        let inp = crate::wrinkles::WrinkleInputs {
+            length_m: 1.4,
+            height_m: 1.4,
+            thickness_m: 0.25e-3,
+            youngs_modulus_Pa: 165e6,
+            poisson_ratio: 0.3,
+            weight_N_per_m2: 1.5,
+            support_displacement_m: 0.1,
+            buckling_constant: 135.0,
+            tolerance_rel: 0.05,
+            max_iterations: 50,
+            initial_zmax_m: 0.014,
+            simpson_intervals: 200,
+        };
+        let loaded = hung_sheet_scene(&inp, 15, 15).expect("a valid scene");
+        let grid = loaded.scene.grid();
+        let x = hung_start(&inp, &grid, 1e-3, 7);
+        let (tl, tr) = (grid.index(0, 14), grid.index(14, 14));
+        assert!((x[tl] - Vector3::new(-0.6, x[tl].y, 0.0)).norm() < 1e-12);
+        assert!((x[tr] - Vector3::new(0.6, x[tr].y, 0.0)).norm() < 1e-12);
+        assert!(
+            x.iter()
+                .all(|p| p.y.abs() <= 1e-3 && p.z <= 1e-12 && p.z >= -1.4 - 1e-12)
+        );
+        assert_ne!(
+            x,
+            hung_start(&inp, &grid, 1e-3, 8),
+            "the seed changes the ripple"
+        );
+        assert_eq!(x, hung_start(&inp, &grid, 1e-3, 7), "and only the seed");
+    }
+}
