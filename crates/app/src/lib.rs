@@ -29,6 +29,7 @@ pub mod sweep_table;
 pub mod tune;
 pub mod validate;
 pub mod wrinkles;
+pub mod wrinkles_full;
 
 pub use job::{Job, Progress, Quiet};
 
@@ -50,6 +51,9 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<crate::tune::MainEffectRow>()?,
         md::<crate::wrinkles::WrinkleRow>()?,
         md::<crate::wrinkles::WrinkleMeshRow>()?,
+        md::<crate::wrinkles_full::WrinkleFullRow>()?,
+        md::<crate::wrinkles_full::FibreRow>()?,
+        md::<crate::wrinkles_full::StartRow>()?,
         md::<drapelab_core::benchmark::BenchRow>()?,
         md::<drapelab_core::benchmark::PopulationRow>()?,
         md::<drapelab_core::benchmark::SkipRow>()?,

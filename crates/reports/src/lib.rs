@@ -10,3 +10,5 @@ pub mod cusick_report;
 pub mod montage;
 pub mod report;
 pub mod seed003_report;
+pub mod wrinkles_report;
+pub mod wrinkles_text;

@@ -23,6 +23,7 @@ mod sweep;
 mod tune;
 mod validate;
 mod wrinkles;
+mod wrinkles_simulate;
 
 pub use benchmark::{Benchmark, BenchmarkParams};
 pub use benchmark_report::{BenchmarkReport, BenchmarkReportParams};
@@ -49,6 +50,7 @@ pub use validate::{Validate, ValidateParams};
 pub use wrinkles::{
     SolvedCase, WrinkleOutputs, Wrinkles, WrinklesParams, report_markdown, write_wrinkles,
 };
+pub use wrinkles_simulate::{WrinklesSimulate, WrinklesSimulateParams};
 
 use drapelab_pipeline::{Registry, Slot};
 
@@ -100,6 +102,7 @@ pub fn registry() -> Registry {
         .with::<Tune>()
         .with::<CalibrationReport>()
         .with::<Wrinkles>()
+        .with::<WrinklesSimulate>()
         .with::<Seed003Report>()
         .with::<Benchmark>()
         .with::<Peers>()

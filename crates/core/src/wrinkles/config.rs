@@ -14,7 +14,8 @@ pub struct Defaults {
     #[serde(default = "d_nu")]
     pub poisson_ratio: f64,
     /// Load constant c of Eq. 7 (the seed gives none). Default 135: Q_c = 1.29 for Table I's middle
-    /// row (h = 140 cm) with ν = 0.3.
+    /// row (h = 140 cm) with ν = 0.3, the seed's reading. The bundled config sets 1931, the reading
+    /// full simulations of the twelve sheets support (reports/wrinkles.md).
     #[serde(default = "d_c")]
     pub buckling_constant: f64,
     /// Relative tolerance on the length L' of Eq. 8 against L. Default 0.05 (the seed's).

@@ -14,14 +14,17 @@ use std::path::Path;
 
 /// The continuum scene of a case on an `nx × ny` grid: the rest state is the flat L × h sheet (grid
 /// x along the supports, grid y up the sheet, the top row at y = h), its two top corners pinned.
+/// The in-plane shear stiffness is `shear_ratio` times the isotropic E·t/(2(1 + ν)) (1: the seed's
+/// isotropic sheet; a woven fabric's is two to four orders of magnitude lower).
 pub fn hung_sheet_scene(
     inp: &WrinkleInputs,
     nx: usize,
     ny: usize,
+    shear_ratio: f64,
 ) -> Result<LoadedScene, InputError> {
     let nu = inp.poisson_ratio;
     let e_t = inp.youngs_modulus_Pa * inp.thickness_m;
-    let g_t = e_t / (2.0 * (1.0 + nu));
+    let g_t = shear_ratio * e_t / (2.0 * (1.0 + nu));
     let d = inp.youngs_modulus_Pa * inp.thickness_m.powi(3) / (12.0 * (1.0 - nu * nu));
     let rho = inp.weight_N_per_m2 / crate::STANDARD_GRAVITY_M_PER_S2;
     let text = format!(
@@ -43,13 +46,66 @@ pub fn hung_sheet_scene(
     Scene::load_table(Path::new("wrinkles-full"), table, &[])
 }
 
-/// The start of a hung sheet: vertical (x along the supports, z up, the top row at z = 0), every
-/// row compressed to the supports' span l, and an out-of-plane ripple y of `amplitude_m` from
+/// How a hung sheet starts, before gravity and the supports find its equilibrium. Written
+/// "compressed", "arc" or "folded-K" (K ≥ 1) in configs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum HungStart {
+    /// Vertical, every row compressed uniformly to the supports' span l (a membrane strain of
+    /// l/L − 1 everywhere, which the sheet must buckle away).
+    Compressed,
+    /// Vertical, every row bent in plan into the circular arc of length L whose chord is l: free of
+    /// membrane strain, so no fold is put in by the start; gravity and the supports make them.
+    Arc,
+    /// Vertical, every row compressed to l and waved in plan into K half sines whose amplitude
+    /// gives the row about its length L: K folds put in by hand, to see whether they stay.
+    Folded(u32),
+}
+
+impl std::fmt::Display for HungStart {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            HungStart::Compressed => write!(f, "compressed"),
+            HungStart::Arc => write!(f, "arc"),
+            HungStart::Folded(k) => write!(f, "folded-{k}"),
+        }
+    }
+}
+
+impl TryFrom<String> for HungStart {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        match s.as_str() {
+            "compressed" => Ok(HungStart::Compressed),
+            "arc" => Ok(HungStart::Arc),
+            _ => s
+                .strip_prefix("folded-")
+                .and_then(|k| k.parse::<u32>().ok())
+                .filter(|&k| k >= 1)
+                .map(HungStart::Folded)
+                .ok_or_else(|| {
+                    format!(
+                        "`{s}` is no start: use \"compressed\", \"arc\" or \"folded-K\" (K ≥ 1)"
+                    )
+                }),
+        }
+    }
+}
+
+impl From<HungStart> for String {
+    fn from(s: HungStart) -> String {
+        s.to_string()
+    }
+}
+
+/// The start of a hung sheet: vertical (x along the supports, z up, the top row at z = 0), each row
+/// spanning the supports' l as `start` says, plus an out-of-plane ripple y of `amplitude_m` from
 /// six sine modes with seeded wavenumbers and phases (breaking the mirror symmetry as a real
 /// sheet's imperfections do). Grid order as `grid` (j · nx + i).
 pub fn hung_start(
     inp: &WrinkleInputs,
     grid: &crate::cloth::Grid,
+    start: HungStart,
     amplitude_m: f64,
     seed: u64,
 ) -> Vec<Vector3<f64>> {
@@ -66,6 +122,7 @@ pub fn hung_start(
         })
         .collect();
     let pi = std::f64::consts::PI;
+    let radius = arc_radius_m(len, l);
     grid.flat_positions()
         .iter()
         .map(|p| {
@@ -76,21 +133,72 @@ pub fn hung_start(
                 .sum::<f64>()
                 * amplitude_m
                 / modes.len() as f64;
-            Vector3::new((p.x - 0.5 * len) * l / len, y, p.y - h)
+            let u = (p.x - 0.5 * len) * l / len;
+            let (x, bulge) = match (start, radius) {
+                (HungStart::Arc, Some(r)) => {
+                    let phi = (p.x - 0.5 * len) / r;
+                    (r * phi.sin(), r * (phi.cos() - (0.5 * len / r).cos()))
+                }
+                (HungStart::Folded(k), Some(_)) => {
+                    // A sine of k half-waves over l has length ≈ l (1 + (kπa/l)²/4) = L.
+                    let k = f64::from(k);
+                    let a = 2.0 * l / (k * pi) * (len / l - 1.0).sqrt();
+                    (u, a * (k * pi * (u + 0.5 * l) / l).sin())
+                }
+                _ => (u, 0.0),
+            };
+            Vector3::new(x, y + bulge, p.y - h)
         })
         .collect()
 }
 
-/// A case solved on an `nx × ny` grid from [`hung_start`] (ripple `amplitude_m`, `seed`): the
-/// static equilibrium (or why there is none), the grid and the final positions.
+/// Radius of the circular arc of length `len` whose chord is `chord` (bisection on the half
+/// angle θ: sin θ / θ = chord / len); None when the chord is not shorter than the arc.
+pub fn arc_radius_m(len: f64, chord: f64) -> Option<f64> {
+    let ratio = chord / len;
+    if !(ratio > 0.0 && ratio < 1.0) {
+        return None;
+    }
+    let (mut lo, mut hi) = (1e-9, std::f64::consts::PI);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid.sin() / mid > ratio {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * len / (0.5 * (lo + hi)))
+}
+
+/// How a hung sheet is set up besides its case and grid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HungSetup {
+    /// The start.
+    pub start: HungStart,
+    /// Amplitude of the start's out-of-plane ripple, m.
+    pub ripple_amplitude_m: f64,
+    /// Seed of the ripple.
+    pub seed: u64,
+    /// In-plane shear stiffness as a fraction of the isotropic E·t/(2(1 + ν)).
+    pub shear_ratio: f64,
+}
+
+/// A case solved on an `nx × ny` grid as `setup` says: the static equilibrium (or why there is
+/// none), the grid and the final positions.
 pub fn solve_hung(
     inp: &WrinkleInputs,
     (nx, ny): (usize, usize),
-    amplitude_m: f64,
-    seed: u64,
+    setup: &HungSetup,
 ) -> Result<crate::simulate::Solution, InputError> {
-    let loaded = hung_sheet_scene(inp, nx, ny)?;
-    let start = hung_start(inp, &loaded.scene.grid(), amplitude_m, seed);
+    let loaded = hung_sheet_scene(inp, nx, ny, setup.shear_ratio)?;
+    let start = hung_start(
+        inp,
+        &loaded.scene.grid(),
+        setup.start,
+        setup.ripple_amplitude_m,
+        setup.seed,
+    );
     Ok(crate::simulate::solve_scene_from(
         &loaded.scene,
         &start,
@@ -167,6 +275,47 @@ pub fn fibre_wrinkles(depth_m: &[f64], z_m: &[f64], threshold_rel: f64) -> Fibre
     }
 }
 
+/// A choice among candidates (a threshold, a constant) made by leave-one-out over cases.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LeaveOneOut {
+    /// The candidate chosen on all cases (the first of the best).
+    pub chosen: usize,
+    /// For each case: the candidate chosen on the other cases, and whether it holds on this one.
+    pub held_out: Vec<(usize, bool)>,
+}
+
+impl LeaveOneOut {
+    /// Cases where the candidate chosen without them holds.
+    pub fn held_out_hits(&self) -> usize {
+        self.held_out.iter().filter(|h| h.1).count()
+    }
+}
+
+/// Leave-one-out over `ok[case][candidate]` (does the candidate hold on the case): for each case
+/// the candidate that holds on most other cases (ties: the first), scored on the case left out.
+/// Candidates are given in order of preference (e.g. the smallest threshold first).
+pub fn leave_one_out(ok: &[Vec<bool>]) -> LeaveOneOut {
+    let candidates = ok.first().map_or(0, Vec::len);
+    let best = |skip: Option<usize>| -> usize {
+        let hits = |c: usize| {
+            ok.iter()
+                .enumerate()
+                .filter(|&(k, row)| Some(k) != skip && row[c])
+                .count()
+        };
+        (0..candidates).fold(0, |b, c| if hits(c) > hits(b) { c } else { b })
+    };
+    LeaveOneOut {
+        chosen: best(None),
+        held_out: (0..ok.len())
+            .map(|k| {
+                let c = best(Some(k));
+                (c, ok[k][c])
+            })
+            .collect(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -223,9 +372,9 @@ mod tests {
             initial_zmax_m: 0.014,
             simpson_intervals: 200,
         };
-        let loaded = hung_sheet_scene(&inp, 15, 15).expect("a valid scene");
+        let loaded = hung_sheet_scene(&inp, 15, 15, 1.0).expect("a valid scene");
         let grid = loaded.scene.grid();
-        let x = hung_start(&inp, &grid, 1e-3, 7);
+        let x = hung_start(&inp, &grid, HungStart::Compressed, 1e-3, 7);
         let (tl, tr) = (grid.index(0, 14), grid.index(14, 14));
         assert!((x[tl] - Vector3::new(-0.6, x[tl].y, 0.0)).norm() < 1e-12);
         assert!((x[tr] - Vector3::new(0.6, x[tr].y, 0.0)).norm() < 1e-12);
@@ -235,9 +384,54 @@ mod tests {
         );
         assert_ne!(
             x,
-            hung_start(&inp, &grid, 1e-3, 8),
+            hung_start(&inp, &grid, HungStart::Compressed, 1e-3, 8),
             "the seed changes the ripple"
         );
-        assert_eq!(x, hung_start(&inp, &grid, 1e-3, 7), "and only the seed");
+        assert_eq!(
+            x,
+            hung_start(&inp, &grid, HungStart::Compressed, 1e-3, 7),
+            "and only the seed"
+        );
+        // The arc start: the same supports, every row of its rest length L (no membrane strain).
+        let arc = hung_start(&inp, &grid, HungStart::Arc, 0.0, 7);
+        assert!((arc[tl] - Vector3::new(-0.6, 0.0, 0.0)).norm() < 1e-12);
+        assert!((arc[tr] - Vector3::new(0.6, 0.0, 0.0)).norm() < 1e-12);
+        let row: f64 = (0..14)
+            .map(|i| (arc[grid.index(i + 1, 3)] - arc[grid.index(i, 3)]).norm())
+            .sum();
+        // Its 14 chords of the arc of radius r and length L: 14 · 2r sin(L/(28r)).
+        let r = arc_radius_m(1.4, 1.2).expect("a chord shorter than the arc");
+        assert!(
+            (2.0 * r * (0.5 * 1.2 / r).asin() - 1.4).abs() < 1e-9,
+            "r = {r}"
+        );
+        let chords = 14.0 * 2.0 * r * (1.4 / (28.0 * r)).sin();
+        assert!(
+            (row - chords).abs() < 1e-9,
+            "an arc row is {row} m long, {chords} m expected"
+        );
+        assert!(arc_radius_m(1.4, 1.4).is_none());
+    }
+
+    /// Leave-one-out picks the candidate that holds on most other cases, the first on ties, and
+    /// scores it on the case left out.
+    #[test]
+    fn leave_one_out_scores_each_case_with_a_choice_made_without_it() {
+        let ok = vec![
+            vec![true, true, false],
+            vec![false, true, false],
+            vec![false, true, true],
+            vec![true, false, true],
+        ];
+        let loo = leave_one_out(&ok);
+        assert_eq!(loo.chosen, 1);
+        // Without case 3, candidate 1 holds on 3 of 3 others; it fails on case 3.
+        assert_eq!(loo.held_out[3], (1, false));
+        // Without case 1, candidates 0, 1 and 2 tie at 2: the first wins, and fails on case 1.
+        assert_eq!(loo.held_out[1], (0, false));
+        // Without case 0, candidates 1 and 2 tie at 2: candidate 1, which holds on case 0.
+        assert_eq!(loo.held_out[0], (1, true));
+        assert_eq!(loo.held_out[2], (0, false));
+        assert_eq!(loo.held_out_hits(), 1);
     }
 }
