@@ -20,12 +20,12 @@ fn opt(v: Option<f64>, digits: usize) -> String {
 }
 
 /// The three columns: one row per case.
-pub fn comparison_table(found: &WrinklesFull) -> String {
+pub fn comparison_table(rows: &[WrinkleFullRow]) -> String {
     let mut s = String::from(
         "| case | n: seed | n: tension field | n: full simulation (coarse) | z_max cm: seed | tension field | full simulation (coarse) | Q: seed | tension field | full simulation | grids | Newton iterations | wall time s | status |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    for r in rows(found) {
+    for r in rows {
         let _ = writeln!(
             s,
             "| {} | {} | {} | **{}** ({}) | {} | {:.2} | **{:.1}** ({:.1}) | {} | {:.2} | {} | {}, {} | {}, {} | {:.1} | {} |",
@@ -353,7 +353,9 @@ pub fn markdown(
     found: &WrinklesFull,
     p: &WrinklesSimulateParams,
 ) -> String {
+    // Both tables once: each row counts its sheet's self-crossings.
     let r = rows(found);
+    let starts = start_rows(found, p.start);
     let n = r.len();
     let (converged, tf, seed) = agreement_counts(&r);
     let name = |slot: &str| {
@@ -375,11 +377,8 @@ the full simulation in **{tf} of {n}** cases, the seed's own table in **{seed} o
 mesh, the result; in brackets the coarser one. Self-crossing edges (the sheet passing through itself): \
 {} on the finer sheets, {} over every coarser solve below.\n\n{}",
         r.iter().map(|x| x.self_crossing_edges).sum::<u32>(),
-        start_rows(found, p.start)
-            .iter()
-            .map(|x| x.self_crossing_edges)
-            .sum::<u32>(),
-        comparison_table(found)
+        starts.iter().map(|x| x.self_crossing_edges).sum::<u32>(),
+        comparison_table(&r)
     );
     if let Some(png) = name("sheets") {
         let _ = write!(
@@ -406,14 +405,14 @@ must buckle away); \"folded-K\": K folds put in by hand across the sheet.\n\n{}"
             .map(|s| format!("\"{s}\""))
             .collect::<Vec<_>>()
             .join(" and "),
-        starts_section(&start_rows(found, p.start))
+        starts_section(&starts)
     );
     if !p.shear_ratios.is_empty() {
         let _ = write!(
             s,
             "\n## What a fabric's low shear stiffness does\n\n{}\n{}",
             crate::wrinkles_text::SHEAR,
-            shear_section(&start_rows(found, p.start), &p.start.to_string())
+            shear_section(&starts, &p.start.to_string())
         );
     }
     let _ = write!(
@@ -428,12 +427,7 @@ must buckle away); \"folded-K\": K folds put in by hand across the sheet.\n\n{}"
         crate::wrinkles_text::EQ7,
         constant_section(found, cfg, &p.shear_ratios)
     );
-    s += &crate::wrinkles_text::findings(
-        found,
-        &r,
-        &start_rows(found, p.start),
-        cfg.defaults.buckling_constant,
-    );
+    s += &crate::wrinkles_text::findings(found, &r, &starts, cfg.defaults.buckling_constant);
     let _ = write!(
         s,
         "\n## The tension-field model (Eqs. 5–10) case by case\n\ndrapelab's values first, the seed's in \
