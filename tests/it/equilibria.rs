@@ -245,3 +245,47 @@ fn the_curved_step_lands_on_the_same_equilibrium_in_fewer_iterations() {
         );
     }
 }
+
+#[test]
+fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
+    // Sheets pinned along one line swing down about it: the folded start (sag_start on) and the
+    // flat start (off) must reach the same equilibrium (or its mirror image, a curl to the other
+    // side), a minimum, the folded one in fewer Newton iterations.
+    for (name, mirror) in [
+        ("hang2.toml", Some(Symmetry::Reflect(1, 0.5))),
+        ("diagonal_corners_wool.toml", None),
+    ] {
+        let folded = solve_scene(&scene(name, &[TOL]), &mut NoObserver);
+        let flat = solve_scene(
+            &scene(name, &[TOL, "solver.static.sag_start=false"]),
+            &mut NoObserver,
+        );
+        let (a, b) = (&folded.report, &flat.report);
+        assert!(
+            a.is_converged() && b.is_converged(),
+            "{name}: {} / {}",
+            a.message,
+            b.message
+        );
+        assert_eq!(a.minimum, Some(true), "{name}");
+        let (x, y) = (folded.grid_positions(), flat.grid_positions());
+        let mut d = largest_distance(x, y);
+        if let Some(Symmetry::Reflect(axis, c)) = mirror {
+            let m: Vec<_> = y
+                .iter()
+                .map(|q| {
+                    let mut q = *q;
+                    q[axis] = 2.0 * c - q[axis];
+                    q
+                })
+                .collect();
+            d = d.min(largest_distance(x, &m));
+        }
+        eprintln!(
+            "{name}: {} iterations folded, {} flat, {d:.1e} m apart",
+            a.iterations, b.iterations
+        );
+        assert!(d < 1e-8, "{name}: {d} m apart");
+        assert!(a.iterations < b.iterations, "{name}");
+    }
+}

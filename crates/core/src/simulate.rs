@@ -283,7 +283,11 @@ pub fn solve_model(
     // every other line, when that grid exists; far fewer fine iterations are needed. Otherwise,
     // without obstacles, from the sagged sheet.
     let coarse = coarse_start(scene, grid, x);
-    if coarse.is_none() && scene.solver.static_.sag_start && scene.obstacles.is_empty() {
+    if coarse.is_none()
+        && scene.solver.static_.sag_start
+        && scene.obstacles.is_empty()
+        && crate::solve::folded_start(model, x).is_none()
+    {
         crate::solve::sagged_start(model, x);
     }
     let mut report = static_solve(scene, grid, model, x, observer);

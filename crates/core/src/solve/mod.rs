@@ -18,7 +18,7 @@ pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use linear::{DofMap, SparseSpd};
 pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{Divergence, DivergenceReason, Globalization, SolveReport, Status, StopReason};
-pub use sag::sagged_start;
+pub use sag::{folded_start, sagged_start};
 pub use vertical_gap::solve_vertical_gap;
 
 use nalgebra::Vector3;

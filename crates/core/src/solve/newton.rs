@@ -45,9 +45,10 @@ pub struct StaticOptions {
     /// where that grid exists. Default true.
     #[serde(default = "default_true")]
     pub coarse_start: bool,
-    /// Without a coarse start and without obstacles, start Newton from the sagged sheet
-    /// ([`super::sagged_start`]: the membrane's sag shape at the depth that minimises the energy)
-    /// instead of the flat one. Default true.
+    /// Without a coarse start and without obstacles, start Newton from the sheet folded down about
+    /// the line of its pins when they lie on one ([`super::folded_start`]: the fold angle that
+    /// minimises the energy), else from the sagged sheet ([`super::sagged_start`]: the membrane's
+    /// sag shape at the depth that minimises the energy), instead of the flat one. Default true.
     #[serde(default = "default_true")]
     pub sag_start: bool,
     /// Follow the curved path x + α dx + ½ α² a, a the step's geodesic acceleration, where a is at
