@@ -202,7 +202,7 @@ pub fn folded_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
     }
     let t = 0.5 * (lo + hi);
     let e = energy(t);
-    if !(e < samples[0]) {
+    if e.partial_cmp(&samples[0]) != Some(std::cmp::Ordering::Less) {
         return None;
     }
     x.copy_from_slice(&trial);
