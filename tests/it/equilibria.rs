@@ -289,3 +289,36 @@ fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
         assert!(a.iterations < b.iterations, "{name}");
     }
 }
+
+#[test]
+fn a_shift_that_fails_means_every_smaller_one_fails() {
+    // The static solve skips the ladder of shifts of an indefinite exact Hessian when its top
+    // fails: that is the same step only if positive definiteness grows with the shift. Check it on
+    // a compressed hang4 (every spring shorter than its rest length: an indefinite Hessian).
+    use drapelab::physics::HessianBlocks;
+    use drapelab::solve::{DofMap, SparseSpd};
+    let s = scene("hang4.toml", &["cloth.nx=21", "cloth.ny=21"]);
+    let built = drapelab::build::build_scene(&s.validated().expect("valid"));
+    let (model, mut x) = (built.model, built.x0);
+    for p in &mut x {
+        p.x *= 0.9;
+        p.y *= 0.9;
+    }
+    let mut h = HessianBlocks::default();
+    model.hessian(&x, &mut h, false);
+    let dofs = DofMap::new(&model.fixed);
+    let mean = h
+        .diagonal(model.len())
+        .iter()
+        .map(|d| d.trace())
+        .sum::<f64>()
+        / dofs.n as f64;
+    let mut spd = SparseSpd::new();
+    let pd: Vec<bool> = (-12..=1)
+        .map(|k| spd.factorize(&dofs, &h, &vec![10f64.powi(k) * mean; dofs.n]))
+        .collect();
+    eprintln!("positive definite from 1e-12 to 1e1 of the mean diagonal: {pd:?}");
+    assert!(!pd[0] && pd[pd.len() - 1], "{pd:?}");
+    let first = pd.iter().position(|&ok| ok).expect("one shift works");
+    assert!(pd[first..].iter().all(|&ok| ok), "{pd:?}");
+}

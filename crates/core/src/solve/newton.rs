@@ -168,6 +168,8 @@ struct Workspace {
     carried: bool,
     /// The damping's initial value (where a carried damping returns when the Hessian is projected).
     mu_initial: f64,
+    /// Whether the last factorization was of the projected Hessian (see [`Workspace::top_fails`]).
+    was_projected: bool,
     /// What the globalization did so far.
     stats: Globalization,
 }
@@ -203,6 +205,7 @@ impl Workspace {
             curvilinear: opts.curvilinear,
             carried: opts.carried_damping,
             mu_initial: opts.lm_damping_initial,
+            was_projected: false,
             stats: Globalization::default(),
         }
     }
@@ -222,22 +225,18 @@ impl Workspace {
         report: &mut SolveReport,
     ) -> bool {
         let mut shift = self.mu;
-        for _ in 0..40 {
-            self.shift.iter_mut().for_each(|s| *s = shift * scale);
-            // Held components (symmetry planes): a diagonal far above the rest decouples them,
-            // and their step is set to zero.
-            for &(d, c) in &self.held {
-                self.shift[d + c] += 1e12 * scale.max(1e-300);
-            }
-            let ok = self.spd.factorize(&self.dofs, &self.h, &self.shift);
-            report.factorizations += 1;
-            if ok {
+        for attempt in 0..40 {
+            if self.try_shift(shift, scale, report) {
                 report.linear_solves += 1;
+                self.was_projected = *projected;
                 return true;
             }
             if self.carried {
                 self.carry_shift(model, x, projected);
                 shift = self.mu;
+            } else if attempt == 0 && self.was_projected && self.top_fails(shift, scale, report) {
+                *projected = true;
+                model.hessian(x, &mut self.h, true);
             } else if !*projected && shift * 10.0 <= self.shift_max {
                 shift = (shift * 10.0).max(MU_MIN);
             } else if !*projected {
@@ -250,6 +249,36 @@ impl Workspace {
             }
         }
         false
+    }
+
+    /// Factorizes the Hessian in `h` shifted by `shift` × `scale` on the diagonal (held components
+    /// decoupled); counts it. False when that is not positive definite.
+    fn try_shift(&mut self, shift: f64, scale: f64, report: &mut SolveReport) -> bool {
+        self.shift.iter_mut().for_each(|s| *s = shift * scale);
+        // Held components (symmetry planes): a diagonal far above the rest decouples them, and
+        // their step is set to zero.
+        for &(d, c) in &self.held {
+            self.shift[d + c] += 1e12 * scale.max(1e-300);
+        }
+        report.factorizations += 1;
+        self.spd.factorize(&self.dofs, &self.h, &self.shift)
+    }
+
+    /// After the damping `shift` alone failed, where the iteration before ended on the projected
+    /// Hessian: whether the top of the ladder of shifts fails too. Positive definiteness only grows
+    /// with a diagonal shift, so then every shift in between fails as well and the ladder can be
+    /// skipped — the same step as climbing it, in one factorization instead of each rung's.
+    fn top_fails(&mut self, shift: f64, scale: f64, report: &mut SolveReport) -> bool {
+        let mut top = shift;
+        while top * 10.0 <= self.shift_max {
+            top = (top * 10.0).max(MU_MIN);
+        }
+        if top == shift {
+            return false;
+        }
+        let fails = !self.try_shift(top, scale, report);
+        self.stats.skipped_shifts += usize::from(fails);
+        fails
     }
 
     /// [`StaticOptions::carried_damping`]: the damping raised tenfold, or the projected Hessian

@@ -154,6 +154,10 @@ pub struct Globalization {
     pub projected_steps: usize,
     /// Line-search trials rejected over the solve (an energy that did not fall enough).
     pub rejected_trials: usize,
+    /// Iterations that skipped the ladder of shifts of the exact Hessian: its top failed too, so
+    /// every shift below it would have (see `StaticOptions::shift_max_rel`).
+    #[serde(default)]
+    pub skipped_shifts: usize,
 }
 
 impl Globalization {
@@ -165,6 +169,7 @@ impl Globalization {
         self.curved_steps += o.curved_steps;
         self.projected_steps += o.projected_steps;
         self.rejected_trials += o.rejected_trials;
+        self.skipped_shifts += o.skipped_shifts;
     }
 }
 
