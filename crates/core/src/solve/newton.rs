@@ -234,7 +234,11 @@ impl Workspace {
             if self.carried {
                 self.carry_shift(model, x, projected);
                 shift = self.mu;
-            } else if attempt == 0 && self.was_projected && self.top_fails(shift, scale, report) {
+            } else if attempt == 0
+                && !*projected
+                && self.was_projected
+                && self.top_fails(shift, scale, report)
+            {
                 *projected = true;
                 model.hessian(x, &mut self.h, true);
             } else if !*projected && shift * 10.0 <= self.shift_max {
