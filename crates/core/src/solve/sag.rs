@@ -103,22 +103,7 @@ pub fn sagged_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
         }
         (s, es) = (t, et);
     }
-    let (mut a, mut b) = (0.5 * s, 2.0 * s);
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut ec, mut ed) = (energy(c), energy(d));
-    for _ in 0..40 {
-        if ec < ed {
-            (b, d, ed) = (d, c, ec);
-            c = b - r * (b - a);
-            ec = energy(c);
-        } else {
-            (a, c, ec) = (c, d, ed);
-            d = a + r * (b - a);
-            ed = energy(d);
-        }
-    }
-    let s = 0.5 * (a + b);
+    let s = golden_section(&mut energy, (0.5 * s, 2.0 * s));
     if energy(s).partial_cmp(&e0) != Some(std::cmp::Ordering::Less) {
         return None;
     }
@@ -126,6 +111,26 @@ pub fn sagged_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
         x[p] = x0[p] - Vector3::new(0.0, 0.0, s * phi[p]);
     }
     Some(s)
+}
+
+/// The minimiser of `f` on the bracket (a, b) by 40 steps of golden-section search (the bracket
+/// shrinks to 0.618⁴⁰ ≈ 4e-9 of its width): the bracket's midpoint.
+fn golden_section(f: &mut impl FnMut(f64) -> f64, (mut a, mut b): (f64, f64)) -> f64 {
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
+    let (mut ec, mut ed) = (f(c), f(d));
+    for _ in 0..40 {
+        if ec < ed {
+            (b, d, ed) = (d, c, ec);
+            c = b - r * (b - a);
+            ec = f(c);
+        } else {
+            (a, c, ec) = (c, d, ed);
+            d = a + r * (b - a);
+            ed = f(d);
+        }
+    }
+    0.5 * (a + b)
 }
 
 /// The line through the fixed particles when they all lie on one (within 1e-9 of the sheet's
@@ -187,20 +192,11 @@ pub fn folded_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
     if k == 0 {
         return None;
     }
-    let (mut lo, mut hi) = (
+    let bracket = (
         (k as f64 - 1.0) * step,
         ((k + 1) as f64 * step).min(FRAC_PI_2),
     );
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..30 {
-        let (c, d) = (hi - r * (hi - lo), lo + r * (hi - lo));
-        if energy(c) < energy(d) {
-            hi = d;
-        } else {
-            lo = c;
-        }
-    }
-    let t = 0.5 * (lo + hi);
+    let t = golden_section(&mut energy, bracket);
     let e = energy(t);
     if e.partial_cmp(&samples[0]) != Some(std::cmp::Ordering::Less) {
         return None;
