@@ -18,9 +18,14 @@ fn largest_distance(a: &drapelab::simulate::Solution, b: &drapelab::simulate::So
 
 #[test]
 fn implicit_euler_settles_on_the_static_drape_of_hang4_and_the_cantilever() {
-    for (file, sets) in [
-        ("hang4.toml", vec!["cloth.nx=21", "cloth.ny=21"]),
-        ("cantilever_wool_warp.toml", vec![]),
+    // With each step's factorization reused (the default) and without: both on the static drape,
+    // the first in fewer factorizations over the two scenes.
+    let mut factorizations = [0usize; 2];
+    for (file, sets, reuse) in [
+        ("hang4.toml", vec!["cloth.nx=21", "cloth.ny=21"], true),
+        ("hang4.toml", vec!["cloth.nx=21", "cloth.ny=21"], false),
+        ("cantilever_wool_warp.toml", vec![], true),
+        ("cantilever_wool_warp.toml", vec![], false),
     ] {
         let stat = solve_scene(&scene(file, &sets), &mut NoObserver);
         assert!(
@@ -33,11 +38,17 @@ fn implicit_euler_settles_on_the_static_drape_of_hang4_and_the_cantilever() {
             "solver.kind=implicit-euler",
             "solver.dynamic.dt_s=0.01",
             "solver.dynamic.max_time_s=200",
+            if reuse {
+                "solver.dynamic.reuse_factorization=true"
+            } else {
+                "solver.dynamic.reuse_factorization=false"
+            },
         ]);
         let dynamic = solve_scene(&scene(file, &dynamic_sets), &mut NoObserver);
+        factorizations[usize::from(!reuse)] += dynamic.report.factorizations;
         let d = largest_distance(&dynamic, &stat);
         eprintln!(
-            "{file}: {} ({} steps, {:.3} s wall, {} factorizations); largest distance to the static drape {d:.2e} m",
+            "{file} (reuse {reuse}): {} ({} steps, {:.3} s wall, {} factorizations); largest distance to the static drape {d:.2e} m",
             dynamic.report.message,
             dynamic.report.iterations,
             dynamic.report.wall_time_s,
@@ -48,6 +59,8 @@ fn implicit_euler_settles_on_the_static_drape_of_hang4_and_the_cantilever() {
         assert!(dynamic.report.iterations > 5, "{file}: a fall takes steps");
         assert!(d < 1e-4, "{file}: {d} m from the static drape");
     }
+    let [reusing, not] = factorizations;
+    assert!(reusing < not, "{reusing} factorizations reusing, {not} not");
 }
 
 /// The scene's implicit-Euler fall from its flat start (first step 10 ms, 1e5 s of simulated time).

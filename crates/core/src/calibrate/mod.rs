@@ -245,6 +245,7 @@ impl Problem {
             Some(x0) => {
                 let mut straight = scene.clone();
                 straight.solver.static_.curvilinear = false;
+                straight.solver.static_.reuse_factorization = true;
                 crate::simulate::solve_scene_from(&straight, x0, &mut NoObserver)
             }
             None => solve_scene(&scene, &mut NoObserver),

@@ -65,6 +65,15 @@ pub struct StaticOptions {
     /// converge with the mesh on that path). False: the shift is the iteration's own. Default false.
     #[serde(default)]
     pub carried_damping: bool,
+    /// Reuse the last factorization while Newton converges: after a whole step that cut the largest
+    /// residual force at least in half, the next step is the chord step −H₀⁻¹ g with the factor
+    /// already at hand (no Hessian, no factorization), taken whole when it lowers the energy; the
+    /// Hessian is factorized afresh as soon as one does not, or the residual falls by less than half
+    /// (Shamanskii's modified Newton). The same equilibrium to the tolerance, fewer factorizations,
+    /// possibly more iterations. Default false (the calibration's warm-started solves and each step
+    /// of implicit Euler turn it on).
+    #[serde(default)]
+    pub reuse_factorization: bool,
 }
 
 fn default_shift_max() -> f64 {
@@ -104,6 +113,7 @@ impl Default for StaticOptions {
             curvilinear: true,
             carried_damping: false,
             shift_max_rel: default_shift_max(),
+            reuse_factorization: false,
         }
     }
 }
@@ -170,6 +180,12 @@ struct Workspace {
     mu_initial: f64,
     /// Whether the last factorization was of the projected Hessian (see [`Workspace::top_fails`]).
     was_projected: bool,
+    /// Whether to reuse the factorization ([`StaticOptions::reuse_factorization`]).
+    reuse: bool,
+    /// The largest residual force at the start of the previous iteration, N.
+    r_prev: f64,
+    /// Whether the previous iteration's step was taken whole (from a factorization still at hand).
+    whole_prev: bool,
     /// What the globalization did so far.
     stats: Globalization,
 }
@@ -178,6 +194,10 @@ struct Workspace {
 const ACCELERATION_MAX: f64 = 1.0;
 /// The finite-difference step (in units of dx) of the acceleration's second derivative.
 const ACCELERATION_FD: f64 = 0.1;
+
+/// A chord step is tried while the largest residual force falls at least by this factor per
+/// iteration ([`StaticOptions::reuse_factorization`]).
+const CHORD_CONTRACTION: f64 = 0.5;
 
 /// Smallest damping used once damping is needed (relative to the mean diagonal).
 const MU_MIN: f64 = 1e-8;
@@ -206,6 +226,9 @@ impl Workspace {
             carried: opts.carried_damping,
             mu_initial: opts.lm_damping_initial,
             was_projected: false,
+            reuse: opts.reuse_factorization,
+            r_prev: f64::INFINITY,
+            whole_prev: false,
             stats: Globalization::default(),
         }
     }
@@ -409,6 +432,13 @@ impl Workspace {
         (r, tol): (f64, f64),
         report: &mut SolveReport,
     ) -> bool {
+        // Shamanskii: while whole steps halve the residual, the factor at hand serves again.
+        let chord = self.reuse && self.whole_prev && r <= CHORD_CONTRACTION * self.r_prev;
+        self.r_prev = r;
+        self.whole_prev = chord && self.chord_step(model, x, load, e, report);
+        if self.whole_prev {
+            return true;
+        }
         let mut projected = false;
         model.hessian(x, &mut self.h, projected);
         // The damping's scale: the mean diagonal of this iteration's exact Hessian.
@@ -433,7 +463,8 @@ impl Workspace {
             match self.line_search(model, x, load, (e, r), (bound.min(1.0), slope)) {
                 Some(alpha) => {
                     self.count(alpha, bound, (curved, projected));
-                    if alpha == 1.0 && bound >= 1.0 {
+                    self.whole_prev = alpha == 1.0 && bound >= 1.0;
+                    if self.whole_prev {
                         self.mu = if self.mu < 1e-12 { 0.0 } else { self.mu / 4.0 };
                     }
                     return true;
@@ -444,6 +475,38 @@ impl Workspace {
             }
         }
         false
+    }
+
+    /// The chord step −H₀⁻¹ g with the factorization at hand, taken whole when no term bounds it and
+    /// it lowers the energy enough (Armijo) or leaves it flat to round-off. False (and `x` as it was)
+    /// otherwise.
+    fn chord_step(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        load: f64,
+        e: &mut f64,
+        report: &mut SolveReport,
+    ) -> bool {
+        let slope = self.step(x.len());
+        report.linear_solves += 1;
+        if slope.is_nan() || slope >= 0.0 || model.max_step(x, &self.dx) < 1.0 {
+            return false;
+        }
+        for (p, xp) in x.iter().enumerate() {
+            self.trial[p] = xp + self.dx[p];
+        }
+        let et = model.energy(&self.trial, load);
+        let flat = (et - *e).abs() <= 1e-11 * e.abs().max(1e-300);
+        if !(et.is_finite() && (et <= *e + 1e-4 * slope || flat)) {
+            self.stats.rejected_trials += 1;
+            return false;
+        }
+        x.copy_from_slice(&self.trial);
+        *e = et;
+        self.stats.full_steps += 1;
+        self.stats.chord_steps += 1;
+        true
     }
 
     /// Counts an accepted step of length `alpha` under the terms' `bound`.

@@ -158,6 +158,10 @@ pub struct Globalization {
     /// every shift below it would have (see `StaticOptions::shift_max_rel`).
     #[serde(default)]
     pub skipped_shifts: usize,
+    /// Iterations that reused the factorization at hand (chord steps of
+    /// `StaticOptions::reuse_factorization`; counted among the full steps too).
+    #[serde(default)]
+    pub chord_steps: usize,
 }
 
 impl Globalization {
@@ -170,6 +174,7 @@ impl Globalization {
         self.projected_steps += o.projected_steps;
         self.rejected_trials += o.rejected_trials;
         self.skipped_shifts += o.skipped_shifts;
+        self.chord_steps += o.chord_steps;
     }
 }
 
