@@ -241,7 +241,8 @@ impl Problem {
         let sol = match start {
             // Warm-started next to an equilibrium, a curved step's two extra gradients buy nothing:
             // straight steps there took the knitted calibration from 377 s to 264 s with the same
-            // calibrated parameters (issue 34, one run each on one machine).
+            // calibrated parameters (issue 34, one run each on one machine); reusing the factorization
+            // (chord steps) took it from 280 s to 247 s (reports/newton_iterations.md).
             Some(x0) => {
                 let mut straight = scene.clone();
                 straight.solver.static_.curvilinear = false;
