@@ -195,6 +195,16 @@ const ACCELERATION_MAX: f64 = 1.0;
 /// The finite-difference step (in units of dx) of the acceleration's second derivative.
 const ACCELERATION_FD: f64 = 0.1;
 
+/// The line search's acceptance of a trial energy `et` from `e` at step length `alpha` along a
+/// direction of directional derivative `slope`: (sufficient decrease, Armijo with 1e-4; flat to
+/// round-off, a change below 1e-11 of the energy).
+fn armijo(et: f64, e: f64, alpha: f64, slope: f64) -> (bool, bool) {
+    (
+        et <= e + 1e-4 * alpha * slope,
+        (et - e).abs() <= 1e-11 * e.abs().max(1e-300),
+    )
+}
+
 /// A chord step is tried while the largest residual force falls at least by this factor per
 /// iteration ([`StaticOptions::reuse_factorization`]).
 const CHORD_CONTRACTION: f64 = 0.5;
@@ -404,12 +414,12 @@ impl Workspace {
                 self.trial[p] = xp + self.dx[p] * alpha + self.acc[p] * half;
             }
             let et = model.energy(&self.trial, load);
-            let flat = (et - *e).abs() <= 1e-11 * e.abs().max(1e-300);
+            let (decreases, flat) = armijo(et, *e, alpha, slope);
             let lowers_residual = flat && {
                 model.gradient(&self.trial, load, &mut self.g_trial);
                 free_max_residual(model, &self.g_trial) < r
             };
-            if et.is_finite() && (et <= *e + 1e-4 * alpha * slope || lowers_residual) {
+            if et.is_finite() && (decreases || lowers_residual) {
                 x.copy_from_slice(&self.trial);
                 *e = et;
                 return Some(alpha);
@@ -497,8 +507,8 @@ impl Workspace {
             self.trial[p] = xp + self.dx[p];
         }
         let et = model.energy(&self.trial, load);
-        let flat = (et - *e).abs() <= 1e-11 * e.abs().max(1e-300);
-        if !(et.is_finite() && (et <= *e + 1e-4 * slope || flat)) {
+        let (decreases, flat) = armijo(et, *e, 1.0, slope);
+        if !(et.is_finite() && (decreases || flat)) {
             self.stats.rejected_trials += 1;
             return false;
         }
