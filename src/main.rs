@@ -7,12 +7,20 @@ fn main() {
         Ok(cli) => cli,
         Err(e) if e.use_stderr() => {
             // A bad flag or value: clap's first line names it; one line, exit code 2.
+            // A missing argument's list follows on indented lines: kept, on the same line.
             let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            eprintln!(
-                "drapelab: {} (see --help)",
-                first.trim_start_matches("error: ").trim()
-            );
+            let mut lines = text.lines();
+            let first = lines.next().unwrap_or("invalid arguments");
+            let listed: Vec<&str> = lines
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            let first = first.trim_start_matches("error: ").trim();
+            if listed.is_empty() {
+                eprintln!("drapelab: {first} (see --help)");
+            } else {
+                eprintln!("drapelab: {first} {} (see --help)", listed.join(", "));
+            }
             std::process::exit(drapelab::error::EXIT_BAD_INPUT);
         }
         Err(e) => e.exit(),

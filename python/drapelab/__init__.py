@@ -22,7 +22,7 @@ import os
 import pathlib
 import shutil
 import tempfile
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -52,6 +52,7 @@ SIMULATE_FILES = (
     "last_state.parquet",
     "timeline.mcap",
     "drape.rrd",
+    "sensitivity.parquet",
 )
 
 
@@ -89,8 +90,13 @@ class Result:
     """
 
     def __init__(self, run_json: str, positions: bytes, present: bytes, triangles: bytes,
-                 nx: int, ny: int, native_time_s: float, tmp: tempfile.TemporaryDirectory) -> None:
+                 nx: int, ny: int, native_time_s: float,
+                 sensitivities: Sequence[Tuple[str, bytes]] = (),
+                 *, tmp: tempfile.TemporaryDirectory) -> None:
         self._tmp = tmp
+        self._sensitivities = {
+            k: np.frombuffer(v, dtype="<f8").reshape(-1, 3).copy() for k, v in sensitivities
+        }
         #: Seconds the call spent in Rust: scene loaded, solved, files written, arrays made.
         self.native_time_s = native_time_s
         self.folder = pathlib.Path(tmp.name)
@@ -102,6 +108,31 @@ class Result:
         self.triangles = np.frombuffer(triangles, dtype="<u4").reshape(-1, 3).astype(np.int64)
         self.nx = nx
         self.ny = ny
+
+    def sensitivity(self, key: str) -> np.ndarray:
+        """How each particle of the converged drape moves per unit of the scene key ``key``
+        (``simulate(..., sensitivity=[key])``): an ``(n, 3)`` float64 array dx*/dθ, m per unit of
+        the key as the scene file writes it, rows as :attr:`positions`. The same numbers as
+        ``sensitivity.parquet``.
+
+        Raises:
+            KeyError: ``key`` was not asked for.
+            RuntimeError: the state has no sensitivities (not converged, not a minimum); the
+                message says why.
+        """
+        if key in self._sensitivities:
+            return self._sensitivities[key]
+        asked = self.run.get("sensitivity") or {}
+        if key not in asked.get("keys", []):
+            raise KeyError(f"{key!r}: not asked for; pass simulate(..., sensitivity=[{key!r}])")
+        raise RuntimeError(f"no sensitivities: {asked.get('reason')}")
+
+    def gradient(self, dj_dx: np.ndarray, keys: Sequence[str]) -> Dict[str, float]:
+        """dJ/dθ of a scalar measure J of the drape for each key, given ∂J/∂x (an ``(n, 3)`` array
+        like :attr:`positions`): the sensitivities contracted with it (equal to one adjoint solve,
+        which the Rust API ``sensitivity::Equilibrium::gradient`` does)."""
+        g = np.asarray(dj_dx, dtype=float).reshape(-1, 3)
+        return {k: float(np.sum(self.sensitivity(k) * g)) for k in keys}
 
     @property
     def converged(self) -> bool:
@@ -159,13 +190,16 @@ def read_scene(path: PathLike) -> Dict[str, Any]:
 
 
 def simulate(scene: Union[PathLike, Mapping[str, Any]],
-             set: Optional[Mapping[str, Any]] = None) -> Result:
+             set: Optional[Mapping[str, Any]] = None,
+             sensitivity: Sequence[str] = ()) -> Result:
     """Solves a scene as ``drapelab simulate`` does.
 
     Args:
         scene: a scene TOML file's path, or a dict with the same keys (``read_scene`` gives one).
-        set: overrides by dotted key, e.g. ``{"cloth.nx": 21, "material.density_kg_per_m2": 0.2}``;
+        set: overrides by dotted key, e.g. ``{"cloth.nx": 21, "cloth.areal_density_kg_per_m2": 0.2}``;
             a grid override moves pins and holds to the same material points.
+        sensitivity: continuous scene keys whose sensitivities dx*/dθ to compute at the converged
+            drape (:meth:`Result.sensitivity`), e.g. ``["material.mass_spring.stiffness_N_per_m"]``.
 
     Returns:
         The :class:`Result`, converged or not (see its ``status``).
@@ -181,7 +215,7 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
         path, table = os.fspath(scene), None
     tmp = tempfile.TemporaryDirectory(prefix="drapelab-")
     try:
-        out = _drapelab.simulate(path, table, overrides, tmp.name)
+        out = _drapelab.simulate(path, table, overrides, tmp.name, list(sensitivity))
     except BaseException:
         tmp.cleanup()
         raise

@@ -9,10 +9,15 @@ class InputError(ValueError):
 def version() -> str: ...
 def read_scene(path: str) -> str: ...
 def simulate(
-    scene_path: Optional[str], scene_json: Optional[str], set_json: str, out: str
-) -> Tuple[str, bytes, bytes, bytes, int, int, float]:
+    scene_path: Optional[str],
+    scene_json: Optional[str],
+    set_json: str,
+    out: str,
+    sensitivity: List[str] = ...,
+) -> Tuple[str, bytes, bytes, bytes, int, int, float, List[Tuple[str, bytes]]]:
     """run.json's text, positions (n×3 little-endian f64, m), present (n bytes), triangles
-    (m×3 little-endian u32), nx, ny, seconds spent in Rust."""
+    (m×3 little-endian u32), nx, ny, seconds spent in Rust, and per key asked for its
+    sensitivities (n×3 little-endian f64, m per unit of the key)."""
 
 def drape_of_mesh(positions: bytes, triangles: bytes) -> str: ...
 def drape_of_silhouette(path: str, scale_json: str) -> str: ...

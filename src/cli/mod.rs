@@ -88,6 +88,17 @@ pub enum Command {
         /// --set record.timeline=true. Repeatable.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Also write sensitivity.parquet: how every particle of the converged drape moves per unit
+        /// of this continuous scene key (dx*/dθ = −H⁻¹ ∂g/∂θ, from the factor of the exact Hessian
+        /// at the equilibrium; one back-substitution per key), e.g. --sensitivity
+        /// material.mass_spring.stiffness_N_per_m. Repeatable. A state that did not converge or is
+        /// no minimum gets none, and run.json says why.
+        #[arg(long = "sensitivity", value_name = "KEY")]
+        sensitivity: Vec<String>,
+        /// Start the solve from a saved drape (a particles.parquet or last_state.parquet of the same
+        /// scene and grid) instead of the scene's own start: a restart.
+        #[arg(long, value_name = "FILE")]
+        start: Option<PathBuf>,
     },
     /// Run a pipeline make-style (only stale stages).
     ///
@@ -407,7 +418,13 @@ pub fn load_scene(path: &Path, sets: &[String]) -> Result<LoadedScene, InputErro
 /// Runs the parsed command line; returns the exit code.
 pub fn run(cli: Cli) -> Result<i32> {
     match cli.command {
-        Command::Simulate { scene, out, set } => simulate(&scene, &out, &set),
+        Command::Simulate {
+            scene,
+            out,
+            set,
+            sensitivity,
+            start,
+        } => simulate(&scene, &out, &set, &sensitivity, start.as_deref()),
         Command::Run {
             pipeline,
             until,
@@ -522,11 +539,26 @@ fn bench_command(a: BenchArgs) -> Result<i32> {
 }
 
 /// `drapelab simulate`.
-fn simulate(scene: &Path, out: &Path, set: &[String]) -> Result<i32> {
+fn simulate(
+    scene: &Path,
+    out: &Path,
+    set: &[String],
+    sensitivity: &[String],
+    start: Option<&Path>,
+) -> Result<i32> {
     let loaded = load_scene(scene, set)?;
+    for key in sensitivity {
+        crate::sensitivity::check_key(&loaded.scene, key, "--sensitivity")?;
+    }
+    let extras = crate::io::SimulateExtras {
+        sensitivity_keys: sensitivity.to_vec(),
+        start: start
+            .map(|f| read_start(f, &loaded.scene.grid()))
+            .transpose()?,
+    };
     args::out_dir(out)?;
     let mut progress = SolveProgress::new(&loaded.scene.name);
-    let report = crate::io::simulate_to_dir(&loaded, out, &mut progress)?;
+    let report = crate::io::simulate_to_dir_with(&loaded, out, &mut progress, &extras)?.report;
     progress.done(&report);
     eprintln!(
         "{}: {} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
@@ -544,6 +576,48 @@ fn simulate(scene: &Path, out: &Path, set: &[String]) -> Result<i32> {
     } else {
         EXIT_FAILED
     })
+}
+
+/// The grid particles' positions of a saved drape (`--start FILE`), checked against the scene's
+/// grid: the same particles (i, j) in the same order, finite positions.
+fn read_start(
+    file: &Path,
+    grid: &crate::cloth::Grid,
+) -> Result<(Vec<nalgebra::Vector3<f64>>, String), InputError> {
+    let bad = |key: &str, m: String| InputError::new(format!("--start {}", file.display()), key, m);
+    let rows = crate::io::read_particles(file).map_err(|e| bad("", format!("{e:#}")))?;
+    if rows.len() != grid.len() {
+        return Err(bad(
+            "",
+            format!(
+                "{} particles, the scene's grid has {} ({} × {}): start from a drape of the same grid",
+                rows.len(),
+                grid.len(),
+                grid.nx,
+                grid.ny
+            ),
+        ));
+    }
+    let mut x = Vec::with_capacity(rows.len());
+    for (p, (i, j, v)) in rows.into_iter().enumerate() {
+        if (i as usize, j as usize) != grid.ij(p) {
+            return Err(bad(
+                "i",
+                format!(
+                    "row {p} is particle ({i}, {j}), expected {:?}: not particles.parquet's order",
+                    grid.ij(p)
+                ),
+            ));
+        }
+        if !v.iter().all(|c| c.is_finite()) {
+            return Err(bad(
+                "x_m",
+                format!("row {p}: a position that is not finite"),
+            ));
+        }
+        x.push(v);
+    }
+    Ok((x, file.display().to_string()))
 }
 
 /// `drapelab status`: 1 with `--check` when a stage is stale.

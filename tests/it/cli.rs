@@ -248,3 +248,14 @@ fn drapelab_tables_lists_the_documented_columns() {
         assert!(section.is_some(), "{file}: no column {column}");
     }
 }
+
+#[test]
+fn a_missing_argument_is_named_on_the_one_line() {
+    for (args, names) in [
+        (vec!["simulate"], vec!["<SCENE>", "--out"]),
+        (vec!["simulate", "x.toml"], vec!["--out"]),
+        (vec!["run"], vec!["<PIPELINE>"]),
+    ] {
+        crate::support::assert_bad_input(&args, &names);
+    }
+}

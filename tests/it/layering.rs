@@ -72,7 +72,7 @@ const NOT_IN_CORE: [&str; 8] = [
 ];
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank.
-const CORE_RANKS: [(&str, u8); 23] = [
+const CORE_RANKS: [(&str, u8); 25] = [
     ("error", 0),
     ("atomic", 0),
     ("table", 0),
@@ -87,6 +87,8 @@ const CORE_RANKS: [(&str, u8); 23] = [
     ("solve", 2),
     ("scene", 3),
     ("build", 4),
+    ("params", 4),
+    ("sensitivity", 5),
     ("simulate", 5),
     ("measure", 5),
     ("cusick", 6),

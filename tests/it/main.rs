@@ -16,6 +16,7 @@ mod pipeline;
 mod recordings;
 mod runs;
 mod self_contact;
+mod sensitivity;
 mod slurm;
 mod stress;
 mod subpixel;

@@ -209,13 +209,7 @@ fn solve_built(
     let report = match start {
         Some(x0) if x0.len() == x.len() => {
             x.copy_from_slice(x0);
-            // A warm start is near its equilibrium: Newton starts far less damped.
-            let mut warm = (**scene).clone();
-            let lm = &mut warm.solver.static_.lm_damping_initial;
-            *lm = lm.min(WARM_LM_DAMPING);
-            let mut report = static_or_dynamic(&warm, &grid, &mut model, &mut x, observer);
-            check_minimum(&model, &x, &mut report);
-            report
+            solve_model_warm(scene, &grid, &mut model, &mut x, observer)
         }
         _ => solve_model(scene, &grid, &mut model, &mut x, observer),
     };
@@ -230,9 +224,27 @@ fn solve_built(
     }
 }
 
+/// Solves a built scene from `x` as it is, a warm start near the equilibrium (a saved drape, a
+/// neighbouring parameter's solution): no coarse, sagged or folded start, and Newton starts far less
+/// damped ([`WARM_LM_DAMPING`]).
+pub fn solve_model_warm(
+    scene: &Scene,
+    grid: &Grid,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let mut warm = scene.clone();
+    let lm = &mut warm.solver.static_.lm_damping_initial;
+    *lm = lm.min(WARM_LM_DAMPING);
+    let mut report = static_or_dynamic(&warm, grid, model, x, observer);
+    check_minimum(model, x, &mut report);
+    report
+}
+
 /// The initial Levenberg–Marquardt damping of a solve from a warm start (relative to the mean
 /// diagonal; the flat or sagged start's default is 1e-3).
-const WARM_LM_DAMPING: f64 = 1e-5;
+pub const WARM_LM_DAMPING: f64 = 1e-5;
 
 /// The scene's solver from `x` as it is: the static solve, or the dynamic integrator.
 fn static_or_dynamic(

@@ -38,8 +38,8 @@ pub(crate) fn to_py(e: anyhow::Error) -> PyErr {
 }
 
 /// What `simulate` hands the Python half: run.json's text, positions (n × 3 f64, m), present
-/// (n bytes), triangles (m × 3 u32), nx, ny, and the seconds spent in Rust (scene loaded, solved,
-/// files written, arrays made).
+/// (n bytes), triangles (m × 3 u32), nx, ny, the seconds spent in Rust (scene loaded, solved,
+/// files written, arrays made), and the sensitivities asked for (key, n × 3 f64 m per unit).
 type Simulated<'py> = (
     String,
     Bound<'py, PyBytes>,
@@ -48,25 +48,35 @@ type Simulated<'py> = (
     usize,
     usize,
     f64,
+    Vec<(String, Bound<'py, PyBytes>)>,
 );
 
 /// Solves a scene (a TOML file, or a table as JSON text) with dotted overrides (JSON object) into
 /// the folder `out`, as `drapelab simulate --out` does.
 #[pyfunction]
-#[pyo3(signature = (scene_path, scene_json, set_json, out))]
+#[pyo3(signature = (scene_path, scene_json, set_json, out, sensitivity=Vec::new()))]
 fn simulate<'py>(
     py: Python<'py>,
     scene_path: Option<String>,
     scene_json: Option<String>,
     set_json: &str,
     out: &str,
+    sensitivity: Vec<String>,
 ) -> PyResult<Simulated<'py>> {
     let started = std::time::Instant::now();
     let loaded = load_scene(scene_path.as_deref(), scene_json.as_deref(), set_json)?;
+    for key in &sensitivity {
+        drapelab_core::sensitivity::check_key(&loaded.scene, key, "sensitivity")
+            .map_err(|e| InputError::new_err(e.to_string()))?;
+    }
+    let extras = drapelab_record::SimulateExtras {
+        sensitivity_keys: sensitivity,
+        start: None,
+    };
     let out = Path::new(out).to_path_buf();
     let (done, interrupted) = py.detach(|| {
         let mut stop = Interrupt::new();
-        let done = drapelab_record::simulate_to_dir_state(&loaded, &out, &mut stop);
+        let done = drapelab_record::simulate_to_dir_with(&loaded, &out, &mut stop, &extras);
         (done, stop.into_error())
     });
     if let Some(e) = interrupted {
@@ -89,6 +99,13 @@ fn simulate<'py>(
         s.grid.nx,
         s.grid.ny,
         started.elapsed().as_secs_f64(),
+        s.sensitivity
+            .iter()
+            .map(|(k, dx)| {
+                let v: Vec<f64> = dx.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+                (k.clone(), PyBytes::new(py, &f64_bytes(&v)))
+            })
+            .collect(),
     ))
 }
 

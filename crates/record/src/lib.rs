@@ -15,6 +15,7 @@ mod photo;
 mod rrd;
 mod run_dir;
 mod sampled;
+mod sensitivity_table;
 mod surface_out;
 mod table;
 mod timeline;
@@ -30,8 +31,11 @@ pub use particles::{ParticleRow, read_particles, write_particles};
 pub use parts::{gather_parquet, merge_recordings};
 pub use photo::{fit_photo, render_scene, score_files};
 pub use rrd::RerunRecorder;
-pub use run_dir::{Simulated, simulate_to_dir, simulate_to_dir_state};
+pub use run_dir::{
+    SimulateExtras, Simulated, simulate_to_dir, simulate_to_dir_state, simulate_to_dir_with,
+};
 pub use sampled::{Sampled, StateSink};
+pub use sensitivity_table::{SensitivityRow, read_sensitivities, write_sensitivities};
 pub use surface_out::{TexturedSurface, glb_bytes, write_glb, write_surface_rrd};
 pub use table::{
     Table, join_columns, read_table, table_batch, table_fields, table_markdown, write_parquet,

@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use drapelab_core::atomic::write_atomic;
 use drapelab_core::build::{BuiltScene, build_scene};
 use drapelab_core::scene::{LoadedScene, Scene};
-use drapelab_core::simulate::solve_model;
+use drapelab_core::simulate::{solve_model, solve_model_warm};
 use drapelab_core::solve::{Observer, Observers, SolveReport, StateEvent, Status, StopReason};
 use serde::Serialize;
 use std::path::Path;
@@ -25,17 +25,48 @@ struct RunRecord<'a> {
     drape: Option<drapelab_core::measure::DrapeMeasures>,
     /// The sheet's self-contact at the end: smallest distance, active pairs, crossings.
     self_contact: drapelab_core::simulate::SelfContactSummary,
+    /// The sensitivities asked for (`--sensitivity`): written, or why not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sensitivity: Option<SensitivityRecord>,
+    /// The saved state the solve started from (`--start`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    start_file: Option<String>,
     scene: &'a Scene,
 }
 
 /// Every file `simulate` may write into its folder.
-pub const SIMULATE_FILES: [&str; 5] = [
+pub const SIMULATE_FILES: [&str; 6] = [
     "run.json",
     "particles.parquet",
     "last_state.parquet",
     "timeline.mcap",
     "drape.rrd",
+    "sensitivity.parquet",
 ];
+
+/// What `run.json` says of the sensitivities asked for.
+#[derive(Debug, Clone, Serialize)]
+struct SensitivityRecord {
+    /// The keys asked for, as given.
+    keys: Vec<String>,
+    /// Whether sensitivity.parquet was written.
+    written: bool,
+    /// Why not, when not (the state is no converged minimum, a key changes the model's structure).
+    reason: Option<String>,
+    /// Wall time of the factorization and the keys' solves, s.
+    time_s: f64,
+}
+
+/// What a simulate run adds to the scene's own outputs.
+#[derive(Debug, Clone, Default)]
+pub struct SimulateExtras {
+    /// Continuous scene keys whose sensitivities dx*/dθ to write into `sensitivity.parquet`
+    /// (`simulate --sensitivity KEY`); checked by [`drapelab_core::sensitivity::check_key`] first.
+    pub sensitivity_keys: Vec<String>,
+    /// A saved drape to start from (`simulate --start FILE`): the grid particles' positions in
+    /// particles.parquet's row order, and the file's name for run.json.
+    pub start: Option<(Vec<nalgebra::Vector3<f64>>, String)>,
+}
 
 /// Solves `loaded` and writes its outputs into `out` (created if needed). Returns the report; a
 /// solve that did not converge writes `run.json` with its status and `last_state.parquet`, never
@@ -64,6 +95,10 @@ pub struct Simulated {
     pub absent: Vec<bool>,
     /// The sheet's grid.
     pub grid: drapelab_core::cloth::Grid,
+    /// The sensitivities asked for ([`SimulateExtras::sensitivity_keys`]), key by key: dx*/dθ of
+    /// the grid particles, m per unit of the key; empty when none were asked for or none exist
+    /// (run.json says why).
+    pub sensitivity: Vec<(String, Vec<nalgebra::Vector3<f64>>)>,
 }
 
 /// [`simulate_to_dir`], also returning the final state (the Python package's `simulate`).
@@ -72,6 +107,16 @@ pub fn simulate_to_dir_state(
     out: &Path,
     progress: &mut dyn Observer,
 ) -> Result<Simulated> {
+    simulate_to_dir_with(loaded, out, progress, &SimulateExtras::default())
+}
+
+/// [`simulate_to_dir_state`] with a start from a saved drape and sensitivities ([`SimulateExtras`]).
+pub fn simulate_to_dir_with(
+    loaded: &LoadedScene,
+    out: &Path,
+    progress: &mut dyn Observer,
+    extras: &SimulateExtras,
+) -> Result<Simulated> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     remove_stale_staging(out);
     let staging = tempfile::Builder::new()
@@ -79,7 +124,7 @@ pub fn simulate_to_dir_state(
         .suffix(".partial")
         .tempdir_in(out)
         .with_context(|| format!("cannot write into {}", out.display()))?;
-    let (simulated, written) = simulate_into(loaded, staging.path(), progress)?;
+    let (simulated, written) = simulate_into(loaded, staging.path(), progress, extras)?;
     publish(staging.path(), out, &written)?;
     Ok(simulated)
 }
@@ -154,6 +199,7 @@ fn simulate_into(
     loaded: &LoadedScene,
     out: &Path,
     progress: &mut dyn Observer,
+    extras: &SimulateExtras,
 ) -> Result<(Simulated, Vec<&'static str>)> {
     let scene = &loaded.scene;
     let BuiltScene {
@@ -164,6 +210,13 @@ fn simulate_into(
     let absent = drapelab_core::build::absent_particles(scene, &x0);
     let (mut timeline, mut rrd) = recorders(scene, out, &grid, &model, &x0)?;
     let mut x = x0;
+    let warm = match &extras.start {
+        Some((start, _)) if start.len() == grid.len() => {
+            x[..grid.len()].copy_from_slice(start);
+            true
+        }
+        _ => false,
+    };
     let report = {
         let mut obs: Vec<&mut dyn Observer> = vec![progress];
         if let Some(t) = timeline.as_mut() {
@@ -172,32 +225,18 @@ fn simulate_into(
         if let Some(r) = rrd.as_mut() {
             obs.push(r);
         }
-        let mut r = solve_model(scene, &grid, &mut model, &mut x, &mut Observers(obs));
+        let obs = &mut Observers(obs);
+        let mut r = if warm {
+            solve_model_warm(scene, &grid, &mut model, &mut x, obs)
+        } else {
+            solve_model(scene, &grid, &mut model, &mut x, obs)
+        };
         drapelab_core::simulate::check_crossings(scene, &grid, &model, &x, &mut r);
         r
     };
-    let final_ev = StateEvent {
-        index: report.iterations,
-        time_s: report.sim_time_s,
-        x: &x,
-        max_residual_N: report.max_residual_N,
-        energy_J: report.energy_J,
-    };
     let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));
-    // A recorder that failed during the solve is dropped (its temporary file with it), not finished.
-    if report.stop == StopReason::Observer {
-        timeline = None;
-        rrd = None;
-    }
     let mut outputs = vec!["run.json"];
-    if let Some(mut t) = timeline {
-        t.finish(finite.then_some(&final_ev))?;
-        outputs.push("timeline.mcap");
-    }
-    if let Some(mut r) = rrd {
-        r.finish(finite.then_some(&final_ev))?;
-        outputs.push("drape.rrd");
-    }
+    finish_recorders(&report, &x, (timeline, rrd), &mut outputs)?;
     let meta = [
         ("drapelab_version", drapelab_core::VERSION.to_string()),
         ("status", report.status.as_str().to_string()),
@@ -210,6 +249,10 @@ fn simulate_into(
     } else if finite && report.status != Status::Diverged {
         write_particles(&out.join("last_state.parquet"), &grid, &x, &absent, &meta)?;
         outputs.push("last_state.parquet");
+    }
+    let (sensitivity, sens_data) = sensitivities(loaded, &grid, &model, &x, &report, extras, out)?;
+    if sensitivity.as_ref().is_some_and(|s| s.written) {
+        outputs.push("sensitivity.parquet");
     }
     let terms = model.term_names();
     let record = RunRecord {
@@ -224,6 +267,8 @@ fn simulate_into(
         drape: (report.is_converged() && !scene.obstacles.is_empty())
             .then(|| drapelab_core::measure::drape_measures(scene, &grid, &x)),
         self_contact: drapelab_core::simulate::self_contact_summary(scene, &grid, &model, &x),
+        sensitivity,
+        start_file: extras.start.as_ref().map(|s| s.1.clone()),
         scene,
     };
     let json = serde_json::to_string_pretty(&record)?;
@@ -239,7 +284,89 @@ fn simulate_into(
             x,
             absent,
             grid,
+            sensitivity: sens_data,
         },
         written,
     ))
+}
+
+/// Closes the recorders with the final state (when finite) and names their files in `outputs`; a
+/// recorder that failed during the solve is dropped (its temporary file with it), not finished.
+fn finish_recorders(
+    report: &SolveReport,
+    x: &[nalgebra::Vector3<f64>],
+    (timeline, rrd): Recorders,
+    outputs: &mut Vec<&'static str>,
+) -> Result<()> {
+    if report.stop == StopReason::Observer {
+        return Ok(());
+    }
+    let final_ev = StateEvent {
+        index: report.iterations,
+        time_s: report.sim_time_s,
+        x,
+        max_residual_N: report.max_residual_N,
+        energy_J: report.energy_J,
+    };
+    let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));
+    if let Some(mut t) = timeline {
+        t.finish(finite.then_some(&final_ev))?;
+        outputs.push("timeline.mcap");
+    }
+    if let Some(mut r) = rrd {
+        r.finish(finite.then_some(&final_ev))?;
+        outputs.push("drape.rrd");
+    }
+    Ok(())
+}
+
+/// The sensitivities `extras` asks for, written into `out/sensitivity.parquet` when the state is a
+/// converged minimum; what run.json says of them (None when none were asked for).
+fn sensitivities(
+    loaded: &LoadedScene,
+    grid: &drapelab_core::cloth::Grid,
+    model: &drapelab_core::physics::Model,
+    x: &[nalgebra::Vector3<f64>],
+    report: &SolveReport,
+    extras: &SimulateExtras,
+    out: &Path,
+) -> Result<(
+    Option<SensitivityRecord>,
+    Vec<(String, Vec<nalgebra::Vector3<f64>>)>,
+)> {
+    use drapelab_core::sensitivity::Equilibrium;
+    if extras.sensitivity_keys.is_empty() {
+        return Ok((None, Vec::new()));
+    }
+    let start = std::time::Instant::now();
+    let result =
+        Equilibrium::new(&loaded.scene, model, x, report, "--sensitivity").and_then(|mut eq| {
+            extras
+                .sensitivity_keys
+                .iter()
+                .map(|k| eq.sensitivity(k))
+                .collect::<Result<Vec<_>, _>>()
+        });
+    let (written, reason, data) = match result {
+        Ok(s) => {
+            crate::sensitivity_table::write_sensitivities(
+                &out.join("sensitivity.parquet"),
+                grid,
+                &s,
+            )?;
+            let data = s
+                .into_iter()
+                .map(|k| (k.key, k.dx[..grid.len()].to_vec()))
+                .collect();
+            (true, None, data)
+        }
+        Err(e) => (false, Some(e.to_string()), Vec::new()),
+    };
+    let record = SensitivityRecord {
+        keys: extras.sensitivity_keys.clone(),
+        written,
+        reason,
+        time_s: start.elapsed().as_secs_f64(),
+    };
+    Ok((Some(record), data))
 }

@@ -96,6 +96,12 @@ pub trait EnergyTerm: Send + Sync {
     /// Pushes the Hessian blocks (N/m): exact, or with `project` its indefinite parts dropped so
     /// that it is positive semi-definite (projected Newton). The block pattern must not depend on `project`.
     fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool);
+    /// Pushes the exact Hessian blocks (N/m) for derivatives of an equilibrium (sensitivities,
+    /// adjoints): the same as the unprojected [`EnergyTerm::add_hessian`] unless the term's solver
+    /// Hessian leaves a curvature out (self-contact leaves out the distance's own curvature).
+    fn add_exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
+        self.add_hessian(x, h, false);
+    }
     /// Largest relative elongation of the term's springs, for divergence checks (0 if none).
     fn max_strain(&self, _x: &Vecs) -> f64 {
         0.0
@@ -191,6 +197,14 @@ impl Model {
         h.clear();
         for t in &self.terms {
             t.add_hessian(x, h, project);
+        }
+    }
+    /// The exact Hessian blocks of the total energy into `h` (cleared first): see
+    /// [`EnergyTerm::add_exact_hessian`].
+    pub fn exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
+        h.clear();
+        for t in &self.terms {
+            t.add_exact_hessian(x, h);
         }
     }
     /// The largest fraction of the step `dx` that every term allows (see [`EnergyTerm::max_step`]).

@@ -4,6 +4,7 @@
 //! bad numerics. Observers ([`Observer`]) receive states and do the I/O.
 
 mod dynamic;
+mod equilibrium;
 mod incremental;
 mod linear;
 mod newton;
@@ -14,6 +15,7 @@ mod vertical_gap;
 pub use dynamic::{
     DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
 };
+pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use linear::{DofMap, SparseSpd};
 pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};

@@ -123,7 +123,7 @@ fn free_max_residual(model: &Model, g: &[Vector3<f64>]) -> f64 {
 }
 
 /// Mean of the Hessian's diagonal over the free DOFs (the scale of the damping), 1 if empty.
-fn mean_free_diagonal(h: &HessianBlocks, dofs: &DofMap, n: usize) -> f64 {
+pub(super) fn mean_free_diagonal(h: &HessianBlocks, dofs: &DofMap, n: usize) -> f64 {
     let diag = h.diagonal(n);
     let (mut sum, mut cnt) = (0.0, 0usize);
     for (p, d) in diag.iter().enumerate() {
@@ -697,16 +697,10 @@ fn held_dofs(model: &Model, dofs: &DofMap) -> Vec<(usize, usize)> {
 /// directions, has a Cholesky factorization. False at a saddle or a maximum (an unstable
 /// equilibrium, e.g. a flat sheet under compression).
 pub fn is_minimum(model: &Model, x: &[Vector3<f64>]) -> bool {
-    let dofs = DofMap::new(&model.fixed);
-    if dofs.n == 0 {
-        return true;
-    }
     let mut h = HessianBlocks::default();
     model.hessian(x, &mut h, false);
-    let scale = mean_free_diagonal(&h, &dofs, model.len());
-    let mut shift = vec![1e-10 * scale; dofs.n];
-    for (d, c) in held_dofs(model, &dofs) {
-        shift[d + c] += 1e12 * scale.max(1e-300);
-    }
-    SparseSpd::new().factorize(&dofs, &h, &shift)
+    !matches!(
+        super::EquilibriumFactor::of(model, h),
+        Err(super::NoFactor::NotAMinimum)
+    )
 }

@@ -1,0 +1,173 @@
+//! `simulate --sensitivity KEY` and `simulate --start FILE` at the command line: the table's rows and
+//! values, run.json's word on them, bad keys and bad start files refused as bad input.
+
+use crate::support::{assert_bad_input, drapelab, root};
+use drapelab::io::{read_particles, read_sensitivities};
+use std::path::Path;
+
+const K: &str = "material.mass_spring.stiffness_N_per_m";
+const RHO: &str = "cloth.areal_density_kg_per_m2";
+
+fn hang4() -> std::path::PathBuf {
+    root().join("datasets/scenes/hang4.toml")
+}
+
+fn run_json(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn sensitivity_parquet_holds_one_row_per_particle_and_key_in_particles_order() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let o = drapelab()
+        .arg("simulate")
+        .arg(hang4())
+        .args([
+            "--out",
+            out.to_str().unwrap(),
+            "--sensitivity",
+            K,
+            "--sensitivity",
+            RHO,
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let particles = read_particles(&out.join("particles.parquet")).unwrap();
+    let rows = read_sensitivities(&out.join("sensitivity.parquet")).unwrap();
+    let n = particles.len();
+    assert_eq!(rows.len(), 2 * n);
+    for (k, key) in [K, RHO].iter().enumerate() {
+        for (p, (i, j, _)) in particles.iter().enumerate() {
+            let r = &rows[k * n + p];
+            assert_eq!((r.i, r.j, r.key.as_str()), (*i, *j, *key));
+        }
+    }
+    // Against the library: the same numbers.
+    let scene = drapelab::scene::Scene::load(&hang4(), &[]).unwrap().scene;
+    let sol = drapelab::simulate::solve_scene(&scene, &mut drapelab::solve::NoObserver);
+    let mut eq =
+        drapelab::sensitivity::Equilibrium::new(&scene, &sol.model, &sol.x, &sol.report, "t")
+            .unwrap();
+    let s = eq.sensitivity(RHO).unwrap();
+    for p in 0..n {
+        let r = &rows[n + p];
+        let d = nalgebra::Vector3::new(r.dx_m_per_unit, r.dy_m_per_unit, r.dz_m_per_unit);
+        assert!(
+            (d - s.dx[p]).norm() <= 1e-12 * (1.0 + s.dx[p].norm()),
+            "{p}"
+        );
+    }
+    // Physics: the pinned corners do not move; a heavier net sags lower at its centre, a stiffer
+    // one less.
+    let centre = 5 * 11 + 5;
+    assert_eq!(rows[n].dz_m_per_unit, 0.0);
+    assert!(rows[n + centre].dz_m_per_unit < 0.0);
+    assert!(rows[centre].dz_m_per_unit > 0.0);
+    let run = run_json(&out);
+    assert_eq!(run["sensitivity"]["written"], true);
+    assert!(
+        run["outputs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|o| o == "sensitivity.parquet")
+    );
+}
+
+#[test]
+fn a_key_that_is_not_a_continuous_parameter_is_bad_input_and_leaves_nothing() {
+    for key in [
+        "cloth.nx",
+        "material.mass_spring.nope",
+        "solver.static.residual_tol_rel",
+    ] {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("o");
+        assert_bad_input(
+            [
+                "simulate",
+                hang4().to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--sensitivity",
+                key,
+            ],
+            &["--sensitivity", key],
+        );
+        assert!(!out.exists(), "{key}: {} left behind", out.display());
+    }
+}
+
+#[test]
+fn a_solve_that_does_not_converge_gets_no_sensitivities_and_says_why() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let o = drapelab()
+        .arg("simulate")
+        .arg(hang4())
+        .args(["--out", out.to_str().unwrap(), "--sensitivity", K])
+        .args(["--set", "solver.static.max_iterations=1"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(!out.join("sensitivity.parquet").exists());
+    let run = run_json(&out);
+    assert_eq!(run["sensitivity"]["written"], false);
+    let reason = run["sensitivity"]["reason"].as_str().unwrap();
+    assert!(reason.contains("did not converge"), "{reason}");
+}
+
+#[test]
+fn a_restart_from_a_saved_drape_lands_on_it_at_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (first, second) = (tmp.path().join("a"), tmp.path().join("b"));
+    let sim = |out: &Path, extra: &[&str]| {
+        let o = drapelab()
+            .arg("simulate")
+            .arg(hang4())
+            .args(["--out", out.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    sim(&first, &[]);
+    let saved = first.join("particles.parquet");
+    sim(&second, &["--start", saved.to_str().unwrap()]);
+    let (a, b) = (
+        read_particles(&saved).unwrap(),
+        read_particles(&second.join("particles.parquet")).unwrap(),
+    );
+    let moved = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| (p.2 - q.2).norm())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-9, "the restart moved the drape by {moved} m");
+    let (r1, r2) = (run_json(&first), run_json(&second));
+    assert!(
+        r2["report"]["iterations"].as_u64().unwrap() < r1["report"]["iterations"].as_u64().unwrap(),
+        "{} vs {}",
+        r2["report"]["iterations"],
+        r1["report"]["iterations"]
+    );
+    assert_eq!(r2["start_file"], saved.to_str().unwrap());
+    // A drape of another grid is refused, naming the flag and the file, and nothing is written.
+    let out = tmp.path().join("c");
+    assert_bad_input(
+        [
+            "simulate",
+            hang4().to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "cloth.nx=13",
+            "--start",
+            saved.to_str().unwrap(),
+        ],
+        &["--start", "particles.parquet", "121 particles"],
+    );
+    assert!(!out.exists());
+}
