@@ -1,12 +1,13 @@
 //! Seed 000's slack-net population as the calibration solves it (the benchmark stage's second
 //! population table): the 14 × 14 net of a scene at `N` Latin-hypercube points of Table 3's box,
-//! each from the nearest drape of the calibration's warm-start lattice. Prints the table, the
+//! each from the nearest drape of the calibration's warm-start lattice, then from that drape's
+//! tangent prediction (the lattice stores each node's sensitivities). Prints both tables, the
 //! lattice's own solve time, and the floor of one solve: the time of one numeric factorization of
 //! the net's Hessian and of one whole iteration's assembly (medians of 200).
 //!
 //! cargo run --release -p drapelab-core --example slack_population -- datasets/scenes/hang4.toml [N]
 
-use drapelab_core::benchmark::{min_median_max, population_table, warm_start_population};
+use drapelab_core::benchmark::{min_median_max, population_table, warm_start_population_with};
 use drapelab_core::physics::HessianBlocks;
 use drapelab_core::scene::Scene;
 use drapelab_core::simulate::solve_scene;
@@ -20,9 +21,14 @@ fn main() -> anyhow::Result<()> {
         .ok_or_else(|| anyhow::anyhow!("usage: slack_population SCENE.toml [N]"))?;
     let n: usize = args.get(1).map(|s| s.parse()).transpose()?.unwrap_or(50);
     let scene = Scene::load(std::path::Path::new(path), &[])?.scene;
-    let (rows, lattice_s) = warm_start_population(&scene, n, 9);
-    println!("lattice solved in {lattice_s:.3} s\n");
-    print!("{}", population_table(&rows));
+    for (tangent, what) in [
+        (false, "from the nearest lattice node's drape"),
+        (true, "from the nearest node's tangent prediction x(θ₀) + (dx/dθ)(θ − θ₀)"),
+    ] {
+        let (rows, lattice_s) = warm_start_population_with(&scene, n, 9, tangent);
+        println!("\n### Each solve {what}\n\nlattice solved in {lattice_s:.3} s\n");
+        print!("{}", population_table(&rows));
+    }
     floor(&scene);
     Ok(())
 }

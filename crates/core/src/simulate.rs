@@ -176,7 +176,7 @@ pub fn self_contact_summary(
 /// checked first ([`Scene::validated`]): an invalid one gives a solution with status invalid, the
 /// bad key in its message, and no particles.
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
-    solve_built(scene, None, observer)
+    solve_built(scene, &[], observer)
 }
 
 /// Solves a validated scene statically or dynamically from the given positions of all particles
@@ -187,12 +187,24 @@ pub fn solve_scene_from(
     x0: &[Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, Some(x0), observer)
+    solve_built(scene, &[x0], observer)
+}
+
+/// [`solve_scene_from`] the candidate start with the lowest energy in the scene's model (e.g. a
+/// neighbouring drape and its tangent prediction): the model is built once for the choice and the
+/// solve. Candidates that do not match the model's particle count are passed over; with none left,
+/// the scene's own start.
+pub fn solve_scene_from_lowest(
+    scene: &Scene,
+    starts: &[&[Vector3<f64>]],
+    observer: &mut dyn Observer,
+) -> Solution {
+    solve_built(scene, starts, observer)
 }
 
 fn solve_built(
     scene: &Scene,
-    start: Option<&[Vector3<f64>]>,
+    starts: &[&[Vector3<f64>]],
     observer: &mut dyn Observer,
 ) -> Solution {
     // Only a checked scene is built; one changed in code into an invalid one is a status, not a panic.
@@ -206,8 +218,15 @@ fn solve_built(
         mut model,
         x0: mut x,
     } = build_scene(scene);
+    let start = starts
+        .iter()
+        .filter(|s| s.len() == x.len())
+        .map(|s| (model.energy(s, 1.0), *s))
+        .filter(|(e, _)| !e.is_nan())
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, s)| s);
     let report = match start {
-        Some(x0) if x0.len() == x.len() => {
+        Some(x0) => {
             x.copy_from_slice(x0);
             solve_model_warm(scene, &grid, &mut model, &mut x, observer)
         }

@@ -439,11 +439,23 @@ pub fn warm_start_population(
     samples: usize,
     seed: u64,
 ) -> (Vec<PopulationRow>, f64) {
+    warm_start_population_with(scene, samples, seed, true)
+}
+
+/// [`warm_start_population`], each solve from its lattice node's tangent prediction or (`tangent`
+/// false) from the node's drape itself.
+pub fn warm_start_population_with(
+    scene: &Scene,
+    samples: usize,
+    seed: u64,
+    tangent: bool,
+) -> (Vec<PopulationRow>, f64) {
     let mut net = scene.regridded(14, 14);
     net.solver.kind = SolverKind::Static;
     net.record.timeline = false;
     net.record.rerun = false;
-    let problem = crate::calibrate::Problem::new(net.clone(), vec![], 50.0);
+    let mut problem = crate::calibrate::Problem::new(net.clone(), vec![], 50.0);
+    problem.tangent_start = tangent;
     let t = Instant::now();
     problem.drape(&[0.5; 5]);
     let lattice_s = t.elapsed().as_secs_f64();

@@ -107,6 +107,10 @@ pub struct Problem {
     /// the sagged start. Either way the cost stays a pure function of the parameter vector.
     /// Default true.
     pub warm_start: bool,
+    /// Start each warm-started evaluation from its lattice node's tangent prediction
+    /// x(θ₀) + (dx/dθ)(θ − θ₀) rather than from the node's drape itself (where the node is an isolated
+    /// minimum and the prediction's energy is the lower). Default true; off only to measure it.
+    pub tangent_start: bool,
     /// Which curve of a simulated drape is compared with the photo's edges. Default the
     /// silhouette of its triangles, the curve a photo shows.
     pub edge_source: EdgeSource,
@@ -133,6 +137,7 @@ impl Problem {
             penalty: 100.0,
             caching: true,
             warm_start: true,
+            tangent_start: true,
             edge_source: EdgeSource::default(),
             projection,
             lattice: Default::default(),
@@ -234,22 +239,26 @@ impl Problem {
     pub fn drape(&self, u: &[f64]) -> (crate::simulate::Solution, Option<Vec<EdgeFit>>) {
         let params = self.bounds.decode(u);
         let scene = self.scene_for(&params);
-        let start = self
-            .warm_start
-            .then(|| self.lattice.get_or_init(|| StartLattice::solve(self)))
-            .and_then(|l| l.nearest(&params));
-        let sol = match start {
+        let starts = match self.warm_start {
+            true => self
+                .lattice
+                .get_or_init(|| StartLattice::solve(self))
+                .starts(&params, self.tangent_start),
+            false => Vec::new(),
+        };
+        let starts: Vec<&[nalgebra::Vector3<f64>]> = starts.iter().map(Vec::as_slice).collect();
+        let sol = match starts.is_empty() {
             // Warm-started next to an equilibrium, a curved step's two extra gradients buy nothing:
             // straight steps there took the knitted calibration from 377 s to 264 s with the same
             // calibrated parameters (issue 34, one run each on one machine); reusing the factorization
             // (chord steps) took it from 280 s to 247 s (reports/newton_iterations.md).
-            Some(x0) => {
+            false => {
                 let mut straight = scene.clone();
                 straight.solver.static_.curvilinear = false;
                 straight.solver.static_.reuse_factorization = true;
-                crate::simulate::solve_scene_from(&straight, x0, &mut NoObserver)
+                crate::simulate::solve_scene_from_lowest(&straight, &starts, &mut NoObserver)
             }
-            None => solve_scene(&scene, &mut NoObserver),
+            true => solve_scene(&scene, &mut NoObserver),
         };
         let edges = match (sol.report.is_converged(), scene_view(&scene)) {
             (true, Ok((view, corners))) => Some(
@@ -290,7 +299,42 @@ pub struct StartLattice {
     stiffness_N_per_m: Vec<f64>,
     natural_length_m: Vec<f64>,
     /// Per topology (A, B, C), per stiffness, per natural length: the converged drape, if it converged.
-    drapes: Vec<Option<Vec<nalgebra::Vector3<f64>>>>,
+    drapes: Vec<Option<LatticeDrape>>,
+}
+
+/// One node's drape and, where it is an isolated minimum, its tangents: the sensitivities to the
+/// stiffness and the natural length ([`crate::sensitivity`]), m per N/m and m per m.
+struct LatticeDrape {
+    x: Vec<nalgebra::Vector3<f64>>,
+    tangents: Option<[Vec<nalgebra::Vector3<f64>>; 2]>,
+}
+
+/// The two keys of the lattice's tangents.
+const TANGENT_KEYS: [&str; 2] = [
+    "material.mass_spring.stiffness_N_per_m",
+    "material.mass_spring.natural_length_m",
+];
+
+impl LatticeDrape {
+    /// The node's drape with its tangents at that drape, when it has them.
+    fn of(scene: &Scene, sol: crate::simulate::Solution) -> Option<Self> {
+        if !sol.report.is_converged() {
+            return None;
+        }
+        let tangents = scene.clone().validated().ok().and_then(|v| {
+            let mut eq = crate::sensitivity::Equilibrium::new(
+                &v,
+                &sol.model,
+                &sol.x,
+                &sol.report,
+                "lattice",
+            )
+            .ok()?;
+            let [a, b] = TANGENT_KEYS.map(|k| eq.sensitivity(k).ok().map(|s| s.dx));
+            Some([a?, b?])
+        });
+        Some(Self { x: sol.x, tangents })
+    }
 }
 
 impl StartLattice {
@@ -314,7 +358,7 @@ impl StartLattice {
             .collect();
         // One chain per (topology, stiffness), in parallel; along a chain, continuation in the
         // natural length (each node from the previous node's drape, the first from the sagged start).
-        let drapes: Vec<Vec<Option<Vec<nalgebra::Vector3<f64>>>>> = chains
+        let drapes: Vec<Vec<Option<LatticeDrape>>> = chains
             .par_iter()
             .map(|&(topology, kk)| {
                 let mut prev: Option<Vec<nalgebra::Vector3<f64>>> = None;
@@ -333,11 +377,11 @@ impl StartLattice {
                             }
                             None => solve_scene(&scene, &mut NoObserver),
                         };
-                        let x = sol.report.is_converged().then_some(sol.x);
-                        if x.is_some() {
-                            prev = x.clone();
+                        let node = LatticeDrape::of(&scene, sol);
+                        if let Some(n) = &node {
+                            prev = Some(n.x.clone());
                         }
-                        x
+                        node
                     })
                     .collect()
             })
@@ -350,8 +394,31 @@ impl StartLattice {
         }
     }
 
-    /// The drape at the lattice node nearest to `p` (in the box's unit coordinates), if it converged.
-    fn nearest(&self, p: &Params) -> Option<&[nalgebra::Vector3<f64>]> {
+    /// The starts of an evaluation at `p`: the drape at the nearest lattice node and, where the
+    /// node has tangents and `tangent` is on, its tangent prediction x(θ₀) + (dx/dθ)(θ − θ₀)
+    /// (within O(|θ − θ₀|²) of the answer); the solve takes the one of lower energy in `p`'s
+    /// model. A function of `p` alone.
+    fn starts(&self, p: &Params, tangent: bool) -> Vec<Vec<nalgebra::Vector3<f64>>> {
+        let Some((node, k0, l0)) = self.nearest(p) else {
+            return Vec::new();
+        };
+        let mut v = vec![node.x.clone()];
+        if let (true, Some([dk, dl])) = (tangent, &node.tangents) {
+            let (a, b) = (p.stiffness_N_per_m - k0, p.natural_length_m - l0);
+            v.push(
+                node.x
+                    .iter()
+                    .zip(dk.iter().zip(dl))
+                    .map(|(x, (u, w))| x + u * a + w * b)
+                    .collect(),
+            );
+        }
+        v
+    }
+
+    /// The lattice node nearest to `p` (in the box's unit coordinates), if its drape converged, with
+    /// the node's stiffness and natural length.
+    fn nearest(&self, p: &Params) -> Option<(&LatticeDrape, f64, f64)> {
         let index = |nodes: &[f64], v: f64| {
             let (lo, hi) = (nodes[0], nodes[nodes.len() - 1]);
             let t = ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
@@ -363,9 +430,12 @@ impl StartLattice {
             Topology::C => 2,
         };
         let (nk, nl) = (self.stiffness_N_per_m.len(), self.natural_length_m.len());
-        let i = (t * nk + index(&self.stiffness_N_per_m, p.stiffness_N_per_m)) * nl
-            + index(&self.natural_length_m, p.natural_length_m);
-        self.drapes.get(i)?.as_deref()
+        let (ik, il) = (
+            index(&self.stiffness_N_per_m, p.stiffness_N_per_m),
+            index(&self.natural_length_m, p.natural_length_m),
+        );
+        let node = self.drapes.get((t * nk + ik) * nl + il)?.as_ref()?;
+        Some((node, self.stiffness_N_per_m[ik], self.natural_length_m[il]))
     }
 }
 
