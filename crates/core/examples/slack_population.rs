@@ -23,7 +23,10 @@ fn main() -> anyhow::Result<()> {
     let scene = Scene::load(std::path::Path::new(path), &[])?.scene;
     for (tangent, what) in [
         (false, "from the nearest lattice node's drape"),
-        (true, "from the nearest node's tangent prediction x(θ₀) + (dx/dθ)(θ − θ₀)"),
+        (
+            true,
+            "from the nearest node's tangent prediction x(θ₀) + (dx/dθ)(θ − θ₀)",
+        ),
     ] {
         let (rows, lattice_s) = warm_start_population_with(&scene, n, 9, tangent);
         println!("\n### Each solve {what}\n\nlattice solved in {lattice_s:.3} s\n");

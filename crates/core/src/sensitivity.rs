@@ -25,6 +25,22 @@ use nalgebra::Vector3;
 /// `cloth.size_y_m` is 10⁻³ off at h = 10⁻⁴ |θ| and 10⁻⁷ at 10⁻⁶ (its round-off is 10⁻⁹ there).
 pub const PARAM_STEP_REL: f64 = 1e-6;
 
+/// The gradient of a rebuilt model at x* and the positions it was taken at (x* with the rebuilt
+/// scene's pins).
+type Side = (Vec<Vector3<f64>>, Vec<Vector3<f64>>);
+
+/// A key's value, its mixed derivative ∂g/∂θ and its fixed particles' motion dx/dθ.
+type Mixed = (f64, Vec<Vector3<f64>>, Vec<Vector3<f64>>);
+
+/// The step of the central differences in θ.
+fn param_step(theta: f64) -> f64 {
+    if theta == 0.0 {
+        1e-8
+    } else {
+        PARAM_STEP_REL * theta.abs()
+    }
+}
+
 /// The largest relative residual ‖H dx + ∂g/∂θ‖/‖∂g/∂θ‖ a sensitivity may leave; beyond, the key
 /// pushes along a neutral mode and has none.
 pub const MAX_RESIDUAL_REL: f64 = 1e-6;
@@ -109,17 +125,10 @@ impl<'a> Equilibrium<'a> {
     }
 
     /// The mixed derivative ∂g/∂θ of `key` at x* and the fixed particles' motion dx/dθ.
-    fn mixed(
-        &self,
-        key: &str,
-    ) -> Result<(f64, Vec<Vector3<f64>>, Vec<Vector3<f64>>), NoSensitivity> {
+    fn mixed(&self, key: &str) -> Result<Mixed, NoSensitivity> {
         let theta = params::value(self.scene, key, &self.source).map_err(NoSensitivity::Input)?;
-        let h = if theta == 0.0 {
-            1e-8
-        } else {
-            PARAM_STEP_REL * theta.abs()
-        };
-        let side = |t: f64| -> Result<(Vec<Vector3<f64>>, Vec<Vector3<f64>>), NoSensitivity> {
+        let h = param_step(theta);
+        let side = |t: f64| -> Result<Side, NoSensitivity> {
             let s = params::with_value(self.scene, key, t, &self.source)
                 .map_err(NoSensitivity::Input)?;
             let b = build_scene(&s);
@@ -217,28 +226,22 @@ fn same_structure(rebuilt: &Model, solved: &Model) -> bool {
 /// and the key, and says what to do.
 pub fn check_key(scene: &ValidatedScene, key: &str, source: &str) -> Result<(), InputError> {
     let theta = params::value(scene, key, source)?;
-    let h = if theta == 0.0 {
-        1e-8
-    } else {
-        PARAM_STEP_REL * theta.abs()
-    };
+    let h = param_step(theta);
     let base = build_scene(scene);
     let mut any = None;
     for t in [theta + h, theta - h] {
-        match params::with_value(scene, key, t, source) {
-            Ok(s) => {
-                let b = build_scene(&s);
-                if !same_structure(&b.model, &base.model) {
-                    return Err(InputError::new(
-                        source,
-                        key,
-                        "changing it changes which particles or energy terms the model has, so the \
+        // A side out of the key's range is the edge of the range, not an error.
+        if let Ok(s) = params::with_value(scene, key, t, source) {
+            let b = build_scene(&s);
+            if !same_structure(&b.model, &base.model) {
+                return Err(InputError::new(
+                    source,
+                    key,
+                    "changing it changes which particles or energy terms the model has, so the \
 drape has no derivative in it; give a key whose change only changes values",
-                    ));
-                }
-                any = Some(());
+                ));
             }
-            Err(_) => {}
+            any = Some(());
         }
     }
     any.ok_or_else(|| {

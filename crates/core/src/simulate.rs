@@ -202,11 +202,7 @@ pub fn solve_scene_from_lowest(
     solve_built(scene, starts, observer)
 }
 
-fn solve_built(
-    scene: &Scene,
-    starts: &[&[Vector3<f64>]],
-    observer: &mut dyn Observer,
-) -> Solution {
+fn solve_built(scene: &Scene, starts: &[&[Vector3<f64>]], observer: &mut dyn Observer) -> Solution {
     // Only a checked scene is built; one changed in code into an invalid one is a status, not a panic.
     let scene = match scene.clone().validated() {
         Ok(v) => v,
@@ -323,12 +319,7 @@ pub fn solve_model(
     }
     let mut report = static_solve(scene, grid, model, x, observer);
     if let Some((r, _)) = coarse {
-        report.iterations += r.iterations;
-        report.linear_solves += r.linear_solves;
-        report.factorizations += r.factorizations;
-        report.factor_time_s += r.factor_time_s;
-        report.wall_time_s += r.wall_time_s;
-        report.globalization.add(&r.globalization);
+        report.add_work(&r);
         report.message += &format!(
             " (from a {}×{} start)",
             grid.nx.div_ceil(2),

@@ -44,6 +44,9 @@ pub const SIMULATE_FILES: [&str; 6] = [
     "sensitivity.parquet",
 ];
 
+/// Sensitivities key by key: dx*/dθ of the grid particles, m per unit of the key.
+pub type KeyedSensitivities = Vec<(String, Vec<nalgebra::Vector3<f64>>)>;
+
 /// What `run.json` says of the sensitivities asked for.
 #[derive(Debug, Clone, Serialize)]
 struct SensitivityRecord {
@@ -98,7 +101,7 @@ pub struct Simulated {
     /// The sensitivities asked for ([`SimulateExtras::sensitivity_keys`]), key by key: dx*/dθ of
     /// the grid particles, m per unit of the key; empty when none were asked for or none exist
     /// (run.json says why).
-    pub sensitivity: Vec<(String, Vec<nalgebra::Vector3<f64>>)>,
+    pub sensitivity: KeyedSensitivities,
 }
 
 /// [`simulate_to_dir`], also returning the final state (the Python package's `simulate`).
@@ -330,10 +333,7 @@ fn sensitivities(
     report: &SolveReport,
     extras: &SimulateExtras,
     out: &Path,
-) -> Result<(
-    Option<SensitivityRecord>,
-    Vec<(String, Vec<nalgebra::Vector3<f64>>)>,
-)> {
+) -> Result<(Option<SensitivityRecord>, KeyedSensitivities)> {
     use drapelab_core::sensitivity::Equilibrium;
     if extras.sensitivity_keys.is_empty() {
         return Ok((None, Vec::new()));

@@ -271,18 +271,26 @@ impl SolveReport {
 }
 
 impl SolveReport {
+    /// Adds the work of another solve of the same problem (a coarse start, an earlier load step or
+    /// friction update) to this report's counters: iterations, linear solves, factorizations, their
+    /// time, wall time and the globalization tallies. The one place where reports are merged.
+    pub fn add_work(&mut self, other: &SolveReport) {
+        self.iterations += other.iterations;
+        self.linear_solves += other.linear_solves;
+        self.factorizations += other.factorizations;
+        self.factor_time_s += other.factor_time_s;
+        self.wall_time_s += other.wall_time_s;
+        self.globalization.add(&other.globalization);
+    }
+
     /// The running total of a solve made of several solves (load increments, contact rounds): work
-    /// and time add up, the status, residual, energy and message are the latest one's.
+    /// and time add up ([`Self::add_work`]), the status, residual, energy and message are the latest
+    /// one's.
     pub fn accumulate(total: Option<SolveReport>, latest: SolveReport) -> SolveReport {
         match total {
             None => latest,
             Some(mut t) => {
-                t.iterations += latest.iterations;
-                t.linear_solves += latest.linear_solves;
-                t.factorizations += latest.factorizations;
-                t.factor_time_s += latest.factor_time_s;
-                t.wall_time_s += latest.wall_time_s;
-                t.globalization.add(&latest.globalization);
+                t.add_work(&latest);
                 t.status = latest.status;
                 t.stop = latest.stop;
                 t.max_residual_N = latest.max_residual_N;
