@@ -200,10 +200,39 @@ const ACCELERATION_FD: f64 = 0.1;
 /// round-off, a change below 1e-11 of the energy).
 fn armijo(et: f64, e: f64, alpha: f64, slope: f64) -> (bool, bool) {
     (
-        et <= e + 1e-4 * alpha * slope,
-        (et - e).abs() <= 1e-11 * e.abs().max(1e-300),
+        et <= e + ARMIJO_DECREASE * alpha * slope,
+        (et - e).abs() <= ENERGY_FLAT_REL * e.abs().max(1e-300),
     )
 }
+
+/// Armijo's sufficient-decrease constant: a step is accepted when the energy falls by at least this
+/// fraction of the decrease its slope promises. The textbook value (Nocedal & Wright); a larger one
+/// rejects more steps, a smaller one accepts steps that barely descend.
+pub const ARMIJO_DECREASE: f64 = 1e-4;
+
+/// An energy change below this fraction of the energy is round-off: such a step is accepted when it
+/// lowers the residual instead. Raise it only if a solve stalls at its round-off floor.
+pub const ENERGY_FLAT_REL: f64 = 1e-11;
+
+/// The factor by which damping and shifts grow after a failed factorization or line search (and
+/// the damping's ladder of shifts, 1e-8, 1e-7, …). A larger factor reaches a working shift in fewer
+/// factorizations but overshoots it.
+pub const DAMPING_GROWTH: f64 = 10.0;
+
+/// The damping is divided by this after a whole step (Levenberg–Marquardt's decrease).
+pub const DAMPING_DECREASE: f64 = 4.0;
+
+/// Factorization attempts (shifts, projection, damping) of one iteration before it gives up.
+pub const FACTORIZE_ATTEMPTS: usize = 40;
+
+/// Halvings of the step a line search tries before it gives up (2⁻³⁰ of the step).
+pub const LINE_SEARCH_HALVINGS: usize = 30;
+
+/// Rounds of (factorize, line search) in one iteration, each with more damping, before it gives up.
+pub const DAMPED_ROUNDS: usize = 20;
+
+/// The damping above which [`StaticOptions::carried_damping`] switches to the projected Hessian.
+pub const CARRIED_DAMPING_MAX: f64 = 1e-3;
 
 /// A chord step is tried while the largest residual force falls at least by this factor per
 /// iteration ([`StaticOptions::reuse_factorization`]).
@@ -258,7 +287,7 @@ impl Workspace {
         report: &mut SolveReport,
     ) -> bool {
         let mut shift = self.mu;
-        for attempt in 0..40 {
+        for attempt in 0..FACTORIZE_ATTEMPTS {
             if self.try_shift(shift, scale, report) {
                 report.linear_solves += 1;
                 self.was_projected = *projected;
@@ -274,14 +303,14 @@ impl Workspace {
             {
                 *projected = true;
                 model.hessian(x, &mut self.h, true);
-            } else if !*projected && shift * 10.0 <= self.shift_max {
-                shift = (shift * 10.0).max(MU_MIN);
+            } else if !*projected && shift * DAMPING_GROWTH <= self.shift_max {
+                shift = (shift * DAMPING_GROWTH).max(MU_MIN);
             } else if !*projected {
                 *projected = true;
                 model.hessian(x, &mut self.h, true);
                 shift = self.mu;
             } else {
-                shift = (shift * 10.0).max(MU_MIN);
+                shift = (shift * DAMPING_GROWTH).max(MU_MIN);
                 self.mu = shift;
             }
         }
@@ -295,7 +324,7 @@ impl Workspace {
         // Held components (symmetry planes): a diagonal far above the rest decouples them, and
         // their step is set to zero.
         for &(d, c) in &self.held {
-            self.shift[d + c] += 1e12 * scale.max(1e-300);
+            self.shift[d + c] += super::equilibrium::HELD_SHIFT_REL * scale.max(1e-300);
         }
         report.factorizations += 1;
         self.spd.factorize(&self.dofs, &self.h, &self.shift)
@@ -307,8 +336,8 @@ impl Workspace {
     /// skipped — the same step as climbing it, in one factorization instead of each rung's.
     fn top_fails(&mut self, shift: f64, scale: f64, report: &mut SolveReport) -> bool {
         let mut top = shift;
-        while top * 10.0 <= self.shift_max {
-            top = (top * 10.0).max(MU_MIN);
+        while top * DAMPING_GROWTH <= self.shift_max {
+            top = (top * DAMPING_GROWTH).max(MU_MIN);
         }
         if top == shift {
             return false;
@@ -321,12 +350,12 @@ impl Workspace {
     /// [`StaticOptions::carried_damping`]: the damping raised tenfold, or the projected Hessian
     /// with the damping back at its initial value once it reaches 1e-3.
     fn carry_shift(&mut self, model: &Model, x: &[Vector3<f64>], projected: &mut bool) {
-        if !*projected && self.mu >= 1e-3 {
+        if !*projected && self.mu >= CARRIED_DAMPING_MAX {
             *projected = true;
             model.hessian(x, &mut self.h, true);
             self.mu = self.mu_initial.min(self.mu);
         } else {
-            self.mu = (self.mu * 10.0).max(MU_MIN);
+            self.mu = (self.mu * DAMPING_GROWTH).max(MU_MIN);
         }
     }
 
@@ -408,7 +437,7 @@ impl Workspace {
         (e, r): (&mut f64, f64),
         (mut alpha, slope): (f64, f64),
     ) -> Option<f64> {
-        for _ in 0..30 {
+        for _ in 0..LINE_SEARCH_HALVINGS {
             let half = 0.5 * alpha * alpha;
             for (p, xp) in x.iter().enumerate() {
                 self.trial[p] = xp + self.dx[p] * alpha + self.acc[p] * half;
@@ -453,7 +482,7 @@ impl Workspace {
         model.hessian(x, &mut self.h, projected);
         // The damping's scale: the mean diagonal of this iteration's exact Hessian.
         let scale = mean_free_diagonal(&self.h, &self.dofs, model.len());
-        for _ in 0..20 {
+        for _ in 0..DAMPED_ROUNDS {
             if !self.factorize(model, x, &mut projected, scale, report) {
                 return false;
             }
@@ -475,13 +504,17 @@ impl Workspace {
                     self.count(alpha, bound, (curved, projected));
                     self.whole_prev = alpha == 1.0 && bound >= 1.0;
                     if self.whole_prev {
-                        self.mu = if self.mu < 1e-12 { 0.0 } else { self.mu / 4.0 };
+                        self.mu = if self.mu < 1e-12 {
+                            0.0
+                        } else {
+                            self.mu / DAMPING_DECREASE
+                        };
                     }
                     return true;
                 }
                 // A step that does not decrease the energy: near the solution, round-off.
                 None if r <= 10.0 * tol => return false,
-                None => self.mu = (self.mu * 10.0).max(MU_MIN),
+                None => self.mu = (self.mu * DAMPING_GROWTH).max(MU_MIN),
             }
         }
         false
