@@ -106,7 +106,7 @@ pub fn value(scene: &Scene, key: &str, source: &str) -> Result<f64, InputError> 
             source,
             key,
             format!(
-                "not a continuous parameter (a {}); give a real-valued key",
+                "not a continuous parameter (its TOML type is {}); give a real-valued key",
                 other.type_str()
             ),
         )),
