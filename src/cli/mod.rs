@@ -340,8 +340,13 @@ pub struct BenchArgs {
 }
 
 /// `drapelab run`: runs a pipeline make-style with a progress display; returns the exit code.
-fn run_pipeline_command(pipeline: &Path, opts: crate::pipeline::RunOptions) -> Result<i32> {
-    run_pipeline_with(pipeline, opts, &crate::stages::registry())
+/// With `quiet` (`-q`), only errors: no summary line.
+fn run_pipeline_command(
+    pipeline: &Path,
+    quiet: bool,
+    opts: crate::pipeline::RunOptions,
+) -> Result<i32> {
+    run_pipeline_quietly(pipeline, opts, &crate::stages::registry(), quiet)
 }
 
 /// Runs a pipeline with the stage kinds of `registry` (drapelab's own, or those plus a program's
@@ -352,20 +357,32 @@ pub fn run_pipeline_with(
     opts: crate::pipeline::RunOptions,
     registry: &crate::pipeline::Registry,
 ) -> Result<i32> {
+    run_pipeline_quietly(pipeline, opts, registry, false)
+}
+
+/// [`run_pipeline_with`]; with `quiet`, the summary line is left out (failures are still said).
+pub fn run_pipeline_quietly(
+    pipeline: &Path,
+    opts: crate::pipeline::RunOptions,
+    registry: &crate::pipeline::Registry,
+    quiet: bool,
+) -> Result<i32> {
     let plan = crate::pipeline::load_plan(pipeline, registry)?;
     let progress = crate::pipeline::progress_for_terminal();
     let summary = crate::pipeline::run_pipeline(&plan, &opts, progress.as_ref())?;
     for (name, why) in &summary.would_run {
         println!("would run {name}: {why}");
     }
-    eprintln!(
-        "{}: {} ran, {} up to date, {} failed{}",
-        plan.name,
-        summary.ran.len(),
-        summary.skipped.len(),
-        summary.failed.len(),
-        if opts.dry_run { " (dry run)" } else { "" }
-    );
+    if !quiet {
+        eprintln!(
+            "{}: {} ran, {} up to date, {} failed{}",
+            plan.name,
+            summary.ran.len(),
+            summary.skipped.len(),
+            summary.failed.len(),
+            if opts.dry_run { " (dry run)" } else { "" }
+        );
+    }
     for (name, why) in &summary.failed {
         eprintln!("  {name}: {why}");
     }
@@ -417,6 +434,7 @@ pub fn load_scene(path: &Path, sets: &[String]) -> Result<LoadedScene, InputErro
 
 /// Runs the parsed command line; returns the exit code.
 pub fn run(cli: Cli) -> Result<i32> {
+    let quiet = cli.quiet;
     match cli.command {
         Command::Simulate {
             scene,
@@ -424,7 +442,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             set,
             sensitivity,
             start,
-        } => simulate(&scene, &out, &set, &sensitivity, start.as_deref()),
+        } => simulate(&scene, &out, &set, (&sensitivity, start.as_deref()), quiet),
         Command::Run {
             pipeline,
             until,
@@ -435,6 +453,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             wait,
         } => run_pipeline_command(
             &pipeline,
+            quiet,
             crate::pipeline::RunOptions {
                 until,
                 force,
@@ -526,7 +545,11 @@ fn score(real: &Path, sim: &Path, side_cm: f64) -> Result<i32> {
 /// `drapelab bench`: the hang4 table, or the whole benchmark pipeline with `--all`.
 fn bench_command(a: BenchArgs) -> Result<i32> {
     if a.all {
-        return run_pipeline_command(Path::new("pipelines/benchmark.toml"), Default::default());
+        return run_pipeline_command(
+            Path::new("pipelines/benchmark.toml"),
+            false,
+            Default::default(),
+        );
     }
     bench::run_bench(
         &a.scene,
@@ -538,13 +561,13 @@ fn bench_command(a: BenchArgs) -> Result<i32> {
     Ok(EXIT_OK)
 }
 
-/// `drapelab simulate`.
+/// `drapelab simulate`: the result line on stdout (none with `-q`).
 fn simulate(
     scene: &Path,
     out: &Path,
     set: &[String],
-    sensitivity: &[String],
-    start: Option<&Path>,
+    (sensitivity, start): (&[String], Option<&Path>),
+    quiet: bool,
 ) -> Result<i32> {
     let loaded = load_scene(scene, set)?;
     for key in sensitivity {
@@ -560,17 +583,19 @@ fn simulate(
     let mut progress = SolveProgress::new(&loaded.scene.name);
     let report = crate::io::simulate_to_dir_with(&loaded, out, &mut progress, &extras)?.report;
     progress.done(&report);
-    eprintln!(
-        "{}: {} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
-        loaded.scene.name,
-        report.status.as_str(),
-        report.solver,
-        report.iterations,
-        report.max_residual_N,
-        report.max_residual_rel,
-        report.wall_time_s,
-        out.display()
-    );
+    if !quiet {
+        println!(
+            "{}: {} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
+            loaded.scene.name,
+            report.status.as_str(),
+            report.solver,
+            report.iterations,
+            report.max_residual_N,
+            report.max_residual_rel,
+            report.wall_time_s,
+            out.display()
+        );
+    }
     Ok(if report.is_converged() {
         EXIT_OK
     } else {

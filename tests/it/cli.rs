@@ -259,3 +259,35 @@ fn a_missing_argument_is_named_on_the_one_line() {
         crate::support::assert_bad_input(&args, &names);
     }
 }
+
+#[test]
+fn the_result_line_is_on_stdout_and_quiet_means_errors_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = root().join("datasets/scenes/hang4.toml");
+    let run = |extra: &[&str], out: &str| {
+        drapelab()
+            .args(extra)
+            .arg("simulate")
+            .arg(&scene)
+            .arg("--out")
+            .arg(tmp.path().join(out))
+            .output()
+            .unwrap()
+    };
+    let o = run(&[], "a");
+    assert!(o.status.success());
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("hang4: converged by"), "stdout: {stdout}");
+    let o = run(&["-q"], "b");
+    assert!(o.status.success());
+    assert!(o.stdout.is_empty() && o.stderr.is_empty(), "{o:?}");
+    assert!(tmp.path().join("b/particles.parquet").exists());
+    // Errors still reach stderr with -q.
+    let o = drapelab()
+        .args(["-q", "simulate", "missing.toml", "--out"])
+        .arg(tmp.path().join("c"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!o.stderr.is_empty());
+}
