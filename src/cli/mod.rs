@@ -570,6 +570,7 @@ fn simulate(
     quiet: bool,
 ) -> Result<i32> {
     let loaded = load_scene(scene, set)?;
+    crate::build::check_something_free(&loaded)?;
     for key in sensitivity {
         crate::sensitivity::check_key(&loaded.scene, key, "--sensitivity")?;
     }

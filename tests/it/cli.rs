@@ -291,3 +291,24 @@ fn the_result_line_is_on_stdout_and_quiet_means_errors_only() {
     assert_eq!(o.status.code(), Some(2));
     assert!(!o.stderr.is_empty());
 }
+
+#[test]
+fn a_sheet_with_nothing_free_is_bad_input_and_leaves_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let scene = root().join("datasets/scenes/hang4.toml");
+    crate::support::assert_bad_input(
+        [
+            "simulate",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "cloth.nx=2",
+            "--set",
+            "cloth.ny=2",
+        ],
+        &["hang4.toml", "boundary", "no free particle"],
+    );
+    assert!(!out.exists());
+}

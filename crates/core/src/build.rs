@@ -54,6 +54,26 @@ pub fn initial_positions(scene: &Scene) -> Vec<Vector3<f64>> {
     scene.initial_positions()
 }
 
+/// Checks that the scene `loaded` has something to solve: at least one free particle with mass
+/// (a 2 × 2 sheet pinned at its four corners has none). The error names the file and `boundary`.
+pub fn check_something_free(
+    loaded: &crate::scene::LoadedScene,
+) -> Result<(), crate::error::InputError> {
+    let model = build_scene(&loaded.scene).model;
+    if model.reference_weight().is_finite() {
+        return Ok(());
+    }
+    Err(crate::error::InputError::new(
+        &loaded.path,
+        "boundary",
+        format!(
+            "no free particle with mass on the {} × {} grid: every particle is pinned, clamped or \
+outside the sheet; pin fewer or use a finer grid (cloth.nx, cloth.ny)",
+            loaded.scene.cloth.nx, loaded.scene.cloth.ny
+        ),
+    ))
+}
+
 /// Builds the model of a validated scene.
 pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
     let c = &scene.cloth;

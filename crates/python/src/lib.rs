@@ -65,6 +65,8 @@ fn simulate<'py>(
 ) -> PyResult<Simulated<'py>> {
     let started = std::time::Instant::now();
     let loaded = load_scene(scene_path.as_deref(), scene_json.as_deref(), set_json)?;
+    drapelab_core::build::check_something_free(&loaded)
+        .map_err(|e| InputError::new_err(e.to_string()))?;
     for key in &sensitivity {
         drapelab_core::sensitivity::check_key(&loaded.scene, key, "sensitivity")
             .map_err(|e| InputError::new_err(e.to_string()))?;
