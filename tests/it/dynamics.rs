@@ -39,9 +39,9 @@ fn implicit_euler_settles_on_the_static_drape_of_hang4_and_the_cantilever() {
             "solver.dynamic.dt_s=0.01",
             "solver.dynamic.max_time_s=200",
             if reuse {
-                "solver.dynamic.reuse_factorization=true"
+                "solver.dynamic.factor_reuse=chord"
             } else {
-                "solver.dynamic.reuse_factorization=false"
+                "solver.dynamic.factor_reuse=fresh"
             },
         ]);
         let dynamic = solve_scene(&scene(file, &dynamic_sets), &mut NoObserver);

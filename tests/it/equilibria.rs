@@ -223,7 +223,7 @@ fn the_curved_step_lands_on_the_same_equilibrium_in_fewer_iterations() {
     let straight = solve_scene(
         &scene(
             "cantilever_wool_warp.toml",
-            &[TOL, "solver.static.curvilinear=false"],
+            &[TOL, "solver.static.direction=straight"],
         ),
         &mut NoObserver,
     );
@@ -248,8 +248,8 @@ fn the_curved_step_lands_on_the_same_equilibrium_in_fewer_iterations() {
 
 #[test]
 fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
-    // Sheets pinned along one line swing down about it: the folded start (sag_start on) and the
-    // flat start (off) must reach the same equilibrium (or its mirror image, a curl to the other
+    // Sheets pinned along one line swing down about it: the folded start (start = "nested", the
+    // default) and the flat start ("nested-flat") must reach the same equilibrium (or its mirror image, a curl to the other
     // side), a minimum, the folded one in fewer Newton iterations.
     for (name, mirror) in [
         ("hang2.toml", Some(Symmetry::Reflect(1, 0.5))),
@@ -257,7 +257,7 @@ fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
     ] {
         let folded = solve_scene(&scene(name, &[TOL]), &mut NoObserver);
         let flat = solve_scene(
-            &scene(name, &[TOL, "solver.static.sag_start=false"]),
+            &scene(name, &[TOL, "solver.static.start=nested-flat"]),
             &mut NoObserver,
         );
         let (a, b) = (&folded.report, &flat.report);
@@ -329,7 +329,7 @@ fn reusing_the_factorization_lands_on_the_same_equilibrium_with_fewer_factorizat
     // path's last iterations only: from a warm start near the answer (the drape at 98 % of the
     // weight), as the calibration uses them, the same equilibrium to 1e-8 m, never more
     // factorizations and fewer over the three (hang4 21²: 7 → 2), every chord step a whole one.
-    let reuse = "solver.static.reuse_factorization=true";
+    let reuse = "solver.static.factor_reuse=chord";
     let (mut reusing, mut not) = (0, 0);
     for (name, sets, lighter) in [
         (

@@ -5,7 +5,25 @@
 //! again. The sensitivities ([`crate::sensitivity`]) differentiate the equilibrium in these.
 
 use crate::error::InputError;
+use crate::physics::Model;
 use crate::scene::{Scene, ValidatedScene};
+use nalgebra::Vector3;
+
+/// A model built over named continuous parameters (parameters as data): a grid scene's keys
+/// ([`continuous_keys`]; `crate::sensitivity::SceneParameters`), a Cusick specimen's
+/// (`crate::cusick::SpecimenParameters`). The sensitivities differentiate an equilibrium through
+/// this alone.
+pub trait Parameterized {
+    /// Every continuous parameter's key.
+    fn keys(&self) -> Vec<String>;
+    /// The value of `key`, in the unit its source writes it; an error names the key.
+    fn value(&self, key: &str) -> Result<f64, InputError>;
+    /// The model with `key` set to `v`, and its start positions (the fixed particles where the
+    /// changed parameters put them); an error (naming the key) where `v` is out of its range.
+    fn model_with(&self, key: &str, v: f64) -> Result<(Model, Vec<Vector3<f64>>), InputError>;
+    /// The model at the parameters as they are.
+    fn model(&self) -> (Model, Vec<Vector3<f64>>);
+}
 
 /// Top-level sections whose numbers steer the solver or the recording, not the physics: they are
 /// not parameters of the equilibrium.

@@ -490,6 +490,7 @@ impl Scene {
             for (k, v) in overrides.iter().filter(|(k, _)| keep(k)) {
                 set_dotted(&mut table, k, v.clone()).map_err(|m| InputError::new(path, k, m))?;
             }
+            read_renamed_keys(&mut table).map_err(|(k, m)| InputError::new(path, k, m))?;
             from_table(path, "", table)
         };
         let mut scene = with(&|_| true)?;
@@ -958,6 +959,102 @@ impl Check<'_> {
     }
 }
 
+/// The solver keys issue 46 turned from booleans into strategies, read as their successors: (table,
+/// old boolean, new key, its value for true, for false).
+const RENAMED_KEYS: [(&str, &str, &str, &str, &str); 4] = [
+    ("static", "curvilinear", "direction", "curved", "straight"),
+    (
+        "static",
+        "carried_damping",
+        "regularization",
+        "carried-damping",
+        "shift-ladder",
+    ),
+    (
+        "static",
+        "reuse_factorization",
+        "factor_reuse",
+        "chord",
+        "fresh",
+    ),
+    (
+        "dynamic",
+        "reuse_factorization",
+        "factor_reuse",
+        "chord",
+        "fresh",
+    ),
+];
+
+/// Rewrites the old boolean solver keys of a scene table (`solver.static.curvilinear`,
+/// `carried_damping`, `reuse_factorization`, `coarse_start` and `sag_start`,
+/// `solver.dynamic.reuse_factorization`) into the strategy keys that replaced them, so that scene
+/// files written before keep their meaning. Err (key, message) for a non-boolean value or an old
+/// key given together with its successor.
+fn read_renamed_keys(table: &mut toml::Table) -> Result<(), (String, String)> {
+    let Some(toml::Value::Table(solver)) = table.get_mut("solver") else {
+        return Ok(());
+    };
+    let flag = |t: &mut toml::Table, sub: &str, old: &str| -> Result<Option<bool>, _> {
+        let key = format!("solver.{sub}.{old}");
+        match t.remove(old) {
+            None => Ok(None),
+            Some(toml::Value::Boolean(b)) => Ok(Some(b)),
+            Some(v) => Err((
+                key,
+                format!("expected a boolean, got the {} {v}", v.type_str()),
+            )),
+        }
+    };
+    for (sub, old, new, yes, no) in RENAMED_KEYS {
+        let Some(toml::Value::Table(t)) = solver.get_mut(sub) else {
+            continue;
+        };
+        if let Some(b) = flag(t, sub, old)? {
+            rename_into(t, (sub, old, new), if b { yes } else { no })?;
+        }
+    }
+    if let Some(toml::Value::Table(t)) = solver.get_mut("static") {
+        let (nested, shaped) = (
+            flag(t, "static", "coarse_start")?,
+            flag(t, "static", "sag_start")?,
+        );
+        if nested.is_some() || shaped.is_some() {
+            let start =
+                crate::solve::Start::from_flags(nested.unwrap_or(true), shaped.unwrap_or(true));
+            let name = serde_json::to_value(start)
+                .map_err(|e| ("solver.static.start".into(), e.to_string()))?;
+            let old = if nested.is_some() {
+                "coarse_start"
+            } else {
+                "sag_start"
+            };
+            rename_into(
+                t,
+                ("static", old, "start"),
+                name.as_str().unwrap_or_default(),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// Sets `new` to `value` in the solver table `t` unless the file gives `new` itself.
+fn rename_into(
+    t: &mut toml::Table,
+    (sub, old, new): (&str, &str, &str),
+    value: &str,
+) -> Result<(), (String, String)> {
+    if t.contains_key(new) {
+        return Err((
+            format!("solver.{sub}.{old}"),
+            format!("replaced by solver.{sub}.{new}, which is given too: keep only `{new}`"),
+        ));
+    }
+    t.insert(new.into(), toml::Value::String(value.into()));
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -986,5 +1083,47 @@ mod tests {
         assert!(set_dotted(&mut t, "loads.x.magnitude_N", toml::Value::Float(1.0)).is_err());
         // A failed set leaves the table as it was.
         assert_eq!(t["cloth"]["nx"].as_integer(), Some(3));
+    }
+
+    #[test]
+    fn the_old_solver_booleans_are_read_as_the_strategies_that_replaced_them() {
+        use crate::solve::{Direction, FactorReuse, Regularization, Start};
+        let hang4 = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/scenes/hang4.toml");
+        let read = |sets: &[&str]| -> Result<Scene, InputError> {
+            let sets: Vec<_> = sets
+                .iter()
+                .map(|s| crate::config::parse_override(s).unwrap())
+                .collect();
+            Scene::load(&hang4, &sets).map(|l| (*l.scene).clone())
+        };
+        let s = read(&[
+            "solver.static.curvilinear=false",
+            "solver.static.carried_damping=true",
+            "solver.static.reuse_factorization=true",
+            "solver.static.coarse_start=false",
+            "solver.dynamic.reuse_factorization=false",
+        ])
+        .unwrap();
+        let o = &s.solver.static_;
+        assert_eq!(o.direction, Direction::Straight);
+        assert_eq!(o.regularization, Regularization::CarriedDamping);
+        assert_eq!(o.factor_reuse, FactorReuse::Chord);
+        assert_eq!(o.start, Start::Shaped);
+        assert_eq!(s.solver.dynamic.factor_reuse, FactorReuse::Fresh);
+        let s = read(&["solver.static.sag_start=false"]).unwrap();
+        assert_eq!(s.solver.static_.start, Start::NestedFlat);
+        // Defaults untouched without the old keys.
+        let s = read(&[]).unwrap();
+        assert_eq!(s.solver.static_.start, Start::Nested);
+        assert_eq!(s.solver.static_.direction, Direction::Curved);
+        // An old key beside its successor, and a non-boolean, name the old key.
+        let e = read(&[
+            "solver.static.curvilinear=true",
+            "solver.static.direction=straight",
+        ])
+        .unwrap_err();
+        assert_eq!(e.key, "solver.static.curvilinear");
+        let e = read(&["solver.static.sag_start=1"]).unwrap_err();
+        assert_eq!(e.key, "solver.static.sag_start");
     }
 }

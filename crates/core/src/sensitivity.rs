@@ -4,17 +4,18 @@
 //! ([`EquilibriumFactor`]).
 //!
 //! The equilibrium satisfies g(x*(θ), θ) = 0 over the free coordinates, so H dx*/dθ = −∂g/∂θ. The
-//! mixed derivative ∂g/∂θ is taken on the model itself: the scene is rebuilt at θ ± h (h = 10⁻⁶ θ, [`PARAM_STEP_REL`])
-//! and the gradient of every energy term evaluated at the same x*, with the fixed particles where
-//! the rebuilt scene puts them (a pin moved by `cloth.size_x_m` moves the drape through the
-//! coupling blocks of H). This central difference of an analytic gradient is exact for the terms
-//! linear in their parameter (stiffnesses, weights, κ) up to round-off and O(h²) for the others
-//! (contact distances, sizes); it needs two gradient assemblies per key and no solve.
+//! mixed derivative ∂g/∂θ is taken term by term ([`crate::physics::Kernel`]): the scene is rebuilt
+//! at θ ± h (h = 10⁻⁶ θ, [`PARAM_STEP_REL`]), each term's coefficients (stiffnesses, rest lengths,
+//! weights) differenced into dc/dθ, and the term's analytic mixed derivative ∂g/∂c · dc/dθ taken at
+//! x*; a term that does not give one (barrier contact, self-contact) contributes the central
+//! difference of its rebuilt gradients at x*. The fixed particles' motion (a pin moved by
+//! `cloth.size_x_m`) enters through the coupling blocks of the exact Hessian, H dx_fixed/dθ. No
+//! solve is needed, and the coefficients' difference is exact for coefficients linear in θ.
 
 use crate::build::build_scene;
 use crate::error::InputError;
-use crate::params;
-use crate::physics::{Model, Vecs};
+use crate::params::{self, Parameterized};
+use crate::physics::{EnergyTerm, Model, Vecs};
 use crate::scene::ValidatedScene;
 use crate::solve::{EquilibriumFactor, NoFactor, SolveReport};
 use nalgebra::Vector3;
@@ -24,10 +25,6 @@ use nalgebra::Vector3;
 /// difference's O(h²) error: on hang2 (a sheet swinging about two pins) the sensitivity to
 /// `cloth.size_y_m` is 10⁻³ off at h = 10⁻⁴ |θ| and 10⁻⁷ at 10⁻⁶ (its round-off is 10⁻⁹ there).
 pub const PARAM_STEP_REL: f64 = 1e-6;
-
-/// The gradient of a rebuilt model at x* and the positions it was taken at (x* with the rebuilt
-/// scene's pins).
-type Side = (Vec<Vector3<f64>>, Vec<Vector3<f64>>);
 
 /// A key's value, its mixed derivative ∂g/∂θ and its fixed particles' motion dx/dθ.
 type Mixed = (f64, Vec<Vector3<f64>>, Vec<Vector3<f64>>);
@@ -92,18 +89,44 @@ neutral mode; residual {r:.1e}): the drape does not move smoothly with it"
     }
 }
 
-/// The equilibrium of a solved scene with its factor, ready for sensitivities and adjoints.
+/// A grid scene's continuous keys as parameters ([`params::continuous_keys`]); `source` names
+/// where the keys come from in errors (a flag, a file).
+pub struct SceneParameters<'a> {
+    /// The scene.
+    pub scene: &'a ValidatedScene,
+    /// Where the keys come from.
+    pub source: String,
+}
+
+impl Parameterized for SceneParameters<'_> {
+    fn keys(&self) -> Vec<String> {
+        params::continuous_keys(self.scene)
+    }
+    fn value(&self, key: &str) -> Result<f64, InputError> {
+        params::value(self.scene, key, &self.source)
+    }
+    fn model_with(&self, key: &str, v: f64) -> Result<(Model, Vec<Vector3<f64>>), InputError> {
+        let s = params::with_value(self.scene, key, v, &self.source)?;
+        let b = build_scene(&s);
+        Ok((b.model, b.x0))
+    }
+    fn model(&self) -> (Model, Vec<Vector3<f64>>) {
+        let b = build_scene(self.scene);
+        (b.model, b.x0)
+    }
+}
+
+/// The equilibrium of a solved model with its factor, ready for sensitivities and adjoints.
 pub struct Equilibrium<'a> {
-    scene: &'a ValidatedScene,
+    params: Box<dyn Parameterized + 'a>,
     model: &'a Model,
     x: &'a [Vector3<f64>],
     factor: EquilibriumFactor,
-    source: String,
 }
 
 impl<'a> Equilibrium<'a> {
-    /// The factor of the solved `model` at `x`; none unless the report says converged. `source`
-    /// names where the keys come from in errors (a flag, a file).
+    /// The factor of the solved scene's `model` at `x`; none unless the report says converged.
+    /// `source` names where the keys come from in errors (a flag, a file).
     pub fn new(
         scene: &'a ValidatedScene,
         model: &'a Model,
@@ -111,39 +134,46 @@ impl<'a> Equilibrium<'a> {
         report: &SolveReport,
         source: &str,
     ) -> Result<Self, NoSensitivity> {
+        let params = SceneParameters {
+            scene,
+            source: source.to_string(),
+        };
+        Self::of(Box::new(params), model, x, report)
+    }
+
+    /// The factor of `model` solved at `x` over the parameters `params` (a scene, a Cusick
+    /// specimen); none unless the report says converged.
+    pub fn of(
+        params: Box<dyn Parameterized + 'a>,
+        model: &'a Model,
+        x: &'a [Vector3<f64>],
+        report: &SolveReport,
+    ) -> Result<Self, NoSensitivity> {
         if !report.is_converged() {
             return Err(NoSensitivity::NoFactor(NoFactor::NotConverged));
         }
         let factor = EquilibriumFactor::new(model, x).map_err(NoSensitivity::NoFactor)?;
         Ok(Self {
-            scene,
+            params,
             model,
             x,
             factor,
-            source: source.to_string(),
         })
     }
 
     /// The mixed derivative ∂g/∂θ of `key` at x* and the fixed particles' motion dx/dθ.
     fn mixed(&self, key: &str) -> Result<Mixed, NoSensitivity> {
-        let theta = params::value(self.scene, key, &self.source).map_err(NoSensitivity::Input)?;
+        let theta = self.params.value(key).map_err(NoSensitivity::Input)?;
         let h = param_step(theta);
-        let side = |t: f64| -> Result<Side, NoSensitivity> {
-            let s = params::with_value(self.scene, key, t, &self.source)
+        let side = |t: f64| -> Result<(Model, Vec<Vector3<f64>>), NoSensitivity> {
+            let (model, x0) = self
+                .params
+                .model_with(key, t)
                 .map_err(NoSensitivity::Input)?;
-            let b = build_scene(&s);
-            if !same_structure(&b.model, self.model) {
+            if !same_structure(&model, self.model) {
                 return Err(NoSensitivity::Structural(key.to_string()));
             }
-            let mut xs = self.x.to_vec();
-            for (p, v) in xs.iter_mut().enumerate() {
-                if b.model.fixed[p] {
-                    *v = b.x0[p];
-                }
-            }
-            let mut g = Vec::new();
-            b.model.gradient(&xs, 1.0, &mut g);
-            Ok((g, xs))
+            Ok((model, x0))
         };
         // Central where both sides are valid scenes, one-sided at the edge of a key's range.
         // A structural change on either side (a pin or a supported particle switching) is a kink of
@@ -154,16 +184,25 @@ impl<'a> Equilibrium<'a> {
             (Err(NoSensitivity::Input(_)), Ok(b)) => (side(theta)?, b, h),
             (Err(e), _) | (_, Err(e)) => return Err(e),
         };
-        let dg =
-            hi.0.iter()
-                .zip(&lo.0)
-                .map(|(a, b)| (a - b) / span)
-                .collect();
-        let dxf =
-            hi.1.iter()
-                .zip(&lo.1)
-                .map(|(a, b)| (a - b) / span)
-                .collect();
+        let dxf: Vec<Vector3<f64>> = (0..self.x.len())
+            .map(|p| match self.model.fixed[p] {
+                true => (hi.1[p] - lo.1[p]) / span,
+                false => Vector3::zeros(),
+            })
+            .collect();
+        let mut dg = vec![Vector3::zeros(); self.x.len()];
+        for ((t, th), tl) in self.model.terms.iter().zip(&hi.0.terms).zip(&lo.0.terms) {
+            mixed_of_term(
+                (t.as_ref(), th.as_ref(), tl.as_ref()),
+                self.x,
+                span,
+                &mut dg,
+            );
+        }
+        // The fixed particles' motion moves the drape through the Hessian's coupling blocks.
+        let mut hess = crate::physics::HessianBlocks::default();
+        self.model.exact_hessian(self.x, &mut hess);
+        hess.mul_add(&dxf, &mut dg);
         Ok((theta, dg, dxf))
     }
 
@@ -208,6 +247,38 @@ impl<'a> Equilibrium<'a> {
     }
 }
 
+/// Adds one term's ∂g/∂θ at `x` to `dg`, from the term of the solved model `t` and its rebuilds
+/// `hi`, `lo` at θ ± `span`/2: the analytic mixed derivative in the term's coefficients along their
+/// change (dc/dθ by the difference of the rebuilt coefficients: exact for coefficients linear in θ,
+/// as stiffnesses, weights and rest lengths are), or, for a term that does not give it (contact,
+/// self-contact), the difference of its rebuilt gradients.
+fn mixed_of_term(
+    (t, hi, lo): (&dyn EnergyTerm, &dyn EnergyTerm, &dyn EnergyTerm),
+    x: &Vecs,
+    span: f64,
+    dg: &mut [Vector3<f64>],
+) {
+    let (ch, cl) = (hi.coefficients(), lo.coefficients());
+    if !ch.is_empty() && ch.len() == cl.len() {
+        // Equal coefficients (an infinite saturation on both sides too) do not move.
+        let dc: Vec<f64> = ch
+            .iter()
+            .zip(&cl)
+            .map(|(a, b)| if a == b { 0.0 } else { (a - b) / span })
+            .collect();
+        if t.add_coefficient_gradient(x, &dc, dg) {
+            return;
+        }
+    }
+    let n = x.len();
+    let (mut gh, mut gl) = (vec![Vector3::zeros(); n], vec![Vector3::zeros(); n]);
+    hi.add_gradient(x, &mut gh);
+    lo.add_gradient(x, &mut gl);
+    for ((d, a), b) in dg.iter_mut().zip(&gh).zip(&gl) {
+        *d += (a - b) / span;
+    }
+}
+
 /// Whether the `rebuilt` model has the particles, the fixed set and the terms of `solved` (which may
 /// have more terms appended by its solve, such as lagged friction).
 fn same_structure(rebuilt: &Model, solved: &Model) -> bool {
@@ -225,15 +296,27 @@ fn same_structure(rebuilt: &Model, solved: &Model) -> bool {
 /// θ(1 ± 10⁻⁶) build a model with the same particles and terms. The error names `source` (the flag)
 /// and the key, and says what to do.
 pub fn check_key(scene: &ValidatedScene, key: &str, source: &str) -> Result<(), InputError> {
-    let theta = params::value(scene, key, source)?;
+    let params = SceneParameters {
+        scene,
+        source: source.to_string(),
+    };
+    check_parameter(&params, key, source)
+}
+
+/// [`check_key`] for any parameterized model; errors name `source` and the key.
+pub fn check_parameter(
+    params: &dyn Parameterized,
+    key: &str,
+    source: &str,
+) -> Result<(), InputError> {
+    let theta = params.value(key)?;
     let h = param_step(theta);
-    let base = build_scene(scene);
+    let (base, _) = params.model();
     let mut any = None;
     for t in [theta + h, theta - h] {
         // A side out of the key's range is the edge of the range, not an error.
-        if let Ok(s) = params::with_value(scene, key, t, source) {
-            let b = build_scene(&s);
-            if !same_structure(&b.model, &base.model) {
+        if let Ok((model, _)) = params.model_with(key, t) {
+            if !same_structure(&model, &base) {
                 return Err(InputError::new(
                     source,
                     key,

@@ -311,7 +311,7 @@ pub fn solve_model(
     // without obstacles, from the sagged sheet.
     let coarse = coarse_start(scene, grid, x);
     if coarse.is_none()
-        && scene.solver.static_.sag_start
+        && scene.solver.static_.start.is_shaped()
         && scene.obstacles.is_empty()
         && crate::solve::folded_start(model, x).is_none()
     {
@@ -319,7 +319,7 @@ pub fn solve_model(
     }
     let mut report = static_solve(scene, grid, model, x, observer);
     if let Some((r, _)) = coarse {
-        report.add_work(&r);
+        report.merge(&r, crate::solve::Part::Start);
         report.message += &format!(
             " (from a {}×{} start)",
             grid.nx.div_ceil(2),
@@ -368,66 +368,100 @@ fn solve_with_friction(
     opts: &crate::solve::StaticOptions,
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    use crate::physics::{FrictionAnchor, LaggedFriction};
-    let contact = crate::build::barrier_contact(scene, &model.masses, &model.fixed);
-    let mu = scene.contact.friction_coefficient;
     let steps = if opts.load_steps > 1 {
         opts.load_steps
     } else {
         20
     };
     let mut loads: Vec<f64> = (1..=steps).map(|k| k as f64 / steps as f64).collect();
-    loads.extend([1.0; 10]);
-    model.terms.push(Box::new(LaggedFriction {
+    loads.extend([1.0; FRICTION_UPDATES]);
+    model.terms.push(Box::new(crate::physics::LaggedFriction {
         anchors: vec![],
-        eps_m: 1e-5,
+        eps_m: FRICTION_EPS_M,
     }));
-    let mut total: Option<SolveReport> = None;
-    for (k, &load) in loads.iter().enumerate() {
-        let anchors = contact
+    let mut lag = FrictionLag {
+        contact: crate::build::barrier_contact(scene, &model.masses, &model.fixed),
+        mu: scene.contact.friction_coefficient,
+        loads,
+        steps,
+        stage: 0,
+        before: Vec::new(),
+    };
+    crate::solve::execute(model, x, opts, &mut lag, observer)
+}
+
+/// Refreshes of the friction anchors at full load after the load increments.
+const FRICTION_UPDATES: usize = 10;
+/// The lagged friction's smoothing length, m (see [`crate::physics::LaggedFriction`]).
+const FRICTION_EPS_M: f64 = 1e-5;
+/// The friction lag has settled when no particle moves by more than this in one update, m.
+const FRICTION_SETTLED_M: f64 = 1e-7;
+
+/// Lagged friction as a continuation: before each stage the anchors are the contacts where the
+/// last stage left them (the model's last term).
+struct FrictionLag {
+    contact: crate::physics::BarrierContact,
+    mu: f64,
+    /// The load factor of each stage.
+    loads: Vec<f64>,
+    /// The number of increments among the stages.
+    steps: usize,
+    stage: usize,
+    /// The positions before the last stage.
+    before: Vec<Vector3<f64>>,
+}
+
+impl crate::solve::Continuation for FrictionLag {
+    fn next(
+        &mut self,
+        model: &mut crate::physics::Model,
+        x: &mut [Vector3<f64>],
+        solved: bool,
+    ) -> crate::solve::Stage {
+        use crate::physics::{FrictionAnchor, LaggedFriction};
+        use crate::solve::Stage;
+        if solved {
+            let moved = x
+                .iter()
+                .zip(&self.before)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            let k = self.stage - 1;
+            if k >= self.steps && moved < FRICTION_SETTLED_M {
+                return Stage::Done(format!(
+                    " (friction μ = {}, {} lag updates)",
+                    self.mu,
+                    k + 1
+                ));
+            }
+        }
+        let Some(&load) = self.loads.get(self.stage) else {
+            return Stage::Done(format!(
+                " (friction μ = {}: lag updates still moving the sheet)",
+                self.mu
+            ));
+        };
+        let anchors = self
+            .contact
             .contacts(x)
             .into_iter()
             .map(|(p, n, force)| FrictionAnchor {
                 particle: p,
                 anchor_m: x[p],
                 normal: n,
-                limit_N: mu * force,
+                limit_N: self.mu * force,
             })
             .collect();
         if let Some(t) = model.terms.last_mut() {
             *t = Box::new(LaggedFriction {
                 anchors,
-                eps_m: 1e-5,
+                eps_m: FRICTION_EPS_M,
             });
         }
-        let before = x.to_vec();
-        let obs: &mut dyn Observer = if k == 0 {
-            &mut *observer
-        } else {
-            &mut crate::solve::NoObserver
-        };
-        let r = crate::solve::solve_static_loads(model, x, opts, &[load], obs);
-        let moved = x
-            .iter()
-            .zip(&before)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
-        let mut t = SolveReport::accumulate(total.take(), r);
-        if !t.is_converged() {
-            return t;
-        }
-        if k >= steps && moved < 1e-7 {
-            t.message = format!("{} (friction μ = {mu}, {} lag updates)", t.message, k + 1);
-            return t;
-        }
-        total = Some(t);
+        self.before = x.to_vec();
+        self.stage += 1;
+        Stage::Solve(load)
     }
-    let mut t = total.expect("at least one solve");
-    t.message = format!(
-        "{} (friction μ = {mu}: lag updates still moving the sheet)",
-        t.message
-    );
-    t
 }
 
 /// Solves the scene on the grid with every other line and writes the interpolated positions into
@@ -441,7 +475,7 @@ fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(S
         .mass_spring
         .as_ref()
         .is_some_and(|m| m.natural_length_m.is_some());
-    if !scene.solver.static_.coarse_start
+    if !scene.solver.static_.start.is_nested()
         || natural
         || !scene.obstacles.is_empty()
         || !scene.boundary.holds.is_empty()

@@ -371,3 +371,95 @@ fn an_equilibrium_free_to_turn_has_the_sensitivity_orthogonal_to_the_turn() {
 fn dot_all(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
     a.iter().zip(b).map(|(p, q)| p.dot(q)).sum()
 }
+
+#[test]
+fn cusick_specimen_sensitivities_match_central_differences_for_every_key() {
+    // The Cusick disc over its own parameters (bending length, anisotropy, saturation, warp angle,
+    // areal density, tensile rigidity, gravity): an orthotropic, saturating drape on the pedestal's
+    // barrier, solved to 1e-12 of a vertex's weight, each key's sensitivity against the central
+    // difference of drapes solved from x* at θ(1 ± δ).
+    use drapelab_core::cusick::{
+        DiscMesh, DrapeParams, SPECIMEN_KEYS, SpecimenParameters, Tester, drape_model, drape_start,
+        polar_disc,
+    };
+    use drapelab_core::params::Parameterized;
+    use drapelab_core::solve::{StaticOptions, solve_static};
+    let tester = Tester::default();
+    let (rest, tris) = polar_disc(tester.specimen_radius_m, 8);
+    let mesh = DiscMesh {
+        rest_xy: &rest,
+        triangles: &tris,
+    };
+    let params = DrapeParams {
+        bending_ratio: 2.0,
+        warp_angle_deg: 20.0,
+        bending_saturation: Some(3.0),
+        self_thickness_m: None,
+        ..DrapeParams::default()
+    };
+    let opts = StaticOptions {
+        residual_tol_rel: 1e-12,
+        max_iterations: 2000,
+        ..StaticOptions::default()
+    };
+    let solve_from = |p: &DrapeParams, start: &[Vector3<f64>], tol: f64| {
+        let model = drape_model(mesh, p, &tester);
+        let mut x = start.to_vec();
+        let opts = StaticOptions {
+            residual_tol_rel: tol,
+            ..opts.clone()
+        };
+        let r = solve_static(&model, &mut x, &opts, &mut NoObserver);
+        (model, x, r)
+    };
+    let (model, x, report) = solve_from(&params, &drape_start(mesh, &params, &tester), 1e-12);
+    assert!(report.is_converged(), "{}", report.message);
+    let specimen = SpecimenParameters {
+        mesh,
+        params: params.clone(),
+        tester: &tester,
+    };
+    let keys = specimen.keys();
+    let mut eq = Equilibrium::of(Box::new(specimen), &model, &x, &report).unwrap();
+    for key in &keys {
+        let s = eq.sensitivity(key).unwrap_or_else(|e| panic!("{key}: {e}"));
+        let theta = s.value;
+        let h = FD_STEP_REL * theta.abs();
+        let side = |t: f64| {
+            let mut p = params.clone();
+            match key.as_str() {
+                "bending_length_m" => p.bending_length_m = t,
+                "areal_density_kg_per_m2" => p.areal_density_kg_per_m2 = t,
+                "tensile_N_per_m" => p.tensile_N_per_m = t,
+                "gravity_m_per_s2" => p.gravity_m_per_s2 = t,
+                "bending_ratio" => p.bending_ratio = t,
+                "bending_saturation" => p.bending_saturation = Some(t),
+                "warp_angle_deg" => p.warp_angle_deg = t,
+                other => panic!("{other} is not set by this test"),
+            }
+            // From x*, to 1e-9 of a vertex's weight: the disc's residual can stall at 5e-10 (bending_ratio
+            // 1.99998), a few times its round-off floor estimate; δx ~ 1e-12 m.
+            let (_, y, r) = solve_from(&p, &x, 1e-9);
+            assert!(r.is_converged(), "{key} at {t}: {}", r.message);
+            y
+        };
+        let (hi, lo) = (side(theta + h), side(theta - h));
+        let fd: Vec<Vector3<f64>> = hi
+            .iter()
+            .zip(&lo)
+            .map(|(a, b)| (a - b) / (2.0 * h))
+            .collect();
+        let diff: Vec<Vector3<f64>> = s.dx.iter().zip(&fd).map(|(a, b)| a - b).collect();
+        let floor = 1e-9 * (x.len() as f64).sqrt() / (theta.abs() * FD_STEP_REL);
+        assert!(
+            norm(&diff) <= TOL_REL * norm(&fd) + floor,
+            "{key}: |sensitivity − fd| = {:.3e}, |fd| = {:.3e} (m per unit)",
+            norm(&diff),
+            norm(&fd)
+        );
+    }
+    for k in SPECIMEN_KEYS.iter().filter(|k| **k != "self_thickness_m") {
+        assert!(keys.iter().any(|c| c == k), "{k} not covered: {keys:?}");
+    }
+    eprintln!("cusick specimen: keys checked {keys:?}");
+}

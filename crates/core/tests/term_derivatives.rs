@@ -162,3 +162,145 @@ fn every_terms_gradient_and_hessian_match_central_differences_in_every_bundled_s
     }
     eprintln!("terms checked: {checked:?}");
 }
+
+/// The relative 2-norm error of a term's mixed derivative ∂g/∂c · dc at `x` against the central
+/// difference of its gradient with the coefficients moved by ±eps dc (best over the steps).
+fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> f64 {
+    let n = x.len();
+    let c = t.coefficients();
+    let mut an = vec![Vector3::zeros(); n];
+    assert!(
+        t.add_coefficient_gradient(x, dc, &mut an),
+        "{}: gives coefficients but no mixed derivative",
+        t.name()
+    );
+    let size = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
+    let mut best = f64::INFINITY;
+    for eps in [1e-4, 1e-5, 1e-6, 1e-7] {
+        let grad_at = |t: &mut dyn EnergyTerm, s: f64| {
+            let moved: Vec<f64> = c
+                .iter()
+                .zip(dc)
+                .map(|(a, d)| if *d == 0.0 { *a } else { a + d * s })
+                .collect();
+            t.set_coefficients(&moved);
+            let mut g = vec![Vector3::zeros(); n];
+            t.add_gradient(x, &mut g);
+            g
+        };
+        let (gp, gm) = (grad_at(t, eps), grad_at(t, -eps));
+        t.set_coefficients(&c);
+        let fd: Vec<Vector3<f64>> = gp
+            .iter()
+            .zip(&gm)
+            .map(|(a, b)| (a - b) / (2.0 * eps))
+            .collect();
+        let diff: Vec<Vector3<f64>> = fd.iter().zip(&an).map(|(a, b)| a - b).collect();
+        best = best.min(size(&diff) / size(&fd).max(size(&an)).max(1e-300));
+    }
+    best
+}
+
+/// Random relative changes of the coefficients (each by up to its own size; none for an infinite one).
+fn random_change(c: &[f64], rng: &mut impl Rng) -> Vec<f64> {
+    c.iter()
+        .map(|v| {
+            if v.is_finite() {
+                v * (rng.random::<f64>() * 2.0 - 1.0)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn every_terms_mixed_derivative_in_its_coefficients_matches_central_differences() {
+    // ∂g/∂c · dc of every term that gives coefficients, at a state off the flat sheet (every spring
+    // strained, every stencil bent), in every bundled scene; and the saturating hinge bending of the
+    // Cusick disc, whose saturation u₀ is a coefficient too. A term whose mixed derivative is wrong
+    // fails here by name; the sensitivities (tests/sensitivities.rs) are built on these.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4646);
+    let mut checked = std::collections::BTreeSet::new();
+    let mut check = |t: &mut dyn EnergyTerm, x: &[Vector3<f64>], scene: &str, rng: &mut _| {
+        let c = t.coefficients();
+        if c.is_empty() {
+            return;
+        }
+        for _ in 0..2 {
+            let dc = random_change(&c, rng);
+            let e = coefficient_error(t, x, &dc);
+            assert!(e <= 1e-6, "{scene}: {}: ∂g/∂c off by {e:e}", t.name());
+        }
+        checked.insert(t.name());
+    };
+    for path in scenes() {
+        let set = [
+            ("cloth.nx".to_string(), toml::Value::Integer(11)),
+            ("cloth.ny".to_string(), toml::Value::Integer(11)),
+        ];
+        let Ok(loaded) = Scene::load(&path, &set) else {
+            continue;
+        };
+        let mut built = drapelab_core::build::build_scene(&loaded.scene);
+        let spacing = built.grid.min_spacing_m();
+        let x: Vec<Vector3<f64>> = built
+            .x0
+            .iter()
+            .map(|p| {
+                p + (Vector3::new(rng.random(), rng.random(), rng.random()) - Vector3::repeat(0.5))
+                    * (0.2 * spacing)
+            })
+            .collect();
+        for t in built.model.terms.iter_mut() {
+            check(t.as_mut(), &x, &loaded.scene.name, &mut rng);
+        }
+    }
+    // The Cusick disc's orthotropic, saturating hinge bending on a small bent sheet.
+    let n = 6;
+    let rest: Vec<[f64; 2]> = (0..n * n)
+        .map(|k| [(k % n) as f64 * 0.01, (k / n) as f64 * 0.01])
+        .collect();
+    let id = |i: usize, j: usize| j * n + i;
+    let tris: Vec<[usize; 3]> = (0..n - 1)
+        .flat_map(|j| (0..n - 1).map(move |i| (i, j)))
+        .flat_map(|(i, j)| {
+            [
+                [id(i, j), id(i + 1, j), id(i + 1, j + 1)],
+                [id(i, j), id(i + 1, j + 1), id(i, j + 1)],
+            ]
+        })
+        .collect();
+    let mut hinge =
+        drapelab_core::physics::saturating_hinge_bending(&rest, &tris, [2e-5, 1e-5], 0.3, 20.0);
+    let bent: Vec<Vector3<f64>> = rest
+        .iter()
+        .map(|p| Vector3::new(p[0], p[1], 3.0 * p[0] * p[0] + 2.0 * p[0] * p[1]))
+        .collect();
+    check(&mut hinge, &bent, "cusick hinge", &mut rng);
+    // A cell's twist (no bundled scene gives a twist rigidity).
+    let cells: Vec<[usize; 4]> = (0..n - 1)
+        .flat_map(|j| {
+            (0..n - 1).map(move |i| [id(i, j), id(i + 1, j), id(i, j + 1), id(i + 1, j + 1)])
+        })
+        .collect();
+    let sides = vec![(0.01, 0.01); cells.len()];
+    let mut twist = drapelab_core::physics::CellTwist::cells(cells, &sides, 3e-6);
+    check(&mut twist, &bent, "twisted sheet", &mut rng);
+    for family in [
+        "springs",
+        "gravity",
+        "bending/continuum",
+        "bending/hinge",
+        "bending/symmetry-plane",
+        "shear",
+        "twist",
+        "point-loads",
+    ] {
+        assert!(
+            checked.iter().any(|n| n.contains(family)),
+            "no {family} term among {checked:?}"
+        );
+    }
+    eprintln!("terms checked: {checked:?}");
+}

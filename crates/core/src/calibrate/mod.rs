@@ -254,8 +254,8 @@ impl Problem {
             // (chord steps) took it from 280 s to 247 s (reports/newton_iterations.md).
             false => {
                 let mut straight = scene.clone();
-                straight.solver.static_.curvilinear = false;
-                straight.solver.static_.reuse_factorization = true;
+                straight.solver.static_.direction = crate::solve::Direction::Straight;
+                straight.solver.static_.factor_reuse = crate::solve::FactorReuse::Chord;
                 crate::simulate::solve_scene_from_lowest(&straight, &starts, &mut NoObserver)
             }
             true => solve_scene(&scene, &mut NoObserver),

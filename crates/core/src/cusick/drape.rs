@@ -12,8 +12,8 @@ use crate::physics::{
     BarrierContact, Gravity, Model, SpringFamily, Springs, saturating_hinge_bending,
 };
 use crate::solve::{
-    ImplicitSettings, NoObserver, Observer, Settle, SolveReport, StaticOptions, StopReason,
-    integrate_implicit, solve_static,
+    Direction, FactorReuse, ImplicitSettings, NoObserver, Observer, Regularization, Settle,
+    SolveReport, StaticOptions, StopReason, integrate_implicit, solve_static,
 };
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -324,7 +324,7 @@ fn solve_drape_once(
             damping: (0.0, 0.0, 0.0),
             newton_iterations: 25,
             // The fall's path as the fold counts were validated on (tests/it/cusick.rs).
-            reuse_factorization: false,
+            factor_reuse: FactorReuse::Fresh,
             newton_tol_rel: 1e-6,
             strain_bound: 10.0,
         };
@@ -347,12 +347,10 @@ fn solve_drape_once(
         residual_tol_rel: 1e-6,
         max_iterations: 1000,
         load_steps: 1,
-        coarse_start: false,
-        sag_start: false,
         // The quasi-static path (straight steps, the damping carried): the fold counts converge
         // with the mesh on it (tests/it/cusick.rs), not on the faster one (0.75–1 node apart).
-        curvilinear: false,
-        carried_damping: true,
+        direction: Direction::Straight,
+        regularization: Regularization::CarriedDamping,
         ..StaticOptions::default()
     };
     let mut report = solve_static(&model, &mut x, &opts, observer);
@@ -361,7 +359,7 @@ fn solve_drape_once(
             "after a fall of {} ({}): {}",
             p.fall_time_s, f.message, report.message
         );
-        report.inner_iterations += f.inner_iterations;
+        report.merge(&f, crate::solve::Part::Start);
     }
     (report, x)
 }

@@ -7,6 +7,7 @@
 mod calibrate;
 mod drape;
 mod fabric;
+mod params;
 
 pub use calibrate::{BendingCalibration, bisect_bending_length, calibrate_bending_length};
 pub use drape::{
@@ -18,6 +19,7 @@ pub use fabric::{
     SeededDrape, SpecimenTargets, calibrate_and_predict, calibrate_fabric, histogram,
     histogram_label, seeded_drapes,
 };
+pub use params::{SPECIMEN_KEYS, SpecimenParameters};
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};
 use nalgebra::Vector3;

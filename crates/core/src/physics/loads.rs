@@ -1,40 +1,59 @@
 //! Concentrated forces on particles: E = −Σ f·x. Linear, so no Hessian; an external load, raised with
 //! the load factor of incremental loading like gravity (seed 003's perturbation forces Q_p).
 
-use super::{EnergyTerm, HessianBlocks, Vecs};
-use nalgebra::Vector3;
+use super::kernel::{Kernel, Local, Potential};
+use nalgebra::{Matrix3, Vector3};
+
+/// The kernel of point loads: one particle a stencil, its force's components (N) the coefficients.
+pub struct LoadKernel {
+    particles: Vec<[u32; 1]>,
+    forces_N: Vec<Vector3<f64>>,
+}
 
 /// Fixed forces on particles.
-pub struct PointLoads {
-    loads: Vec<(u32, Vector3<f64>)>,
-}
+pub type PointLoads = Potential<LoadKernel, 1>;
 
 impl PointLoads {
     /// Forces `(particle, force in N)`.
     pub fn new(loads: Vec<(usize, Vector3<f64>)>) -> Self {
-        Self {
-            loads: loads.into_iter().map(|(p, f)| (p as u32, f)).collect(),
-        }
+        Potential::of(LoadKernel {
+            particles: loads.iter().map(|(p, _)| [*p as u32]).collect(),
+            forces_N: loads.into_iter().map(|(_, f)| f).collect(),
+        })
     }
 }
 
-impl EnergyTerm for PointLoads {
+impl Kernel<1> for LoadKernel {
+    const COEFFICIENTS: usize = 3;
     fn name(&self) -> String {
         "point-loads".into()
     }
-    fn energy(&self, x: &Vecs) -> f64 {
-        -self
-            .loads
-            .iter()
-            .map(|(p, f)| f.dot(&x[*p as usize]))
-            .sum::<f64>()
+    fn stencils(&self) -> &[[u32; 1]] {
+        &self.particles
     }
-    fn add_gradient(&self, _x: &Vecs, g: &mut Vecs) {
-        for (p, f) in &self.loads {
-            g[*p as usize] -= f;
-        }
+    fn energy(&self, k: usize, x: &Local<1>) -> f64 {
+        -self.forces_N[k].dot(&x[0])
     }
-    fn add_hessian(&self, _x: &Vecs, _h: &mut HessianBlocks, _project: bool) {}
+    fn gradient(&self, k: usize, _x: &Local<1>) -> Local<1> {
+        [-self.forces_N[k]]
+    }
+    fn hessian(
+        &self,
+        _k: usize,
+        _x: &Local<1>,
+        _project: bool,
+        _push: &mut impl FnMut(usize, usize, Matrix3<f64>),
+    ) {
+    }
+    fn coefficients(&self, k: usize, out: &mut Vec<f64>) {
+        out.extend(self.forces_N[k].iter());
+    }
+    fn set_coefficients(&mut self, k: usize, c: &[f64]) {
+        self.forces_N[k] = Vector3::new(c[0], c[1], c[2]);
+    }
+    fn coefficient_gradient(&self, _k: usize, _x: &Local<1>, dc: &[f64]) -> Local<1> {
+        [-Vector3::new(dc[0], dc[1], dc[2])]
+    }
     fn is_external_load(&self) -> bool {
         true
     }

@@ -6,21 +6,25 @@ mod bending;
 mod contact;
 mod friction;
 mod gravity;
+mod kernel;
 mod loads;
 mod mesh_bending;
 mod self_contact;
 mod shear;
 mod springs;
 
-pub use bending::{CellTwist, LinearBending, MirrorBending, QuadraticStencil};
+pub use bending::{
+    CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,
+};
 pub use contact::{BarrierContact, max_penetration_m};
 pub use friction::{FrictionAnchor, LaggedFriction};
-pub use gravity::Gravity;
-pub use loads::PointLoads;
+pub use gravity::{Gravity, GravityKernel};
+pub use kernel::{Kernel, Local, Potential};
+pub use loads::{LoadKernel, PointLoads};
 pub use mesh_bending::{hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending};
 pub use self_contact::{SelfContact, SelfContactState};
-pub use shear::CellShear;
-pub use springs::{SpringFamily, Springs};
+pub use shear::{CellShear, ShearKernel};
+pub use springs::{SpringFamily, SpringKernel, Springs};
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -127,6 +131,20 @@ pub trait EnergyTerm: Send + Sync {
     }
     /// Whether this is the sheet's self-contact term.
     fn is_self_contact(&self) -> bool {
+        false
+    }
+    /// The term's coefficients, flat: the numbers its stencils are built over from the scene's
+    /// parameters (stiffnesses, rest lengths, weights; SI units). Empty for a term that does not
+    /// give them (its derivative in a parameter is then taken by differences of its gradient).
+    fn coefficients(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    /// Sets the coefficients (the layout of [`EnergyTerm::coefficients`]).
+    fn set_coefficients(&mut self, _c: &[f64]) {}
+    /// Adds the mixed derivative ∂(∂E/∂x)/∂c · dc to `g`: how the gradient at `x` changes along a
+    /// change `dc` of the coefficients (per unit of the parameter `dc` is a derivative in). False,
+    /// with `g` untouched, when the term does not give it.
+    fn add_coefficient_gradient(&self, _x: &Vecs, _dc: &[f64], _g: &mut Vecs) -> bool {
         false
     }
 }

@@ -1,7 +1,8 @@
 //! Linear springs, seed 000 Eq. 2: F = K (|L| − L0) L/|L|, energy ½K(|L| − L0)².
 
-use super::{EnergyTerm, HessianBlocks, Vecs};
-use nalgebra::Matrix3;
+use super::Vecs;
+use super::kernel::{Kernel, Local, Potential};
+use nalgebra::{Matrix3, Vector3};
 
 /// Which family a set of springs belongs to (seed 000, Fig. 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,13 +17,17 @@ pub enum SpringFamily {
     Tensile,
 }
 
-/// A set of springs of one family.
-pub struct Springs {
+/// The kernel of a set of springs of one family: per spring (a, b) the energy ½k(|x_b − x_a| − L0)²,
+/// its coefficients (L0 in m, k in N/m).
+pub struct SpringKernel {
     family: SpringFamily,
-    pairs: Vec<(u32, u32)>,
+    pairs: Vec<[u32; 2]>,
     rest_m: Vec<f64>,
     stiffness_N_per_m: Vec<f64>,
 }
+
+/// A set of springs of one family.
+pub type Springs = Potential<SpringKernel, 2>;
 
 impl Springs {
     /// Springs between `pairs` with rest lengths (m) and stiffnesses (N/m).
@@ -33,84 +38,88 @@ impl Springs {
         stiffness_N_per_m: Vec<f64>,
     ) -> Self {
         assert!(pairs.len() == rest_m.len() && pairs.len() == stiffness_N_per_m.len());
-        Self {
+        Potential::of(SpringKernel {
             family,
             pairs: pairs
                 .into_iter()
-                .map(|(a, b)| (a as u32, b as u32))
+                .map(|(a, b)| [a as u32, b as u32])
                 .collect(),
             rest_m,
             stiffness_N_per_m,
-        }
-    }
-    /// Number of springs.
-    pub fn len(&self) -> usize {
-        self.pairs.len()
-    }
-    /// Whether there are no springs.
-    pub fn is_empty(&self) -> bool {
-        self.pairs.is_empty()
+        })
     }
 }
 
-impl EnergyTerm for Springs {
+impl Kernel<2> for SpringKernel {
+    const COEFFICIENTS: usize = 2;
     fn name(&self) -> String {
         format!("springs/{:?}", self.family).to_lowercase()
     }
-    fn energy(&self, x: &Vecs) -> f64 {
-        let mut e = 0.0;
-        for (k, &(a, b)) in self.pairs.iter().enumerate() {
-            let l = (x[b as usize] - x[a as usize]).norm();
-            let d = l - self.rest_m[k];
-            e += 0.5 * self.stiffness_N_per_m[k] * d * d;
-        }
-        e
+    fn stencils(&self) -> &[[u32; 2]] {
+        &self.pairs
     }
-    fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
-        for (k, &(a, b)) in self.pairs.iter().enumerate() {
-            let (a, b) = (a as usize, b as usize);
-            let d = x[b] - x[a];
-            let l = d.norm();
-            if l == 0.0 {
-                continue;
-            }
-            let f = d * (self.stiffness_N_per_m[k] * (l - self.rest_m[k]) / l);
-            g[b] += f;
-            g[a] -= f;
-        }
+    fn energy(&self, k: usize, x: &Local<2>) -> f64 {
+        let l = (x[1] - x[0]).norm();
+        let d = l - self.rest_m[k];
+        0.5 * self.stiffness_N_per_m[k] * d * d
     }
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
-        for (k, &(a, b)) in self.pairs.iter().enumerate() {
-            let (a, b) = (a as usize, b as usize);
-            let d = x[b] - x[a];
-            let l = d.norm().max(1e-12 * self.rest_m[k]);
-            let u = d / l;
-            let uu = u * u.transpose();
-            // K = k[ûûᵀ + (1 − L0/l)(I − ûûᵀ)]; projected, the transverse factor is clamped at 0:
-            // a compressed spring contributes no negative stiffness.
-            let t = 1.0 - self.rest_m[k] / l;
-            let t = if project { t.max(0.0) } else { t };
-            let kk = (uu + (Matrix3::identity() - uu) * t) * self.stiffness_N_per_m[k];
-            h.push(a, a, kk);
-            h.push(b, b, kk);
-            h.push(b, a, -kk);
+    fn gradient(&self, k: usize, x: &Local<2>) -> Local<2> {
+        let d = x[1] - x[0];
+        let l = d.norm();
+        if l == 0.0 {
+            return [Vector3::zeros(); 2];
         }
+        let f = d * (self.stiffness_N_per_m[k] * (l - self.rest_m[k]) / l);
+        [-f, f]
+    }
+    fn hessian(
+        &self,
+        k: usize,
+        x: &Local<2>,
+        project: bool,
+        push: &mut impl FnMut(usize, usize, Matrix3<f64>),
+    ) {
+        let d = x[1] - x[0];
+        let l = d.norm().max(1e-12 * self.rest_m[k]);
+        let u = d / l;
+        let uu = u * u.transpose();
+        // K = k[ûûᵀ + (1 − L0/l)(I − ûûᵀ)]; projected, the transverse factor is clamped at 0:
+        // a compressed spring contributes no negative stiffness.
+        let t = 1.0 - self.rest_m[k] / l;
+        let t = if project { t.max(0.0) } else { t };
+        let kk = (uu + (Matrix3::identity() - uu) * t) * self.stiffness_N_per_m[k];
+        push(0, 0, kk);
+        push(1, 1, kk);
+        push(1, 0, -kk);
+    }
+    fn coefficients(&self, k: usize, out: &mut Vec<f64>) {
+        out.extend([self.rest_m[k], self.stiffness_N_per_m[k]]);
+    }
+    fn set_coefficients(&mut self, k: usize, c: &[f64]) {
+        (self.rest_m[k], self.stiffness_N_per_m[k]) = (c[0], c[1]);
+    }
+    /// ∂f/∂k = (l − L0) d/l, ∂f/∂L0 = −k d/l for the force f = k (l − L0) d/l on b.
+    fn coefficient_gradient(&self, k: usize, x: &Local<2>, dc: &[f64]) -> Local<2> {
+        let d = x[1] - x[0];
+        let l = d.norm();
+        if l == 0.0 {
+            return [Vector3::zeros(); 2];
+        }
+        let f = d * (((l - self.rest_m[k]) * dc[1] - self.stiffness_N_per_m[k] * dc[0]) / l);
+        [-f, f]
     }
     fn stiffness_scale(&self) -> f64 {
         self.stiffness_N_per_m.iter().copied().fold(0.0, f64::max)
     }
-    fn max_strain(&self, x: &Vecs) -> f64 {
-        self.pairs
-            .iter()
-            .zip(&self.rest_m)
-            .map(|(&(a, b), &l0)| (((x[b as usize] - x[a as usize]).norm() - l0) / l0).abs())
-            .fold(0.0, f64::max)
+    fn strain(&self, k: usize, x: &Local<2>) -> f64 {
+        let l0 = self.rest_m[k];
+        (((x[1] - x[0]).norm() - l0) / l0).abs()
     }
     fn provot_correct(&self, x: &mut Vecs, free: &[bool], rate: f64) {
         if !matches!(self.family, SpringFamily::Structural | SpringFamily::Shear) {
             return;
         }
-        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+        for (k, &[a, b]) in self.pairs.iter().enumerate() {
             let (a, b) = (a as usize, b as usize);
             let d = x[b] - x[a];
             let l = d.norm();

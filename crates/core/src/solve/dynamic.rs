@@ -79,11 +79,12 @@ pub struct DynamicOptions {
     /// Default 25 (a step in contact takes 10 to 20: the barrier's step bound shortens Newton's steps).
     #[serde(default = "default_newton_iterations")]
     pub newton_iterations: usize,
-    /// Implicit Euler: each step's Newton reuses its factorization while it converges (chord steps,
-    /// `solver.static.reuse_factorization`), and the step grows with the iterations that factorized.
-    /// Default true (false: every iteration factorizes, the behaviour before issue 34's last step).
-    #[serde(default = "default_true")]
-    pub reuse_factorization: bool,
+    /// Implicit Euler: whether each step's Newton reuses its factorization while it converges
+    /// (`"chord"`, see `solver.static.factor_reuse`; the step then grows with the iterations that
+    /// factorized) or factorizes every iteration (`"fresh"`, the behaviour before issue 34's last
+    /// step). Default `"chord"`. The old boolean `reuse_factorization` is read as this key.
+    #[serde(default = "default_chord")]
+    pub factor_reuse: super::FactorReuse,
     /// When > 0, explicit and symplectic Euler use this fraction of their estimated stability limit
     /// ([`stability_limit_dt`] at the initial state) instead of `dt_s`. Default 0 (use `dt_s`).
     #[serde(default)]
@@ -146,6 +147,10 @@ fn default_strain() -> f64 {
 fn default_cg() -> f64 {
     1e-10
 }
+fn default_chord() -> super::FactorReuse {
+    super::FactorReuse::Chord
+}
+
 fn default_true() -> bool {
     true
 }
@@ -160,7 +165,7 @@ impl Default for DynamicOptions {
             rayleigh_mass_per_s: 0.0,
             rayleigh_stiffness_s: 0.0,
             newton_iterations: default_newton_iterations(),
-            reuse_factorization: true,
+            factor_reuse: super::FactorReuse::Chord,
             auto_dt_fraction: 0.0,
             max_time_s: default_max_time(),
             residual_tol_rel: default_tol(),
@@ -427,7 +432,7 @@ fn solve_implicit(
         adaptive: opts.adaptive_dt,
         damping: (c, alpha, beta),
         newton_iterations: opts.newton_iterations,
-        reuse_factorization: opts.reuse_factorization,
+        factor_reuse: opts.factor_reuse,
         // Each step well below the settle tolerance: a step's leftover force would move a soft mode
         // by force/stiffness every step, a speed that never settles.
         newton_tol_rel: 1e-2 * opts.residual_tol_rel,

@@ -130,8 +130,8 @@ pub struct ImplicitSettings {
     pub damping: (f64, f64, f64),
     /// Newton iterations allowed per step.
     pub newton_iterations: usize,
-    /// Chord steps within a step ([`StaticOptions::reuse_factorization`]).
-    pub reuse_factorization: bool,
+    /// Whether a step's Newton reuses its factorization ([`super::FactorReuse`]).
+    pub factor_reuse: super::FactorReuse,
     /// Newton's tolerance per step, relative to the lightest particle's weight.
     pub newton_tol_rel: f64,
     /// A strain beyond which a step reports divergence.
@@ -183,15 +183,12 @@ fn step(
         strain_bound: s.strain_bound,
         // The Hessian changes little over one step's iterations: chord steps save factorizations
         // (37 % over eight scenes, reports/newton_iterations.md).
-        reuse_factorization: s.reuse_factorization,
+        factor_reuse: s.factor_reuse,
         ..StaticOptions::default()
     };
     let r = solve_static_loads(model, x, &opts, &[1.0], &mut NoObserver);
     model.terms.pop();
-    report.factorizations += r.factorizations;
-    report.linear_solves += r.linear_solves;
-    report.inner_iterations += r.iterations;
-    report.factor_time_s += r.factor_time_s;
+    report.merge(&r, super::Part::InnerSolve);
     if r.is_converged() && x.iter().all(|p| p.iter().all(|c| c.is_finite())) {
         for p in 0..x.len() {
             v[p] = if model.fixed[p] {

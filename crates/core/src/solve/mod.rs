@@ -3,6 +3,7 @@
 //! Every solve returns a [`SolveReport`] with a [`Status`]; solvers never print and never panic on
 //! bad numerics. Observers ([`Observer`]) receive states and do the I/O.
 
+mod continuation;
 mod dynamic;
 mod equilibrium;
 mod incremental;
@@ -10,8 +11,11 @@ mod linear;
 mod newton;
 mod report;
 mod sag;
+mod step;
+mod strategy;
 mod vertical_gap;
 
+pub use continuation::{Continuation, Stage, execute};
 pub use dynamic::{
     DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
 };
@@ -19,8 +23,13 @@ pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use linear::{DofMap, SparseSpd};
 pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};
-pub use report::{Divergence, DivergenceReason, Globalization, SolveReport, Status, StopReason};
+pub use report::{
+    Divergence, DivergenceReason, Globalization, Part, SolveReport, Status, StopReason,
+};
 pub use sag::{folded_start, sagged_start};
+pub use strategy::{
+    Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Start, Verdict,
+};
 pub use vertical_gap::solve_vertical_gap;
 
 use nalgebra::Vector3;

@@ -159,7 +159,7 @@ pub struct Globalization {
     #[serde(default)]
     pub skipped_shifts: usize,
     /// Iterations that reused the factorization at hand (chord steps of
-    /// `StaticOptions::reuse_factorization`; counted among the full steps too).
+    /// `FactorReuse::Chord`; counted among the full steps too).
     #[serde(default)]
     pub chord_steps: usize,
 }
@@ -270,37 +270,44 @@ impl SolveReport {
     }
 }
 
-impl SolveReport {
-    /// Adds the work of another solve of the same problem (a coarse start, an earlier load step or
-    /// friction update) to this report's counters: iterations, linear solves, factorizations, their
-    /// time, wall time and the globalization tallies. The one place where reports are merged.
-    pub fn add_work(&mut self, other: &SolveReport) {
-        self.iterations += other.iterations;
-        self.linear_solves += other.linear_solves;
-        self.factorizations += other.factorizations;
-        self.factor_time_s += other.factor_time_s;
-        self.wall_time_s += other.wall_time_s;
-        self.globalization.add(&other.globalization);
-    }
+/// How a part's report joins the report of the whole solve ([`SolveReport::merge`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// Work that gave the solve its start (a coarser grid's solve, the Cusick drape's fall): its
+    /// counters and times add up; the whole keeps its own outcome.
+    Start,
+    /// A stage of a continuation (a load increment, a friction update, a contact round): counters
+    /// and times add up; the outcome (status, residual, energy, message, minimum) is the stage's.
+    Stage,
+    /// The Newton solve of one implicit time step: its iterations are the integration's inner
+    /// iterations; factorizations, linear solves and their time add up.
+    InnerSolve,
+}
 
-    /// The running total of a solve made of several solves (load increments, contact rounds): work
-    /// and time add up ([`Self::add_work`]), the status, residual, energy and message are the latest
-    /// one's.
-    pub fn accumulate(total: Option<SolveReport>, latest: SolveReport) -> SolveReport {
-        match total {
-            None => latest,
-            Some(mut t) => {
-                t.add_work(&latest);
-                t.status = latest.status;
-                t.stop = latest.stop;
-                t.max_residual_N = latest.max_residual_N;
-                t.max_residual_rel = latest.max_residual_rel;
-                t.energy_J = latest.energy_J;
-                t.divergence = latest.divergence;
-                t.message = latest.message;
-                t.minimum = latest.minimum;
-                t
-            }
+impl SolveReport {
+    /// Merges the report of a part of this solve into it, as `how` says: the one place where
+    /// reports are merged.
+    pub fn merge(&mut self, part: &SolveReport, how: Part) {
+        self.linear_solves += part.linear_solves;
+        self.factorizations += part.factorizations;
+        self.factor_time_s += part.factor_time_s;
+        if how == Part::InnerSolve {
+            self.inner_iterations += part.iterations;
+            return;
+        }
+        self.iterations += part.iterations;
+        self.inner_iterations += part.inner_iterations;
+        self.wall_time_s += part.wall_time_s;
+        self.globalization.add(&part.globalization);
+        if how == Part::Stage {
+            self.status = part.status;
+            self.stop = part.stop;
+            self.max_residual_N = part.max_residual_N;
+            self.max_residual_rel = part.max_residual_rel;
+            self.energy_J = part.energy_J;
+            self.divergence = part.divergence.clone();
+            self.message = part.message.clone();
+            self.minimum = part.minimum;
         }
     }
 }

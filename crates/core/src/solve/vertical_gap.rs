@@ -9,9 +9,8 @@
 //! let go), which suits tables, pedestals and rods; on a sphere the sheet stays where it first touched.
 //! The barrier method is the frictionless one.
 
-use super::{
-    NoObserver, Observer, SolveReport, StaticOptions, Status, StopReason, solve_static_loads,
-};
+use super::continuation::{Continuation, Stage, execute};
+use super::{Observer, SolveReport, StaticOptions, StopReason};
 use crate::contact::Obstacle;
 use crate::physics::Model;
 use nalgebra::Vector3;
@@ -57,97 +56,147 @@ pub fn solve_vertical_gap(
     opts: &StaticOptions,
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let pinned = model.fixed.clone();
-    let mut held = vec![false; model.len()];
-    let mut total: Option<SolveReport> = None;
-    let mut g = Vec::new();
     let increments = if opts.load_steps > 1 {
         opts.load_steps
     } else {
         DEFAULT_INCREMENTS
     };
-    let depth_limit = 0.25 * spacing_m;
-    let full_step = 1.0 / increments as f64;
-    let (mut load, mut step) = (0.0f64, full_step);
-    let (mut first, mut rounds, mut cutbacks) = (true, 0, 0);
-    while load < 1.0 {
-        let target = if load + step > 1.0 - 1e-12 {
+    let mut gap = VerticalGap {
+        obstacles,
+        pinned: model.fixed.clone(),
+        held: vec![false; model.len()],
+        depth_limit: 0.25 * spacing_m,
+        increments,
+        full_step: 1.0 / increments as f64,
+        load: 0.0,
+        step: 1.0 / increments as f64,
+        increment: Increment::default(),
+        counts: (0, 0),
+        g: Vec::new(),
+    };
+    execute(model, x, opts, &mut gap, observer)
+}
+
+/// The state at the start of a load increment, to roll a rejected one back to.
+#[derive(Default)]
+struct Increment {
+    target: f64,
+    round: usize,
+    start: Vec<Vector3<f64>>,
+    held: Vec<bool>,
+    fixed: Vec<bool>,
+}
+
+/// Seed 003's contact determination as a continuation: per load increment, rounds of (solve,
+/// pull back, let go) until the held set settles.
+struct VerticalGap<'a> {
+    obstacles: &'a [Obstacle],
+    /// The model's own fixed particles (pins), never pulled back or let go.
+    pinned: Vec<bool>,
+    /// Nodes held on an obstacle's surface.
+    held: Vec<bool>,
+    depth_limit: f64,
+    increments: usize,
+    full_step: f64,
+    /// The load reached, and the next increment's size.
+    load: f64,
+    step: f64,
+    increment: Increment,
+    /// (rounds, halved increments) so far.
+    counts: (usize, usize),
+    g: Vec<Vector3<f64>>,
+}
+
+impl VerticalGap<'_> {
+    /// Starts the next increment from `x`: its first round.
+    fn begin(&mut self, model: &Model, x: &[Vector3<f64>]) -> Stage {
+        let target = if self.load + self.step > 1.0 - 1e-12 {
             1.0
         } else {
-            load + step
+            self.load + self.step
         };
-        let start = x.to_vec();
-        let (held_before, fixed_before) = (held.clone(), model.fixed.clone());
-        let mut settled = false;
-        let mut rejected = false;
-        for round in 0..MAX_ROUNDS {
-            rounds += 1;
-            let obs: &mut dyn Observer = if first {
-                &mut *observer
-            } else {
-                &mut NoObserver
-            };
-            first = false;
-            let report = SolveReport::accumulate(
-                total.take(),
-                solve_static_loads(model, x, opts, &[target], obs),
-            );
-            if report.status != Status::Converged {
-                return report;
-            }
-            total = Some(report);
-            // The seed's premise: increments small enough that no node passes into an obstacle
-            // beyond the pull-back's reach. When one went deeper on its way, take half the step.
-            if round == 0
-                && step > full_step / MAX_CUTBACK
-                && passed_too_deep(obstacles, &start, x, &held, &pinned, depth_limit)
-            {
-                x.copy_from_slice(&start);
-                held.clone_from(&held_before);
-                model.fixed.clone_from(&fixed_before);
-                step *= 0.5;
-                cutbacks += 1;
-                rejected = true;
-                break;
-            }
-            let mut changed = pull_back(model, x, obstacles, &pinned, &mut held);
-            // Let go of the held nodes that the obstacle no longer supports.
-            if round < RELEASE_ROUNDS {
-                model.gradient(x, target, &mut g);
-                for p in 0..model.n_grid {
-                    if held[p] && -g[p].z > 0.0 {
-                        held[p] = false;
-                        model.fixed[p] = false;
-                        changed = true;
-                    }
+        self.increment = Increment {
+            target,
+            round: 0,
+            start: x.to_vec(),
+            held: self.held.clone(),
+            fixed: model.fixed.clone(),
+        };
+        self.counts.0 += 1;
+        Stage::Solve(target)
+    }
+
+    /// The note on the result: nodes held, increments, halvings, rounds.
+    fn note(&self) -> String {
+        let (rounds, cutbacks) = self.counts;
+        format!(
+            " ({} nodes held by vertical-gap contact; {} load increments, {cutbacks} halved, {rounds} rounds)",
+            self.held.iter().filter(|h| **h).count(),
+            self.increments,
+        )
+    }
+}
+
+impl Continuation for VerticalGap<'_> {
+    fn next(&mut self, model: &mut Model, x: &mut [Vector3<f64>], solved: bool) -> Stage {
+        if !solved {
+            return self.begin(model, x);
+        }
+        let target = self.increment.target;
+        // The seed's premise: increments small enough that no node passes into an obstacle beyond
+        // the pull-back's reach. When one went deeper on its way, take half the step.
+        let inc = &self.increment;
+        if inc.round == 0
+            && self.step > self.full_step / MAX_CUTBACK
+            && passed_too_deep(
+                self.obstacles,
+                &inc.start,
+                x,
+                &self.held,
+                &self.pinned,
+                self.depth_limit,
+            )
+        {
+            x.copy_from_slice(&inc.start);
+            self.held.clone_from(&inc.held);
+            model.fixed.clone_from(&inc.fixed);
+            self.step *= 0.5;
+            self.counts.1 += 1;
+            return self.begin(model, x);
+        }
+        let mut changed = pull_back(model, x, self.obstacles, &self.pinned, &mut self.held);
+        // Let go of the held nodes that the obstacle no longer supports.
+        if self.increment.round < RELEASE_ROUNDS {
+            model.gradient(x, target, &mut self.g);
+            for p in 0..model.n_grid {
+                if self.held[p] && -self.g[p].z > 0.0 {
+                    self.held[p] = false;
+                    model.fixed[p] = false;
+                    changed = true;
                 }
             }
-            if !changed {
-                settled = true;
-                break;
+        }
+        if changed {
+            self.increment.round += 1;
+            if self.increment.round == MAX_ROUNDS {
+                return Stage::Stop(
+                    StopReason::ContactRounds,
+                    format!(
+                        "vertical-gap contact did not settle in {MAX_ROUNDS} rounds at load {target:.3}"
+                    ),
+                );
             }
+            self.counts.0 += 1;
+            return Stage::Solve(target);
         }
-        if rejected {
-            continue;
+        self.load = target;
+        self.step = (2.0 * self.step).min(self.full_step);
+        if self.load < 1.0 {
+            self.begin(model, x)
+        } else {
+            Stage::Done(self.note())
         }
-        if !settled {
-            let mut report = total.expect("at least one round");
-            report.stop_for(StopReason::ContactRounds);
-            report.message = format!(
-                "vertical-gap contact did not settle in {MAX_ROUNDS} rounds at load {target:.3}"
-            );
-            return report;
-        }
-        load = target;
-        step = (2.0 * step).min(full_step);
     }
-    let mut report = total.expect("at least one round");
-    report.message = format!(
-        "{} ({} nodes held by vertical-gap contact; {increments} load increments, {cutbacks} halved, {rounds} rounds)",
-        report.message,
-        held.iter().filter(|h| **h).count(),
-    );
-    report
 }
 
 /// The seed's pull-back: every free node that went into an obstacle is put back on its surface

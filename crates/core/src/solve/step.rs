@@ -1,0 +1,527 @@
+//! One damped Newton iteration (seed 003 §10.2) put together from the step's parts
+//! ([`super::strategy`]): the Hessian regularized ([`Regularization`]), a straight or curved step
+//! ([`Direction`]), a chord step with the factor at hand ([`FactorReuse`]), and a backtracking
+//! line search ([`Backtracking`] over [`Armijo`]) bounded by the terms' collision-free step
+//! ([`Model::max_step`]). [`super::newton`] owns the loop over iterations and load steps.
+
+use super::linear::{DofMap, SparseSpd};
+use super::newton::StaticOptions;
+use super::strategy::{
+    Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Verdict,
+};
+use super::{Globalization, SolveReport};
+use crate::physics::{HessianBlocks, Model};
+use nalgebra::Vector3;
+
+/// Mean of the Hessian's diagonal over the free DOFs (the scale of the damping), 1 if empty.
+pub(super) fn mean_free_diagonal(h: &HessianBlocks, dofs: &DofMap, n: usize) -> f64 {
+    let diag = h.diagonal(n);
+    let (mut sum, mut cnt) = (0.0, 0usize);
+    for (p, d) in diag.iter().enumerate() {
+        if dofs.dof(p).is_some() {
+            sum += d.trace();
+            cnt += 3;
+        }
+    }
+    if cnt > 0 && sum > 0.0 {
+        sum / cnt as f64
+    } else {
+        1.0
+    }
+}
+
+/// (first DOF, component) of every held component of the free particles.
+fn held_dofs(model: &Model, dofs: &DofMap) -> Vec<(usize, usize)> {
+    (0..model.len())
+        .filter_map(|p| dofs.dof(p).map(|d| (p, d)))
+        .flat_map(|(p, d)| {
+            (0..3)
+                .filter(move |&c| model.is_held(p, c))
+                .map(move |c| (d, c))
+        })
+        .collect()
+}
+
+/// Which Hessian an iteration factorizes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Hessian {
+    /// The exact one (quadratic convergence).
+    Exact,
+    /// Every term's indefinite part dropped (positive semi-definite).
+    Projected,
+}
+
+impl Hessian {
+    fn is_projected(self) -> bool {
+        self == Hessian::Projected
+    }
+}
+
+/// How an iteration's step was taken.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Taken {
+    /// Whole (length 1, no term bounding it): the factor at hand may serve a chord step.
+    Whole,
+    /// Shortened by the line search or a term's bound, or no step yet.
+    Partial,
+}
+
+/// The Newton step's parts, from the options.
+#[derive(Debug, Clone, Copy)]
+struct Parts {
+    regularization: Regularization,
+    direction: Direction,
+    factor_reuse: FactorReuse,
+    /// The largest shift of the exact Hessian ([`StaticOptions::shift_max_rel`]).
+    shift_max: f64,
+    /// The damping's initial value (where a carried damping returns when the Hessian is projected).
+    mu_initial: f64,
+    search: Backtracking<Armijo>,
+}
+
+/// The line search every Newton step uses.
+const SEARCH: Backtracking<Armijo> = Backtracking {
+    condition: Armijo {
+        decrease: ARMIJO_DECREASE,
+        flat_rel: ENERGY_FLAT_REL,
+    },
+    halvings: LINE_SEARCH_HALVINGS,
+};
+
+/// What the Newton loop carries between iterations: the buffers (nothing is allocated per
+/// iteration) and the Levenberg–Marquardt damping.
+pub(super) struct Workspace {
+    pub(super) dofs: DofMap,
+    held: Vec<(usize, usize)>,
+    pub(super) spd: SparseSpd,
+    pub(super) g: Vec<Vector3<f64>>,
+    h: HessianBlocks,
+    rhs: Vec<f64>,
+    dx: Vec<Vector3<f64>>,
+    trial: Vec<Vector3<f64>>,
+    g_trial: Vec<Vector3<f64>>,
+    g_back: Vec<Vector3<f64>>,
+    /// The step's geodesic acceleration (zero on a straight step).
+    acc: Vec<Vector3<f64>>,
+    shift: Vec<f64>,
+    /// Levenberg–Marquardt damping relative to the mean free diagonal of the Hessian.
+    mu: f64,
+    /// The step's parts.
+    parts: Parts,
+    /// The Hessian of the last factorization (see [`Workspace::top_fails`]).
+    last_hessian: Hessian,
+    /// The largest residual force at the start of the previous iteration, N.
+    r_prev: f64,
+    /// How the previous iteration's step was taken.
+    last_step: Taken,
+    /// What the globalization did so far.
+    pub(super) stats: Globalization,
+}
+
+/// The largest geodesic acceleration taken, relative to the step: |½ a| ≤ |dx|.
+const ACCELERATION_MAX: f64 = 1.0;
+/// The finite-difference step (in units of dx) of the acceleration's second derivative.
+const ACCELERATION_FD: f64 = 0.1;
+
+/// Armijo's sufficient-decrease constant: a step is accepted when the energy falls by at least this
+/// fraction of the decrease its slope promises. The textbook value (Nocedal & Wright); a larger one
+/// rejects more steps, a smaller one accepts steps that barely descend.
+pub const ARMIJO_DECREASE: f64 = 1e-4;
+
+/// An energy change below this fraction of the energy is round-off: such a step is accepted when it
+/// lowers the residual instead. Raise it only if a solve stalls at its round-off floor.
+pub const ENERGY_FLAT_REL: f64 = 1e-11;
+
+/// The factor by which damping and shifts grow after a failed factorization or line search (and
+/// the damping's ladder of shifts, 1e-8, 1e-7, …). A larger factor reaches a working shift in fewer
+/// factorizations but overshoots it.
+pub const DAMPING_GROWTH: f64 = 10.0;
+
+/// The damping is divided by this after a whole step (Levenberg–Marquardt's decrease).
+pub const DAMPING_DECREASE: f64 = 4.0;
+
+/// Factorization attempts (shifts, projection, damping) of one iteration before it gives up.
+pub const FACTORIZE_ATTEMPTS: usize = 40;
+
+/// Halvings of the step a line search tries before it gives up (2⁻³⁰ of the step).
+pub const LINE_SEARCH_HALVINGS: usize = 30;
+
+/// Rounds of (factorize, line search) in one iteration, each with more damping, before it gives up.
+pub const DAMPED_ROUNDS: usize = 20;
+
+/// The damping above which [`Regularization::CarriedDamping`] switches to the projected Hessian.
+pub const CARRIED_DAMPING_MAX: f64 = 1e-3;
+
+/// A chord step is tried while the largest residual force falls at least by this factor per
+/// iteration ([`FactorReuse::Chord`]).
+const CHORD_CONTRACTION: f64 = 0.5;
+
+/// Smallest damping used once damping is needed (relative to the mean diagonal).
+const MU_MIN: f64 = 1e-8;
+
+impl Workspace {
+    pub(super) fn new(model: &Model, x: &[Vector3<f64>], opts: &StaticOptions) -> Self {
+        let dofs = DofMap::new(&model.fixed);
+        let held = held_dofs(model, &dofs);
+        let n = dofs.n;
+        Self {
+            dofs,
+            held,
+            spd: SparseSpd::new(),
+            g: Vec::new(),
+            h: HessianBlocks::default(),
+            rhs: vec![0.0; n],
+            dx: vec![Vector3::zeros(); x.len()],
+            trial: x.to_vec(),
+            g_trial: Vec::new(),
+            g_back: Vec::new(),
+            acc: vec![Vector3::zeros(); x.len()],
+            shift: vec![0.0; n],
+            mu: opts.lm_damping_initial,
+            parts: Parts {
+                regularization: opts.regularization,
+                direction: opts.direction,
+                factor_reuse: opts.factor_reuse,
+                shift_max: opts.shift_max_rel,
+                mu_initial: opts.lm_damping_initial,
+                search: SEARCH,
+            },
+            last_hessian: Hessian::Exact,
+            r_prev: f64::INFINITY,
+            last_step: Taken::Partial,
+            stats: Globalization::default(),
+        }
+    }
+
+    /// Factorizes the Hessian in `h` (computed at `x`), shifted by the damping: the exact Hessian
+    /// (quadratic convergence; projected Newton stalls on a hanging net whose compressed springs'
+    /// transverse stiffness it drops), shifted further tenfold while it is indefinite up to
+    /// `shift_max` of the diagonal (for this iteration only), then the projected Hessian (every
+    /// term's indefinite part clamped) with the damping, raised tenfold while it fails. False when no
+    /// damping helps.
+    fn factorize(
+        &mut self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        hessian: &mut Hessian,
+        scale: f64,
+        report: &mut SolveReport,
+    ) -> bool {
+        let mut shift = self.mu;
+        for attempt in 0..FACTORIZE_ATTEMPTS {
+            if self.try_shift(shift, scale, report) {
+                report.linear_solves += 1;
+                self.last_hessian = *hessian;
+                return true;
+            }
+            shift = match self.parts.regularization {
+                Regularization::CarriedDamping => self.carry_shift(model, x, hessian),
+                Regularization::ShiftLadder => {
+                    self.climb(model, x, hessian, (shift, attempt == 0, scale), report)
+                }
+            };
+        }
+        false
+    }
+
+    /// [`Regularization::ShiftLadder`]'s next shift after `shift` failed: straight to the projected
+    /// Hessian when the last iteration ended on it and the ladder's top fails too (tried on the
+    /// first failure only); else the shift tenfold up to the ladder's top; then the projected
+    /// Hessian with the damping; then the damping tenfold.
+    fn climb(
+        &mut self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        hessian: &mut Hessian,
+        (shift, first, scale): (f64, bool, f64),
+        report: &mut SolveReport,
+    ) -> f64 {
+        let exact = !hessian.is_projected();
+        if first
+            && exact
+            && self.last_hessian.is_projected()
+            && self.top_fails(shift, scale, report)
+        {
+            *hessian = Hessian::Projected;
+            model.hessian(x, &mut self.h, true);
+            shift
+        } else if exact && shift * DAMPING_GROWTH <= self.parts.shift_max {
+            (shift * DAMPING_GROWTH).max(MU_MIN)
+        } else if exact {
+            *hessian = Hessian::Projected;
+            model.hessian(x, &mut self.h, true);
+            self.mu
+        } else {
+            self.mu = (shift * DAMPING_GROWTH).max(MU_MIN);
+            self.mu
+        }
+    }
+
+    /// Factorizes the Hessian in `h` shifted by `shift` × `scale` on the diagonal (held components
+    /// decoupled); counts it. False when that is not positive definite.
+    fn try_shift(&mut self, shift: f64, scale: f64, report: &mut SolveReport) -> bool {
+        self.shift.iter_mut().for_each(|s| *s = shift * scale);
+        // Held components (symmetry planes): a diagonal far above the rest decouples them, and
+        // their step is set to zero.
+        for &(d, c) in &self.held {
+            self.shift[d + c] += super::equilibrium::HELD_SHIFT_REL * scale.max(1e-300);
+        }
+        report.factorizations += 1;
+        self.spd.factorize(&self.dofs, &self.h, &self.shift)
+    }
+
+    /// After the damping `shift` alone failed, where the iteration before ended on the projected
+    /// Hessian: whether the top of the ladder of shifts fails too. Positive definiteness only grows
+    /// with a diagonal shift, so then every shift in between fails as well and the ladder can be
+    /// skipped — the same step as climbing it, in one factorization instead of each rung's.
+    fn top_fails(&mut self, shift: f64, scale: f64, report: &mut SolveReport) -> bool {
+        let mut top = shift;
+        while top * DAMPING_GROWTH <= self.parts.shift_max {
+            top = (top * DAMPING_GROWTH).max(MU_MIN);
+        }
+        if top == shift {
+            return false;
+        }
+        let fails = !self.try_shift(top, scale, report);
+        self.stats.skipped_shifts += usize::from(fails);
+        fails
+    }
+
+    /// [`Regularization::CarriedDamping`]: the damping raised tenfold, or the projected Hessian
+    /// with the damping back at its initial value once it reaches 1e-3; the
+    /// next shift.
+    fn carry_shift(&mut self, model: &Model, x: &[Vector3<f64>], hessian: &mut Hessian) -> f64 {
+        if !hessian.is_projected() && self.mu >= CARRIED_DAMPING_MAX {
+            *hessian = Hessian::Projected;
+            model.hessian(x, &mut self.h, true);
+            self.mu = self.parts.mu_initial.min(self.mu);
+        } else {
+            self.mu = (self.mu * DAMPING_GROWTH).max(MU_MIN);
+        }
+        self.mu
+    }
+
+    /// The Newton step −(H + μD)⁻¹ g into `dx` (zero on fixed particles and held components), and
+    /// the directional derivative gᵀdx.
+    fn step(&mut self, x_len: usize) -> f64 {
+        let mut dx = std::mem::take(&mut self.dx);
+        let g = std::mem::take(&mut self.g);
+        self.solve_for(&g, &mut dx);
+        let slope = (0..x_len).map(|p| g[p].dot(&dx[p])).sum();
+        self.g = g;
+        self.dx = dx;
+        slope
+    }
+
+    /// −(H + μD)⁻¹ f into `out` with the last factorization, zero on fixed particles and held
+    /// components.
+    fn solve_for(&mut self, f: &[Vector3<f64>], out: &mut [Vector3<f64>]) {
+        for (p, fp) in f.iter().enumerate() {
+            if let Some(d) = self.dofs.dof(p) {
+                self.rhs[d] = -fp.x;
+                self.rhs[d + 1] = -fp.y;
+                self.rhs[d + 2] = -fp.z;
+            }
+        }
+        for &(d, c) in &self.held {
+            self.rhs[d + c] = 0.0;
+        }
+        self.spd.solve_in_place(&mut self.rhs);
+        for &(d, c) in &self.held {
+            self.rhs[d + c] = 0.0;
+        }
+        for (p, o) in out.iter_mut().enumerate() {
+            *o = match self.dofs.dof(p) {
+                Some(d) => Vector3::new(self.rhs[d], self.rhs[d + 1], self.rhs[d + 2]),
+                None => Vector3::zeros(),
+            };
+        }
+    }
+
+    /// The step's geodesic acceleration into `acc` (Transtrum & Sethna 2012): a = −(H + μD)⁻¹ T, T
+    /// the second derivative of the gradient along dx by central differences, so that the path
+    /// x + α dx + ½ α² a also cancels the gradient's second-order change. False when that is not
+    /// finite or |½ a| > [`ACCELERATION_MAX`] |dx|.
+    fn acceleration(&mut self, model: &Model, x: &[Vector3<f64>], load: f64) -> bool {
+        let h = ACCELERATION_FD;
+        for (p, xp) in x.iter().enumerate() {
+            self.trial[p] = xp + self.dx[p] * h;
+        }
+        model.gradient(&self.trial, load, &mut self.g_trial);
+        for (p, xp) in x.iter().enumerate() {
+            self.trial[p] = xp - self.dx[p] * h;
+        }
+        model.gradient(&self.trial, load, &mut self.g_back);
+        // T into g_trial (its buffer, so nothing is allocated per iteration).
+        for ((t, g), b) in self.g_trial.iter_mut().zip(&self.g).zip(&self.g_back) {
+            *t = (*t - g * 2.0 + b) / (h * h);
+        }
+        let (t, mut acc) = (
+            std::mem::take(&mut self.g_trial),
+            std::mem::take(&mut self.acc),
+        );
+        self.solve_for(&t, &mut acc);
+        (self.g_trial, self.acc) = (t, acc);
+        let norm = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
+        let na = norm(&self.acc);
+        na.is_finite() && 0.5 * na <= ACCELERATION_MAX * norm(&self.dx)
+    }
+
+    /// Backtracking (Armijo) line search along `dx` from the step length `alpha` (below 1 where a
+    /// term bounds the step: contact). Near the solution the energy change falls below round-off:
+    /// there a step that lowers the largest residual force is accepted instead. Returns the accepted
+    /// step length, if any.
+    fn line_search(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        load: f64,
+        (e, r): (&mut f64, f64),
+        (alpha, slope): (f64, f64),
+    ) -> Option<f64> {
+        let Self {
+            trial,
+            g_trial,
+            dx,
+            acc,
+            stats,
+            parts,
+            ..
+        } = self;
+        let trial = std::cell::RefCell::new(trial);
+        let energy_at = |alpha: f64| {
+            let half = 0.5 * alpha * alpha;
+            let mut t = trial.borrow_mut();
+            for (p, xp) in x.iter().enumerate() {
+                t[p] = xp + dx[p] * alpha + acc[p] * half;
+            }
+            model.energy(&t[..], load)
+        };
+        let lowers_residual = || {
+            model.gradient(&trial.borrow()[..], load, g_trial);
+            model.max_residual(g_trial) < r
+        };
+        let found = parts.search.search(
+            (*e, slope),
+            alpha,
+            energy_at,
+            lowers_residual,
+            &mut stats.rejected_trials,
+        );
+        let (alpha, et) = found?;
+        x.copy_from_slice(&trial.borrow()[..]);
+        *e = et;
+        Some(alpha)
+    }
+
+    /// One damped Newton iteration from `x`: factorize, step (curved where the acceleration is
+    /// small), line search, then adapt the damping (divided by 4 after a whole step, raised tenfold
+    /// from 1e-8 when no step lowers the energy). False when no step lowers the energy.
+    pub(super) fn iterate(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        load: f64,
+        e: &mut f64,
+        (r, tol): (f64, f64),
+        report: &mut SolveReport,
+    ) -> bool {
+        // Shamanskii: while whole steps halve the residual, the factor at hand serves again.
+        let chord = self.parts.factor_reuse == FactorReuse::Chord
+            && self.last_step == Taken::Whole
+            && r <= CHORD_CONTRACTION * self.r_prev;
+        self.r_prev = r;
+        if chord && self.chord_step(model, x, load, e, report) {
+            self.last_step = Taken::Whole;
+            return true;
+        }
+        self.last_step = Taken::Partial;
+        let mut hessian = Hessian::Exact;
+        model.hessian(x, &mut self.h, false);
+        // The damping's scale: the mean diagonal of this iteration's exact Hessian.
+        let scale = mean_free_diagonal(&self.h, &self.dofs, model.len());
+        for _ in 0..DAMPED_ROUNDS {
+            if !self.factorize(model, x, &mut hessian, scale, report) {
+                return false;
+            }
+            let slope = self.step(x.len());
+            let mut bound = model.max_step(x, &self.dx);
+            let curved = self.parts.direction == Direction::Curved
+                && !hessian.is_projected()
+                && self.acceleration(model, x, load);
+            if curved {
+                // The bound of the chord to the curve's end as well as of the tangent (the chord
+                // into g_back, free until the next acceleration).
+                for ((c, d), a) in self.g_back.iter_mut().zip(&self.dx).zip(&self.acc) {
+                    *c = d + a * 0.5;
+                }
+                bound = bound.min(model.max_step(x, &self.g_back));
+            } else {
+                self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
+            }
+            match self.line_search(model, x, load, (e, r), (bound.min(1.0), slope)) {
+                Some(alpha) => {
+                    self.count(alpha, bound, (curved, hessian.is_projected()));
+                    if alpha == 1.0 && bound >= 1.0 {
+                        self.last_step = Taken::Whole;
+                        self.mu = if self.mu < 1e-12 {
+                            0.0
+                        } else {
+                            self.mu / DAMPING_DECREASE
+                        };
+                    }
+                    return true;
+                }
+                // A step that does not decrease the energy: near the solution, round-off.
+                None if r <= 10.0 * tol => return false,
+                None => self.mu = (self.mu * DAMPING_GROWTH).max(MU_MIN),
+            }
+        }
+        false
+    }
+
+    /// The chord step −H₀⁻¹ g with the factorization at hand, taken whole when no term bounds it and
+    /// it lowers the energy enough (Armijo) or leaves it flat to round-off. False (and `x` as it was)
+    /// otherwise.
+    fn chord_step(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        load: f64,
+        e: &mut f64,
+        report: &mut SolveReport,
+    ) -> bool {
+        let slope = self.step(x.len());
+        report.linear_solves += 1;
+        if slope.is_nan() || slope >= 0.0 || model.max_step(x, &self.dx) < 1.0 {
+            return false;
+        }
+        for (p, xp) in x.iter().enumerate() {
+            self.trial[p] = xp + self.dx[p];
+        }
+        let et = model.energy(&self.trial, load);
+        if self.parts.search.condition.verdict(*e, et, 1.0, slope) == Verdict::Reject {
+            self.stats.rejected_trials += 1;
+            return false;
+        }
+        x.copy_from_slice(&self.trial);
+        *e = et;
+        self.stats.full_steps += 1;
+        self.stats.chord_steps += 1;
+        true
+    }
+
+    /// Counts an accepted step of length `alpha` under the terms' `bound`.
+    fn count(&mut self, alpha: f64, bound: f64, (curved, projected): (bool, bool)) {
+        let s = &mut self.stats;
+        if alpha == 1.0 {
+            s.full_steps += 1;
+        } else if alpha == bound {
+            s.bounded_steps += 1;
+        } else {
+            s.shortened_steps += 1;
+        }
+        s.curved_steps += usize::from(curved);
+        s.projected_steps += usize::from(projected);
+    }
+}
