@@ -67,6 +67,14 @@ fn sensitivity_parquet_holds_one_row_per_particle_and_key_in_particles_order() {
     assert!(rows[centre].dz_m_per_unit > 0.0);
     let run = run_json(&out);
     assert_eq!(run["sensitivity"]["written"], true);
+    // dE*/dθ per key, as the library gives it; a heavier net stores less energy (it hangs lower:
+    // gravity's energy falls faster than the springs' rises).
+    let de = run["sensitivity"]["d_energy_J_per_unit"]
+        .as_array()
+        .unwrap();
+    assert_eq!(de.len(), 2);
+    assert!((de[1].as_f64().unwrap() - s.d_energy).abs() <= 1e-12 * s.d_energy.abs());
+    assert!(s.d_energy < 0.0, "{}", s.d_energy);
     assert!(
         run["outputs"]
             .as_array()

@@ -26,8 +26,9 @@ use nalgebra::Vector3;
 /// `cloth.size_y_m` is 10⁻³ off at h = 10⁻⁴ |θ| and 10⁻⁷ at 10⁻⁶ (its round-off is 10⁻⁹ there).
 pub const PARAM_STEP_REL: f64 = 1e-6;
 
-/// A key's value, its mixed derivative ∂g/∂θ and its fixed particles' motion dx/dθ.
-type Mixed = (f64, Vec<Vector3<f64>>, Vec<Vector3<f64>>);
+/// A key's value, its mixed derivative ∂g/∂θ, its fixed particles' motion dx/dθ and the energy's
+/// derivative dE*/dθ.
+type Mixed = (f64, Vec<Vector3<f64>>, Vec<Vector3<f64>>, f64);
 
 /// The step of the central differences in θ.
 fn param_step(theta: f64) -> f64 {
@@ -54,6 +55,10 @@ pub struct KeySensitivity {
     /// ∂g/∂θ at x* (the total derivative along the fixed particles' motion), N per unit of the key;
     /// the adjoint contracts it.
     pub dg: Vec<Vector3<f64>>,
+    /// dE*/dθ, the equilibrium energy's derivative, J per unit of the key: by the envelope theorem
+    /// ∂E/∂θ at x* plus the fixed particles' forces along their motion (the drape's own motion does
+    /// no work at a minimum), with no solve.
+    pub d_energy: f64,
 }
 
 /// Why a key has no sensitivity.
@@ -191,24 +196,28 @@ impl<'a> Equilibrium<'a> {
             })
             .collect();
         let mut dg = vec![Vector3::zeros(); self.x.len()];
+        let mut de = 0.0;
         for ((t, th), tl) in self.model.terms.iter().zip(&hi.0.terms).zip(&lo.0.terms) {
-            mixed_of_term(
+            de += mixed_of_term(
                 (t.as_ref(), th.as_ref(), tl.as_ref()),
                 self.x,
                 span,
                 &mut dg,
             );
         }
+        let mut g = Vec::new();
+        self.model.gradient(self.x, 1.0, &mut g);
+        de += g.iter().zip(&dxf).map(|(a, b)| a.dot(b)).sum::<f64>();
         // The fixed particles' motion moves the drape through the Hessian's coupling blocks.
         let mut hess = crate::physics::HessianBlocks::default();
         self.model.exact_hessian(self.x, &mut hess);
         hess.mul_add(&dxf, &mut dg);
-        Ok((theta, dg, dxf))
+        Ok((theta, dg, dxf, de))
     }
 
     /// dx*/dθ for the continuous parameter `key`.
     pub fn sensitivity(&mut self, key: &str) -> Result<KeySensitivity, NoSensitivity> {
-        let (value, dg, dxf) = self.mixed(key)?;
+        let (value, dg, dxf, d_energy) = self.mixed(key)?;
         let (dx, residual) = self.factor.sensitivity_checked(&dg, &dxf);
         if residual > MAX_RESIDUAL_REL {
             return Err(NoSensitivity::NotIsolated(key.to_string(), residual));
@@ -218,6 +227,7 @@ impl<'a> Equilibrium<'a> {
             value,
             dx,
             dg,
+            d_energy,
         })
     }
 
@@ -232,7 +242,7 @@ impl<'a> Equilibrium<'a> {
         let lambda = self.adjoint(dj_dx);
         keys.iter()
             .map(|k| {
-                let (_, dg, dxf) = self.mixed(k)?;
+                let (_, dg, dxf, _) = self.mixed(k)?;
                 Ok((0..self.x.len())
                     .map(|p| {
                         if self.factor.is_free(p) {
@@ -247,17 +257,17 @@ impl<'a> Equilibrium<'a> {
     }
 }
 
-/// Adds one term's ∂g/∂θ at `x` to `dg`, from the term of the solved model `t` and its rebuilds
-/// `hi`, `lo` at θ ± `span`/2: the analytic mixed derivative in the term's coefficients along their
-/// change (dc/dθ by the difference of the rebuilt coefficients: exact for coefficients linear in θ,
-/// as stiffnesses, weights and rest lengths are), or, for a term that does not give it (contact,
-/// self-contact), the difference of its rebuilt gradients.
+/// Adds one term's ∂g/∂θ at `x` to `dg` and returns its ∂E/∂θ, from the term of the solved model
+/// `t` and its rebuilds `hi`, `lo` at θ ± `span`/2: the analytic mixed derivatives in the term's
+/// coefficients along their change (dc/dθ by the difference of the rebuilt coefficients: exact for
+/// coefficients linear in θ, as stiffnesses, weights and rest lengths are), or, for a term that
+/// does not give them (contact, self-contact), the differences of its rebuilt gradient and energy.
 fn mixed_of_term(
     (t, hi, lo): (&dyn EnergyTerm, &dyn EnergyTerm, &dyn EnergyTerm),
     x: &Vecs,
     span: f64,
     dg: &mut [Vector3<f64>],
-) {
+) -> f64 {
     let (ch, cl) = (hi.coefficients(), lo.coefficients());
     if !ch.is_empty() && ch.len() == cl.len() {
         // Equal coefficients (an infinite saturation on both sides too) do not move.
@@ -266,8 +276,10 @@ fn mixed_of_term(
             .zip(&cl)
             .map(|(a, b)| if a == b { 0.0 } else { (a - b) / span })
             .collect();
-        if t.add_coefficient_gradient(x, &dc, dg) {
-            return;
+        if let Some(de) = t.coefficient_energy(x, &dc)
+            && t.add_coefficient_gradient(x, &dc, dg)
+        {
+            return de;
         }
     }
     let n = x.len();
@@ -277,6 +289,7 @@ fn mixed_of_term(
     for ((d, a), b) in dg.iter_mut().zip(&gh).zip(&gl) {
         *d += (a - b) / span;
     }
+    (hi.energy(x) - lo.energy(x)) / span
 }
 
 /// Whether the `rebuilt` model has the particles, the fixed set and the terms of `solved` (which may

@@ -463,3 +463,55 @@ fn cusick_specimen_sensitivities_match_central_differences_for_every_key() {
     }
     eprintln!("cusick specimen: keys checked {keys:?}");
 }
+
+#[test]
+fn the_equilibrium_energys_derivative_is_the_envelope_theorems() {
+    // dE*/dθ = ∂E/∂θ at x* (plus the pins' forces along their motion): at a minimum the drape's own
+    // motion does no work. Against the central difference of equilibrium energies for every key of
+    // hang4 (kernels only) and of the table drape (obstacle barrier: its differences of energy).
+    for scene in [
+        load("hang4", &[]),
+        load(
+            "table_wool",
+            &[
+                ("cloth.nx", toml::Value::Integer(21)),
+                ("cloth.ny", toml::Value::Integer(21)),
+            ],
+        ),
+    ] {
+        let sol = solved(&scene);
+        let mut eq = Equilibrium::new(&scene, &sol.model, &sol.x, &sol.report, "test").unwrap();
+        let mut checked = 0;
+        for key in continuous_keys(&scene) {
+            let Ok(s) = eq.sensitivity(&key) else {
+                continue;
+            };
+            let theta = s.value;
+            let h = FD_STEP_REL * theta.abs().max(1e-3);
+            let energy = |t: f64| -> Option<f64> {
+                let changed = with_value(&scene, &key, t, "test").ok()?;
+                let b = drapelab_core::build::build_scene(&changed);
+                let start: Vec<Vector3<f64>> = (0..sol.x.len())
+                    .map(|p| if b.model.fixed[p] { b.x0[p] } else { sol.x[p] })
+                    .collect();
+                let r = solve_scene_from(&changed, &start, &mut NoObserver);
+                r.report.is_converged().then_some(r.report.energy_J)
+            };
+            let (Some(hi), Some(lo)) = (energy(theta + h), energy(theta - h)) else {
+                continue;
+            };
+            let fd = (hi - lo) / (2.0 * h);
+            // The energies' own round-off: 1e-14 of the energy over the step.
+            let floor = 1e-14 * sol.report.energy_J.abs() / h;
+            assert!(
+                (s.d_energy - fd).abs() <= 1e-5 * fd.abs() + floor,
+                "{}: {key}: dE*/dθ {:.6e} against {fd:.6e} J per unit",
+                scene.name,
+                s.d_energy
+            );
+            checked += 1;
+        }
+        eprintln!("{}: {checked} keys' dE*/dθ checked", scene.name);
+        assert!(checked >= 4, "{}: only {checked} keys", scene.name);
+    }
+}

@@ -163,11 +163,15 @@ fn every_terms_gradient_and_hessian_match_central_differences_in_every_bundled_s
     eprintln!("terms checked: {checked:?}");
 }
 
-/// The relative 2-norm error of a term's mixed derivative ∂g/∂c · dc at `x` against the central
-/// difference of its gradient with the coefficients moved by ±eps dc (best over the steps).
-fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> f64 {
+/// The relative errors of a term's mixed derivative ∂g/∂c · dc (2-norm) and of ∂E/∂c · dc at `x`
+/// against the central differences of its gradient and energy with the coefficients moved by
+/// ±eps dc (each the best over the steps).
+fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> (f64, f64) {
     let n = x.len();
     let c = t.coefficients();
+    let de = t
+        .coefficient_energy(x, dc)
+        .unwrap_or_else(|| panic!("{}: gives coefficients but no ∂E/∂c", t.name()));
     let mut an = vec![Vector3::zeros(); n];
     assert!(
         t.add_coefficient_gradient(x, dc, &mut an),
@@ -175,9 +179,9 @@ fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> 
         t.name()
     );
     let size = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
-    let mut best = f64::INFINITY;
+    let (mut best, mut best_e) = (f64::INFINITY, f64::INFINITY);
     for eps in [1e-4, 1e-5, 1e-6, 1e-7] {
-        let grad_at = |t: &mut dyn EnergyTerm, s: f64| {
+        let grad_at = |t: &mut dyn EnergyTerm, s: f64| -> (Vec<Vector3<f64>>, f64) {
             let moved: Vec<f64> = c
                 .iter()
                 .zip(dc)
@@ -186,9 +190,11 @@ fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> 
             t.set_coefficients(&moved);
             let mut g = vec![Vector3::zeros(); n];
             t.add_gradient(x, &mut g);
-            g
+            (g, t.energy(x))
         };
-        let (gp, gm) = (grad_at(t, eps), grad_at(t, -eps));
+        let ((gp, ep), (gm, em)) = (grad_at(t, eps), grad_at(t, -eps));
+        let fde = (ep - em) / (2.0 * eps);
+        best_e = best_e.min((fde - de).abs() / fde.abs().max(de.abs()).max(1e-300));
         t.set_coefficients(&c);
         let fd: Vec<Vector3<f64>> = gp
             .iter()
@@ -198,7 +204,7 @@ fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> 
         let diff: Vec<Vector3<f64>> = fd.iter().zip(&an).map(|(a, b)| a - b).collect();
         best = best.min(size(&diff) / size(&fd).max(size(&an)).max(1e-300));
     }
-    best
+    (best, best_e)
 }
 
 /// Random relative changes of the coefficients (each by up to its own size; none for an infinite one).
@@ -215,8 +221,8 @@ fn random_change(c: &[f64], rng: &mut impl Rng) -> Vec<f64> {
 }
 
 #[test]
-fn every_terms_mixed_derivative_in_its_coefficients_matches_central_differences() {
-    // ∂g/∂c · dc of every term that gives coefficients, at a state off the flat sheet (every spring
+fn every_terms_derivatives_in_its_coefficients_match_central_differences() {
+    // ∂g/∂c · dc and ∂E/∂c · dc of every term that gives coefficients, at a state off the flat sheet (every spring
     // strained, every stencil bent), in every bundled scene; and the saturating hinge bending of the
     // Cusick disc, whose saturation u₀ is a coefficient too. A term whose mixed derivative is wrong
     // fails here by name; the sensitivities (tests/sensitivities.rs) are built on these.
@@ -229,8 +235,13 @@ fn every_terms_mixed_derivative_in_its_coefficients_matches_central_differences(
         }
         for _ in 0..2 {
             let dc = random_change(&c, rng);
-            let e = coefficient_error(t, x, &dc);
+            let (e, e_energy) = coefficient_error(t, x, &dc);
             assert!(e <= 1e-6, "{scene}: {}: ∂g/∂c off by {e:e}", t.name());
+            assert!(
+                e_energy <= 1e-6,
+                "{scene}: {}: ∂E/∂c off by {e_energy:e}",
+                t.name()
+            );
         }
         checked.insert(t.name());
     };

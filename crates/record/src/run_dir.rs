@@ -56,6 +56,9 @@ struct SensitivityRecord {
     written: bool,
     /// Why not, when not (the state is no converged minimum, a key changes the model's structure).
     reason: Option<String>,
+    /// Per key (in the order of `keys`), dE*/dθ: the equilibrium energy's derivative, J per unit of
+    /// the key (the envelope theorem: ∂E/∂θ at x*); empty when none were written.
+    d_energy_J_per_unit: Vec<f64>,
     /// Wall time of the factorization and the keys' solves, s.
     time_s: f64,
 }
@@ -347,8 +350,9 @@ fn sensitivities(
                 .map(|k| eq.sensitivity(k))
                 .collect::<Result<Vec<_>, _>>()
         });
-    let (written, reason, data) = match result {
+    let (written, reason, data, d_energy) = match result {
         Ok(s) => {
+            let d_energy = s.iter().map(|k| k.d_energy).collect();
             crate::sensitivity_table::write_sensitivities(
                 &out.join("sensitivity.parquet"),
                 grid,
@@ -358,14 +362,15 @@ fn sensitivities(
                 .into_iter()
                 .map(|k| (k.key, k.dx[..grid.len()].to_vec()))
                 .collect();
-            (true, None, data)
+            (true, None, data, d_energy)
         }
-        Err(e) => (false, Some(e.to_string()), Vec::new()),
+        Err(e) => (false, Some(e.to_string()), Vec::new(), Vec::new()),
     };
     let record = SensitivityRecord {
         keys: extras.sensitivity_keys.clone(),
         written,
         reason,
+        d_energy_J_per_unit: d_energy,
         time_s: start.elapsed().as_secs_f64(),
     };
     Ok((Some(record), data))

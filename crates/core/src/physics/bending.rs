@@ -117,9 +117,11 @@ impl<const N: usize> Kernel<N> for QuadraticKernel<N> {
     fn stencils(&self) -> &[[u32; N]] {
         &self.stencils
     }
+    #[inline]
     fn energy(&self, k: usize, x: &Local<N>) -> f64 {
         self.law(k, &self.u(k, x)).0
     }
+    #[inline]
     fn gradient(&self, k: usize, x: &Local<N>) -> Local<N> {
         let u = self.u(k, x);
         let u = u * self.law(k, &u).1;
@@ -169,6 +171,7 @@ impl<const N: usize> Kernel<N> for QuadraticKernel<N> {
     }
     /// g_m = c_m f(u), f = ∂E/∂u = s₁ u, u = Σ c_m x_m: dg_m = dc_m f + c_m (∂f/∂u du + ∂f/∂k dk
     /// + ∂f/∂u₀ du₀), du = Σ dc_m x_m, ∂f/∂k = f/k, ∂f/∂u₀ = k |u|² u/(q³ u₀³).
+    #[inline]
     fn coefficient_gradient(&self, k: usize, x: &Local<N>, dc: &[f64]) -> Local<N> {
         let u = self.u(k, x);
         let (_, s1, s3) = self.law(k, &u);
@@ -185,6 +188,24 @@ impl<const N: usize> Kernel<N> for QuadraticKernel<N> {
         }
         let c = self.coef[k];
         std::array::from_fn(|m| f * dc[m] + df * c[m])
+    }
+    /// dE = ∂E/∂u · du + E/k dk + ∂E/∂u₀ du₀, ∂E/∂u₀ = 2 k u₀ (q − 1) − k |u|²/(q u₀).
+    #[inline]
+    fn coefficient_energy(&self, k: usize, x: &Local<N>, dc: &[f64]) -> f64 {
+        let u = self.u(k, x);
+        let (e, s1, _) = self.law(k, &u);
+        let du: Vector3<f64> = (0..N).map(|m| x[m] * dc[m]).sum();
+        let kk = self.stiffness[k];
+        let mut de = (u * s1).dot(&du) + e / kk * dc[N];
+        match self.saturation.get(k) {
+            Some(&u0) if u0.is_finite() && dc[N + 1] != 0.0 => {
+                let u2 = u.norm_squared();
+                let q = (1.0 + u2 / (u0 * u0)).sqrt();
+                de += (2.0 * kk * u0 * (q - 1.0) - kk * u2 / (q * u0)) * dc[N + 1];
+            }
+            _ => {}
+        }
+        de
     }
 }
 
@@ -236,9 +257,11 @@ impl Kernel<2> for MirrorKernel {
     fn stencils(&self) -> &[[u32; 2]] {
         &self.pairs
     }
+    #[inline]
     fn energy(&self, k: usize, x: &Local<2>) -> f64 {
         0.5 * self.stiffness_N_per_m[k] * self.v(x).norm_squared()
     }
+    #[inline]
     fn gradient(&self, k: usize, x: &Local<2>) -> Local<2> {
         let f = self.v(x) * self.stiffness_N_per_m[k];
         [-f, f]
@@ -266,9 +289,14 @@ impl Kernel<2> for MirrorKernel {
     fn set_coefficients(&mut self, k: usize, c: &[f64]) {
         self.stiffness_N_per_m[k] = c[0];
     }
+    #[inline]
     fn coefficient_gradient(&self, _k: usize, x: &Local<2>, dc: &[f64]) -> Local<2> {
         let f = self.v(x) * dc[0];
         [-f, f]
+    }
+    #[inline]
+    fn coefficient_energy(&self, _k: usize, x: &Local<2>, dc: &[f64]) -> f64 {
+        0.5 * self.v(x).norm_squared() * dc[0]
     }
     fn stiffness_scale(&self) -> f64 {
         self.stiffness_N_per_m.iter().copied().fold(0.0, f64::max)

@@ -30,9 +30,11 @@ impl Kernel<1> for GravityKernel {
     fn stencils(&self) -> &[[u32; 1]] {
         &self.particles
     }
+    #[inline]
     fn energy(&self, k: usize, x: &Local<1>) -> f64 {
         self.weights_N[k] * x[0].z
     }
+    #[inline]
     fn gradient(&self, k: usize, _x: &Local<1>) -> Local<1> {
         [Vector3::new(0.0, 0.0, self.weights_N[k])]
     }
@@ -50,8 +52,13 @@ impl Kernel<1> for GravityKernel {
     fn set_coefficients(&mut self, k: usize, c: &[f64]) {
         self.weights_N[k] = c[0];
     }
+    #[inline]
     fn coefficient_gradient(&self, _k: usize, _x: &Local<1>, dc: &[f64]) -> Local<1> {
         [Vector3::new(0.0, 0.0, dc[0])]
+    }
+    #[inline]
+    fn coefficient_energy(&self, _k: usize, x: &Local<1>, dc: &[f64]) -> f64 {
+        x[0].z * dc[0]
     }
     fn is_external_load(&self) -> bool {
         true

@@ -39,6 +39,8 @@ pub trait Kernel<const N: usize>: Send + Sync {
     /// The mixed derivative Σ_c ∂(∂E_s/∂x)/∂c · dc: how the stencil's gradient changes along a
     /// change `dc` of its coefficients, N per unit of the parameter `dc` is a derivative in.
     fn coefficient_gradient(&self, s: usize, x: &Local<N>, dc: &[f64]) -> Local<N>;
+    /// ∂E_s/∂c · dc: how the stencil's energy changes along `dc`, J per unit of the parameter.
+    fn coefficient_energy(&self, s: usize, x: &Local<N>, dc: &[f64]) -> f64;
     /// The largest stiffness (N/m) the kernel couples particles with (see
     /// [`EnergyTerm::stiffness_scale`]).
     fn stiffness_scale(&self) -> f64 {
@@ -75,6 +77,7 @@ impl<K: Kernel<N>, const N: usize> Potential<K, N> {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+    #[inline]
     fn gather(&self, s: usize, x: &Vecs) -> (Local<N>, [usize; N]) {
         let idx = self.kernel.stencils()[s].map(|v| v as usize);
         (idx.map(|p| x[p]), idx)
@@ -149,5 +152,17 @@ impl<K: Kernel<N>, const N: usize> EnergyTerm for Potential<K, N> {
             }
         }
         true
+    }
+    fn coefficient_energy(&self, x: &Vecs, dc: &[f64]) -> Option<f64> {
+        let k = K::COEFFICIENTS;
+        (dc.len() == self.len() * k).then(|| {
+            (0..self.len())
+                .map(|s| {
+                    let xs = self.gather(s, x).0;
+                    self.kernel
+                        .coefficient_energy(s, &xs, &dc[s * k..(s + 1) * k])
+                })
+                .sum()
+        })
     }
 }

@@ -31,9 +31,11 @@ impl Kernel<1> for LoadKernel {
     fn stencils(&self) -> &[[u32; 1]] {
         &self.particles
     }
+    #[inline]
     fn energy(&self, k: usize, x: &Local<1>) -> f64 {
         -self.forces_N[k].dot(&x[0])
     }
+    #[inline]
     fn gradient(&self, k: usize, _x: &Local<1>) -> Local<1> {
         [-self.forces_N[k]]
     }
@@ -51,8 +53,13 @@ impl Kernel<1> for LoadKernel {
     fn set_coefficients(&mut self, k: usize, c: &[f64]) {
         self.forces_N[k] = Vector3::new(c[0], c[1], c[2]);
     }
+    #[inline]
     fn coefficient_gradient(&self, _k: usize, _x: &Local<1>, dc: &[f64]) -> Local<1> {
         [-Vector3::new(dc[0], dc[1], dc[2])]
+    }
+    #[inline]
+    fn coefficient_energy(&self, _k: usize, x: &Local<1>, dc: &[f64]) -> f64 {
+        -Vector3::new(dc[0], dc[1], dc[2]).dot(&x[0])
     }
     fn is_external_load(&self) -> bool {
         true

@@ -147,6 +147,10 @@ pub trait EnergyTerm: Send + Sync {
     fn add_coefficient_gradient(&self, _x: &Vecs, _dc: &[f64], _g: &mut Vecs) -> bool {
         false
     }
+    /// ∂E/∂c · dc at `x` (J per unit of the parameter), None when the term does not give it.
+    fn coefficient_energy(&self, _x: &Vecs, _dc: &[f64]) -> Option<f64> {
+        None
+    }
 }
 
 /// The assembled model: masses, pins and energy terms.

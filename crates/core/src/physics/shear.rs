@@ -34,6 +34,7 @@ impl CellShear {
 
 impl ShearKernel {
     /// (s, ∂s/∂p for the four corners, e_x·e_y).
+    #[inline]
     fn strain(&self, k: usize, c: &Local<4>) -> (f64, [Vector3<f64>; 4]) {
         let ex = ((c[1] - c[0]) + (c[3] - c[2])) * 0.5;
         let ey = ((c[2] - c[0]) + (c[3] - c[1])) * 0.5;
@@ -53,11 +54,13 @@ impl Kernel<4> for ShearKernel {
     fn stencils(&self) -> &[[u32; 4]] {
         &self.cells
     }
+    #[inline]
     fn energy(&self, k: usize, x: &Local<4>) -> f64 {
         let (hx, hy) = self.sides_m[k];
         let (s, _) = self.strain(k, x);
         0.5 * self.shear_N_per_m[k] * hx * hy * s * s
     }
+    #[inline]
     fn gradient(&self, k: usize, x: &Local<4>) -> Local<4> {
         let (hx, hy) = self.sides_m[k];
         let (s, gr) = self.strain(k, x);
@@ -96,9 +99,17 @@ impl Kernel<4> for ShearKernel {
         self.shear_N_per_m[k] = c[2];
     }
     /// g = G (e_x·e_y)/(h_x h_y) ∂(e_x·e_y): dg = g (dG/G − dh_x/h_x − dh_y/h_y).
+    #[inline]
     fn coefficient_gradient(&self, k: usize, x: &Local<4>, dc: &[f64]) -> Local<4> {
         let (hx, hy) = self.sides_m[k];
         let rate = dc[2] / self.shear_N_per_m[k] - dc[0] / hx - dc[1] / hy;
         self.gradient(k, x).map(|g| g * rate)
+    }
+    /// E = ½ G (e_x·e_y)²/(h_x h_y): dE = E (dG/G − dh_x/h_x − dh_y/h_y).
+    #[inline]
+    fn coefficient_energy(&self, k: usize, x: &Local<4>, dc: &[f64]) -> f64 {
+        let (hx, hy) = self.sides_m[k];
+        let rate = dc[2] / self.shear_N_per_m[k] - dc[0] / hx - dc[1] / hy;
+        self.energy(k, x) * rate
     }
 }

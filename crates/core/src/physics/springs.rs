@@ -58,11 +58,13 @@ impl Kernel<2> for SpringKernel {
     fn stencils(&self) -> &[[u32; 2]] {
         &self.pairs
     }
+    #[inline]
     fn energy(&self, k: usize, x: &Local<2>) -> f64 {
         let l = (x[1] - x[0]).norm();
         let d = l - self.rest_m[k];
         0.5 * self.stiffness_N_per_m[k] * d * d
     }
+    #[inline]
     fn gradient(&self, k: usize, x: &Local<2>) -> Local<2> {
         let d = x[1] - x[0];
         let l = d.norm();
@@ -99,6 +101,7 @@ impl Kernel<2> for SpringKernel {
         (self.rest_m[k], self.stiffness_N_per_m[k]) = (c[0], c[1]);
     }
     /// ∂f/∂k = (l − L0) d/l, ∂f/∂L0 = −k d/l for the force f = k (l − L0) d/l on b.
+    #[inline]
     fn coefficient_gradient(&self, k: usize, x: &Local<2>, dc: &[f64]) -> Local<2> {
         let d = x[1] - x[0];
         let l = d.norm();
@@ -108,9 +111,16 @@ impl Kernel<2> for SpringKernel {
         let f = d * (((l - self.rest_m[k]) * dc[1] - self.stiffness_N_per_m[k] * dc[0]) / l);
         [-f, f]
     }
+    /// ∂E/∂k = ½ (l − L0)², ∂E/∂L0 = −k (l − L0).
+    #[inline]
+    fn coefficient_energy(&self, k: usize, x: &Local<2>, dc: &[f64]) -> f64 {
+        let d = (x[1] - x[0]).norm() - self.rest_m[k];
+        0.5 * d * d * dc[1] - self.stiffness_N_per_m[k] * d * dc[0]
+    }
     fn stiffness_scale(&self) -> f64 {
         self.stiffness_N_per_m.iter().copied().fold(0.0, f64::max)
     }
+    #[inline]
     fn strain(&self, k: usize, x: &Local<2>) -> f64 {
         let l0 = self.rest_m[k];
         (((x[1] - x[0]).norm() - l0) / l0).abs()

@@ -1,8 +1,11 @@
 //! Sparse symmetric positive-definite solves on the free degrees of freedom (faer's supernodal
-//! Cholesky). The symbolic analysis (pattern, ordering, supernodes) of a sparsity pattern is done
-//! once per process and shared by every solve with that pattern — every Newton iteration, and every
-//! solve of a calibration population on one grid — and the numeric values are scattered into a
-//! buffer kept between factorizations, so an iteration allocates nothing.
+//! Cholesky). The symbolic analysis (pattern, ordering, supernodes) of a sparsity structure is done
+//! once per process and shared by every solve with that structure — every Newton iteration, and
+//! every solve of a calibration population on one grid — and the numeric values are scattered into
+//! a buffer kept between factorizations, so an iteration allocates nothing. A set of contact pairs
+//! that changes within the structure a solve already holds (self-contact's pairs coming and going,
+//! an obstacle's active particles) is mapped into it without a new analysis; one that leaves it
+//! grows it to the union.
 
 use crate::physics::HessianBlocks;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -53,40 +56,129 @@ impl DofMap {
     }
 }
 
-/// A sparsity pattern analysed once: the lower triangle over the free DOFs, where each Hessian
-/// entry lands in the compressed values, and the symbolic Cholesky factorization.
+/// A sparsity structure analysed once: the lower triangle over the free DOFs of a set of particle
+/// blocks, and its symbolic Cholesky factorization (ordering, supernodes).
+struct Structure {
+    first: Vec<u32>,
+    /// The particle blocks (p ≥ q) it holds, sorted and unique.
+    blocks: Vec<(u32, u32)>,
+    sym: SymbolicSparseColMat<usize>,
+    symbolic: SymbolicCholesky<usize>,
+}
+
+/// The structures analysed so far in this process, by their blocks (a handful: one per grid and
+/// pin set, and the self-contact patterns a solve grew).
+static STRUCTURES: Mutex<Vec<(u64, Arc<Structure>)>> = Mutex::new(Vec::new());
+/// Structures kept at most; the oldest is dropped beyond.
+const MAX_STRUCTURES: usize = 64;
+
+/// A structure that holds more blocks than this times those of the Hessian at hand is analysed
+/// afresh for that Hessian when a new block forces an analysis anyway (its fill would cost more
+/// than the analyses it saves).
+const MAX_SUPERSET: f64 = 1.25;
+
+fn structure_key(first: &[u32], blocks: &[(u32, u32)]) -> u64 {
+    let mut s = std::collections::hash_map::DefaultHasher::new();
+    blocks.hash(&mut s);
+    first.hash(&mut s);
+    s.finish()
+}
+
+/// The unique blocks of `h` between free particles, sorted.
+fn free_blocks(dofs: &DofMap, h: &HessianBlocks) -> Vec<(u32, u32)> {
+    let mut b: Vec<(u32, u32)> = h
+        .pairs
+        .iter()
+        .copied()
+        .filter(|&(p, q)| dofs.dof(p as usize).is_some() && dofs.dof(q as usize).is_some())
+        .collect();
+    b.sort_unstable();
+    b.dedup();
+    b
+}
+
+impl Structure {
+    fn analyse(dofs: &DofMap, blocks: Vec<(u32, u32)>) -> Option<Self> {
+        let n = dofs.n;
+        let mut idx: Vec<Pair<usize, usize>> = Vec::new();
+        for &(p, q) in &blocks {
+            let (Some(dp), Some(dq)) = (dofs.dof(p as usize), dofs.dof(q as usize)) else {
+                continue;
+            };
+            for r in 0..3 {
+                for c in 0..3 {
+                    if p != q || r >= c {
+                        idx.push(Pair::new(dp + r, dq + c));
+                    }
+                }
+            }
+        }
+        idx.extend((0..n).map(|d| Pair::new(d, d)));
+        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx).ok()?;
+        // Supernodal always: on the 14 × 14 slack net it factorizes in 0.84 ms against 1.26 ms
+        // simplicial and 1.9 ms with faer's automatic choice (measured on this machine).
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        // AMD: faer 0.24 offers no nested dissection (AMD, COLAMD, identity or a given permutation),
+        // and its supernodal path panics with the identity ordering on these patterns.
+        let symbolic =
+            factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, SymmetricOrdering::Amd, params)
+                .ok()?;
+        Some(Self {
+            first: dofs.first.clone(),
+            blocks,
+            sym,
+            symbolic,
+        })
+    }
+
+    /// The structure of `blocks` over `dofs`, from the process-wide cache or analysed now (with
+    /// whether it was analysed now).
+    fn shared(dofs: &DofMap, blocks: Vec<(u32, u32)>) -> Option<(Arc<Self>, bool)> {
+        let key = structure_key(&dofs.first, &blocks);
+        let same = |s: &Structure| s.blocks == blocks && s.first == dofs.first;
+        {
+            let cache = STRUCTURES.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some((_, s)) = cache.iter().find(|(k, s)| *k == key && same(s)) {
+                return Some((s.clone(), false));
+            }
+        }
+        let s = Arc::new(Self::analyse(dofs, blocks)?);
+        let mut cache = STRUCTURES.lock().unwrap_or_else(|e| e.into_inner());
+        if cache.len() >= MAX_STRUCTURES {
+            cache.remove(0);
+        }
+        cache.push((key, s.clone()));
+        Some((s, true))
+    }
+
+    /// Whether every block of `blocks` (sorted) is in the structure, over the same DOFs.
+    fn covers(&self, dofs: &DofMap, blocks: &[(u32, u32)]) -> bool {
+        self.first == dofs.first && blocks.iter().all(|b| self.blocks.binary_search(b).is_ok())
+    }
+}
+
+/// Where the entries of one list of Hessian blocks land in a structure.
 struct Pattern {
     pairs: Vec<(u32, u32)>,
-    first: Vec<u32>,
-    sym: SymbolicSparseColMat<usize>,
+    structure: Arc<Structure>,
     /// The entries ([`SparseSpd::entries`] order, then the diagonal shifts) in the order they are
     /// summed: by column, then by (row, column) as faer's own assembly sorts them, so that the
     /// summation order of duplicate entries (and with it every bit of the result) is faer's.
     order: Vec<u32>,
     /// For each entry of `order`, its position in the compressed values.
     slot: Vec<u32>,
-    symbolic: SymbolicCholesky<usize>,
-}
-
-/// The patterns analysed so far in this process (a handful: one per grid and pin set).
-static PATTERNS: Mutex<Vec<(u64, Arc<Pattern>)>> = Mutex::new(Vec::new());
-/// Patterns kept at most; the oldest is dropped beyond.
-const MAX_PATTERNS: usize = 64;
-
-fn pattern_key(dofs: &DofMap, h: &HessianBlocks) -> u64 {
-    let mut s = std::collections::hash_map::DefaultHasher::new();
-    h.pairs.hash(&mut s);
-    dofs.first.hash(&mut s);
-    s.finish()
 }
 
 impl Pattern {
-    fn analyse(dofs: &DofMap, h: &HessianBlocks) -> Option<Self> {
+    /// The entries of `h` over `dofs` mapped into `structure` (which holds all of its blocks).
+    fn map(dofs: &DofMap, h: &HessianBlocks, structure: Arc<Structure>) -> Self {
         let n = dofs.n;
         let mut idx: Vec<Pair<usize, usize>> = Vec::new();
         SparseSpd::entries(dofs, h, |r, c, _| idx.push(Pair::new(r, c)));
         idx.extend((0..n).map(|d| Pair::new(d, d)));
-        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx).ok()?;
         // Bucket the entries by column in their own order, then sort each column's by (row, col).
         let mut start = vec![0usize; n + 1];
         for p in &idx {
@@ -104,6 +196,7 @@ impl Pattern {
         for c in 0..n {
             order[start[c]..start[c + 1]].sort_unstable_by_key(|&i| (idx[i].row, idx[i].col));
         }
+        let sym = &structure.sym;
         let position = |r: usize, c: usize| -> u32 {
             let (start, end) = (sym.col_ptr()[c], sym.col_ptr()[c + 1]);
             let k = sym.row_idx()[start..end].partition_point(|&i| i < r);
@@ -113,48 +206,72 @@ impl Pattern {
             .iter()
             .map(|&i| position(idx[i].row, idx[i].col))
             .collect();
-        let order: Vec<u32> = order.into_iter().map(|i| i as u32).collect();
-        // Supernodal always: on the 14 × 14 slack net it factorizes in 0.84 ms against 1.26 ms
-        // simplicial and 1.9 ms with faer's automatic choice (measured on this machine).
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        // AMD: faer 0.24 offers no nested dissection (AMD, COLAMD, identity or a given permutation),
-        // and its supernodal path panics with the identity ordering on these patterns.
-        let symbolic =
-            factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, SymmetricOrdering::Amd, params)
-                .ok()?;
-        Some(Self {
+        Self {
             pairs: h.pairs.clone(),
-            first: dofs.first.clone(),
-            sym,
-            order,
+            order: order.into_iter().map(|i| i as u32).collect(),
             slot,
-            symbolic,
-        })
+            structure,
+        }
     }
 
-    /// The pattern of `h` over `dofs`, from the process-wide cache or analysed now (with whether it
-    /// was analysed now).
-    fn shared(dofs: &DofMap, h: &HessianBlocks) -> Option<(Arc<Self>, bool)> {
-        let key = pattern_key(dofs, h);
-        let same = |p: &Pattern| p.pairs == h.pairs && p.first == dofs.first;
+    /// The pattern of `h` on its own structure, from the process-wide cache or mapped now (with
+    /// whether its structure was analysed now).
+    fn exact(dofs: &DofMap, h: &HessianBlocks) -> Option<(Arc<Self>, bool)> {
+        let mut key = std::collections::hash_map::DefaultHasher::new();
+        h.pairs.hash(&mut key);
+        dofs.first.hash(&mut key);
+        let key = key.finish();
+        let same = |p: &Pattern| p.pairs == h.pairs && p.structure.first == dofs.first;
         {
             let cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
             if let Some((_, p)) = cache.iter().find(|(k, p)| *k == key && same(p)) {
                 return Some((p.clone(), false));
             }
         }
-        let p = Arc::new(Self::analyse(dofs, h)?);
+        let (structure, analysed) = Structure::shared(dofs, free_blocks(dofs, h))?;
+        let p = Arc::new(Self::map(dofs, h, structure));
         let mut cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
-        if cache.len() >= MAX_PATTERNS {
+        if cache.len() >= MAX_STRUCTURES {
             cache.remove(0);
         }
         cache.push((key, p.clone()));
-        Some((p, true))
+        Some((p, analysed))
+    }
+
+    /// The pattern of `h` after `last` (this solver's previous pattern, if any): on `last`'s
+    /// structure when that holds every block of `h` (a contact set that changed within it: no
+    /// analysis); otherwise on the union of its blocks and `h`'s (so that blocks that come and go
+    /// stay inside), or on `h`'s own where the union has grown past [`MAX_SUPERSET`] of them, or
+    /// where there is no `last`. The structure depends on this solve's own history only, never on
+    /// what other solves analysed: the same solve gives the same bits. With whether a structure was
+    /// analysed now.
+    fn next(
+        dofs: &DofMap,
+        h: &HessianBlocks,
+        last: Option<&Arc<Pattern>>,
+    ) -> Option<(Arc<Self>, bool)> {
+        let Some(own) = last.map(|p| &p.structure).filter(|s| s.first == dofs.first) else {
+            return Self::exact(dofs, h);
+        };
+        let blocks = free_blocks(dofs, h);
+        if own.covers(dofs, &blocks) {
+            return Some((Arc::new(Self::map(dofs, h, own.clone())), false));
+        }
+        let mut union = own.blocks.clone();
+        union.extend_from_slice(&blocks);
+        union.sort_unstable();
+        union.dedup();
+        if union.len() as f64 > MAX_SUPERSET * blocks.len() as f64 {
+            return Self::exact(dofs, h);
+        }
+        let (structure, analysed) = Structure::shared(dofs, union)?;
+        Some((Arc::new(Self::map(dofs, h, structure)), analysed))
     }
 }
+
+/// The patterns of whole Hessians on their own structures met so far in this process (one per
+/// grid, pin set and contact set): a solve's first factorization finds its mapping here.
+static PATTERNS: Mutex<Vec<(u64, Arc<Pattern>)>> = Mutex::new(Vec::new());
 
 /// A sparse SPD matrix H + diag(shift) over the free DOFs, assembled from Hessian blocks, factorized
 /// with a shared symbolic analysis and numeric buffers kept between calls.
@@ -168,6 +285,8 @@ pub struct SparseSpd {
     pub factorizations: usize,
     /// Symbolic analyses this solver had to do (0 when every pattern came from the cache).
     pub analyses: usize,
+    /// Wall time of those analyses (ordering and symbolic factorization), s.
+    pub analysis_time_s: f64,
     /// Wall time spent in numeric factorizations and triangular solves, s.
     pub factor_time_s: f64,
 }
@@ -189,6 +308,7 @@ impl SparseSpd {
             mem: MemBuffer::new(StackReq::empty()),
             factorizations: 0,
             analyses: 0,
+            analysis_time_s: 0.0,
             factor_time_s: 0.0,
         }
     }
@@ -215,21 +335,28 @@ impl SparseSpd {
         let stale = self
             .pattern
             .as_ref()
-            .is_none_or(|p| p.pairs != h.pairs || p.first != dofs.first);
+            .is_none_or(|p| p.pairs != h.pairs || p.structure.first != dofs.first);
         if stale {
-            let Some((pattern, analysed)) = Pattern::shared(dofs, h) else {
+            let start = Instant::now();
+            let Some((pattern, analysed)) = Pattern::next(dofs, h, self.pattern.as_ref()) else {
                 return false;
             };
             self.analyses += usize::from(analysed);
-            self.mem = MemBuffer::new(StackReq::any_of(&[
-                pattern
-                    .symbolic
-                    .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
-                pattern.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
-            ]));
-            self.l_values = vec![0.0; pattern.symbolic.len_val()];
-            self.values = vec![0.0; pattern.sym.row_idx().len()];
+            let symbolic = &pattern.structure.symbolic;
+            let same_structure = self
+                .pattern
+                .as_ref()
+                .is_some_and(|p| Arc::ptr_eq(&p.structure, &pattern.structure));
+            if !same_structure {
+                self.mem = MemBuffer::new(StackReq::any_of(&[
+                    symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+                    symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+                ]));
+                self.l_values = vec![0.0; symbolic.len_val()];
+                self.values = vec![0.0; pattern.structure.sym.row_idx().len()];
+            }
             self.pattern = Some(pattern);
+            self.analysis_time_s += start.elapsed().as_secs_f64();
         }
         let Some(pattern) = self.pattern.as_ref() else {
             return false;
@@ -247,9 +374,10 @@ impl SparseSpd {
         for (&e, &slot) in pattern.order.iter().zip(&pattern.slot) {
             values[slot as usize] += raw[e as usize];
         }
-        let mat = SparseColMatRef::new(pattern.sym.as_ref(), values);
+        let structure = &pattern.structure;
+        let mat = SparseColMatRef::new(structure.sym.as_ref(), values);
         self.factorizations += 1;
-        let ok = pattern
+        let ok = structure
             .symbolic
             .factorize_numeric_llt(
                 &mut self.l_values,
@@ -272,7 +400,7 @@ impl SparseSpd {
             return;
         };
         let start = Instant::now();
-        let llt = LltRef::new(&pattern.symbolic, &self.l_values);
+        let llt = LltRef::new(&pattern.structure.symbolic, &self.l_values);
         llt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(rhs, n, 1),
@@ -280,5 +408,71 @@ impl SparseSpd {
             MemStack::new(&mut self.mem),
         );
         self.factor_time_s += start.elapsed().as_secs_f64();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Matrix3;
+
+    /// A chain of `n` free particles, each coupled to the next, plus the extra blocks `extra`
+    /// (p > q): an SPD matrix (diagonally dominant).
+    fn chain(n: usize, extra: &[(usize, usize)]) -> HessianBlocks {
+        let mut h = HessianBlocks::default();
+        for p in 0..n {
+            h.push(p, p, Matrix3::identity() * 10.0);
+            if p > 0 {
+                h.push(p, p - 1, Matrix3::identity() * -1.0);
+            }
+        }
+        for &(p, q) in extra {
+            h.push(p, q, Matrix3::from_diagonal_element(0.5));
+        }
+        h
+    }
+
+    fn solve(spd: &mut SparseSpd, dofs: &DofMap, h: &HessianBlocks) -> Vec<f64> {
+        assert!(spd.factorize(dofs, h, &vec![0.0; dofs.n]));
+        let mut x: Vec<f64> = (0..dofs.n).map(|k| (k as f64 * 0.7).sin()).collect();
+        spd.solve_in_place(&mut x);
+        x
+    }
+
+    #[test]
+    fn a_contact_set_that_changes_within_the_structure_needs_no_new_analysis() {
+        // Contact blocks that come and go (self-contact's pairs): the first new block grows the
+        // structure to the union, after which the pairs may come and go without an analysis; every
+        // solve equals the solve on the matrix's own structure.
+        let n = 40;
+        let dofs = DofMap::new(&vec![false; n]);
+        let (plain, touching) = (chain(n, &[]), chain(n, &[(30, 3), (25, 7)]));
+        let mut spd = SparseSpd::new();
+        let fresh = |h: &HessianBlocks| solve(&mut SparseSpd::new(), &dofs, h);
+        let mut seen = Vec::new();
+        for h in [&plain, &touching, &plain, &touching, &plain] {
+            let y = solve(&mut spd, &dofs, h);
+            let want = fresh(h);
+            let err = y
+                .iter()
+                .zip(&want)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-14, "{err}");
+            seen.push(spd.analyses);
+        }
+        // Analysed at most for the plain chain and the union; then nothing (whatever other tests
+        // left in the process-wide cache, no more than two).
+        assert!(seen[4] <= 2 && seen[4] == seen[1], "{seen:?}");
+        // The same sequence in another solver gives the same bits.
+        let mut other = SparseSpd::new();
+        for h in [&plain, &touching, &plain] {
+            solve(&mut other, &dofs, h);
+        }
+        let (a, b) = (
+            solve(&mut spd, &dofs, &touching),
+            solve(&mut other, &dofs, &touching),
+        );
+        assert_eq!(a, b);
     }
 }

@@ -248,6 +248,8 @@ fn finish_report(
     report.iterations = iter;
     report.globalization = ws.stats;
     report.factor_time_s = ws.spd.factor_time_s;
+    report.analyses = ws.spd.analyses;
+    report.analysis_time_s = ws.spd.analysis_time_s;
     report.max_residual_N = model.max_residual(&ws.g);
     report.max_residual_rel = report.max_residual_N / model.reference_weight();
     report.energy_J = model.energy(x, final_load);

@@ -200,6 +200,13 @@ pub struct SolveReport {
     /// Wall time of the factorizations and triangular solves alone, s.
     #[serde(default)]
     pub factor_time_s: f64,
+    /// Symbolic analyses of a new sparsity pattern (ordering, elimination tree): one per pattern
+    /// the process has not seen, e.g. each new set of self-contact pairs.
+    #[serde(default)]
+    pub analyses: usize,
+    /// Wall time of those analyses (and of finding a cached pattern), s.
+    #[serde(default)]
+    pub analysis_time_s: f64,
     /// Largest residual force on a free particle in N, at the final state.
     pub max_residual_N: f64,
     /// The same relative to the weight of the lightest free particle.
@@ -241,6 +248,8 @@ impl SolveReport {
             inner_iterations: 0,
             factorizations: 0,
             factor_time_s: 0.0,
+            analyses: 0,
+            analysis_time_s: 0.0,
             max_residual_N: f64::NAN,
             max_residual_rel: f64::NAN,
             energy_J: f64::NAN,
@@ -291,6 +300,8 @@ impl SolveReport {
         self.linear_solves += part.linear_solves;
         self.factorizations += part.factorizations;
         self.factor_time_s += part.factor_time_s;
+        self.analyses += part.analyses;
+        self.analysis_time_s += part.analysis_time_s;
         if how == Part::InnerSolve {
             self.inner_iterations += part.iterations;
             return;
