@@ -253,7 +253,7 @@ fn point_loads(
             (p, d * l.magnitude_N)
         })
         .collect();
-    terms.push(Box::new(crate::physics::PointLoads::new(loads)));
+    terms.push(Box::new(crate::physics::PointLoads::forces(loads)));
 }
 
 /// The scene's `[[boundary.holds]]` into the per-particle held components.

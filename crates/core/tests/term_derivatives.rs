@@ -180,6 +180,13 @@ fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> 
     );
     let size = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
     let (mut best, mut best_e) = (f64::INFINITY, f64::INFINITY);
+    let rel = c
+        .iter()
+        .zip(dc)
+        .filter(|(a, d)| a.is_finite() && **a != 0.0 && **d != 0.0)
+        .map(|(a, d)| (d / a).abs())
+        .fold(0.0, f64::max);
+    let e_scale = t.energy(x).abs() * rel;
     for eps in [1e-4, 1e-5, 1e-6, 1e-7] {
         let grad_at = |t: &mut dyn EnergyTerm, s: f64| -> (Vec<Vector3<f64>>, f64) {
             let moved: Vec<f64> = c
@@ -194,7 +201,10 @@ fn coefficient_error(t: &mut dyn EnergyTerm, x: &[Vector3<f64>], dc: &[f64]) -> 
         };
         let ((gp, ep), (gm, em)) = (grad_at(t, eps), grad_at(t, -eps));
         let fde = (ep - em) / (2.0 * eps);
-        best_e = best_e.min((fde - de).abs() / fde.abs().max(de.abs()).max(1e-300));
+        // Relative to the derivative, or where the coefficients' changes nearly cancel (a cell's
+        // dG/G − dh_x/h_x − dh_y/h_y ≈ 0), to a thousandth of the energy's own scale of change.
+        let scale = fde.abs().max(de.abs()).max(1e-3 * e_scale).max(1e-300);
+        best_e = best_e.min((fde - de).abs() / scale);
         t.set_coefficients(&c);
         let fd: Vec<Vector3<f64>> = gp
             .iter()

@@ -5,7 +5,6 @@
 mod bending;
 mod contact;
 mod friction;
-mod gravity;
 mod kernel;
 mod loads;
 mod mesh_bending;
@@ -18,9 +17,8 @@ pub use bending::{
 };
 pub use contact::{BarrierContact, max_penetration_m};
 pub use friction::{FrictionAnchor, LaggedFriction};
-pub use gravity::{Gravity, GravityKernel};
 pub use kernel::{Kernel, Local, Potential};
-pub use loads::{LoadKernel, PointLoads};
+pub use loads::{Gravity, LoadKernel, PointLoads};
 pub use mesh_bending::{hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending};
 pub use self_contact::{SelfContact, SelfContactState};
 pub use shear::{CellShear, ShearKernel};
