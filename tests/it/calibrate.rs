@@ -495,3 +495,29 @@ fn assert_recovers(
     );
     assert!(l_err <= half("natural_length_m") && k_err <= half("stiffness_N_per_m"));
 }
+
+#[test]
+fn levenberg_marquardt_recovers_the_synthetic_sample_in_a_few_dozen_solves() {
+    // Calibration by gradients on sample 8 (truth: 55 mm, 1100 N/m): the natural length to 2 %,
+    // a curve distance below the quick ICA's bound, in at most 25 solves a topology — where one
+    // quick ICA run spends hundreds of simulations.
+    use drapelab::calibrate::LmSettings;
+    let problem = sample_8_problem(sample_8_edges());
+    let r = problem.run_lm(&LmSettings::default());
+    eprintln!(
+        "LM: {:?}, {:.4} % of the side, {} solves, {} steps, JᵀJ {:?}, {}",
+        r.best, r.best_cost_pct, r.solves, r.iterations, r.jtj, r.stop
+    );
+    assert!(
+        (r.best.natural_length_m - 0.055).abs() < 0.02 * 0.055,
+        "natural length {} vs 0.055",
+        r.best.natural_length_m
+    );
+    assert!(r.best_cost_pct < 0.1, "{} % of the side", r.best_cost_pct);
+    assert!(r.solves <= 3 * LmSettings::default().max_solves);
+    assert!(r.iterations >= 1, "no step was taken");
+    // JᵀJ is the Gauss–Newton curvature: symmetric, positive semi-definite.
+    let [[a, b], [c, d]] = r.jtj;
+    assert!((b - c).abs() <= 1e-12 * (b.abs() + c.abs()) && a >= 0.0 && d >= 0.0);
+    assert!(a * d - b * c >= -1e-9 * a * d);
+}

@@ -68,6 +68,13 @@ pub struct CalibrateParams {
     /// the `comparison.parquet` output. Default false.
     #[serde(default)]
     pub baseline_cmaes: bool,
+    /// Also calibrate by gradients: Levenberg–Marquardt over stiffness and natural length per
+    /// topology on the edge-curve residuals, its Jacobian from the drapes' sensitivities
+    /// ([`drapelab_core::calibrate::Problem::run_lm`]), once per sample, into `comparison.parquet`
+    /// (optimizer `levenberg-marquardt`, evaluations = its equilibrium solves). Default false; the
+    /// main job turns it on.
+    #[serde(default)]
+    pub levenberg_marquardt: bool,
 }
 
 pub fn default_true() -> bool {
@@ -230,6 +237,7 @@ pub fn sample_setup(
         identifiable_rel: p.identifiable_rel,
         identifiability_window: p.identifiability_window,
         baseline_cmaes: p.baseline_cmaes,
+        levenberg_marquardt: p.levenberg_marquardt,
     };
     let mut problem = Problem::new(scene, measured.to_vec(), p.side_cm);
     problem.edge_source = p.edge_source;

@@ -103,7 +103,8 @@ impl ResultRow {
 pub struct ComparisonRow {
     /// Sample name.
     pub sample: String,
-    /// "ica" or "cma-es".
+    /// "ica", "cma-es" (the baseline at ICA's budget) or "levenberg-marquardt" (calibration by
+    /// gradients; its evaluations are equilibrium solves).
     pub optimizer: String,
     /// Run number.
     pub run: u32,
@@ -115,8 +116,7 @@ pub struct ComparisonRow {
 
 impl Table for ComparisonRow {
     const FILE: &'static str = "comparison.parquet";
-    const ROW: &'static str =
-        "One optimiser run's best cost on one sample (ICA or the CMA-ES baseline).";
+    const ROW: &'static str = "One optimiser run's best cost on one sample (ICA, the CMA-ES baseline or Levenberg–Marquardt).";
 }
 
 impl ComparisonRow {

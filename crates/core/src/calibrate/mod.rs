@@ -2,8 +2,10 @@
 //! search space of Table 3 on the unit box, a cost that simulates a hang and scores its edges against
 //! the measured ones (cached, non-convergence penalised and counted), and one ICA run per call.
 
+mod gradient;
 mod sample;
 
+pub use gradient::{LmReport, LmSettings};
 pub use sample::{
     EvaluatedCountry, OptimizerRun, SampleCalibration, SampleSettings, calibrate_sample,
 };

@@ -28,6 +28,8 @@ pub struct SampleSettings {
     pub identifiability_window: f64,
     /// Run CMA-ES at each ICA run's budget as a baseline.
     pub baseline_cmaes: bool,
+    /// Calibrate by gradients too ([`Problem::run_lm`]), once, as a third optimizer.
+    pub levenberg_marquardt: bool,
 }
 
 /// One country of one decade of one run.
@@ -50,7 +52,7 @@ pub struct EvaluatedCountry {
 /// One optimiser run's best cost (ICA or the CMA-ES baseline).
 #[derive(Debug, Clone)]
 pub struct OptimizerRun {
-    /// "ica" or "cma-es".
+    /// "ica", "cma-es" or "levenberg-marquardt".
     pub optimizer: &'static str,
     /// Run number.
     pub run: u32,
@@ -150,6 +152,17 @@ pub fn calibrate_sample(
             best = Some((report.best_cost, report.best_x.clone()));
         }
         run_done();
+    }
+    if s.levenberg_marquardt {
+        // Its own problem (counters and cache) over the same warm-start lattice, which ICA's runs
+        // have solved already.
+        let lm = problem.fresh().run_lm(&super::LmSettings::default());
+        runs.push(OptimizerRun {
+            optimizer: "levenberg-marquardt",
+            run: 0,
+            evaluations: lm.solves as u64,
+            best_cost_pct: lm.best_cost_pct,
+        });
     }
     let (ica_cost, ica_u) = best.ok_or_else(|| anyhow::anyhow!("no ICA run (runs = 0)"))?;
     let (u, cost) = problem.polish(&ica_u, s.polish_iterations);

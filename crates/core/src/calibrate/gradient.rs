@@ -1,0 +1,386 @@
+//! Calibration by gradients: Levenberg–Marquardt over the parameters a static hang depends on (the
+//! springs' stiffness and natural length, one topology at a time) on the edge-curve residuals, with
+//! the Jacobian from the drape's sensitivities. At a converged drape x*(θ) the factor of its exact
+//! Hessian gives dx*/dθ for both keys ([`crate::sensitivity`]: one factorization, two
+//! back-substitutions, no solve), and the residuals' Jacobian is J = (∂r/∂x)(dx*/dθ), taken as the
+//! central difference of the residuals along each tangent (the edges are fitted again, no solve).
+//! Each step's drape starts from the tangent prediction x* + (dx*/dθ)Δθ. Solves are what it costs:
+//! ICA spends thousands per sample.
+
+use super::{Params, Problem, StartLattice, TANGENT_KEYS};
+use crate::edges::{EdgeFit, scene_view, simulated_edges};
+use crate::material::Topology;
+use crate::solve::NoObserver;
+use nalgebra::{Matrix2, Vector2, Vector3};
+
+/// Settings of the Levenberg–Marquardt calibration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LmSettings {
+    /// Equilibrium solves allowed per topology. Default 25.
+    pub max_solves: usize,
+    /// Initial damping λ (relative to JᵀJ's diagonal). Default 1e-3.
+    pub lambda_initial: f64,
+    /// Converged when an accepted step lowers the residuals' sum of squares by less than this
+    /// fraction, or moves the unit-box parameters by less than its square root. Default 1e-8.
+    pub tol_rel: f64,
+}
+
+impl Default for LmSettings {
+    fn default() -> Self {
+        Self {
+            max_solves: 25,
+            lambda_initial: 1e-3,
+            tol_rel: 1e-8,
+        }
+    }
+}
+
+/// The outcome of a Levenberg–Marquardt calibration of one sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LmReport {
+    /// The best parameters (damping and elongation rate at their lower bounds: a static drape does
+    /// not see them).
+    pub best: Params,
+    /// Its mean curve distance over the measured edges, % of the side (the cost of ICA's runs).
+    pub best_cost_pct: f64,
+    /// Equilibrium solves, over every topology tried.
+    pub solves: usize,
+    /// Accepted steps, over every topology.
+    pub iterations: usize,
+    /// JᵀJ at the best point in (N/m, m) coordinates, residuals in % of the side: the Gauss–Newton
+    /// curvature of half the residuals' sum of squares, for intervals.
+    pub jtj: [[f64; 2]; 2],
+    /// Why the best topology's run stopped.
+    pub stop: String,
+}
+
+/// A converged drape with its residuals and their Jacobian in the unit box's (stiffness, natural
+/// length) coordinates.
+struct Point {
+    u: Vector2<f64>,
+    x: Vec<Vector3<f64>>,
+    r: Vec<f64>,
+    /// dx*/du for each coordinate (the tangents times the box's widths).
+    tangents: [Vec<Vector3<f64>>; 2],
+    jac: Vec<[f64; 2]>,
+}
+
+impl Point {
+    fn sum_sq(&self) -> f64 {
+        self.r.iter().map(|v| v * v).sum()
+    }
+}
+
+impl Problem {
+    /// The residuals of a drape `x` of `scene`: per measured edge with a simulated counterpart, the
+    /// difference of the two curves at 201 points over their span, in % of the side and scaled by
+    /// 1/√201, so that each edge's part has the norm of its curve distance. None when an edge is
+    /// missing or the view cannot be set.
+    fn edge_residuals(
+        &self,
+        scene: &crate::scene::Scene,
+        grid: &crate::cloth::Grid,
+        x: &[Vector3<f64>],
+    ) -> Option<Vec<f64>> {
+        let (view, corners) = scene_view(scene).ok()?;
+        let sim: Vec<EdgeFit> =
+            simulated_edges(grid, x, view, corners, self.edge_source, self.projection)
+                .into_iter()
+                .filter_map(|(n, pts)| EdgeFit::from_points(&n, &pts, 4))
+                .collect();
+        const N: usize = 201;
+        let scale = 100.0 / (self.side_cm * (N as f64).sqrt());
+        let mut r = Vec::with_capacity(self.measured.len() * N);
+        for m in &self.measured {
+            let s = sim.iter().find(|s| s.edge == m.edge)?;
+            let span = m.x_max_cm.max(s.x_max_cm);
+            r.extend((0..N).map(|k| {
+                let xk = span * k as f64 / (N - 1) as f64;
+                scale * (m.eval(xk) - s.eval(xk))
+            }));
+        }
+        (!r.is_empty()).then_some(r)
+    }
+
+    /// The mean curve distance (% of the side) of residuals from [`Self::edge_residuals`].
+    fn mean_distance(&self, r: &[f64]) -> f64 {
+        let n = self.measured.len().max(1);
+        r.chunks(r.len() / n)
+            .map(|e| e.iter().map(|v| v * v).sum::<f64>().sqrt())
+            .sum::<f64>()
+            / n as f64
+    }
+
+    /// The parameters at unit-box coordinates `u` (stiffness, natural length) of `topology`.
+    fn lm_params(&self, u: &Vector2<f64>, topology: Topology) -> Params {
+        let b = &self.bounds;
+        let lerp = |(a, c): (f64, f64), t: f64| a + t.clamp(0.0, 1.0) * (c - a);
+        Params {
+            stiffness_N_per_m: lerp(b.stiffness_N_per_m, u[0]),
+            damping_Ns_per_m: b.damping_Ns_per_m.0,
+            elongation_rate: b.elongation_rate.0,
+            natural_length_m: lerp(b.natural_length_m, u[1]),
+            topology,
+        }
+    }
+
+    /// The drape at `u` from the lowest of `starts`, with residuals, tangents and Jacobian; None
+    /// when it does not converge, is no isolated minimum or loses an edge.
+    fn lm_point(
+        &self,
+        u: Vector2<f64>,
+        topology: Topology,
+        starts: &[&[Vector3<f64>]],
+    ) -> Option<Point> {
+        let scene = self.scene_for(&self.lm_params(&u, topology));
+        let mut straight = scene.clone();
+        straight.solver.static_.direction = crate::solve::Direction::Straight;
+        straight.solver.static_.factor_reuse = crate::solve::FactorReuse::Chord;
+        let sol = crate::simulate::solve_scene_from_lowest(&straight, starts, &mut NoObserver);
+        if !sol.report.is_converged() {
+            return None;
+        }
+        let r = self.edge_residuals(&scene, &sol.grid, &sol.x)?;
+        let valid = scene.clone().validated().ok()?;
+        let mut eq = crate::sensitivity::Equilibrium::new(
+            &valid,
+            &sol.model,
+            &sol.x,
+            &sol.report,
+            "levenberg-marquardt",
+        )
+        .ok()?;
+        let b = &self.bounds;
+        let widths = [
+            b.stiffness_N_per_m.1 - b.stiffness_N_per_m.0,
+            b.natural_length_m.1 - b.natural_length_m.0,
+        ];
+        let mut tangents: [Vec<Vector3<f64>>; 2] = [Vec::new(), Vec::new()];
+        for i in 0..2 {
+            let dx = eq.sensitivity(TANGENT_KEYS[i]).ok()?.dx;
+            tangents[i] = dx.iter().map(|v| v * widths[i]).collect();
+        }
+        let jac = self.jacobian(&scene, &sol, &tangents, r.len())?;
+        drop(eq);
+        Some(Point {
+            u,
+            x: sol.x,
+            r,
+            tangents,
+            jac,
+        })
+    }
+
+    /// ∂r/∂u: the central difference of the residuals along each tangent, a step that moves no
+    /// particle by more than 10⁻⁶ m.
+    fn jacobian(
+        &self,
+        scene: &crate::scene::Scene,
+        sol: &crate::simulate::Solution,
+        tangents: &[Vec<Vector3<f64>>; 2],
+        n: usize,
+    ) -> Option<Vec<[f64; 2]>> {
+        let mut jac = vec![[0.0; 2]; n];
+        for (i, t) in tangents.iter().enumerate() {
+            let big = t.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            if big == 0.0 {
+                continue;
+            }
+            let h = 1e-6 / big;
+            let moved = |s: f64| -> Vec<Vector3<f64>> {
+                sol.x.iter().zip(t).map(|(x, d)| x + d * s).collect()
+            };
+            let rp = self.edge_residuals(scene, &sol.grid, &moved(h))?;
+            let rm = self.edge_residuals(scene, &sol.grid, &moved(-h))?;
+            if rp.len() != n || rm.len() != n {
+                return None;
+            }
+            for k in 0..n {
+                jac[k][i] = (rp[k] - rm[k]) / (2.0 * h);
+            }
+        }
+        Some(jac)
+    }
+}
+
+/// JᵀJ and Jᵀr of a point.
+fn normal_equations(p: &Point) -> (Matrix2<f64>, Vector2<f64>) {
+    let mut a = Matrix2::zeros();
+    let mut g = Vector2::zeros();
+    for (j, r) in p.jac.iter().zip(&p.r) {
+        let j = Vector2::new(j[0], j[1]);
+        a += j * j.transpose();
+        g += j * *r;
+    }
+    (a, g)
+}
+
+/// The damped Gauss–Newton step from `p` with the box's bounds: a coordinate at its bound whose
+/// step would leave the box is held there and the other one solved alone (projected
+/// Levenberg–Marquardt; the natural length of the stiffest samples sits at Table 3's lower bound).
+fn bounded_step(p: &Point, lambda: f64) -> Option<Vector2<f64>> {
+    let (a, g) = normal_equations(p);
+    let damped = a + Matrix2::from_diagonal(&a.diagonal()) * lambda;
+    let step = damped.lu().solve(&(-g))?;
+    let leaves = |i: usize| (p.u[i] <= 0.0 && step[i] < 0.0) || (p.u[i] >= 1.0 && step[i] > 0.0);
+    match (leaves(0), leaves(1)) {
+        (false, false) => Some(step),
+        (true, true) => Some(Vector2::zeros()),
+        (held0, _) => {
+            let free = usize::from(held0);
+            let mut s = Vector2::zeros();
+            if damped[(free, free)] > 0.0 {
+                s[free] = -g[free] / damped[(free, free)];
+            }
+            Some(s)
+        }
+    }
+}
+
+/// One topology's run: (best point, accepted steps, solves, why it stopped).
+type Run = (Option<Point>, usize, usize, String);
+
+impl Problem {
+    /// Solves the warm-start lattice now (it is otherwise solved at the first evaluation that needs
+    /// it), so that its cost can be timed apart.
+    pub fn warm_start_lattice(&self) {
+        self.lattice.get_or_init(|| StartLattice::solve(self));
+    }
+
+    /// Levenberg–Marquardt calibration of the stiffness and natural length, for each topology from
+    /// its best node of the warm-start lattice (the drapes every optimizer of the problem shares);
+    /// the best topology's result.
+    pub fn run_lm(&self, settings: &LmSettings) -> LmReport {
+        let lattice = self.lattice.get_or_init(|| StartLattice::solve(self));
+        let mut best: Option<(Topology, Point, String)> = None;
+        let (mut solves, mut iterations) = (0, 0);
+        for topology in [Topology::A, Topology::B, Topology::C] {
+            let (point, its, n, stop) = self.lm_topology(lattice, topology, settings);
+            solves += n;
+            iterations += its;
+            if let Some(p) = point
+                && best
+                    .as_ref()
+                    .is_none_or(|(_, b, _)| p.sum_sq() < b.sum_sq())
+            {
+                best = Some((topology, p, stop));
+            }
+        }
+        let b = &self.bounds;
+        let widths = [
+            b.stiffness_N_per_m.1 - b.stiffness_N_per_m.0,
+            b.natural_length_m.1 - b.natural_length_m.0,
+        ];
+        match best {
+            Some((topology, p, stop)) => {
+                let (a, _) = normal_equations(&p);
+                let jtj = [
+                    [
+                        a[(0, 0)] / (widths[0] * widths[0]),
+                        a[(0, 1)] / (widths[0] * widths[1]),
+                    ],
+                    [
+                        a[(1, 0)] / (widths[0] * widths[1]),
+                        a[(1, 1)] / (widths[1] * widths[1]),
+                    ],
+                ];
+                LmReport {
+                    best: self.lm_params(&p.u, topology),
+                    best_cost_pct: self.mean_distance(&p.r),
+                    solves,
+                    iterations,
+                    jtj,
+                    stop,
+                }
+            }
+            None => LmReport {
+                best: self.lm_params(&Vector2::new(0.5, 0.5), Topology::A),
+                best_cost_pct: self.penalty,
+                solves,
+                iterations,
+                jtj: [[0.0; 2]; 2],
+                stop: "no topology gave a converged drape with every edge".into(),
+            },
+        }
+    }
+
+    /// The lattice node of `topology` whose drape is closest to the measured edges, in unit-box
+    /// coordinates, with its drape.
+    fn best_node(
+        &self,
+        lattice: &StartLattice,
+        topology: Topology,
+    ) -> Option<(Vector2<f64>, Vec<Vector3<f64>>)> {
+        let b = &self.bounds;
+        let unit = |(lo, hi): (f64, f64), v: f64| (v - lo) / (hi - lo);
+        let mut best: Option<(f64, Vector2<f64>, Vec<Vector3<f64>>)> = None;
+        for &k in &lattice.stiffness_N_per_m {
+            for &l in &lattice.natural_length_m {
+                let u = Vector2::new(unit(b.stiffness_N_per_m, k), unit(b.natural_length_m, l));
+                let p = self.lm_params(&u, topology);
+                let Some((node, _, _)) = lattice.nearest(&p) else {
+                    continue;
+                };
+                let scene = self.scene_for(&p);
+                let grid = scene.grid();
+                let Some(r) = self.edge_residuals(&scene, &grid, &node.x) else {
+                    continue;
+                };
+                let ss: f64 = r.iter().map(|v| v * v).sum();
+                if best.as_ref().is_none_or(|(s, _, _)| ss < *s) {
+                    best = Some((ss, u, node.x.clone()));
+                }
+            }
+        }
+        best.map(|(_, u, x)| (u, x))
+    }
+
+    /// Levenberg–Marquardt for one topology from its best lattice node.
+    fn lm_topology(&self, lattice: &StartLattice, topology: Topology, s: &LmSettings) -> Run {
+        let Some((u0, x0)) = self.best_node(lattice, topology) else {
+            return (None, 0, 0, "no lattice node".into());
+        };
+        let mut solves = 1;
+        let Some(mut p) = self.lm_point(u0, topology, &[&x0]) else {
+            return (None, 0, solves, "the start did not converge".into());
+        };
+        let (mut lambda, mut accepted) = (s.lambda_initial, 0);
+        let stop = loop {
+            if solves >= s.max_solves {
+                break format!("{solves} solves");
+            }
+            let Some(step) = bounded_step(&p, lambda) else {
+                break "singular normal equations".into();
+            };
+            let u = (p.u + step).map(|v| v.clamp(0.0, 1.0));
+            let du = u - p.u;
+            if du.norm() < s.tol_rel.sqrt() {
+                break "converged (step)".into();
+            }
+            let predicted: Vec<Vector3<f64>> =
+                p.x.iter()
+                    .zip(p.tangents[0].iter().zip(&p.tangents[1]))
+                    .map(|(x, (a, b))| x + a * du[0] + b * du[1])
+                    .collect();
+            solves += 1;
+            match self.lm_point(u, topology, &[&predicted, &p.x]) {
+                Some(q) if q.sum_sq() < p.sum_sq() => {
+                    let gain = (p.sum_sq() - q.sum_sq()) / p.sum_sq().max(1e-300);
+                    p = q;
+                    accepted += 1;
+                    lambda = (lambda / 3.0).max(1e-9);
+                    if gain < s.tol_rel {
+                        break "converged (cost)".into();
+                    }
+                }
+                _ => {
+                    lambda *= 4.0;
+                    if lambda > 1e8 {
+                        break "no step lowers the residuals".into();
+                    }
+                }
+            }
+        };
+        (Some(p), accepted, solves, stop)
+    }
+}
