@@ -154,15 +154,7 @@ pub fn calibrate_sample(
         run_done();
     }
     if s.levenberg_marquardt {
-        // Its own problem (counters and cache) over the same warm-start lattice, which ICA's runs
-        // have solved already.
-        let lm = problem.fresh().run_lm(&super::LmSettings::default());
-        runs.push(OptimizerRun {
-            optimizer: "levenberg-marquardt",
-            run: 0,
-            evaluations: lm.solves as u64,
-            best_cost_pct: lm.best_cost_pct,
-        });
+        runs.push(levenberg_marquardt_run(problem));
     }
     let (ica_cost, ica_u) = best.ok_or_else(|| anyhow::anyhow!("no ICA run (runs = 0)"))?;
     let (u, cost) = problem.polish(&ica_u, s.polish_iterations);
@@ -189,6 +181,18 @@ pub fn calibrate_sample(
         runs,
         evaluations,
     })
+}
+
+/// The calibration by gradients ([`Problem::run_lm`]) as one optimizer run: on its own problem
+/// (counters and cache) over the same warm-start lattice, which ICA's runs have solved already.
+fn levenberg_marquardt_run(problem: &Problem) -> OptimizerRun {
+    let lm = problem.fresh().run_lm(&super::LmSettings::default());
+    OptimizerRun {
+        optimizer: "levenberg-marquardt",
+        run: 0,
+        evaluations: lm.solves as u64,
+        best_cost_pct: lm.best_cost_pct,
+    }
 }
 
 /// Mean Eq. 5 (seed 000) of the drape at `u` against the measured edges, %.
