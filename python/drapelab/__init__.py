@@ -293,9 +293,13 @@ def fit_edges(photo: PathLike, camera: Optional[PathLike] = None,
 
 
 def calibrate(edges: PathLike, sample: str, *, samples: PathLike, scene: PathLike,
-              ica: Mapping[str, Any], **params: Any) -> Dict[str, Any]:
-    """One sample calibrated by ICA against its measured edges (seed 000), as a ``calibrate``
-    stage does for each sample, without writing files.
+              ica: Optional[Mapping[str, Any]] = None, optimizer: str = "ica",
+              **params: Any) -> Dict[str, Any]:
+    """One sample calibrated against its measured edges, as a ``calibrate`` stage does for each
+    sample, without writing files: by ICA (seed 000, ``optimizer="ica"``) or by gradients
+    (``optimizer="levenberg-marquardt"``: Levenberg–Marquardt over stiffness and natural length per
+    topology, its Jacobian from the drapes' sensitivities; a few dozen solves instead of thousands,
+    no ``ica`` needed).
 
     Args:
         edges: a fit-edges table (``edges.parquet``).
@@ -303,17 +307,26 @@ def calibrate(edges: PathLike, sample: str, *, samples: PathLike, scene: PathLik
         samples: the samples table with their densities (``datasets/knitted/knitted_samples.csv``).
         scene: the net's scene (``datasets/scenes/hang4.toml``).
         ica: ICA's settings (seed 000 Table 1): ``decades``, ``countries``, ``imperialists``,
-            ``beta``, ``gamma`` (rad), ``revolution_rate``, ``xi``, ``seed``.
+            ``beta``, ``gamma`` (rad), ``revolution_rate``, ``xi``, ``seed``; required by ``"ica"``.
+        optimizer: ``"ica"`` (default) or ``"levenberg-marquardt"``.
         params: the calibrate stage's other parameters (``runs``, ``grid``, ``side_cm``,
             ``polish_iterations``, ...; ``drapelab kinds`` lists them with defaults).
 
     Returns:
-        The results row: calibrated stiffnesses (N/m), natural lengths, the runs' spread and each
-        parameter's identifiability.
+        ICA: the results row (calibrated stiffness in N/m, natural length in m, the runs' spread and
+        each parameter's identifiability). Levenberg–Marquardt: ``topology``,
+        ``stiffness_N_per_m``, ``natural_length_m``, ``curve_distance_pct``, ``solves``, ``steps``,
+        ``stop``.
     """
+    files = (os.fspath(edges), os.fspath(samples), os.fspath(scene))
+    if optimizer == "levenberg-marquardt":
+        return json.loads(_drapelab.calibrate_lm(*files, sample, _json(dict(params))))
+    if optimizer != "ica":
+        raise InputError(f"optimizer: `{optimizer}` is not one of \"ica\", \"levenberg-marquardt\"")
+    if ica is None:
+        raise InputError("ica: ICA's settings are required by optimizer \"ica\"")
     p = dict(params, ica=dict(ica))
-    return json.loads(_drapelab.calibrate(os.fspath(edges), os.fspath(samples),
-                                          os.fspath(scene), sample, _json(p)))
+    return json.loads(_drapelab.calibrate(*files, sample, _json(p)))
 
 
 def run_pipeline(path: PathLike, until: Optional[str] = None,

@@ -284,6 +284,24 @@ def test_calibrate_one_sample_returns_its_row(project, monkeypatch):
         drapelab.calibrate(edges, "datasets/knitted/sample_99/hang4", runs=1, **kw)
 
 
+def test_calibrate_by_gradients_recovers_the_natural_length(project, monkeypatch):
+    # Sample 3 was made with a natural length of 53 mm (datasets/knitted/ground_truth.csv):
+    # Levenberg–Marquardt on the drapes' sensitivities finds it in a few dozen solves, no ICA needed.
+    root, _ = project
+    monkeypatch.chdir(root)
+    edges = "runs/p/fit4/edges.parquet"
+    kw = dict(samples="datasets/knitted/knitted_samples.csv", scene="datasets/scenes/hang4.toml")
+    row = drapelab.calibrate(edges, "datasets/knitted/sample_03/hang4", optimizer="levenberg-marquardt", **kw)
+    assert row["optimizer"] == "levenberg-marquardt" and row["topology"] in ("a", "b", "c")
+    assert abs(row["natural_length_m"] - 0.053) < 0.01 * 0.053, row
+    assert 500 <= row["stiffness_N_per_m"] <= 1200 and row["curve_distance_pct"] < 0.1, row
+    assert 1 <= row["solves"] <= 75, row
+    with pytest.raises(drapelab.InputError, match="optimizer"):
+        drapelab.calibrate(edges, "datasets/knitted/sample_03/hang4", optimizer="newton", **kw)
+    with pytest.raises(drapelab.InputError, match="ica"):
+        drapelab.calibrate(edges, "datasets/knitted/sample_03/hang4", **kw)
+
+
 def test_the_example_runs(tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg", DRAPELAB_EXAMPLE_OUT=str(tmp_path))
     out = subprocess.run([sys.executable, str(ROOT / "examples/python/sag_sweep.py")], cwd=ROOT, env=env,

@@ -226,8 +226,7 @@ pub fn sample_setup(
     p: &CalibrateParams,
     ica: IcaSettings,
 ) -> Result<(Problem, SampleSettings)> {
-    let densities = read_sample_densities(samples)?;
-    let scene = sample_scene(scene, &densities, sample, p.grid)?;
+    let problem = sample_problem((scene, samples), sample, measured, p)?;
     let settings = SampleSettings {
         runs: p.runs,
         ica,
@@ -239,9 +238,82 @@ pub fn sample_setup(
         baseline_cmaes: p.baseline_cmaes,
         levenberg_marquardt: p.levenberg_marquardt,
     };
+    Ok((problem, settings))
+}
+
+/// The problem of calibrating `sample` against its `measured` edges: the net of `scene` with the
+/// sample's density from the `samples` table (seed 000 Table 2), `p`'s grid, side and edge source.
+fn sample_problem(
+    (scene, samples): (&Path, &Path),
+    sample: &str,
+    measured: &[EdgeFit],
+    p: &CalibrateParams,
+) -> Result<Problem> {
+    let densities = read_sample_densities(samples)?;
+    let scene = sample_scene(scene, &densities, sample, p.grid)?;
     let mut problem = Problem::new(scene, measured.to_vec(), p.side_cm);
     problem.edge_source = p.edge_source;
-    Ok((problem, settings))
+    Ok(problem)
+}
+
+/// What the calibration by gradients found for one sample (the Python package's
+/// `calibrate(optimizer="levenberg-marquardt")`).
+#[derive(Debug, Clone, Serialize)]
+pub struct LmRow {
+    /// Sample name.
+    pub sample: String,
+    /// Always "levenberg-marquardt".
+    pub optimizer: String,
+    /// The spring families found best ("a", "b" or "c").
+    pub topology: String,
+    /// Spring stiffness, N/m.
+    pub stiffness_N_per_m: f64,
+    /// Natural length, m.
+    pub natural_length_m: f64,
+    /// Mean curve distance over the measured edges, % of the side.
+    pub curve_distance_pct: f64,
+    /// Equilibrium solves over the three topologies (the warm-start lattice not counted).
+    pub solves: u64,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Why the best topology's run stopped.
+    pub stop: String,
+}
+
+/// One sample of an `edges` table calibrated by gradients ([`Problem::run_lm`]) with `p`'s grid,
+/// side and edge source, without files written.
+pub fn calibrate_one_lm(
+    (edges, samples, scene): (&Path, &Path, &Path),
+    sample: &str,
+    p: &CalibrateParams,
+) -> Result<LmRow> {
+    let measured = sample_edges(edges, sample)?;
+    let problem = sample_problem((scene, samples), sample, &measured, p)?;
+    let r = problem.run_lm(&drapelab_core::calibrate::LmSettings::default());
+    Ok(LmRow {
+        sample: sample.to_string(),
+        optimizer: "levenberg-marquardt".into(),
+        topology: format!("{:?}", r.best.topology).to_lowercase(),
+        stiffness_N_per_m: r.best.stiffness_N_per_m,
+        natural_length_m: r.best.natural_length_m,
+        curve_distance_pct: r.best_cost_pct,
+        solves: r.solves as u64,
+        steps: r.iterations as u64,
+        stop: r.stop,
+    })
+}
+
+/// The measured edges of `sample` in an `edges` table; an error when it has none.
+fn sample_edges(edges: &Path, sample: &str) -> Result<Vec<EdgeFit>> {
+    let measured: Vec<EdgeFit> = read_edges(edges)?
+        .into_iter()
+        .filter(|(s, _)| s == sample)
+        .map(|(_, e)| e)
+        .collect();
+    if measured.is_empty() {
+        bail!("{}: no edges of sample `{sample}`", edges.display());
+    }
+    Ok(measured)
 }
 
 /// One sample of an `edges` table calibrated with `p` (which gives `ica`), without files written:
@@ -251,14 +323,7 @@ pub fn calibrate_one(
     sample: &str,
     p: &CalibrateParams,
 ) -> Result<ResultRow> {
-    let measured: Vec<EdgeFit> = read_edges(edges)?
-        .into_iter()
-        .filter(|(s, _)| s == sample)
-        .map(|(_, e)| e)
-        .collect();
-    if measured.is_empty() {
-        bail!("{}: no edges of sample `{sample}`", edges.display());
-    }
+    let measured = sample_edges(edges, sample)?;
     let Some(ica) = p.ica.clone() else {
         bail!("calibrating one sample needs the ICA settings `ica`");
     };

@@ -12,7 +12,7 @@ mod convert;
 mod interrupt;
 
 use convert::{bytes_f64, f64_bytes, json, load_scene, u32_bytes};
-use drapelab_app::calibrate::{CalibrateParams, calibrate_one};
+use drapelab_app::calibrate::{CalibrateParams, calibrate_one, calibrate_one_lm};
 use interrupt::Interrupt;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -191,6 +191,31 @@ fn calibrate(
     json(&row)
 }
 
+/// One sample of an edges table calibrated by gradients (Levenberg–Marquardt on the drapes'
+/// sensitivities) with the calibrate stage's grid, side and edge source; its row as JSON text.
+#[pyfunction]
+fn calibrate_lm(
+    py: Python<'_>,
+    edges: &str,
+    samples: &str,
+    scene: &str,
+    sample: &str,
+    params_json: &str,
+) -> PyResult<String> {
+    let mut p: CalibrateParams = serde_json::from_str(params_json)
+        .map_err(|e| InputError::new_err(format!("params: {e}")))?;
+    // ICA's settings play no part: the other parameters are checked as the stage checks them.
+    p.ica_from_input = p.ica.is_none();
+    if let Err((key, msg)) = p.check() {
+        return Err(InputError::new_err(format!("params: key `{key}`: {msg}")));
+    }
+    let files = (Path::new(edges), Path::new(samples), Path::new(scene));
+    let row = py
+        .detach(|| calibrate_one_lm(files, sample, &p))
+        .map_err(to_py)?;
+    json(&row)
+}
+
 /// Runs a pipeline make-style (`drapelab run`); the summary as JSON text.
 #[pyfunction]
 #[pyo3(signature = (path, until, force))]
@@ -249,6 +274,7 @@ fn _drapelab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(drape_of_silhouette, m)?)?;
     m.add_function(wrap_pyfunction!(fit_edges, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate_lm, m)?)?;
     m.add_function(wrap_pyfunction!(run_pipeline, m)?)?;
     m.add_function(wrap_pyfunction!(read_scene, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
