@@ -179,16 +179,25 @@ fn calibrate(
     sample: &str,
     params_json: &str,
 ) -> PyResult<String> {
-    let p: CalibrateParams = serde_json::from_str(params_json)
-        .map_err(|e| InputError::new_err(format!("params: {e}")))?;
-    if let Err((key, msg)) = p.check() {
-        return Err(InputError::new_err(format!("params: key `{key}`: {msg}")));
-    }
+    let p = calibrate_params(params_json, false)?;
     let files = (Path::new(edges), Path::new(samples), Path::new(scene));
     let row = py
         .detach(|| calibrate_one(files, sample, &p))
         .map_err(to_py)?;
     json(&row)
+}
+
+/// The calibrate stage's parameters from JSON text, checked as the stage checks them; `without_ica`:
+/// ICA's settings play no part (calibration by gradients) and may be left out.
+fn calibrate_params(params_json: &str, without_ica: bool) -> PyResult<CalibrateParams> {
+    let mut p: CalibrateParams = serde_json::from_str(params_json)
+        .map_err(|e| InputError::new_err(format!("params: {e}")))?;
+    if without_ica {
+        p.ica_from_input = p.ica.is_none();
+    }
+    p.check()
+        .map_err(|(key, msg)| InputError::new_err(format!("params: key `{key}`: {msg}")))?;
+    Ok(p)
 }
 
 /// One sample of an edges table calibrated by gradients (Levenberg–Marquardt on the drapes'
@@ -202,13 +211,7 @@ fn calibrate_lm(
     sample: &str,
     params_json: &str,
 ) -> PyResult<String> {
-    let mut p: CalibrateParams = serde_json::from_str(params_json)
-        .map_err(|e| InputError::new_err(format!("params: {e}")))?;
-    // ICA's settings play no part: the other parameters are checked as the stage checks them.
-    p.ica_from_input = p.ica.is_none();
-    if let Err((key, msg)) = p.check() {
-        return Err(InputError::new_err(format!("params: key `{key}`: {msg}")));
-    }
+    let p = calibrate_params(params_json, true)?;
     let files = (Path::new(edges), Path::new(samples), Path::new(scene));
     let row = py
         .detach(|| calibrate_one_lm(files, sample, &p))
