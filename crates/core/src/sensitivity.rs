@@ -7,8 +7,9 @@
 //! mixed derivative ∂g/∂θ is taken term by term ([`crate::physics::Kernel`]): the scene is rebuilt
 //! at θ ± h (h = 10⁻⁶ θ, [`PARAM_STEP_REL`]), each term's coefficients (stiffnesses, rest lengths,
 //! weights) differenced into dc/dθ, and the term's analytic mixed derivative ∂g/∂c · dc/dθ taken at
-//! x*; a term that does not give one (barrier contact, self-contact) contributes the central
-//! difference of its rebuilt gradients at x*. The fixed particles' motion (a pin moved by
+//! x*: analytic for the elastic terms, loads, friction, self-contact and the obstacles' barrier in
+//! κ and d̂, a per-particle difference of the barrier's force for an obstacle's shape. A term that
+//! gives no coefficients would contribute the central difference of its rebuilt gradients at x*. The fixed particles' motion (a pin moved by
 //! `cloth.size_x_m`) enters through the coupling blocks of the exact Hessian, H dx_fixed/dθ. No
 //! solve is needed, and the coefficients' difference is exact for coefficients linear in θ.
 
@@ -261,7 +262,7 @@ impl<'a> Equilibrium<'a> {
 /// `t` and its rebuilds `hi`, `lo` at θ ± `span`/2: the analytic mixed derivatives in the term's
 /// coefficients along their change (dc/dθ by the difference of the rebuilt coefficients: exact for
 /// coefficients linear in θ, as stiffnesses, weights and rest lengths are), or, for a term that
-/// does not give them (contact, self-contact), the differences of its rebuilt gradient and energy.
+/// does not give them, the differences of its rebuilt gradient and energy.
 fn mixed_of_term(
     (t, hi, lo): (&dyn EnergyTerm, &dyn EnergyTerm, &dyn EnergyTerm),
     x: &Vecs,

@@ -375,10 +375,12 @@ fn solve_with_friction(
     };
     let mut loads: Vec<f64> = (1..=steps).map(|k| k as f64 / steps as f64).collect();
     loads.extend([1.0; FRICTION_UPDATES]);
-    model.terms.push(Box::new(crate::physics::LaggedFriction {
-        anchors: vec![],
-        eps_m: FRICTION_EPS_M,
-    }));
+    model
+        .terms
+        .push(Box::new(crate::physics::LaggedFriction::anchored(
+            vec![],
+            FRICTION_EPS_M,
+        )));
     let mut lag = FrictionLag {
         contact: crate::build::barrier_contact(scene, &model.masses, &model.fixed),
         mu: scene.contact.friction_coefficient,
@@ -453,10 +455,7 @@ impl crate::solve::Continuation for FrictionLag {
             })
             .collect();
         if let Some(t) = model.terms.last_mut() {
-            *t = Box::new(LaggedFriction {
-                anchors,
-                eps_m: FRICTION_EPS_M,
-            });
+            *t = Box::new(LaggedFriction::anchored(anchors, FRICTION_EPS_M));
         }
         self.before = x.to_vec();
         self.stage += 1;

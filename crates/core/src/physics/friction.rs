@@ -2,9 +2,10 @@
 //! contact at the lagged state xᵏ keeps its contact force λ and tangent plane (normal n); moving
 //! tangentially by u = P(x − xᵏ), P = I − nnᵀ, costs D = μ λ f₀(|u|) with f₀ smoothing Coulomb's law over
 //! a slip of ε: f₀(y) = y²/ε − y³/(3ε²) below ε, y − ε/3 beyond. The solver refreshes the anchors
-//! (lags) between load increments.
+//! (lags) between load increments. A per-stencil kernel ([`super::Kernel`]): one anchored particle a
+//! stencil, its coefficients μλ and ε.
 
-use super::{EnergyTerm, HessianBlocks, Vecs};
+use super::kernel::{Kernel, Local, Potential};
 use nalgebra::{Matrix3, Vector3};
 
 /// One anchored contact.
@@ -20,60 +21,129 @@ pub struct FrictionAnchor {
     pub limit_N: f64,
 }
 
-/// Lagged friction on a set of anchored contacts.
-pub struct LaggedFriction {
-    /// The contacts.
-    pub anchors: Vec<FrictionAnchor>,
-    /// Slip over which static friction turns into sliding, m.
-    pub eps_m: f64,
+/// The kernel of lagged friction: one anchored particle a stencil; its coefficients μλ (N) and the
+/// smoothing slip ε (m), each the stencil's own.
+pub struct FrictionKernel {
+    stencils: Vec<[u32; 1]>,
+    anchors: Vec<FrictionAnchor>,
+    eps_m: Vec<f64>,
 }
+
+/// Lagged friction on a set of anchored contacts.
+pub type LaggedFriction = Potential<FrictionKernel, 1>;
 
 impl LaggedFriction {
-    fn slip(&self, a: &FrictionAnchor, x: &Vecs) -> Vector3<f64> {
-        let d = x[a.particle] - a.anchor_m;
+    /// Friction on `anchors`, Coulomb's law smoothed over a slip of `eps_m` (m).
+    pub fn anchored(anchors: Vec<FrictionAnchor>, eps_m: f64) -> Self {
+        Potential::of(FrictionKernel {
+            stencils: anchors.iter().map(|a| [a.particle as u32]).collect(),
+            eps_m: vec![eps_m; anchors.len()],
+            anchors,
+        })
+    }
+}
+
+impl FrictionKernel {
+    /// The tangential slip u = P(x − xᵏ) of anchor `a` at `x`.
+    fn slip(a: &FrictionAnchor, x: &Vector3<f64>) -> Vector3<f64> {
+        let d = x - a.anchor_m;
         d - a.normal * a.normal.dot(&d)
     }
-    fn f0(&self, y: f64) -> f64 {
-        let e = self.eps_m;
+    /// f₀(y) and ∂f₀/∂ε at smoothing slip `e`.
+    fn f0(e: f64, y: f64) -> (f64, f64) {
         if y < e {
-            y * y / e - y * y * y / (3.0 * e * e)
+            (
+                y * y / e - y * y * y / (3.0 * e * e),
+                -y * y / (e * e) + 2.0 * y * y * y / (3.0 * e * e * e),
+            )
         } else {
-            y - e / 3.0
+            (y - e / 3.0, -1.0 / 3.0)
         }
     }
-    /// f₁(y)/y, the factor of the force along u (finite at y = 0).
-    fn f1_over_y(&self, y: f64) -> f64 {
-        let e = self.eps_m;
+    /// f₁(y)/y, the factor of the force along u (finite at y = 0), and its derivative in ε, at
+    /// smoothing slip `e`.
+    fn f1_over_y(e: f64, y: f64) -> (f64, f64) {
         if y < e {
-            2.0 / e - y / (e * e)
+            (
+                2.0 / e - y / (e * e),
+                -2.0 / (e * e) + 2.0 * y / (e * e * e),
+            )
         } else {
-            1.0 / y
+            (1.0 / y, 0.0)
         }
     }
 }
 
-impl EnergyTerm for LaggedFriction {
+impl Kernel<1> for FrictionKernel {
+    const COEFFICIENTS: usize = 2;
     fn name(&self) -> String {
         "contact/friction".into()
     }
-    fn energy(&self, x: &Vecs) -> f64 {
-        self.anchors
-            .iter()
-            .map(|a| a.limit_N * self.f0(self.slip(a, x).norm()))
-            .sum()
+    fn stencils(&self) -> &[[u32; 1]] {
+        &self.stencils
     }
-    fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
-        for a in &self.anchors {
-            let u = self.slip(a, x);
-            g[a.particle] += u * (a.limit_N * self.f1_over_y(u.norm()));
-        }
+    fn energy(&self, s: usize, x: &Local<1>) -> f64 {
+        let a = &self.anchors[s];
+        a.limit_N * Self::f0(self.eps_m[s], Self::slip(a, &x[0]).norm()).0
     }
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, _project: bool) {
-        // The positive part: μλ f₁(y)/y P (the curvature term along u is negative below ε and dropped).
-        for a in &self.anchors {
-            let y = self.slip(a, x).norm();
-            let p = Matrix3::identity() - a.normal * a.normal.transpose();
-            h.push(a.particle, a.particle, p * (a.limit_N * self.f1_over_y(y)));
+    fn gradient(&self, s: usize, x: &Local<1>) -> Local<1> {
+        let a = &self.anchors[s];
+        let u = Self::slip(a, &x[0]);
+        [u * (a.limit_N * Self::f1_over_y(self.eps_m[s], u.norm()).0)]
+    }
+    /// The positive part: μλ f₁(y)/y P (the curvature term along u is negative below ε and is
+    /// dropped, projected or not).
+    fn hessian(
+        &self,
+        s: usize,
+        x: &Local<1>,
+        _project: bool,
+        push: &mut impl FnMut(usize, usize, Matrix3<f64>),
+    ) {
+        let a = &self.anchors[s];
+        let y = Self::slip(a, &x[0]).norm();
+        let p = Matrix3::identity() - a.normal * a.normal.transpose();
+        push(0, 0, p * (a.limit_N * Self::f1_over_y(self.eps_m[s], y).0));
+    }
+    /// With the curvature along the slip: μλ (φ P + φ′(y)/y u uᵀ), φ = f₁(y)/y (φ′ = −1/ε² below
+    /// ε, −1/y² beyond).
+    fn exact_hessian(
+        &self,
+        s: usize,
+        x: &Local<1>,
+        push: &mut impl FnMut(usize, usize, Matrix3<f64>),
+    ) {
+        let a = &self.anchors[s];
+        let u = Self::slip(a, &x[0]);
+        let y = u.norm();
+        let p = Matrix3::identity() - a.normal * a.normal.transpose();
+        let mut h = p * Self::f1_over_y(self.eps_m[s], y).0;
+        if y > 0.0 {
+            let dphi = if y < self.eps_m[s] {
+                -1.0 / (self.eps_m[s] * self.eps_m[s])
+            } else {
+                -1.0 / (y * y)
+            };
+            h += u * u.transpose() * (dphi / y);
         }
+        push(0, 0, h * a.limit_N);
+    }
+    fn coefficients(&self, s: usize, out: &mut Vec<f64>) {
+        out.extend([self.anchors[s].limit_N, self.eps_m[s]]);
+    }
+    fn set_coefficients(&mut self, s: usize, c: &[f64]) {
+        self.anchors[s].limit_N = c[0];
+        self.eps_m[s] = c[1];
+    }
+    fn coefficient_gradient(&self, s: usize, x: &Local<1>, dc: &[f64]) -> Local<1> {
+        let a = &self.anchors[s];
+        let u = Self::slip(a, &x[0]);
+        let (f, df) = Self::f1_over_y(self.eps_m[s], u.norm());
+        [u * (dc[0] * f + a.limit_N * df * dc[1])]
+    }
+    fn coefficient_energy(&self, s: usize, x: &Local<1>, dc: &[f64]) -> f64 {
+        let a = &self.anchors[s];
+        let (f, df) = Self::f0(self.eps_m[s], Self::slip(a, &x[0]).norm());
+        dc[0] * f + a.limit_N * df * dc[1]
     }
 }

@@ -32,6 +32,17 @@ pub trait Kernel<const N: usize>: Send + Sync {
         project: bool,
         push: &mut impl FnMut(usize, usize, Matrix3<f64>),
     );
+    /// The exact Hessian blocks of stencil `s` for derivatives of an equilibrium (see
+    /// [`EnergyTerm::add_exact_hessian`]): the unprojected [`Kernel::hessian`] unless the solver's
+    /// Hessian leaves a curvature out.
+    fn exact_hessian(
+        &self,
+        s: usize,
+        x: &Local<N>,
+        push: &mut impl FnMut(usize, usize, Matrix3<f64>),
+    ) {
+        self.hessian(s, x, false, push);
+    }
     /// Stencil `s`'s coefficients, appended to `out` (SI units; [`Kernel::COEFFICIENTS`] of them).
     fn coefficients(&self, s: usize, out: &mut Vec<f64>);
     /// Sets stencil `s`'s coefficients (the layout of [`Kernel::coefficients`]).
@@ -108,6 +119,13 @@ impl<K: Kernel<N>, const N: usize> EnergyTerm for Potential<K, N> {
             self.kernel.hessian(s, &xs, project, &mut |a, b, blk| {
                 h.push(idx[a], idx[b], blk)
             });
+        }
+    }
+    fn add_exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
+        for s in 0..self.len() {
+            let (xs, idx) = self.gather(s, x);
+            self.kernel
+                .exact_hessian(s, &xs, &mut |a, b, blk| h.push(idx[a], idx[b], blk));
         }
     }
     fn stiffness_scale(&self) -> f64 {

@@ -16,7 +16,7 @@ pub use bending::{
     CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,
 };
 pub use contact::{BarrierContact, max_penetration_m};
-pub use friction::{FrictionAnchor, LaggedFriction};
+pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
 pub use kernel::{Kernel, Local, Potential};
 pub use loads::{Gravity, LoadKernel, PointLoads};
 pub use mesh_bending::{hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending};

@@ -11,7 +11,7 @@
 //! a quarter of the shortest edge. On a smooth sheet no pair of non-adjacent primitives is within
 //! reach, the list is empty, and the term costs a comparison of positions with boxes.
 
-use super::contact::barrier;
+use super::contact::{barrier, barrier_band_derivatives};
 use super::{EnergyTerm, HessianBlocks, Vecs};
 use crate::contact::proximity::{
     Aabb, MeshTopology, Pair, additive_ccd, candidate_pairs, pair_distance,
@@ -334,6 +334,47 @@ impl EnergyTerm for SelfContact {
         }
         c.time_s += start.elapsed().as_secs_f64();
         bound
+    }
+    /// ξ (m), d̂ (m), κ (J): the fabric's thickness and the barrier's band and stiffness.
+    fn coefficients(&self) -> Vec<f64> {
+        vec![self.thickness_m, self.band_m, self.kappa_J]
+    }
+    fn set_coefficients(&mut self, c: &[f64]) {
+        (self.thickness_m, self.band_m, self.kappa_J) = (c[0], c[1], c[2]);
+        // The activation distance moved: the candidate list is rebuilt for it.
+        self.cache.lock().unwrap_or_else(|e| e.into_inner()).valid = false;
+    }
+    /// Analytic in all three: κ ∂b′/∂c ∇d per pair, with ∂b′/∂ξ = −b″ and ∂b′/∂d̂ from
+    /// [`barrier_band_derivatives`].
+    fn add_coefficient_gradient(&self, x: &Vecs, dc: &[f64], g: &mut Vecs) -> bool {
+        let [dxi, dband, dkappa] = match dc {
+            [a, b, c] => [*a, *b, *c],
+            _ => return false,
+        };
+        self.each_active(x, |idx, d, coef| {
+            let (_, db, d2b) = barrier(d - self.thickness_m, self.band_m);
+            let ddb = barrier_band_derivatives(d - self.thickness_m, self.band_m).1;
+            let r: Vector3<f64> = (0..4).map(|k| x[idx[k]] * coef[k]).sum();
+            let n = r / d;
+            let s = dkappa * db + self.kappa_J * (ddb * dband - d2b * dxi);
+            for k in 0..4 {
+                g[idx[k]] += n * (s * coef[k]);
+            }
+        });
+        true
+    }
+    fn coefficient_energy(&self, x: &Vecs, dc: &[f64]) -> Option<f64> {
+        let [dxi, dband, dkappa] = match dc {
+            [a, b, c] => [*a, *b, *c],
+            _ => return None,
+        };
+        let mut e = 0.0;
+        self.each_active(x, |_, d, _| {
+            let (b, db, _) = barrier(d - self.thickness_m, self.band_m);
+            let db_dband = barrier_band_derivatives(d - self.thickness_m, self.band_m).0;
+            e += dkappa * b + self.kappa_J * (db_dband * dband - db * dxi);
+        });
+        Some(e)
     }
     fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {
         Some(self.state(x))
