@@ -403,13 +403,13 @@ fn cusick_specimen_sensitivities_match_central_differences_for_every_key() {
         ..StaticOptions::default()
     };
     let solve_from = |p: &DrapeParams, start: &[Vector3<f64>], tol: f64| {
-        let model = drape_model(mesh, p, &tester);
+        let mut model = drape_model(mesh, p, &tester);
         let mut x = start.to_vec();
         let opts = StaticOptions {
             residual_tol_rel: tol,
             ..opts.clone()
         };
-        let r = solve_static(&model, &mut x, &opts, &mut NoObserver);
+        let r = solve_static(&mut model, &mut x, &opts, &mut NoObserver);
         (model, x, r)
     };
     let (model, x, report) = solve_from(&params, &drape_start(mesh, &params, &tester), 1e-12);

@@ -403,7 +403,7 @@ sticky vertical gap {:.2} cm from the friction barrier's corner: the two treatme
 /// Load–displacement by incremental loading against the single step (§10.3.3): the text and the SVG.
 pub fn load_displacement(c: &Scene, p: &Seed003ReportParams) -> Result<(String, String)> {
     let mut md = String::new();
-    let built = drapelab_core::build::build_scene(&c.clone().validated()?);
+    let mut built = drapelab_core::build::build_scene(&c.clone().validated()?);
     let tip = built.grid.index(built.grid.nx - 1, built.grid.ny / 2);
     let opts = &c.solver.static_;
     let mut x = built.x0.clone();
@@ -412,14 +412,14 @@ pub fn load_displacement(c: &Scene, p: &Seed003ReportParams) -> Result<(String, 
     let mut iters = 0;
     for k in 1..=p.load_steps {
         let load = k as f64 / p.load_steps as f64;
-        let r = solve_static_loads(&built.model, &mut x, opts, &[load], &mut NoObserver);
+        let r = solve_static_loads(&mut built.model, &mut x, opts, &[load], &mut NoObserver);
         iters += r.iterations;
         curve.push((load, (built.x0[tip].z - x[tip].z) * 100.0));
     }
     let t_inc = t0.elapsed().as_secs_f64();
     let mut y = built.x0.clone();
     let t1 = Instant::now();
-    let single = solve_static_loads(&built.model, &mut y, opts, &[1.0], &mut NoObserver);
+    let single = solve_static_loads(&mut built.model, &mut y, opts, &[1.0], &mut NoObserver);
     let t_one = t1.elapsed().as_secs_f64();
     let _ = write!(
         md,

@@ -353,7 +353,7 @@ fn solve_drape_once(
         regularization: Regularization::CarriedDamping,
         ..StaticOptions::default()
     };
-    let mut report = solve_static(&model, &mut x, &opts, observer);
+    let mut report = solve_static(&mut model, &mut x, &opts, observer);
     if let Some(f) = fall {
         report.message = format!(
             "after a fall of {} ({}): {}",

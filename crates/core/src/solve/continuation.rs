@@ -1,22 +1,27 @@
 //! The one executor of static continuations (argmin's habit: the executor owns the loop). A
-//! continuation is a sequence of Newton solves of one model whose set-up changes between them: a
-//! load raised in increments with obstacles' contact sets refreshed (seed 003 §10.7.1's vertical
-//! gap), friction anchors lagged one solve behind, a start from a coarser grid. The
-//! [`Continuation`] says what the next stage is; [`execute`] runs the solves, hands the observer
-//! the first stage, stops at the first stage that does not converge, and merges the reports
-//! ([`SolveReport::merge`]).
+//! continuation is a sequence of Newton stages of one model whose set-up changes between them: the
+//! external loads raised in increments (seed 003 §10.3.3, [`super::newton::LoadRamp`]), obstacles'
+//! contact sets refreshed (§10.7.1's vertical gap), friction anchors lagged one solve behind. The
+//! [`Continuation`] says what the next stage is; [`execute`] runs the Newton runs, hands the
+//! observer the first run, stops at the first stage that does not reach its goal, and merges the
+//! runs' reports ([`SolveReport::merge`]).
 
-use super::{
-    NoObserver, Observer, Part, SolveReport, StaticOptions, StopReason, solve_static_loads,
-};
+use super::newton::{Goal, NewtonRun};
+use super::{NoObserver, Observer, Part, SolveReport, StaticOptions, StopReason};
 use crate::physics::Model;
 use nalgebra::Vector3;
 
 /// What a continuation does next.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Stage {
-    /// Solve the model at this load factor (1 = full load), from the positions as they are.
+    /// Solve the model at this load factor (1 = full load), from the positions as they are, to the
+    /// tolerance: the end of the current Newton run if an increment began it, else a fresh run (the
+    /// continuation may have changed the model since the last one).
     Solve(f64),
+    /// Raise the load to this factor within the current Newton run (its damping, factor and
+    /// iteration budget carried on), solved only roughly: an increment of incremental loading. The
+    /// model must not change until the run ends with a [`Stage::Solve`].
+    Increment(f64),
     /// Done: the last stage's outcome is the result; this note is added to its message.
     Done(String),
     /// Stopped short of a result, for this reason, with this message.
@@ -25,15 +30,27 @@ pub enum Stage {
 
 /// A static continuation: the set-up of each stage of [`execute`].
 pub trait Continuation {
-    /// The next stage. Called before the first solve with `solved` false, then after each stage
-    /// that converged with `solved` true; it may change the model (fixed particles, terms) and the
-    /// positions (a contact pull-back, a rejected increment rolled back) first.
+    /// The next stage. Called before the first stage with `solved` false, then after each stage
+    /// that reached its goal with `solved` true; it may change the model (fixed particles, terms) and
+    /// the positions (a contact pull-back, a rejected increment rolled back) before a
+    /// [`Stage::Solve`] that starts a fresh run.
     fn next(&mut self, model: &mut Model, x: &mut [Vector3<f64>], solved: bool) -> Stage;
 }
 
+/// The reports of the runs so far, merged ([`Part::Stage`]).
+fn merged(total: Option<SolveReport>, run: SolveReport) -> SolveReport {
+    match total {
+        None => run,
+        Some(mut t) => {
+            t.merge(&run, Part::Stage);
+            t
+        }
+    }
+}
+
 /// Runs `continuation` on `model` from `x` (updated in place) with Newton under `opts`: the
-/// observer sees the first stage's iterations; a stage that does not converge ends it with that
-/// stage's status. The work of every stage adds up in the report.
+/// observer sees the first run's iterations; a stage that does not reach its goal ends it with that
+/// run's status. The work of every run adds up in the report.
 pub fn execute(
     model: &mut Model,
     x: &mut [Vector3<f64>],
@@ -42,35 +59,50 @@ pub fn execute(
     observer: &mut dyn Observer,
 ) -> SolveReport {
     let mut total: Option<SolveReport> = None;
+    let mut run: Option<NewtonRun> = None;
+    let mut solved = false;
     loop {
-        match continuation.next(model, x, total.is_some()) {
-            Stage::Solve(load) => {
-                let obs: &mut dyn Observer = match total {
-                    None => &mut *observer,
-                    Some(_) => &mut NoObserver,
-                };
-                let stage = solve_static_loads(model, x, opts, &[load], obs);
-                let converged = stage.is_converged();
-                match &mut total {
-                    None => total = Some(stage),
-                    Some(t) => t.merge(&stage, Part::Stage),
-                }
-                if !converged {
-                    return total.expect("a stage was solved");
-                }
-            }
+        let (load, goal) = match continuation.next(model, x, solved) {
+            Stage::Solve(load) => (load, Goal::Tolerance),
+            Stage::Increment(load) => (load, Goal::Increment),
             Stage::Done(note) => {
-                let mut t = total.unwrap_or_else(|| SolveReport::unsolved("static-newton"));
+                let mut t = match run.take() {
+                    Some(r) => merged(total, r.finish(model, x)),
+                    None => total.unwrap_or_else(|| SolveReport::unsolved("static-newton")),
+                };
                 t.message += &note;
                 return t;
             }
             Stage::Stop(reason, message) => {
-                let mut t = total.unwrap_or_else(|| SolveReport::unsolved("static-newton"));
+                let mut t = match run.take() {
+                    Some(r) => merged(total, r.finish(model, x)),
+                    None => total.unwrap_or_else(|| SolveReport::unsolved("static-newton")),
+                };
                 t.stop_for(reason);
                 t.message = message;
                 return t;
             }
+        };
+        let mut current = match run.take() {
+            Some(r) => r,
+            None => match NewtonRun::new(model, x, opts) {
+                Ok(r) => r,
+                Err(invalid) => return merged(total, *invalid),
+            },
+        };
+        let obs: &mut dyn Observer = match total {
+            None => &mut *observer,
+            Some(_) => &mut NoObserver,
+        };
+        let reached = current.stage(model, x, opts, (load, goal), obs);
+        if !reached {
+            return merged(total, current.finish(model, x));
         }
+        match goal {
+            Goal::Increment => run = Some(current),
+            Goal::Tolerance => total = Some(merged(total, current.finish(model, x))),
+        }
+        solved = true;
     }
 }
 
@@ -97,7 +129,19 @@ mod tests {
         // A particle hanging from a pinned one by a spring (k = 100 N/m, L0 = 0.1 m, m = 0.1 kg):
         // at full load the spring stretches by m g / k.
         let k = 100.0;
-        let mut model = Model {
+        let (mut model, mut x) = hung(k);
+        let opts = StaticOptions::default();
+        let r = execute(&mut model, &mut x, &opts, &mut Ramp(0), &mut NoObserver);
+        assert!(r.is_converged(), "{}", r.message);
+        assert!(r.message.ends_with(" (ramped)"));
+        assert!((x[1].z + 0.1 + 0.1 * 9.81 / k).abs() < 1e-9, "{}", x[1].z);
+        // Four stages' work: at least one iteration each.
+        assert!(r.iterations >= 4, "{}", r.iterations);
+    }
+
+    /// The spring-hung particle of the test above.
+    fn hung(k: f64) -> (Model, Vec<Vector3<f64>>) {
+        let model = Model {
             masses: vec![0.0, 0.1],
             fixed: vec![true, false],
             held_components: vec![],
@@ -115,13 +159,33 @@ mod tests {
             damping_Ns_per_m: 0.0,
             elongation_rate: None,
         };
-        let mut x = vec![Vector3::zeros(), Vector3::new(0.0, 0.0, -0.1)];
-        let opts = StaticOptions::default();
-        let r = execute(&mut model, &mut x, &opts, &mut Ramp(0), &mut NoObserver);
+        (model, vec![Vector3::zeros(), Vector3::new(0.0, 0.0, -0.1)])
+    }
+
+    #[test]
+    fn a_load_ramp_is_one_newton_run_through_its_increments() {
+        let k = 100.0;
+        let (mut model, mut x) = hung(k);
+        let opts = StaticOptions {
+            load_steps: 5,
+            ..StaticOptions::default()
+        };
+        let r = super::super::solve_static(&mut model, &mut x, &opts, &mut NoObserver);
         assert!(r.is_converged(), "{}", r.message);
-        assert!(r.message.ends_with(" (ramped)"));
         assert!((x[1].z + 0.1 + 0.1 * 9.81 / k).abs() < 1e-9, "{}", x[1].z);
-        // Four stages' work: at least one iteration each.
-        assert!(r.iterations >= 4, "{}", r.iterations);
+        // One run: its iterations share one budget, and one too small for all five increments
+        // stops it.
+        let (mut model, mut x) = hung(k);
+        let tight = StaticOptions {
+            max_iterations: r.iterations - 1,
+            ..opts
+        };
+        let short = super::super::solve_static(&mut model, &mut x, &tight, &mut NoObserver);
+        assert!(!short.is_converged(), "{}", short.message);
+        assert!(
+            short.message.contains("Newton iterations"),
+            "{}",
+            short.message
+        );
     }
 }

@@ -243,7 +243,7 @@ mod tests {
         (model, x)
     }
 
-    fn equilibrium(model: &Model, x: &mut [Vector3<f64>]) {
+    fn equilibrium(model: &mut Model, x: &mut [Vector3<f64>]) {
         let opts = crate::solve::StaticOptions {
             residual_tol_rel: 1e-12,
             ..Default::default()
@@ -255,17 +255,17 @@ mod tests {
     #[test]
     fn sensitivity_to_the_mass_matches_central_differences_of_the_equilibria() {
         let m = 0.01;
-        let (model, mut x) = chain(m);
-        equilibrium(&model, &mut x);
+        let (mut model, mut x) = chain(m);
+        equilibrium(&mut model, &mut x);
         let mut f = EquilibriumFactor::new(&model, &x).expect("a minimum");
         // ∂g/∂m at fixed x: the weight's gradient per kg, (0, 0, g) on each particle.
         let dg = vec![Vector3::new(0.0, 0.0, 9.81); 4];
         let s = f.sensitivity(&dg, &[Vector3::zeros(); 4]);
         let h = 1e-5;
         let solve_at = |mm: f64| {
-            let (mo, mut xx) = chain(mm);
+            let (mut mo, mut xx) = chain(mm);
             xx.copy_from_slice(&x);
-            equilibrium(&mo, &mut xx);
+            equilibrium(&mut mo, &mut xx);
             xx
         };
         let (xp, xm) = (solve_at(m + h), solve_at(m - h));

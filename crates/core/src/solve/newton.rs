@@ -14,7 +14,7 @@
 
 use super::step::Workspace;
 use super::strategy::{Direction, FactorReuse, Regularization, Start};
-use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
+use super::{DivergenceReason, Observer, SolveReport, Stage, StateEvent, Status, StopReason};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -108,7 +108,7 @@ impl Default for StaticOptions {
 /// Solves for the static equilibrium starting from `x` (updated in place), the external loads raised
 /// in `opts.load_steps` equal steps.
 pub fn solve_static(
-    model: &Model,
+    model: &mut Model,
     x: &mut [Vector3<f64>],
     opts: &StaticOptions,
     observer: &mut dyn Observer,
@@ -119,100 +119,177 @@ pub fn solve_static(
 }
 
 /// [`solve_static`] through the given load factors (increasing; the last one is solved to the
-/// tolerance and reported, the others only roughly).
+/// tolerance and reported, the others only roughly), one Newton run through the executor
+/// ([`super::execute`] of a [`LoadRamp`]).
 pub fn solve_static_loads(
-    model: &Model,
+    model: &mut Model,
     x: &mut [Vector3<f64>],
     opts: &StaticOptions,
     loads: &[f64],
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let start = Instant::now();
-    let w_ref = model.reference_weight();
-    let tol = opts.residual_tol_rel * w_ref;
-    let mut report = SolveReport::unsolved("static-newton");
-    let mut ws = Workspace::new(model, x, opts);
-    if ws.dofs.n == 0 || !w_ref.is_finite() {
-        report.stop_for(StopReason::Invalid);
-        report.message = "no free particle with mass: nothing to solve".into();
-        return report;
+    super::execute(model, x, opts, &mut LoadRamp::new(loads), observer)
+}
+
+/// Incremental loading (seed 003 §10.3.3) as a continuation: the external loads raised through the
+/// given factors within one Newton run, the last solved to the tolerance.
+pub struct LoadRamp {
+    loads: Vec<f64>,
+    next: usize,
+}
+
+impl LoadRamp {
+    /// The ramp through `loads` (full load at once when empty).
+    pub fn new(loads: &[f64]) -> Self {
+        let loads = if loads.is_empty() {
+            vec![1.0]
+        } else {
+            loads.to_vec()
+        };
+        Self { loads, next: 0 }
     }
-    let steps = loads.len().max(1);
-    let mut iter = 0usize;
-    let mut floor = false;
-    'load: for step in 1..=steps {
-        let load = loads.get(step - 1).copied().unwrap_or(1.0);
-        let last = step == steps;
+}
+
+impl super::Continuation for LoadRamp {
+    fn next(&mut self, _model: &mut Model, _x: &mut [Vector3<f64>], _solved: bool) -> Stage {
+        let k = self.next;
+        self.next += 1;
+        match self.loads.get(k) {
+            Some(&load) if k + 1 == self.loads.len() => Stage::Solve(load),
+            Some(&load) => Stage::Increment(load),
+            None => Stage::Done(String::new()),
+        }
+    }
+}
+
+/// How far a stage of a Newton run solves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Goal {
+    /// An increment of incremental loading: to the tolerance or 10⁻⁶ of the lightest weight,
+    /// whichever is looser.
+    Increment,
+    /// To the tolerance (or the round-off floor of forces).
+    Tolerance,
+}
+
+/// One Newton run: its workspace (damping, factor, sparsity structure), its iterations and its
+/// report, carried over the stages of a load ramp. The executor ([`super::execute`]) owns the loop
+/// over stages; [`NewtonRun::stage`] owns the loop over iterations.
+pub(super) struct NewtonRun {
+    ws: Workspace,
+    report: SolveReport,
+    iter: usize,
+    floor: bool,
+    start: Instant,
+    /// The load of the last stage.
+    load: f64,
+}
+
+impl NewtonRun {
+    /// A run of `model` from `x`; the report of an invalid one (no free particle with mass).
+    pub(super) fn new(
+        model: &Model,
+        x: &[Vector3<f64>],
+        opts: &StaticOptions,
+    ) -> Result<Self, Box<SolveReport>> {
+        let mut report = SolveReport::unsolved("static-newton");
+        let ws = Workspace::new(model, x, opts);
+        if ws.dofs.n == 0 || !model.reference_weight().is_finite() {
+            report.stop_for(StopReason::Invalid);
+            report.message = "no free particle with mass: nothing to solve".into();
+            return Err(Box::new(report));
+        }
+        Ok(Self {
+            ws,
+            report,
+            iter: 0,
+            floor: false,
+            start: Instant::now(),
+            load: 1.0,
+        })
+    }
+
+    /// Newton's iterations at load factor `load` up to `goal`: true when reached, false when the
+    /// run stopped (its report says why).
+    pub(super) fn stage(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        opts: &StaticOptions,
+        (load, goal): (f64, Goal),
+        observer: &mut dyn Observer,
+    ) -> bool {
+        self.load = load;
+        let w_ref = model.reference_weight();
+        let tol = opts.residual_tol_rel * w_ref;
+        let last = goal == Goal::Tolerance;
+        let (ws, report) = (&mut self.ws, &mut self.report);
         let mut e = model.energy(x, load);
         loop {
             model.gradient(x, load, &mut ws.g);
             let r = model.max_residual(&ws.g);
             if !r.is_finite() || !e.is_finite() {
-                report.diverge(iter, None, DivergenceReason::NonFinite);
-                break 'load;
+                report.diverge(self.iter, None, DivergenceReason::NonFinite);
+                return false;
             }
-            if let Err(err) = observe_iterate(observer, iter, x, (r, e)) {
+            if let Err(err) = observe_iterate(observer, self.iter, x, (r, e)) {
                 report.stop_for(StopReason::Observer);
-                report.message = format!("an observer failed at iteration {iter}: {err:#}");
-                break 'load;
+                report.message = format!("an observer failed at iteration {}: {err:#}", self.iter);
+                return false;
             }
             if r <= tol && last {
                 report.stop_for(StopReason::Converged);
-                break 'load;
+                return true;
             }
             // Round-off floor: the residual cannot fall below ~16 ε k |x| (see Model::roundoff_force);
             // reaching it after the tolerance proved unreachable is convergence, said in the message.
             if last && r <= model.roundoff_force(x) && r <= 1e3 * tol {
                 report.stop_for(StopReason::RoundoffFloor);
-                floor = true;
-                break 'load;
+                self.floor = true;
+                return true;
             }
             if r <= tol.max(1e-6 * w_ref) && !last {
-                continue 'load;
+                return true;
             }
-            if iter >= opts.max_iterations {
+            if self.iter >= opts.max_iterations {
                 report.message = format!(
                     "{} Newton iterations without reaching the tolerance",
                     opts.max_iterations
                 );
-                break 'load;
+                return false;
             }
-            iter += 1;
-            if !ws.iterate(model, x, load, &mut e, (r, tol), &mut report) {
+            self.iter += 1;
+            if !ws.iterate(model, x, load, &mut e, (r, tol), report) {
                 // A step that does not decrease the energy: near the solution, round-off.
                 model.gradient(x, load, &mut ws.g);
                 let r = model.max_residual(&ws.g);
                 if r <= tol && last {
                     report.stop_for(StopReason::Converged);
-                } else {
-                    report.stop_for(StopReason::LineSearch);
-                    report.message =
-                        format!("line search failed at iteration {iter} with residual {r:.3e} N");
+                    return true;
                 }
-                break 'load;
+                report.stop_for(StopReason::LineSearch);
+                report.message = format!(
+                    "line search failed at iteration {} with residual {r:.3e} N",
+                    self.iter
+                );
+                return false;
             }
             let strain = model.max_strain(x);
             if strain > opts.strain_bound {
                 let bound = opts.strain_bound;
-                report.diverge(
-                    iter,
-                    None,
-                    DivergenceReason::StrainBeyondBound { strain, bound },
-                );
-                break 'load;
+                let reason = DivergenceReason::StrainBeyondBound { strain, bound };
+                report.diverge(self.iter, None, reason);
+                return false;
             }
         }
     }
-    let final_load = loads.last().copied().unwrap_or(1.0);
-    finish_report(
-        model,
-        x,
-        final_load,
-        &mut ws,
-        (iter, floor, start),
-        &mut report,
-    );
-    report
+
+    /// The run's report, with the final numbers at its last stage's load.
+    pub(super) fn finish(mut self, model: &Model, x: &[Vector3<f64>]) -> SolveReport {
+        let timing = (self.iter, self.floor, self.start);
+        finish_report(model, x, self.load, &mut self.ws, timing, &mut self.report);
+        self.report
+    }
 }
 
 /// Hands Newton iterate `iter` (residual `r` N, energy `e` J) to `observer` when it wants it.

@@ -2,7 +2,8 @@
 //! ([`super::strategy`]): the Hessian regularized ([`Regularization`]), a straight or curved step
 //! ([`Direction`]), a chord step with the factor at hand ([`FactorReuse`]), and a backtracking
 //! line search ([`Backtracking`] over [`Armijo`]) bounded by the terms' collision-free step
-//! ([`Model::max_step`]). [`super::newton`] owns the loop over iterations and load steps.
+//! ([`Model::max_step`]). [`super::newton`] owns the loop over iterations, the executor
+//! ([`super::execute`]) the loop over load increments and other stages.
 
 use super::linear::{DofMap, SparseSpd};
 use super::newton::StaticOptions;
