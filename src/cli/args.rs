@@ -71,8 +71,9 @@ pub fn degree() -> RangedU64ValueParser<usize> {
 }
 
 /// Creates the output folder `out` and checks that it can be written into; else an input error
-/// naming `--out` and the folder.
-pub fn out_dir(out: &std::path::Path) -> Result<(), crate::error::InputError> {
+/// naming `--out` and the folder. Hold the guard while writing: a folder it made and nothing was
+/// written into is removed when the guard drops.
+pub fn out_dir(out: &std::path::Path) -> Result<crate::atomic::MadeDirs, crate::error::InputError> {
     let bad = |e: std::io::Error| {
         crate::error::InputError::new(
             "--out",
@@ -83,10 +84,10 @@ pub fn out_dir(out: &std::path::Path) -> Result<(), crate::error::InputError> {
             ),
         )
     };
-    std::fs::create_dir_all(out).map_err(bad)?;
+    let guard = crate::atomic::MadeDirs::create(out).map_err(bad)?;
     tempfile::Builder::new()
         .prefix(".drapelab-write-check")
         .tempfile_in(out)
         .map_err(bad)?;
-    Ok(())
+    Ok(guard)
 }

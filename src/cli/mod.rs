@@ -74,8 +74,8 @@ impl From<ExecutorArg> for crate::pipeline::ExecutorKind {
 pub enum Command {
     /// Solve one scene and record it.
     ///
-    /// Writes particles.parquet, run.json and, when the scene's [record] asks, timeline.mcap
-    /// (Foxglove) and drape.rrd (rerun) into DIR.
+    /// Writes particles.parquet, triangles.parquet, run.json and, when the scene's [record] asks,
+    /// timeline.mcap (Foxglove) and drape.rrd (rerun) into DIR; with --obj also drape.obj.
     ///
     /// Example: drapelab simulate datasets/scenes/hang4.toml --out runs/hang4 --set cloth.nx=41 --set cloth.ny=41
     Simulate {
@@ -99,6 +99,11 @@ pub enum Command {
         /// scene and grid) instead of the scene's own start: a restart.
         #[arg(long, value_name = "FILE")]
         start: Option<PathBuf>,
+        /// Also write the converged drape as drape.obj (Wavefront OBJ, metres; every particle a
+        /// vertex in particles.parquet's order) for Blender, MeshLab or a CAD tool.
+        /// triangles.parquet (the same faces as row indices) is written beside every state.
+        #[arg(long)]
+        obj: bool,
     },
     /// Run a pipeline make-style (only stale stages).
     ///
@@ -367,7 +372,7 @@ pub fn run_pipeline_quietly(
     registry: &crate::pipeline::Registry,
     quiet: bool,
 ) -> Result<i32> {
-    let plan = crate::pipeline::load_plan(pipeline, registry)?;
+    let plan = crate::pipeline::load_checked_plan(pipeline, registry)?;
     let progress = crate::pipeline::progress_for_terminal();
     let summary = crate::pipeline::run_pipeline(&plan, &opts, progress.as_ref())?;
     for (name, why) in &summary.would_run {
@@ -442,7 +447,14 @@ pub fn run(cli: Cli) -> Result<i32> {
             set,
             sensitivity,
             start,
-        } => simulate(&scene, &out, &set, (&sensitivity, start.as_deref()), quiet),
+            obj,
+        } => simulate(
+            &scene,
+            &out,
+            &set,
+            (&sensitivity, start.as_deref(), obj),
+            quiet,
+        ),
         Command::Run {
             pipeline,
             until,
@@ -509,7 +521,7 @@ fn render(a: RenderArgs) -> Result<i32> {
         a.rotate_deg,
         a.seed,
     )?;
-    args::out_dir(&a.out)?;
+    let _out = args::out_dir(&a.out)?;
     let path = crate::io::render_scene(&loaded, &a.out, &opts, a.jpeg_quality, 4)?;
     eprintln!("rendered {} → {}", loaded.scene.name, path.display());
     Ok(EXIT_OK)
@@ -566,7 +578,7 @@ fn simulate(
     scene: &Path,
     out: &Path,
     set: &[String],
-    (sensitivity, start): (&[String], Option<&Path>),
+    (sensitivity, start, obj): (&[String], Option<&Path>, bool),
     quiet: bool,
 ) -> Result<i32> {
     let loaded = load_scene(scene, set)?;
@@ -579,14 +591,21 @@ fn simulate(
         start: start
             .map(|f| read_start(f, &loaded.scene.grid()))
             .transpose()?,
+        obj,
     };
-    args::out_dir(out)?;
+    let _out = args::out_dir(out)?;
     let mut progress = SolveProgress::new(&loaded.scene.name);
     let report = crate::io::simulate_to_dir_with(&loaded, out, &mut progress, &extras)?.report;
     progress.done(&report);
     if !quiet {
+        // Why a solve did not converge, on the line itself (run.json has the numbers).
+        let why = match (&report.divergence, report.is_converged()) {
+            (Some(d), _) => format!(" ({} at step {})", d.reason, d.step),
+            (None, false) if !report.message.is_empty() => format!(" ({})", report.message),
+            _ => String::new(),
+        };
         println!(
-            "{}: {} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
+            "{}: {}{why} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
             loaded.scene.name,
             report.status.as_str(),
             report.solver,
@@ -648,7 +667,7 @@ fn read_start(
 
 /// `drapelab status`: 1 with `--check` when a stage is stale.
 fn status(pipeline: &Path, check: bool) -> Result<i32> {
-    let plan = crate::pipeline::load_plan(pipeline, &crate::stages::registry())?;
+    let plan = crate::pipeline::load_checked_plan(pipeline, &crate::stages::registry())?;
     let mut stale = 0;
     for (name, state) in crate::pipeline::stage_states(&plan) {
         let last = crate::pipeline::Manifest::read(&crate::pipeline::manifest_path(&plan, &name))
@@ -843,7 +862,7 @@ fn fit_edges(
 /// `drapelab wrinkles`.
 fn wrinkles(config: &Path, out: &Path, mesh: &[usize]) -> Result<i32> {
     let cfg = crate::wrinkles::load_config(config)?;
-    args::out_dir(out)?;
+    let _out = args::out_dir(out)?;
     let outputs = crate::app::wrinkles::WrinkleOutputs {
         table: Some(out.join("wrinkles.parquet")),
         mesh: Some(out.join("mesh.parquet")),

@@ -154,6 +154,27 @@ fn a_diverged_run_writes_its_status_and_no_particles() {
     assert_eq!(run["status"], "diverged");
     assert!(run["report"]["divergence"]["step"].as_u64().is_some());
     assert!(!out.join("particles.parquet").exists());
+    // The result line says why; a finite last state is kept for looking at, labelled diverged.
+    let line = String::from_utf8_lossy(&o.stdout);
+    let kind = run["report"]["divergence"]["reason"]["kind"]
+        .as_str()
+        .unwrap();
+    assert!(
+        line.contains("diverged (") && line.contains("at step"),
+        "{line}"
+    );
+    assert_eq!(
+        out.join("last_state.parquet").exists(),
+        kind != "non-finite",
+        "{kind}"
+    );
+    assert!(run["host"].as_str().is_some_and(|h| !h.is_empty()));
+    assert!(
+        run["finished_utc"]
+            .as_str()
+            .is_some_and(|t| t.ends_with('Z'))
+    );
+    assert_eq!(run["build_id"].as_str().map(str::len), Some(16));
 }
 
 #[test]

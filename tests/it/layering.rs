@@ -72,8 +72,9 @@ const NOT_IN_CORE: [&str; 8] = [
 ];
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank.
-const CORE_RANKS: [(&str, u8); 25] = [
+const CORE_RANKS: [(&str, u8); 26] = [
     ("error", 0),
+    ("provenance", 0),
     ("atomic", 0),
     ("table", 0),
     ("material", 0),

@@ -177,6 +177,76 @@ print(len(absent))
 }
 
 #[test]
+fn the_drape_is_written_as_a_mesh_over_present_particles_only() {
+    // A grid sheet and a disc cut from one: triangles.parquet's rows index particles.parquet, two
+    // per cell where all four corners are present, none touching an absent particle; --obj writes
+    // the same faces over every particle as a vertex.
+    let tmp = tempfile::tempdir().unwrap();
+    let code = r#"
+import sys, pyarrow.parquet as pq
+p = pq.read_table(sys.argv[1] + "/particles.parquet").to_pydict()
+t = pq.read_table(sys.argv[1] + "/triangles.parquet")
+assert [f.name for f in t.schema] == ["a", "b", "c"], t.schema
+assert all(str(f.type) == "int32" for f in t.schema), t.schema
+t = t.to_pydict()
+n = len(p["i"])
+tris = list(zip(t["a"], t["b"], t["c"]))
+assert all(0 <= v < n and p["present"][v] for tri in tris for v in tri)
+# Each triangle is half a grid cell; a cell with four corners present gives two, one with three
+# at most one, others none.
+nx, ny = max(p["i"]) + 1, max(p["j"]) + 1
+at = {(p["i"][k], p["j"][k]): k for k in range(n)}
+assert all(max(p["i"][v] for v in t) - min(p["i"][v] for v in t) == 1 and
+           max(p["j"][v] for v in t) - min(p["j"][v] for v in t) == 1 for t in tris)
+corners = [sum(p["present"][at[(i + a, j + b)]] for a in (0, 1) for b in (0, 1))
+           for i in range(nx - 1) for j in range(ny - 1)]
+full, three = corners.count(4), corners.count(3)
+assert 2 * full <= len(tris) <= 2 * full + three, (len(tris), full, three)
+print(len(tris), sum(p["present"]), n)
+"#;
+    for (scene, obj) in [("hang4", true), ("pedestal_wool", false)] {
+        let out = tmp.path().join(scene);
+        let mut cmd = drapelab();
+        cmd.arg("simulate")
+            .arg(root().join(format!("datasets/scenes/{scene}.toml")))
+            .arg("--out")
+            .arg(&out)
+            .args(["--set", "cloth.nx=15", "--set", "cloth.ny=15"]);
+        if obj {
+            cmd.arg("--obj");
+        }
+        let ok = cmd.output().unwrap();
+        assert!(
+            ok.status.success(),
+            "{}",
+            String::from_utf8_lossy(&ok.stderr)
+        );
+        let said = crate::support::run_python(code, &[&out]);
+        let counts: Vec<usize> = said
+            .split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect();
+        if scene == "hang4" {
+            assert_eq!(counts, vec![2 * 14 * 14, 225, 225], "{said}");
+        } else {
+            assert!(counts[1] < counts[2] && counts[0] > 0, "{said}");
+        }
+        assert_eq!(out.join("drape.obj").exists(), obj);
+        if obj {
+            let text = std::fs::read_to_string(out.join("drape.obj")).unwrap();
+            let v = text.lines().filter(|l| l.starts_with("v ")).count();
+            let f: Vec<&str> = text.lines().filter(|l| l.starts_with("f ")).collect();
+            assert_eq!((v, f.len()), (225, 2 * 14 * 14));
+            assert!(f.iter().all(|l| {
+                l.split_whitespace()
+                    .skip(1)
+                    .all(|k| (1..=225).contains(&k.parse::<usize>().unwrap()))
+            }));
+        }
+    }
+}
+
+#[test]
 fn bad_flags_and_files_are_refused_with_one_line_naming_them() {
     let tmp = tempfile::tempdir().unwrap();
     let hang4 = root().join("datasets/scenes/hang4.toml");
@@ -206,6 +276,21 @@ fn bad_flags_and_files_are_refused_with_one_line_naming_them() {
             out.display()
         );
     }
+    // A scene render cannot view (a table drape) is refused after --out was made: nothing left.
+    let nested = tmp.path().join("new/render");
+    assert_bad_input(
+        [
+            Path::new("render"),
+            &root().join("datasets/scenes/table_wool.toml"),
+            Path::new("--out"),
+            &nested,
+        ],
+        &["boundary.pin_corners"],
+    );
+    assert!(
+        !tmp.path().join("new").exists(),
+        "a refused render left its folder"
+    );
     assert_bad_input(["bench", "--sizes", "1"], &["--sizes"]);
     assert_bad_input(["bench", "--tol", "0"], &["--tol"]);
     assert_bad_input(
@@ -233,6 +318,24 @@ fn bad_flags_and_files_are_refused_with_one_line_naming_them() {
     );
 }
 
+#[test]
+fn status_finds_the_project_from_inside_pipelines() {
+    // `cd pipelines && drapelab status t.toml`: the project root is the folder above.
+    let (_tmp, file) = project(&one_stage(
+        "simulate",
+        "inputs.scene = \"datasets/scenes/hang2.toml\"\noutputs.particles = \"{run}/p.parquet\"\n\
+         outputs.run = \"{run}/run.json\"",
+    ));
+    let o = drapelab()
+        .current_dir(file.parent().unwrap())
+        .args(["status", "t.toml"])
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(said.contains("s: stale"), "{said}");
+}
+
 /// A pipeline with one stage of `kind` and the given inputs, outputs and params.
 fn one_stage(kind: &str, rest: &str) -> String {
     format!("name = \"t\"\n[stages.s]\nkind = \"{kind}\"\n{rest}\n")
@@ -246,8 +349,22 @@ fn a_bad_set_in_a_pipeline_names_the_pipeline_and_stage_and_a_bad_report_column_
         "inputs.scene = \"datasets/scenes/hang2.toml\"\noutputs.particles = \"{run}/p.parquet\"\n\
          outputs.run = \"{run}/run.json\"\nparams.set = { \"cloth.nx\" = -3 }",
     ));
-    assert_bad_input(
-        [Path::new("run"), &file],
+    // Refused alike by status, a dry run and a run, and the run leaves no lock and no folder.
+    let refused_everywhere = |file: &Path, names: &[&str]| {
+        for cmd in [&["status"][..], &["run", "--dry-run"], &["run"]] {
+            let mut a: Vec<&Path> = cmd.iter().map(Path::new).collect();
+            a.push(file);
+            assert_bad_input(a, names);
+        }
+        let runs = file.parent().unwrap().parent().unwrap().join("runs");
+        assert!(
+            !runs.join("t").exists(),
+            "a refused run left {}",
+            runs.display()
+        );
+    };
+    refused_everywhere(
+        &file,
         &["t.toml", "stages.s.params.set.cloth.nx", "hang2.toml"],
     );
     let (_tmp, file) = project(&one_stage(
@@ -255,8 +372,8 @@ fn a_bad_set_in_a_pipeline_names_the_pipeline_and_stage_and_a_bad_report_column_
         "inputs.scenes = [\"datasets/scenes/hang2.toml\"]\noutputs.table = \"{run}/sweep.parquet\"\n\
          params.axes = { \"material.mass_spring.stiffness_N_per_m\" = [-1.0, 2.0] }",
     ));
-    assert_bad_input(
-        [Path::new("run"), &file],
+    refused_everywhere(
+        &file,
         &["t.toml", "stages.s.params.axes", "stiffness_N_per_m"],
     );
     let (_tmp, file) = project(

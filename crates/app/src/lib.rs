@@ -39,6 +39,7 @@ pub fn tables_markdown() -> anyhow::Result<String> {
     use drapelab_record::table_markdown as md;
     let sections = [
         md::<drapelab_record::ParticleRow>()?,
+        md::<drapelab_record::TriangleRow>()?,
         md::<drapelab_record::SensitivityRow>()?,
         md::<drapelab_record::EdgeRow>()?,
         md::<crate::sweep_table::SweepPoint>()?,

@@ -73,3 +73,36 @@ pub fn write_text(path: &Path, text: &str) -> Result<PathBuf> {
         Ok(())
     })
 }
+
+/// Folders a command made for its outputs: the ones left empty are removed again when this drops
+/// (innermost first), so that a command that fails after making them leaves nothing behind.
+#[derive(Debug, Default)]
+pub struct MadeDirs {
+    made: Vec<PathBuf>,
+}
+
+impl MadeDirs {
+    /// Makes `dir` and its missing parents, remembering which were missing.
+    pub fn create(dir: &Path) -> std::io::Result<Self> {
+        let made = dir
+            .ancestors()
+            .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+            .map(Path::to_path_buf)
+            .collect();
+        let guard = Self { made };
+        std::fs::create_dir_all(dir)?;
+        Ok(guard)
+    }
+}
+
+impl Drop for MadeDirs {
+    fn drop(&mut self) {
+        // `remove_dir` removes only an empty folder: one with an output in it stays, and so do its
+        // parents.
+        for d in &self.made {
+            if std::fs::remove_dir(d).is_err() {
+                break;
+            }
+        }
+    }
+}

@@ -4,7 +4,7 @@
 use crate::cloth::{Grid, tributary_lengths};
 use crate::material::Rigidities;
 use crate::physics::{
-    CellShear, CellTwist, EnergyTerm, Gravity, LinearBending, Model, SpringFamily, Springs,
+    CellShear, CellTwist, EnergyTerm, LinearBending, Model, ModelBuilder, SpringFamily, Springs,
 };
 use crate::scene::{Scene, ValidatedScene};
 use nalgebra::Vector3;
@@ -74,79 +74,57 @@ outside the sheet; pin fewer or use a finer grid (cloth.nx, cloth.ny)",
     ))
 }
 
-/// Builds the model of a validated scene.
+/// Builds the model of a validated scene ([`ModelBuilder`]: the material's terms on the grid, then
+/// gravity, point loads, the obstacles' barrier and self-contact).
 pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
     let c = &scene.cloth;
     let grid = scene.grid();
     let mut x0 = initial_positions(scene);
-    let mut masses = grid.lumped_masses(c.areal_density_kg_per_m2);
-    let mut fixed = vec![false; grid.len()];
+    let mut b = ModelBuilder::new(
+        grid.lumped_masses(c.areal_density_kg_per_m2),
+        vec![false; grid.len()],
+        scene.gravity.g_m_per_s2,
+    );
     // A disc sheet: the particles outside the inscribed circle are absent (fixed, massless, in no term).
     let absent = absent_particles(scene, &x0);
     for (p, &a) in absent.iter().enumerate() {
         if a {
-            masses[p] = 0.0;
-            fixed[p] = true;
+            b.masses[p] = 0.0;
+            b.fixed[p] = true;
         }
     }
     for corner in &scene.boundary.pin_corners {
         let (i, j) = corner.ij(&grid);
-        fixed[grid.index(i, j)] = true;
+        b.fixed[grid.index(i, j)] = true;
     }
     for p in &scene.boundary.pin_particles {
-        fixed[grid.index(p[0], p[1])] = true;
+        b.fixed[grid.index(p[0], p[1])] = true;
     }
-    let mut terms: Vec<Box<dyn EnergyTerm>> = Vec::new();
-    let g = scene.gravity.g_m_per_s2;
-    let (damping, elongation) = match &scene.material.mass_spring {
-        Some(ms) => (ms.damping_Ns_per_m, Some(ms.elongation_rate)),
-        None => (0.0, None),
-    };
     if let Some(ms) = &scene.material.mass_spring {
-        mass_spring_terms(scene, ms, &grid, &absent, &mut fixed, &mut terms);
+        b.mass_spring_dynamics(ms.damping_Ns_per_m, Some(ms.elongation_rate));
+        mass_spring_terms(scene, ms, &grid, &absent, &mut b.fixed, &mut b.terms);
     }
-    let mut held = Vec::new();
     if let Some(cont) = &scene.material.continuum {
         let r = cont.rigidities().expect("validated scene");
-        symmetry_planes(
-            &grid,
-            &r,
-            &scene.boundary.symmetry_edges,
-            &x0,
-            &mut held,
-            &mut terms,
-        );
-        continuum_terms(
-            &grid,
-            &r,
-            &absent,
-            &scene.boundary.clamp_edges,
-            &mut fixed,
-            &mut masses,
-            &mut x0,
-            &mut terms,
-        );
+        let edges = &scene.boundary.symmetry_edges;
+        symmetry_planes(&grid, &r, edges, &x0, &mut b.held, &mut b.terms);
+        let clamps = &scene.boundary.clamp_edges;
+        continuum_terms(&grid, &r, &absent, clamps, &mut b, &mut x0);
     }
-    if g > 0.0 {
-        terms.push(Box::new(Gravity::new(masses.clone(), g)));
+    b.gravity();
+    point_loads(scene, &grid, &absent, &x0, &mut b.terms);
+    holds(scene, &grid, &mut b.held);
+    contact_terms(scene, &x0, &mut b);
+    if scene.solver.kind.self_contact(scene.contact.self_contact) {
+        let xi = self_thickness_m(scene);
+        let triangles = sheet_triangles(&grid, &absent);
+        b.self_contact(triangles, &x0, (xi, xi), kappa_gravity(scene));
     }
-    point_loads(scene, &grid, &absent, &x0, &mut terms);
-    holds(scene, &grid, &mut held);
-    contact_terms(scene, &x0, &masses, &mut fixed, &mut terms);
-    if let Some(t) = self_contact(scene, &grid, &absent, &x0, &masses) {
-        terms.push(Box::new(t));
+    BuiltScene {
+        grid,
+        model: b.build(),
+        x0,
     }
-    let model = Model {
-        n_grid: grid.len(),
-        masses,
-        fixed,
-        held_components: held,
-        terms,
-        gravity_m_per_s2: g,
-        damping_Ns_per_m: damping,
-        elongation_rate: elongation,
-    };
-    BuiltScene { grid, model, x0 }
 }
 
 /// Seed 000's mass-spring net (§3, Table 3): structural, shear and bend springs of the present
@@ -280,20 +258,14 @@ fn holds(scene: &Scene, grid: &Grid, held: &mut Vec<[bool; 3]>) {
 /// form (a skirt's waist), are fixed (seed 003 §10.5, §10.7.2.3); with
 /// the barrier method every other particle gets the barrier term (the vertical-gap method works in the
 /// solver instead, [`crate::simulate`]).
-fn contact_terms(
-    scene: &Scene,
-    x0: &[Vector3<f64>],
-    masses: &[f64],
-    fixed: &mut [bool],
-    terms: &mut Vec<Box<dyn EnergyTerm>>,
-) {
+fn contact_terms(scene: &Scene, x0: &[Vector3<f64>], b: &mut ModelBuilder) {
     use crate::contact::Obstacle;
     use crate::scene::ContactMethod;
     if scene.obstacles.is_empty() {
         return;
     }
     if scene.contact.fix_supported {
-        for (p, x) in x0.iter().enumerate().take(fixed.len()) {
+        for (p, x) in x0.iter().enumerate().take(b.fixed.len()) {
             let on_top = scene.obstacles.iter().any(|o| match o {
                 Obstacle::Box { .. } | Obstacle::Pedestal { .. } => o.top_at(x.x, x.y).is_some(),
                 // A body form: the part over its flat top (the waist of a skirt).
@@ -304,12 +276,23 @@ fn contact_terms(
                 _ => false,
             });
             if on_top {
-                fixed[p] = true;
+                b.fixed[p] = true;
             }
         }
     }
     if scene.contact.method == ContactMethod::Barrier {
-        terms.push(Box::new(barrier_contact(scene, masses, fixed)));
+        let (obstacles, d_hat) = (scene.obstacles.clone(), scene.contact.distance_m);
+        b.obstacles(obstacles, d_hat, kappa_gravity(scene));
+    }
+}
+
+/// The gravity the barriers' κ is set by (a particle's weight at a tenth of the band): the scene's,
+/// or the standard one in a scene without gravity (whose contacts are pressed by loads).
+fn kappa_gravity(scene: &Scene) -> f64 {
+    if scene.gravity.g_m_per_s2 > 0.0 {
+        scene.gravity.g_m_per_s2
+    } else {
+        crate::STANDARD_GRAVITY_M_PER_S2
     }
 }
 
@@ -320,17 +303,12 @@ pub fn barrier_contact(
     masses: &[f64],
     fixed: &[bool],
 ) -> crate::physics::BarrierContact {
-    let g = if scene.gravity.g_m_per_s2 > 0.0 {
-        scene.gravity.g_m_per_s2
-    } else {
-        crate::STANDARD_GRAVITY_M_PER_S2
-    };
     crate::physics::BarrierContact::for_particles(
         scene.obstacles.clone(),
         scene.contact.distance_m,
         masses,
         fixed,
-        g,
+        kappa_gravity(scene),
     )
 }
 
@@ -354,40 +332,6 @@ pub fn sheet_triangles(grid: &Grid, absent: &[bool]) -> Vec<[u32; 3]> {
         .into_iter()
         .filter(|t| t.iter().all(|&v| !absent[v as usize]))
         .collect()
-}
-
-/// The sheet's self-contact term (when the scene's `contact.self` and solver ask for it): the grid
-/// triangulated over its present particles, thickness ξ ([`self_thickness_m`]), band ξ, κ from the
-/// mean particle weight.
-fn self_contact(
-    scene: &Scene,
-    grid: &Grid,
-    absent: &[bool],
-    x0: &[Vector3<f64>],
-    masses: &[f64],
-) -> Option<crate::physics::SelfContact> {
-    if !scene.solver.kind.self_contact(scene.contact.self_contact) {
-        return None;
-    }
-    let triangles = sheet_triangles(grid, absent);
-    let heavy: Vec<f64> = masses[..grid.len()]
-        .iter()
-        .copied()
-        .filter(|m| *m > 0.0)
-        .collect();
-    if triangles.is_empty() || heavy.is_empty() {
-        return None;
-    }
-    let g = if scene.gravity.g_m_per_s2 > 0.0 {
-        scene.gravity.g_m_per_s2
-    } else {
-        crate::STANDARD_GRAVITY_M_PER_S2
-    };
-    let weight = g * heavy.iter().sum::<f64>() / heavy.len() as f64;
-    let xi = self_thickness_m(scene);
-    Some(crate::physics::SelfContact::new(
-        triangles, x0, xi, xi, weight,
-    ))
 }
 
 /// Symmetry planes along grid edges (a quarter or half model, seed 003 §10.4.2): the particles on the
@@ -489,12 +433,11 @@ fn continuum_terms(
     r: &Rigidities,
     absent: &[bool],
     clamps: &[crate::cloth::Edge],
-    fixed: &mut Vec<bool>,
-    masses: &mut Vec<f64>,
+    b: &mut ModelBuilder,
     x0: &mut Vec<Vector3<f64>>,
-    terms: &mut Vec<Box<dyn EnergyTerm>>,
 ) {
     let (nx, ny) = (grid.nx, grid.ny);
+    let (fixed, masses, terms) = (&mut b.fixed, &mut b.masses, &mut b.terms);
     let wx = tributary_lengths(&grid.xs);
     let wy = tributary_lengths(&grid.ys);
     terms.push(Box::new(tensile_springs(grid, r, absent)));

@@ -27,6 +27,7 @@ pub mod measure;
 pub mod optim;
 pub mod params;
 pub mod physics;
+pub mod provenance;
 pub mod raster;
 pub mod scene;
 pub mod sensitivity;

@@ -171,10 +171,8 @@ fn every_terms_gradient_and_hessian_match_central_differences_in_every_bundled_s
             }
             checked.insert(t.name());
         }
-        // Contact is in play only near the drape: its coefficients (κ, d̂, the obstacles' shapes,
-        // the thickness) are checked at the drape itself, where pairs and particles sit inside the
-        // barrier's band (off it, a particle may be inside an obstacle).
-        // Friction is checked off the drape, where its anchored particles slip.
+        // Contact's coefficients (κ, d̂, obstacle shapes, thickness) are checked at the drape, in
+        // the barrier's band (off it a particle may be inside); friction off it, where it slips.
         let drape = sol.x.clone();
         for t in sol
             .model
@@ -191,40 +189,7 @@ fn every_terms_gradient_and_hessian_match_central_differences_in_every_bundled_s
                 continue;
             }
             let c = t.coefficients();
-            // Random changes of all; each of the last few alone where it is not zero (the band, the
-            // thickness: a random change of all is mostly the per-particle κ); and random changes
-            // of the last few together (the obstacles' shapes, a zero coordinate by ±1 mm: one
-            // alone may move nothing by symmetry, a pedestal's centre along x).
-            let tail = c.len().saturating_sub(16);
-            let single = |i: usize| -> Vec<f64> {
-                let mut d = vec![0.0; c.len()];
-                d[i] = c[i];
-                d
-            };
-            let mut changes: Vec<Vec<f64>> = (0..2)
-                .map(|_| random_change(&c, &mut rng))
-                .chain((tail..c.len()).filter(|&i| c[i] != 0.0).map(single))
-                .collect();
-            for _ in 0..2 {
-                let mut d = random_change(&c, &mut rng);
-                for (i, v) in d.iter_mut().enumerate() {
-                    if i < tail {
-                        *v = 0.0;
-                    } else if c[i] == 0.0 {
-                        *v = 1e-3 * (rng.random::<f64>() * 2.0 - 1.0);
-                    }
-                }
-                changes.push(d);
-            }
-            for dc in changes {
-                let (e, e_energy) = coefficient_error(t.as_mut(), x, &dc);
-                assert!(e <= 1e-6, "{name}: {}: ∂g/∂c off by {e:e}", t.name());
-                assert!(
-                    e_energy <= 1e-6,
-                    "{name}: {}: ∂E/∂c off by {e_energy:e}",
-                    t.name()
-                );
-            }
+            check_contact_coefficients(t.as_mut(), x, &name, &mut rng);
             let mut g = vec![Vector3::zeros(); x.len()];
             t.add_coefficient_gradient(x, &random_change(&c, &mut rng), &mut g);
             if g.iter().any(|v| v.norm() > 0.0) {
@@ -247,6 +212,51 @@ fn every_terms_gradient_and_hessian_match_central_differences_in_every_bundled_s
         );
     }
     eprintln!("terms checked: {checked:?}");
+}
+
+/// Checks a contact term's derivatives in its coefficients at `x` (see the caller): random changes
+/// of all of them and of its last few (band, thickness, obstacle shapes), alone and together.
+fn check_contact_coefficients(
+    t: &mut dyn EnergyTerm,
+    x: &[Vector3<f64>],
+    name: &str,
+    rng: &mut impl Rng,
+) {
+    let c = t.coefficients();
+    // Random changes of all; each of the last few alone where it is not zero (the band, the
+    // thickness: a random change of all is mostly the per-particle κ); and random changes
+    // of the last few together (the obstacles' shapes, a zero coordinate by ±1 mm: one
+    // alone may move nothing by symmetry, a pedestal's centre along x).
+    let tail = c.len().saturating_sub(16);
+    let single = |i: usize| -> Vec<f64> {
+        let mut d = vec![0.0; c.len()];
+        d[i] = c[i];
+        d
+    };
+    let mut changes: Vec<Vec<f64>> = (0..2)
+        .map(|_| random_change(&c, rng))
+        .chain((tail..c.len()).filter(|&i| c[i] != 0.0).map(single))
+        .collect();
+    for _ in 0..2 {
+        let mut d = random_change(&c, rng);
+        for (i, v) in d.iter_mut().enumerate() {
+            if i < tail {
+                *v = 0.0;
+            } else if c[i] == 0.0 {
+                *v = 1e-3 * (rng.random::<f64>() * 2.0 - 1.0);
+            }
+        }
+        changes.push(d);
+    }
+    for dc in changes {
+        let (e, e_energy) = coefficient_error(t, x, &dc);
+        assert!(e <= 1e-6, "{name}: {}: ∂g/∂c off by {e:e}", t.name());
+        assert!(
+            e_energy <= 1e-6,
+            "{name}: {}: ∂E/∂c off by {e_energy:e}",
+            t.name()
+        );
+    }
 }
 
 /// The relative errors of a term's mixed derivative ∂g/∂c · dc (2-norm) and of ∂E/∂c · dc at `x`

@@ -26,7 +26,8 @@ pub use outcome::{FailureCause, StageOutcome, StaleReason};
 pub use plan::{Paths, Plan, PlannedStage, StageSpec, load_plan};
 pub use progress::{LogProgress, MultiBarProgress, Progress, progress_for_terminal};
 pub use runner::{
-    RunOptions, RunSummary, StageState, manifest_path, run_pipeline, run_worker, stage_states,
+    RunOptions, RunSummary, StageState, load_checked_plan, manifest_path, run_pipeline, run_worker,
+    stage_states,
 };
 pub use stage::{
     ItemKind, ParamError, Registry, Slot, Stage, StageContext, StageKind, typed_params,

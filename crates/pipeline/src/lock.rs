@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 pub struct Holder {
     /// Process id.
     pub pid: u32,
-    /// Host name (`HOSTNAME`, else "unknown").
+    /// Host name ([`drapelab_core::provenance::host`]).
     pub host: String,
     /// When it took the lock, Unix time in s.
     pub started_unix_s: u64,
@@ -27,21 +27,20 @@ impl Holder {
     fn this_process() -> Self {
         Self {
             pid: std::process::id(),
-            host: std::env::var("HOSTNAME").unwrap_or_else(|_| "unknown".into()),
-            started_unix_s: std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map(|d| d.as_secs())
-                .unwrap_or(0),
+            host: drapelab_core::provenance::host(),
+            started_unix_s: drapelab_core::provenance::unix_now_s(),
             command_line: std::env::args().collect(),
         }
     }
     fn describe(&self) -> String {
+        use drapelab_core::provenance::{age, utc};
         format!(
-            "process {} on {} (`{}`, since Unix time {} s)",
+            "process {} on {} (`{}`), running since {} ({} ago)",
             self.pid,
             self.host,
             self.command_line.join(" "),
-            self.started_unix_s
+            utc(self.started_unix_s),
+            age(self.started_unix_s)
         )
     }
 }
@@ -126,6 +125,15 @@ impl Drop for RunLock {
     fn drop(&mut self) {
         // An empty file means "released cleanly"; the kernel drops the lock with the descriptor.
         self.file.set_len(0).ok();
+        // A run that wrote nothing (refused as bad input before its first stage) leaves no folder:
+        // the lock file goes, then the folder if it is empty. (A run waiting on this lock then
+        // holds a removed file; a third run arriving in that instant would make a new one.)
+        if let Some(dir) = self.path.parent()
+            && std::fs::read_dir(dir).is_ok_and(|d| d.count() == 1)
+        {
+            std::fs::remove_file(&self.path).ok();
+            std::fs::remove_dir(dir).ok();
+        }
         self.file.unlock().ok();
     }
 }
@@ -144,16 +152,19 @@ mod tests {
 
     #[test]
     fn a_second_lock_is_refused_naming_the_holder_and_a_left_record_is_taken_over() {
-        let dir = tempfile::tempdir().unwrap();
-        let first = RunLock::acquire(dir.path(), LockWait::No).unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let run = tmp.path().join("runs/t");
+        let first = RunLock::acquire(&run, LockWait::No).unwrap();
         assert!(first.taken_over.is_none());
-        let err = RunLock::acquire(dir.path(), LockWait::No).unwrap_err();
+        let err = RunLock::acquire(&run, LockWait::No).unwrap_err();
         assert!(
             err.message
                 .contains(&format!("process {}", std::process::id())),
             "{err}"
         );
         drop(first);
+        // A run that wrote nothing leaves no folder behind.
+        assert!(!run.exists());
         // A record without a holder (as a killed run leaves it) is taken over.
         let stale = Holder {
             pid: 4_000_000,
@@ -161,12 +172,9 @@ mod tests {
             started_unix_s: 1,
             command_line: vec!["drapelab".into(), "run".into()],
         };
-        std::fs::write(
-            dir.path().join(".lock"),
-            serde_json::to_string(&stale).unwrap(),
-        )
-        .unwrap();
-        let again = RunLock::acquire(dir.path(), LockWait::No).unwrap();
+        std::fs::create_dir_all(&run).unwrap();
+        std::fs::write(run.join(".lock"), serde_json::to_string(&stale).unwrap()).unwrap();
+        let again = RunLock::acquire(&run, LockWait::No).unwrap();
         assert_eq!(again.taken_over, Some(stale));
     }
 }

@@ -36,19 +36,7 @@ pub struct Manifest {
     pub build: String,
 }
 
-/// The first 16 hex digits of the blake3 hash of the running executable: a rebuilt drapelab (changed
-/// code) makes every stage stale, while rebuilding unchanged code gives the same binary and leaves
-/// them up to date. Hashed once per process.
-pub fn build_id() -> &'static str {
-    static ID: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    ID.get_or_init(|| {
-        std::env::current_exe()
-            .ok()
-            .and_then(|p| hash_file(&p).ok())
-            .map(|h| h[..16].to_string())
-            .unwrap_or_else(|| "unknown".into())
-    })
-}
+pub use drapelab_core::provenance::build_id;
 
 impl Manifest {
     /// Reads a manifest; None when absent or unreadable (then the stage is stale).

@@ -145,7 +145,8 @@ impl Plan {
     }
 }
 
-/// The project root of a pipeline file: the folder above `pipelines/`, else the file's folder.
+/// The project root of a pipeline file: the folder above `pipelines/`, else the file's folder. A
+/// file named from inside `pipelines/` (`cd pipelines && drapelab status main.toml`) finds it too.
 pub fn project_root(file: &Path) -> PathBuf {
     let dir = file.parent().map(Path::to_path_buf).unwrap_or_default();
     let dir = if dir.as_os_str().is_empty() {
@@ -153,13 +154,17 @@ pub fn project_root(file: &Path) -> PathBuf {
     } else {
         dir
     };
-    if dir.file_name().is_some_and(|n| n == "pipelines") {
-        dir.parent()
+    let is_pipelines = |d: &Path| d.file_name().is_some_and(|n| n == "pipelines");
+    if is_pipelines(&dir) {
+        return dir
+            .parent()
             .map(Path::to_path_buf)
             .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or_else(|| PathBuf::from("."))
-    } else {
-        dir
+            .unwrap_or_else(|| PathBuf::from("."));
+    }
+    match dir.canonicalize() {
+        Ok(abs) if is_pipelines(&abs) => abs.parent().map_or(dir, Path::to_path_buf),
+        _ => dir,
     }
 }
 

@@ -311,6 +311,41 @@ impl RunSummary {
 }
 
 /// The context of stage `s` now (its input files by slot, its outputs) and its input hashes.
+/// Reads and validates a pipeline file ([`load_plan`](crate::load_plan)), then checks each stage
+/// whose inputs all exist against them ([`Stage::precheck`](crate::Stage::precheck): a scene's
+/// overrides, a sweep's axes): bad input is refused here, in `status` and `--dry-run` as in `run`.
+pub fn load_checked_plan(file: &Path, registry: &crate::Registry) -> Result<Plan> {
+    let plan = crate::load_plan(file, registry)?;
+    let silent = Silent;
+    for s in &plan.stages {
+        let (ctx, _) = stage_context(&plan, s, &silent);
+        let all_there = s.input_patterns.keys().all(|k| {
+            ctx.inputs
+                .get(k)
+                .is_some_and(|f| !f.is_empty() && f.iter().all(|p| p.is_file()))
+        });
+        if !all_there {
+            continue;
+        }
+        // Only bad input refuses the plan; another failure (an unreadable file) is the run's.
+        match s.kind.precheck(&ctx) {
+            Err(e) if e.chain().any(|c| c.is::<InputError>()) => return Err(e),
+            _ => {}
+        }
+    }
+    Ok(plan)
+}
+
+/// A progress that says nothing (the checks of [`load_checked_plan`]).
+struct Silent;
+
+impl Progress for Silent {
+    fn stage_started(&self, _stage: &str, _items: u64) {}
+    fn item_done(&self, _stage: &str) {}
+    fn stage_finished(&self, _stage: &str, _outcome: &StageOutcome, _wall_s: f64) {}
+    fn stage_skipped(&self, _stage: &str, _why: &str) {}
+}
+
 fn stage_context<'a>(
     plan: &Plan,
     s: &PlannedStage,
@@ -402,9 +437,11 @@ fn run_stage(
 ) -> Result<StageOutcome> {
     let start = Instant::now();
     let (ctx, inputs) = stage_context(plan, s, progress);
+    // Output folders this stage makes: removed again if it fails leaving them empty.
+    let mut _made = Vec::new();
     for o in ctx.outputs.values() {
         if let Some(d) = o.parent() {
-            std::fs::create_dir_all(d)?;
+            _made.push(drapelab_core::atomic::MadeDirs::create(d)?);
             remove_partials(d);
         }
     }

@@ -81,6 +81,14 @@ pub trait Stage: Send + Sync {
     /// Checks a params table; the resolved parameters (defaults filled in) as JSON, part of the
     /// up-to-date key.
     fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError>;
+    /// Checks the parameters against the stage's input files, when the plan loads and every
+    /// input already exists (a scene's overrides against the scene): an [`InputError`] refuses the
+    /// plan in `status`, `run --dry-run` and `run` alike, before any work.
+    ///
+    /// [`InputError`]: drapelab_core::error::InputError
+    fn precheck(&self, _ctx: &StageContext<'_>) -> Result<()> {
+        Ok(())
+    }
     /// Runs the stage (a stage with items runs through [`Stage::items`] instead).
     fn run(&self, ctx: &StageContext<'_>) -> Result<()>;
     /// How many independent items the stage has, when it runs by items (parts and executors,
@@ -114,6 +122,10 @@ pub trait StageKind: Send + Sync + 'static {
     const OUTPUTS: &'static [Slot];
     /// Checks beyond the types (ranges, consistency).
     fn check(_params: &Self::Params) -> Result<(), ParamError> {
+        Ok(())
+    }
+    /// [`Stage::precheck`] with the typed parameters. Default: nothing to check.
+    fn precheck(_ctx: &StageContext<'_>, _params: &Self::Params) -> Result<()> {
         Ok(())
     }
     /// Runs the stage with its parameters (not called for an [`ItemKind`]).
@@ -185,6 +197,9 @@ macro_rules! typed_stage_methods {
             let p: K::Params = typed_params(params)?;
             K::check(&p)?;
             serde_json::to_value(&p).map_err(|e| ParamError::new("", e.to_string()))
+        }
+        fn precheck(&self, ctx: &StageContext<'_>) -> Result<()> {
+            K::precheck(ctx, &params_of::<K>(ctx)?)
         }
         fn run(&self, ctx: &StageContext<'_>) -> Result<()> {
             K::run(ctx, &params_of::<K>(ctx)?)

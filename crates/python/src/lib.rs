@@ -73,7 +73,7 @@ fn simulate<'py>(
     }
     let extras = drapelab_record::SimulateExtras {
         sensitivity_keys: sensitivity,
-        start: None,
+        ..Default::default()
     };
     let out = Path::new(out).to_path_buf();
     let (done, interrupted) = py.detach(|| {
@@ -229,8 +229,7 @@ fn run_pipeline(
     force: Vec<String>,
 ) -> PyResult<String> {
     let registry = drapelab_stages::registry();
-    let plan =
-        drapelab_pipeline::load_plan(Path::new(path), &registry).map_err(|e| to_py(e.into()))?;
+    let plan = drapelab_pipeline::load_checked_plan(Path::new(path), &registry).map_err(to_py)?;
     let opts = drapelab_pipeline::RunOptions {
         until,
         force,

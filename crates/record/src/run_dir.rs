@@ -14,6 +14,12 @@ use std::path::Path;
 #[derive(Serialize)]
 struct RunRecord<'a> {
     drapelab_version: &'a str,
+    /// The build that ran: the first 16 hex digits of the executable's blake3 hash.
+    build_id: &'a str,
+    /// When the run finished, RFC 3339 UTC.
+    finished_utc: String,
+    /// The machine it ran on.
+    host: String,
     scene_file: String,
     command_line: Vec<String>,
     status: &'a str,
@@ -35,10 +41,12 @@ struct RunRecord<'a> {
 }
 
 /// Every file `simulate` may write into its folder.
-pub const SIMULATE_FILES: [&str; 6] = [
+pub const SIMULATE_FILES: [&str; 8] = [
     "run.json",
     "particles.parquet",
     "last_state.parquet",
+    "triangles.parquet",
+    "drape.obj",
     "timeline.mcap",
     "drape.rrd",
     "sensitivity.parquet",
@@ -72,6 +80,8 @@ pub struct SimulateExtras {
     /// A saved drape to start from (`simulate --start FILE`): the grid particles' positions in
     /// particles.parquet's row order, and the file's name for run.json.
     pub start: Option<(Vec<nalgebra::Vector3<f64>>, String)>,
+    /// Also write the converged drape as `drape.obj` (`simulate --obj`).
+    pub obj: bool,
 }
 
 /// Solves `loaded` and writes its outputs into `out` (created if needed). Returns the report; a
@@ -240,22 +250,10 @@ fn simulate_into(
         drapelab_core::simulate::check_crossings(scene, &grid, &model, &x, &mut r);
         r
     };
-    let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));
     let mut outputs = vec!["run.json"];
     finish_recorders(&report, &x, (timeline, rrd), &mut outputs)?;
-    let meta = [
-        ("drapelab_version", drapelab_core::VERSION.to_string()),
-        ("status", report.status.as_str().to_string()),
-        ("solver", report.solver.clone()),
-        ("scene", scene.name.clone()),
-    ];
-    if report.status == Status::Converged {
-        write_particles(&out.join("particles.parquet"), &grid, &x, &absent, &meta)?;
-        outputs.push("particles.parquet");
-    } else if finite && report.status != Status::Diverged {
-        write_particles(&out.join("last_state.parquet"), &grid, &x, &absent, &meta)?;
-        outputs.push("last_state.parquet");
-    }
+    let state = (&grid, absent.as_slice(), x.as_slice());
+    state_files(scene, state, &report, extras.obj, out, &mut outputs)?;
     let (sensitivity, sens_data) = sensitivities(loaded, &grid, &model, &x, &report, extras, out)?;
     if sensitivity.as_ref().is_some_and(|s| s.written) {
         outputs.push("sensitivity.parquet");
@@ -263,6 +261,9 @@ fn simulate_into(
     let terms = model.term_names();
     let record = RunRecord {
         drapelab_version: drapelab_core::VERSION,
+        build_id: drapelab_core::provenance::build_id(),
+        finished_utc: drapelab_core::provenance::utc(drapelab_core::provenance::unix_now_s()),
+        host: drapelab_core::provenance::host(),
         scene_file: loaded.path.display().to_string(),
         command_line: std::env::args().collect(),
         status: report.status.as_str(),
@@ -294,6 +295,47 @@ fn simulate_into(
         },
         written,
     ))
+}
+
+/// The final state: `particles.parquet` of a converged drape, else `last_state.parquet` of a
+/// finite one (labelled by its status, for looking at where it went wrong; a non-finite state is
+/// not written); beside it the sheet as a mesh, `triangles.parquet`, and `drape.obj` of a
+/// converged drape when asked.
+fn state_files(
+    scene: &Scene,
+    (grid, absent, x): (
+        &drapelab_core::cloth::Grid,
+        &[bool],
+        &[nalgebra::Vector3<f64>],
+    ),
+    report: &SolveReport,
+    obj: bool,
+    out: &Path,
+    outputs: &mut Vec<&'static str>,
+) -> Result<()> {
+    let meta = [
+        ("drapelab_version", drapelab_core::VERSION.to_string()),
+        ("status", report.status.as_str().to_string()),
+        ("solver", report.solver.clone()),
+        ("scene", scene.name.clone()),
+    ];
+    let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));
+    let file = match (report.status == Status::Converged, finite) {
+        (true, _) => "particles.parquet",
+        (false, true) => "last_state.parquet",
+        (false, false) => return Ok(()),
+    };
+    write_particles(&out.join(file), grid, x, absent, &meta)?;
+    outputs.push(file);
+    let tris = drapelab_core::build::sheet_triangles(grid, absent);
+    crate::write_triangles(&out.join("triangles.parquet"), &tris)?;
+    outputs.push("triangles.parquet");
+    if obj && report.is_converged() {
+        let text = crate::obj_text(&scene.name, &x[..grid.len()], &tris);
+        drapelab_core::atomic::write_text(&out.join("drape.obj"), &text)?;
+        outputs.push("drape.obj");
+    }
+    Ok(())
 }
 
 /// Closes the recorders with the final state (when finite) and names their files in `outputs`; a

@@ -19,6 +19,13 @@ impl StageKind for Simulate {
         Slot::optional("timeline", "timeline.mcap, when record.timeline is set"),
         Slot::optional("recording", "drape.rrd, when record.rerun is set"),
     ];
+    /// The scene loads with the overrides (a bad value is refused naming `params.set.KEY`).
+    fn precheck(ctx: &StageContext<'_>, p: &SimulateParams) -> Result<()> {
+        let ctx = &crate::job(ctx);
+        let overrides: Vec<_> = p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
+        ctx.load_scene(ctx.input("scene")?, &overrides, |k| format!("set.{k}"))
+            .map(drop)
+    }
     fn run(ctx: &StageContext<'_>, p: &SimulateParams) -> Result<()> {
         let ctx = &crate::job(ctx);
         run(ctx, p).map(drop)

@@ -24,6 +24,10 @@ impl StageKind for Sweep {
     fn check(p: &SweepParams) -> Result<(), ParamError> {
         p.check().map_err(|(k, m)| ParamError::new(k, m))
     }
+    /// Every scene loads at every point (a bad axis or `set` value is refused naming it).
+    fn precheck(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {
+        count(&crate::job(ctx), p).map(drop)
+    }
 }
 
 /// Items: every scene at every design point (scene-major), one row each.

@@ -8,9 +8,7 @@
 
 use super::Tester;
 use crate::contact::Obstacle;
-use crate::physics::{
-    BarrierContact, Gravity, Model, SpringFamily, Springs, saturating_hinge_bending,
-};
+use crate::physics::{Model, ModelBuilder, SpringFamily, Springs, saturating_hinge_bending};
 use crate::solve::{
     Direction, FactorReuse, ImplicitSettings, NoObserver, Observer, Regularization, Settle,
     SolveReport, StaticOptions, StopReason, integrate_implicit, solve_static,
@@ -140,37 +138,36 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
     let rigidity = weight * p.bending_length_m.powi(3);
     let root = p.bending_ratio.max(1e-6).sqrt();
     let fixed: Vec<bool> = mesh.rest_xy.iter().map(|q| held(q, tester)).collect();
-    let mut terms: Vec<Box<dyn crate::physics::EnergyTerm>> = vec![
-        Box::new(Springs::new(SpringFamily::Tensile, pairs, rest, stiff)),
-        Box::new(saturating_hinge_bending(
-            mesh.rest_xy,
-            mesh.triangles,
-            [rigidity * root, rigidity / root],
-            p.warp_angle_deg.to_radians(),
-            p.bending_saturation
-                .map_or(f64::INFINITY, |s| s / p.bending_length_m),
-        )),
-        Box::new(Gravity::new(masses.clone(), p.gravity_m_per_s2)),
-        Box::new(pedestal_contact(&masses, &fixed, p, tester)),
-    ];
+    let mut b = ModelBuilder::new(masses, fixed, p.gravity_m_per_s2);
+    b.term(Box::new(Springs::new(
+        SpringFamily::Tensile,
+        pairs,
+        rest,
+        stiff,
+    )));
+    b.term(Box::new(saturating_hinge_bending(
+        mesh.rest_xy,
+        mesh.triangles,
+        [rigidity * root, rigidity / root],
+        p.warp_angle_deg.to_radians(),
+        p.bending_saturation
+            .map_or(f64::INFINITY, |s| s / p.bending_length_m),
+    )));
+    b.gravity();
+    // The pedestal (its top at z = 0, 1 m deep): a barrier keeps every free vertex out of it on any
+    // path (the fall, Newton's iterations), exact step bound (it is convex).
+    let pedestal = Obstacle::Pedestal {
+        centre_m: [0.0, 0.0, 0.0],
+        radius_m: tester.pedestal_radius_m,
+        height_m: 1.0,
+    };
+    b.obstacles(vec![pedestal], PEDESTAL_CONTACT_M, p.gravity_m_per_s2);
     if let Some(xi) = p.self_thickness_m {
         let rest: Vec<Vector3<f64>> = (0..n).map(rest3).collect();
         let tris = mesh.triangles.iter().map(|t| t.map(|v| v as u32)).collect();
-        let weight = p.gravity_m_per_s2 * masses.iter().sum::<f64>() / n.max(1) as f64;
-        terms.push(Box::new(crate::physics::SelfContact::new(
-            tris, &rest, xi, xi, weight,
-        )));
+        b.self_contact(tris, &rest, (xi, xi), p.gravity_m_per_s2);
     }
-    Model {
-        masses: masses.clone(),
-        fixed: fixed.clone(),
-        held_components: Vec::new(),
-        n_grid: n,
-        terms,
-        gravity_m_per_s2: p.gravity_m_per_s2,
-        damping_Ns_per_m: 0.0,
-        elongation_rate: None,
-    }
+    b.build()
 }
 
 /// Activation distance of the pedestal's barrier, m (a third of a fabric's thickness).
@@ -180,28 +177,6 @@ pub const PEDESTAL_CONTACT_M: f64 = 1e-4;
 /// the barrier's activation distance (a free vertex there would start touching the obstacle).
 fn held(q: &[f64; 2], tester: &Tester) -> bool {
     q[0].hypot(q[1]) < tester.pedestal_radius_m + PEDESTAL_CONTACT_M
-}
-
-/// The pedestal as an obstacle (its top at z = 0, 1 m deep): a barrier keeps every free vertex out
-/// of it on any path (the fall, Newton's iterations), exact step bound (it is convex).
-fn pedestal_contact(
-    masses: &[f64],
-    fixed: &[bool],
-    p: &DrapeParams,
-    tester: &Tester,
-) -> BarrierContact {
-    let pedestal = Obstacle::Pedestal {
-        centre_m: [0.0, 0.0, 0.0],
-        radius_m: tester.pedestal_radius_m,
-        height_m: 1.0,
-    };
-    BarrierContact::for_particles(
-        vec![pedestal],
-        PEDESTAL_CONTACT_M,
-        masses,
-        fixed,
-        p.gravity_m_per_s2,
-    )
 }
 
 /// The start: the specimen lowered into a cone of slope `start_cone_deg` outside the pedestal, every

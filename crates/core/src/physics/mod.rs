@@ -2,6 +2,7 @@
 //! semi-definite (projected) Hessian as 3×3 blocks. A [`Model`] is the sum of the terms a scene needs,
 //! the lumped masses and the pinned particles; solvers see nothing else.
 
+mod assembly;
 mod bending;
 mod contact;
 mod friction;
@@ -12,6 +13,7 @@ mod self_contact;
 mod shear;
 mod springs;
 
+pub use assembly::ModelBuilder;
 pub use bending::{
     CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,
 };
