@@ -10,9 +10,9 @@ exception: its :attr:`Result.status` says so (``"max-iterations"``, ``"diverged"
 release the GIL and stop on Ctrl-C (``KeyboardInterrupt``) within about 50 ms of an iteration.
 
 >>> import drapelab
->>> r = drapelab.simulate("datasets/scenes/hang4.toml", set={"cloth.nx": 21, "cloth.ny": 21})
->>> r.status, r.positions.shape
-('converged', (441, 3))
+>>> r = drapelab.simulate("datasets/scenes/hang4.toml", overrides={"cloth.nx": 21, "cloth.ny": 21})
+>>> r.status, r.positions.shape, r.grid().shape
+('converged', (441, 3), (21, 21, 3))
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ import os
 import pathlib
 import shutil
 import tempfile
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -35,6 +36,7 @@ __all__ = [
     "InputError",
     "Result",
     "simulate",
+    "simulate_many",
     "read_scene",
     "measure_drape",
     "measure_silhouette",
@@ -50,6 +52,8 @@ SIMULATE_FILES = (
     "run.json",
     "particles.parquet",
     "last_state.parquet",
+    "triangles.parquet",
+    "drape.obj",
     "timeline.mcap",
     "drape.rrd",
     "sensitivity.parquet",
@@ -92,8 +96,10 @@ class Result:
     def __init__(self, run_json: str, positions: bytes, present: bytes, triangles: bytes,
                  nx: int, ny: int, native_time_s: float,
                  sensitivities: Sequence[Tuple[str, bytes]] = (),
+                 frames: Sequence[Tuple[int, Optional[float], bytes]] = (),
                  *, tmp: tempfile.TemporaryDirectory) -> None:
         self._tmp = tmp
+        self._frames = frames
         self._sensitivities = {
             k: np.frombuffer(v, dtype="<f8").reshape(-1, 3).copy() for k, v in sensitivities
         }
@@ -133,6 +139,41 @@ class Result:
         which the Rust API ``sensitivity::Equilibrium::gradient`` does)."""
         g = np.asarray(dj_dx, dtype=float).reshape(-1, 3)
         return {k: float(np.sum(self.sensitivity(k) * g)) for k in keys}
+
+    def grid(self) -> np.ndarray:
+        """The positions as the grid they sit on: an ``(ny, nx, 3)`` view of :attr:`positions`,
+        ``grid()[j, i]`` the particle in column ``i`` and row ``j`` (the centre is
+        ``grid()[ny // 2, nx // 2]``)."""
+        return self.positions.reshape(self.ny, self.nx, 3)
+
+    def frames(self) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
+        """The solve's states as ``simulate(..., frames=K)`` kept them (at most K, evenly spaced
+        over the Newton iterations or time steps, the first included): ``(x, index, t)`` with
+        ``x`` an ``(frames, n, 3)`` float64 array (m, rows as :attr:`positions`), ``index`` the
+        iteration or step of each and ``t`` its simulated time in s (None for a static solve).
+
+        Raises:
+            RuntimeError: no frames were asked for.
+        """
+        if not self._frames:
+            raise RuntimeError("no frames: pass simulate(..., frames=200) to keep them")
+        x = np.stack([np.frombuffer(b, dtype="<f8").reshape(-1, 3) for _, _, b in self._frames])
+        index = np.array([i for i, _, _ in self._frames], dtype=np.int64)
+        times = [t for _, t, _ in self._frames]
+        t = None if any(v is None for v in times) else np.array(times, dtype=float)
+        return x, index, t
+
+    def to_pandas(self):
+        """The particles (``i``, ``j``, ``x_m``, ``y_m``, ``z_m``, ``present``) as a pandas
+        DataFrame, rows as :attr:`positions` (needs ``pandas``)."""
+        import pandas as pd
+
+        j, i = np.divmod(np.arange(self.nx * self.ny), self.nx)
+        return pd.DataFrame({
+            "i": i.astype(np.uint32), "j": j.astype(np.uint32),
+            "x_m": self.positions[:, 0], "y_m": self.positions[:, 1], "z_m": self.positions[:, 2],
+            "present": self.present,
+        })
 
     @property
     def converged(self) -> bool:
@@ -190,16 +231,25 @@ def read_scene(path: PathLike) -> Dict[str, Any]:
 
 
 def simulate(scene: Union[PathLike, Mapping[str, Any]],
-             set: Optional[Mapping[str, Any]] = None,
-             sensitivity: Sequence[str] = ()) -> Result:
+             overrides: Optional[Mapping[str, Any]] = None,
+             sensitivity: Sequence[str] = (),
+             frames: int = 0,
+             progress: Optional[Callable[[int, Optional[float], float, float], Any]] = None,
+             *, set: Optional[Mapping[str, Any]] = None) -> Result:
     """Solves a scene as ``drapelab simulate`` does.
 
     Args:
         scene: a scene TOML file's path, or a dict with the same keys (``read_scene`` gives one).
-        set: overrides by dotted key, e.g. ``{"cloth.nx": 21, "cloth.areal_density_kg_per_m2": 0.2}``;
-            a grid override moves pins and holds to the same material points.
+        overrides: values by dotted key, e.g.
+            ``{"cloth.nx": 21, "cloth.areal_density_kg_per_m2": 0.2}``; a grid override moves pins
+            and holds to the same material points. (``set=`` is its old name, still taken.)
         sensitivity: continuous scene keys whose sensitivities dx*/dθ to compute at the converged
             drape (:meth:`Result.sensitivity`), e.g. ``["material.mass_spring.stiffness_N_per_m"]``.
+        frames: keep up to this many states of the solve, evenly spaced (:meth:`Result.frames`);
+            0 keeps none.
+        progress: called as ``progress(index, time_s, max_residual_N, energy_J)`` at most every
+            50 ms during the solve (``time_s`` None for a static solve); an exception it raises
+            stops the solve and is raised again.
 
     Returns:
         The :class:`Result`, converged or not (see its ``status``).
@@ -208,18 +258,56 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
         InputError: an unknown key, a bad value or an unreadable file, named in the message.
         KeyboardInterrupt: Ctrl-C during the solve.
     """
-    overrides = _json(dict(set or {}))
+    if set is not None and overrides is not None:
+        raise InputError("set: give overrides= (its new name) or set=, not both")
+    overrides_json = _json(dict(overrides if overrides is not None else (set or {})))
     if isinstance(scene, Mapping):
         path, table = None, _json(dict(scene))
     else:
         path, table = os.fspath(scene), None
+    if not isinstance(frames, int) or frames < 0:
+        raise InputError(f"frames: a count ≥ 0, got {frames!r}")
     tmp = tempfile.TemporaryDirectory(prefix="drapelab-")
     try:
-        out = _drapelab.simulate(path, table, overrides, tmp.name, list(sensitivity))
+        out = _drapelab.simulate(path, table, overrides_json, tmp.name, list(sensitivity),
+                                 frames, progress)
     except BaseException:
         tmp.cleanup()
         raise
     return Result(*out, tmp=tmp)
+
+
+def simulate_many(scenes: Union[PathLike, Mapping[str, Any],
+                                Sequence[Union[PathLike, Mapping[str, Any]]]],
+                  overrides: Optional[Sequence[Mapping[str, Any]]] = None,
+                  threads: Optional[int] = None, **kwargs: Any) -> List[Result]:
+    """Solves several scenes at once, each as :func:`simulate` does, in parallel threads (the
+    solves release the GIL): a list of scenes, or one scene under a list of overrides (a sweep), or
+    both paired one to one. Results come back in order.
+
+    Args:
+        scenes: a scene (path or dict) or a list of them.
+        overrides: a list of override dicts (one solve each).
+        threads: how many solves at a time (default: the CPU count).
+        **kwargs: passed to every :func:`simulate` (``sensitivity``, ``frames``).
+
+    >>> rs = drapelab.simulate_many("datasets/scenes/hang4.toml",
+    ...     overrides=[{"material.mass_spring.stiffness_N_per_m": k} for k in (600.0, 1100.0)])
+    """
+    single = isinstance(scenes, (str, os.PathLike, Mapping))
+    scene_list = [scenes] if single else list(scenes)
+    over = list(overrides) if overrides is not None else [None]
+    if len(scene_list) == 1:
+        scene_list = scene_list * len(over)
+    elif len(over) == 1:
+        over = over * len(scene_list)
+    if len(scene_list) != len(over):
+        raise InputError(f"overrides: {len(over)} for {len(scene_list)} scenes; give one per scene")
+    if threads is not None and (not isinstance(threads, int) or threads < 1):
+        raise InputError(f"threads: a count ≥ 1, got {threads!r}")
+    with ThreadPoolExecutor(max_workers=threads or os.cpu_count() or 1) as pool:
+        jobs = [pool.submit(simulate, s, o, **kwargs) for s, o in zip(scene_list, over)]
+        return [j.result() for j in jobs]
 
 
 def _measures(text: str) -> Dict[str, Any]:
@@ -334,8 +422,9 @@ def run_pipeline(path: PathLike, until: Optional[str] = None,
     """Runs a pipeline make-style, as ``drapelab run`` does: only stale stages run.
 
     Args:
-        path: the pipeline file (``pipelines/main.toml``); paths in it are relative to the current
-            folder, as for the command line.
+        path: the pipeline file (``pipelines/main.toml``); paths in it are relative to the project
+            root, the folder above ``pipelines/`` (else the file's own folder), wherever Python runs,
+            as for the command line.
         until: run only this stage and what it depends on.
         force: rerun these stages and their dependents even when up to date.
 

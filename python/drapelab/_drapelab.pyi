@@ -1,7 +1,7 @@
 """Type stubs of drapelab's native module (crates/python): plain values in and out; the public API is
 `drapelab` itself, which wraps these into NumPy arrays, dicts and `Result`."""
 
-from typing import List, Optional, Tuple
+from typing import Any, Callable, List, Optional, Tuple
 
 class InputError(ValueError):
     """Bad input: the message names the file (or argument) and the key."""
@@ -14,10 +14,14 @@ def simulate(
     set_json: str,
     out: str,
     sensitivity: List[str] = ...,
-) -> Tuple[str, bytes, bytes, bytes, int, int, float, List[Tuple[str, bytes]]]:
+    frames: int = ...,
+    progress: Optional[Callable[[int, Optional[float], float, float], Any]] = ...,
+) -> Tuple[str, bytes, bytes, bytes, int, int, float, List[Tuple[str, bytes]],
+           List[Tuple[int, Optional[float], bytes]]]:
     """run.json's text, positions (n×3 little-endian f64, m), present (n bytes), triangles
-    (m×3 little-endian u32), nx, ny, seconds spent in Rust, and per key asked for its
-    sensitivities (n×3 little-endian f64, m per unit of the key)."""
+    (m×3 little-endian u32), nx, ny, seconds spent in Rust, per key asked for its
+    sensitivities (n×3 little-endian f64, m per unit of the key), and the frames kept
+    (iteration or step, simulated time or None, n×3 little-endian f64, m)."""
 
 def drape_of_mesh(positions: bytes, triangles: bytes) -> str: ...
 def drape_of_silhouette(path: str, scale_json: str) -> str: ...

@@ -129,7 +129,7 @@ pub enum Command {
         dry_run: bool,
         /// Where the items of sweep and calibrate stages run, overriding the pipeline's [executor]
         /// kind: local (this process's threads) or slurm (one `sbatch --array` job per stage; needs
-        /// a filesystem shared with the nodes; README "Running on a Slurm cluster").
+        /// a filesystem shared with the nodes; docs/src/guide/slurm.md).
         #[arg(long, value_enum)]
         executor: Option<ExecutorArg>,
         /// When another `drapelab run` holds this pipeline's run folder, wait for it to finish
@@ -178,7 +178,7 @@ pub enum Command {
     /// List every Parquet table drapelab writes: its columns (units in the names), types, nullability.
     ///
     /// The listing is traced from the tables' row types, the one place each schema is written; the
-    /// README's "Tables" section is this output.
+    /// book's Tables page (docs/src/reference/tables.md) is this output.
     Tables,
     /// Dress a drape as a smooth textured surface (seed 003 §10.8) for 3D tools and pictures.
     ///
@@ -206,7 +206,7 @@ pub enum Command {
     /// Seed 000 Figs 3, 11, 12. Writes DIR/edges.parquet (edge, power, coefficient of x^power in cm,
     /// RMS residual, points) and DIR/overlay.png (fitted curves red, reference line blue). Calibrate
     /// with --px-per-cm and --corners, or --markers and --side-cm, or --camera-json (a camera file
-    /// as the README's "Camera files" describes it, or the one `render` writes).
+    /// as docs/src/guide/photos.md describes it, or the one `render` writes).
     FitEdges(FitEdgesArgs),
     /// Score simulated edges against measured ones (seed 000 Eq. 5).
     ///

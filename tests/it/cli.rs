@@ -333,3 +333,84 @@ fn a_sheet_with_nothing_free_is_bad_input_and_leaves_nothing() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn every_physical_number_out_of_range_is_refused_naming_its_key() {
+    // A property test over the bundled scenes: each continuous key set to a value no fabric has
+    // (infinite, NaN, ±1e300, 1e-300) is refused naming that key; through the command line it is
+    // exit 2 with one line and nothing written, for a sample of them.
+    use drapelab::params::{continuous_keys, with_value};
+    use drapelab::scene::Scene;
+    let bad = [f64::NAN, f64::INFINITY, 1e300, -1e300, 1e-300];
+    let mut refused = 0;
+    let mut sample = Vec::new();
+    let dir = root().join("datasets/scenes");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    for file in &files {
+        let scene = Scene::load(file, &[]).unwrap().scene.into_inner();
+        for key in continuous_keys(&scene) {
+            for v in bad {
+                match with_value(&scene, &key, v, "mutated") {
+                    Ok(_) => panic!("{}: {key} = {v} was accepted", file.display()),
+                    Err(e) => assert_eq!(e.key, key, "{}: {key} = {v}: {e}", file.display()),
+                }
+                refused += 1;
+            }
+            if sample.len() < 12 && refused % 37 == 0 {
+                sample.push((file.clone(), key.clone()));
+            }
+        }
+    }
+    assert!(refused > 500, "{refused}");
+    let tmp = tempfile::tempdir().unwrap();
+    for (k, (file, key)) in sample.iter().enumerate() {
+        let out = tmp.path().join(format!("o{k}"));
+        crate::support::assert_bad_input(
+            [
+                Path::new("simulate"),
+                file,
+                Path::new("--out"),
+                &out,
+                Path::new("--set"),
+                Path::new(&format!("{key}=1e300")),
+            ],
+            &[key.as_str()],
+        );
+        assert!(!out.exists(), "{key}: a refused run left {}", out.display());
+    }
+}
+
+#[test]
+fn verbose_simulate_logs_the_iterations_and_the_work() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = root().join("datasets/scenes/hang4.toml");
+    let run = |flags: &[&str], out: &str| {
+        let o = drapelab()
+            .args(flags)
+            .arg("simulate")
+            .arg(&scene)
+            .arg("--out")
+            .arg(tmp.path().join(out))
+            .env_remove("RUST_LOG")
+            .output()
+            .unwrap();
+        assert!(o.status.success());
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let (plain, v, vv) = (run(&[], "a"), run(&["-v"], "b"), run(&["-vv"], "c"));
+    let steps = |s: &str| {
+        s.lines()
+            .filter(|l| l.contains("residual") && l.contains("step "))
+            .count()
+    };
+    assert_eq!(steps(&plain), 0, "{plain}");
+    assert!(v.contains("step 0:") && v.contains("factorizations"), "{v}");
+    // hang4 converges in 11 iterations: -v logs steps 0 and 10, -vv every one.
+    assert_eq!(steps(&v), 2, "{v}");
+    assert!(steps(&vv) >= 11, "{vv}");
+}

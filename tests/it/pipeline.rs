@@ -353,6 +353,10 @@ want = {"scene": pa.string(), "point": pa.uint32(), "material.mass_spring.stiffn
 for k, ty in want.items():
     assert t.schema.field(k).type == ty, (k, t.schema.field(k).type)
 assert t.num_rows == 4
+# The run's metadata: which drapelab made it, where and when.
+meta = {k.decode(): v.decode() for k, v in t.schema.metadata.items()}
+assert {"drapelab_version", "build_id", "host", "finished_utc"} <= set(meta), meta
+assert len(meta["build_id"]) == 16 and meta["finished_utc"].endswith("Z"), meta
 df = pl.read_parquet(sys.argv[1])
 assert (df["status"] == "converged").all()
 # Stiffer springs sag less: the centre hangs higher at 1100 N/m than at 600 N/m.

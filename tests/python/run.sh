@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 target="${CARGO_TARGET_DIR:-$PWD/target}"
 venv=.venv-package
-if ! "$venv/bin/python" -c "import pytest, pyarrow, polars, matplotlib" 2>/dev/null; then
+if ! "$venv/bin/python" -c "import pytest, pyarrow, polars, matplotlib, pandas" 2>/dev/null; then
     python3 -m venv "$venv"
     "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r tests/python/requirements.txt
 fi

@@ -44,7 +44,7 @@ pub struct CalibrateParams {
     pub edge_source: EdgeSource,
     /// Measurement error of the photos in the cost's unit (curve distance, % of the side), for the
     /// identifiability analysis: a worst-case bound (0.03 is the photo-to-particle gap of the bundled
-    /// dataset, README "Edges from photos"). Default: none, the standard error of least squares
+    /// dataset, docs/src/guide/photos.md). Default: none, the standard error of least squares
     /// estimated from the residual at the optimum ([`drapelab_core::calibrate::Noise`]).
     #[serde(default)]
     pub measurement_noise_pct: Option<f64>,

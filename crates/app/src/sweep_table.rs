@@ -25,7 +25,7 @@ pub struct SweepPoint {
 
 impl Table for SweepPoint {
     const FILE: &'static str = "sweep.parquet";
-    const ROW: &'static str = "One scene at one design point. Its first columns; then one column per swept key (named by its first key, e.g. `material.mass_spring.stiffness_N_per_m`; i64, f64 or string), then the columns below.";
+    const ROW: &'static str = "One scene at one design point. Its first columns; then one column per swept key (named by its first key, e.g. `material.mass_spring.stiffness_N_per_m`; i64, f64 or string), then the columns below. Schema metadata: `drapelab_version`, `build_id`, `host`, `finished_utc` (as every table gathered from parts).";
 }
 
 /// How one point solved and how it drapes: the last columns of `sweep.parquet`. The drape measures

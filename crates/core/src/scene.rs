@@ -16,9 +16,9 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClothSpec {
-    /// Side along x in m.
+    /// Side along x in m, 1e-4 to 100 ([`SHEET_SIDE_M`]).
     pub size_x_m: f64,
-    /// Side along y in m.
+    /// Side along y in m, 1e-4 to 100.
     pub size_y_m: f64,
     /// Particles along x (≥ 2).
     pub nx: usize,
@@ -141,7 +141,8 @@ pub struct PointLoad {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GravitySpec {
-    /// Gravitational acceleration in m/s², acting along −z. Default 9.80665.
+    /// Gravitational acceleration in m/s², acting along −z, 0 to 1000 ([`GRAVITY_M_PER_S2`]).
+    /// Default 9.80665.
     #[serde(default = "default_g")]
     pub g_m_per_s2: f64,
 }
@@ -527,6 +528,7 @@ impl Scene {
     /// Checks every value's range; the error names the key.
     pub fn validate(&self, path: &Path) -> Result<(), InputError> {
         let ck = Check { path };
+        self.check_magnitudes(&ck)?;
         self.check_cloth(&ck)?;
         self.check_material(&ck)?;
         self.check_boundary(&ck)?;
@@ -534,11 +536,49 @@ impl Scene {
         self.check_solver(&ck)
     }
 
+    /// Every physical number of the scene (its solver and recording options aside) is finite and
+    /// zero or of a size drapelab computes in ([`MAGNITUDES`]); the error names the dotted key.
+    fn check_magnitudes(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        fn walk(ck: &Check<'_>, key: &str, v: &toml::Value) -> Result<(), InputError> {
+            match v {
+                toml::Value::Float(f) if !f.is_finite() => {
+                    ck.err(key, format!("must be a finite number, got {f}"))
+                }
+                toml::Value::Float(f)
+                    if *f != 0.0 && !(MAGNITUDES.0..=MAGNITUDES.1).contains(&f.abs()) =>
+                {
+                    ck.err(
+                        key,
+                        format!(
+                            "{f} is outside the sizes drapelab computes in: zero, or {:e} to {:e} \
+in the key's unit (SI)",
+                            MAGNITUDES.0, MAGNITUDES.1
+                        ),
+                    )
+                }
+                toml::Value::Table(t) => t
+                    .iter()
+                    .try_for_each(|(k, v)| walk(ck, &format!("{key}.{k}"), v)),
+                toml::Value::Array(a) => a
+                    .iter()
+                    .enumerate()
+                    .try_for_each(|(i, v)| walk(ck, &format!("{key}.{i}"), v)),
+                _ => Ok(()),
+            }
+        }
+        let Ok(toml::Value::Table(t)) = toml::Value::try_from(self) else {
+            return Ok(());
+        };
+        t.iter()
+            .filter(|(k, _)| !["solver", "record"].contains(&k.as_str()))
+            .try_for_each(|(k, v)| walk(ck, k, v))
+    }
+
     /// The cloth: sizes, density, grid, grading and refined lines.
     fn check_cloth(&self, ck: &Check<'_>) -> Result<(), InputError> {
         let c = &self.cloth;
-        ck.pos("cloth.size_x_m", c.size_x_m)?;
-        ck.pos("cloth.size_y_m", c.size_y_m)?;
+        ck.within("cloth.size_x_m", c.size_x_m, SHEET_SIDE_M)?;
+        ck.within("cloth.size_y_m", c.size_y_m, SHEET_SIDE_M)?;
         ck.pos("cloth.areal_density_kg_per_m2", c.areal_density_kg_per_m2)?;
         if !c.initial_perturbation_m.is_finite() {
             return ck.err("cloth.initial_perturbation_m", "must be finite".into());
@@ -839,6 +879,11 @@ would already touch itself; use a coarser grid or a thinner sheet"
     /// Gravity, the solvers' tolerances and budgets, and the recording.
     fn check_solver(&self, ck: &Check<'_>) -> Result<(), InputError> {
         ck.nonneg("gravity.g_m_per_s2", self.gravity.g_m_per_s2)?;
+        ck.within(
+            "gravity.g_m_per_s2",
+            self.gravity.g_m_per_s2,
+            GRAVITY_M_PER_S2,
+        )?;
         let s = &self.solver.static_;
         ck.pos("solver.static.residual_tol_rel", s.residual_tol_rel)?;
         ck.pos("solver.static.lm_damping_initial", s.lm_damping_initial)?;
@@ -957,7 +1002,26 @@ impl Check<'_> {
         }
         Ok(())
     }
+    /// `v` within the physical bounds `(lo, hi)` of the key (in its unit).
+    fn within(&self, key: &str, v: f64, (lo, hi): (f64, f64)) -> Result<(), InputError> {
+        if !(v.is_finite() && (lo..=hi).contains(&v)) {
+            return self.err(key, format!("must be in {lo} to {hi}, got {v}"));
+        }
+        Ok(())
+    }
 }
+
+/// The sizes drapelab computes in: every physical number of a scene is zero or between these in
+/// size, in SI units (10⁻¹² to 10¹²): beyond them sums of forces and energies lose their digits or
+/// overflow, and a solve would end in NaN as if the physics had failed.
+pub const MAGNITUDES: (f64, f64) = (1e-12, 1e12);
+
+/// The sides a sheet may have, m: from 0.1 mm (a yarn's width) to 100 m.
+pub const SHEET_SIDE_M: (f64, f64) = (1e-4, 100.0);
+
+/// The gravitational accelerations a scene may have, m/s²: none (0, loads alone) to 1000 (a
+/// centrifuge's 100 g).
+pub const GRAVITY_M_PER_S2: (f64, f64) = (0.0, 1000.0);
 
 /// The solver keys issue 46 turned from booleans into strategies, read as their successors: (table,
 /// old boolean, new key, its value for true, for false).

@@ -10,6 +10,7 @@
 
 mod convert;
 mod interrupt;
+mod watch;
 
 use convert::{bytes_f64, f64_bytes, json, load_scene, u32_bytes};
 use drapelab_app::calibrate::{CalibrateParams, calibrate_one, calibrate_one_lm};
@@ -39,7 +40,8 @@ pub(crate) fn to_py(e: anyhow::Error) -> PyErr {
 
 /// What `simulate` hands the Python half: run.json's text, positions (n × 3 f64, m), present
 /// (n bytes), triangles (m × 3 u32), nx, ny, the seconds spent in Rust (scene loaded, solved,
-/// files written, arrays made), and the sensitivities asked for (key, n × 3 f64 m per unit).
+/// files written, arrays made), the sensitivities asked for (key, n × 3 f64 m per unit) and the
+/// frames kept (iteration or step, simulated time, n × 3 f64 m).
 type Simulated<'py> = (
     String,
     Bound<'py, PyBytes>,
@@ -49,12 +51,14 @@ type Simulated<'py> = (
     usize,
     f64,
     Vec<(String, Bound<'py, PyBytes>)>,
+    Vec<(usize, Option<f64>, Bound<'py, PyBytes>)>,
 );
 
 /// Solves a scene (a TOML file, or a table as JSON text) with dotted overrides (JSON object) into
 /// the folder `out`, as `drapelab simulate --out` does.
 #[pyfunction]
-#[pyo3(signature = (scene_path, scene_json, set_json, out, sensitivity=Vec::new()))]
+#[pyo3(signature = (scene_path, scene_json, set_json, out, sensitivity=Vec::new(), frames=0, progress=None))]
+#[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
     scene_path: Option<String>,
@@ -62,6 +66,8 @@ fn simulate<'py>(
     set_json: &str,
     out: &str,
     sensitivity: Vec<String>,
+    frames: usize,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Simulated<'py>> {
     let started = std::time::Instant::now();
     let loaded = load_scene(scene_path.as_deref(), scene_json.as_deref(), set_json)?;
@@ -76,12 +82,15 @@ fn simulate<'py>(
         ..Default::default()
     };
     let out = Path::new(out).to_path_buf();
-    let (done, interrupted) = py.detach(|| {
+    let n = loaded.scene.grid().len();
+    let (done, interrupted, watch) = py.detach(|| {
         let mut stop = Interrupt::new();
-        let done = drapelab_record::simulate_to_dir_with(&loaded, &out, &mut stop, &extras);
-        (done, stop.into_error())
+        let mut watch = watch::Watch::new(progress, frames, n);
+        let mut both = drapelab_core::solve::Observers(vec![&mut stop, &mut watch]);
+        let done = drapelab_record::simulate_to_dir_with(&loaded, &out, &mut both, &extras);
+        (done, stop.into_error(), watch)
     });
-    if let Some(e) = interrupted {
+    if let Some(e) = interrupted.or(watch.error) {
         return Err(e);
     }
     let s = done.map_err(to_py)?;
@@ -107,6 +116,11 @@ fn simulate<'py>(
                 let v: Vec<f64> = dx.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
                 (k.clone(), PyBytes::new(py, &f64_bytes(&v)))
             })
+            .collect(),
+        watch
+            .frames
+            .iter()
+            .map(|(i, t, x)| (*i, *t, PyBytes::new(py, &f64_bytes(x))))
             .collect(),
     ))
 }

@@ -1,6 +1,6 @@
 //! `edges.parquet`: one row per sample, edge and power of a fitted edge polynomial (seed 000 §2.3).
 
-use crate::table::{Table, read_table, write_table};
+use crate::table::{Table, write_table};
 use anyhow::Result;
 use drapelab_core::edges::{EdgeFit, Projection};
 use serde::{Deserialize, Serialize};
@@ -15,8 +15,9 @@ pub struct EdgeRow {
     pub edge: String,
     /// Power of x this coefficient multiplies.
     pub power: u32,
-    /// Coefficient of x^power, x and y in cm.
-    pub coefficient: f64,
+    /// Coefficient of x^power in y(x) with x and y in cm: its unit is cm^(1 − power). Files
+    /// written before the unit was in the name (column `coefficient`) are read as well.
+    pub coefficient_cm: f64,
     /// RMS distance of the edge points from the polynomial, cm.
     pub rms_residual_cm: f64,
     /// Edge points fitted.
@@ -60,7 +61,7 @@ pub fn write_edges(path: &Path, fits: &[(String, EdgeFit)]) -> Result<()> {
                     sample: s.clone(),
                     edge: f.edge.clone(),
                     power: p as u32,
-                    coefficient: *c,
+                    coefficient_cm: *c,
                     rms_residual_cm: f.rms_residual_cm,
                     n_points: f.n_points as u32,
                     x_min_cm: f.x_min_cm,
@@ -78,7 +79,9 @@ pub fn write_edges(path: &Path, fits: &[(String, EdgeFit)]) -> Result<()> {
 /// Reads (sample, fit) pairs back, in file order, coefficients by power.
 pub fn read_edges(path: &Path) -> Result<Vec<(String, EdgeFit)>> {
     let mut out: Vec<(String, EdgeFit)> = Vec::new();
-    for r in read_table::<EdgeRow>(path)? {
+    for r in
+        crate::table::read_table_renamed::<EdgeRow>(path, &[("coefficient", "coefficient_cm")])?
+    {
         let k = match out
             .iter()
             .position(|(s, e)| *s == r.sample && e.edge == r.edge)
@@ -114,7 +117,30 @@ pub fn read_edges(path: &Path) -> Result<Vec<(String, EdgeFit)>> {
         if c.len() <= p {
             c.resize(p + 1, 0.0);
         }
-        c[p] = r.coefficient;
+        c[p] = r.coefficient_cm;
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_table_with_the_old_coefficient_column_reads_as_the_new_one() {
+        // The bundled ground truth was written with the column `coefficient`.
+        let old = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../datasets/knitted/sample_08/hang4/edges_truth.parquet");
+        let fits = read_edges(&old).unwrap();
+        assert!(!fits.is_empty());
+        // Written again, it has `coefficient_cm`, and reads back the same.
+        let dir = tempfile::tempdir().unwrap();
+        let new = dir.path().join("edges.parquet");
+        write_edges(&new, &fits).unwrap();
+        let again = read_edges(&new).unwrap();
+        for ((s, a), (t, b)) in fits.iter().zip(&again) {
+            assert_eq!((s, &a.edge, &a.coefficients), (t, &b.edge, &b.coefficients));
+            assert!(a.coefficients.iter().any(|c| *c != 0.0));
+        }
+    }
 }

@@ -42,7 +42,36 @@ pub fn gather_parquet(parts: &[PathBuf], out: &Path) -> Result<()> {
         batches.extend(b);
     }
     let batch = arrow::compute::concat_batches(&schema, &batches)?;
-    write_parquet(out, &batch, None)
+    // Which drapelab made the table, where and when, in the Arrow schema (pyarrow's
+    // `read_table(...).schema.metadata`) and as Parquet key-value pairs.
+    let meta = run_metadata();
+    let schema = schema
+        .as_ref()
+        .clone()
+        .with_metadata(meta.iter().cloned().collect());
+    let kv = meta
+        .into_iter()
+        .map(|(k, v)| parquet::file::metadata::KeyValue::new(k, v))
+        .collect();
+    let props = crate::table::writer_properties()
+        .set_key_value_metadata(Some(kv))
+        .build();
+    write_parquet(
+        out,
+        &batch.with_schema(std::sync::Arc::new(schema))?,
+        Some(props),
+    )
+}
+
+/// The run metadata of a gathered table: `drapelab_version`, `build_id`, `host`, `finished_utc`.
+pub fn run_metadata() -> Vec<(String, String)> {
+    use drapelab_core::provenance::{build_id, host, unix_now_s, utc};
+    vec![
+        ("drapelab_version".into(), drapelab_core::VERSION.into()),
+        ("build_id".into(), build_id().into()),
+        ("host".into(), host()),
+        ("finished_utc".into(), utc(unix_now_s())),
+    ]
 }
 
 /// Writes one rerun recording at `out` (atomically, application `app`) holding every chunk of the

@@ -97,6 +97,12 @@ pub fn table_markdown<T: Table>() -> Result<String> {
 /// be opened, is not Parquet, or does not hold `T`'s columns is an
 /// [`InputError`](drapelab_core::error::InputError) naming it (exit 2).
 pub fn read_table<T: Table>(path: &Path) -> Result<Vec<T>> {
+    read_table_renamed(path, &[])
+}
+
+/// [`read_table`] of a file whose columns may carry older names: each `(old, new)` of `renames`
+/// is read as `new` (a column renamed when its unit joined its name).
+pub fn read_table_renamed<T: Table>(path: &Path, renames: &[(&str, &str)]) -> Result<Vec<T>> {
     use drapelab_core::error::InputError;
     let bad = |what: String| InputError::new(path, "", what);
     let f = std::fs::File::open(path).map_err(|e| bad(format!("cannot open: {e}")))?;
@@ -111,11 +117,37 @@ pub fn read_table<T: Table>(path: &Path) -> Result<Vec<T>> {
     let mut out = Vec::new();
     for batch in reader {
         let batch = batch.map_err(|e| bad(format!("corrupt Parquet data: {e}")))?;
+        let batch = renamed(batch, renames)?;
         let rows: Vec<T> = serde_arrow::from_record_batch(&batch)
             .map_err(|e| bad(format!("not a {} table: {e}", T::FILE)))?;
         out.extend(rows);
     }
     Ok(out)
+}
+
+/// `batch` with its columns named `old` renamed `new` (those it has).
+fn renamed(batch: RecordBatch, renames: &[(&str, &str)]) -> Result<RecordBatch> {
+    let schema = batch.schema();
+    if !schema
+        .fields()
+        .iter()
+        .any(|f| renames.iter().any(|(o, _)| f.name() == o))
+    {
+        return Ok(batch);
+    }
+    let fields: Vec<arrow::datatypes::Field> = schema
+        .fields()
+        .iter()
+        .map(|f| match renames.iter().find(|(o, _)| f.name() == o) {
+            Some((_, n)) => f.as_ref().clone().with_name(*n),
+            None => f.as_ref().clone(),
+        })
+        .collect();
+    let schema = arrow::datatypes::Schema::new_with_metadata(fields, schema.metadata().clone());
+    Ok(RecordBatch::try_new(
+        std::sync::Arc::new(schema),
+        batch.columns().to_vec(),
+    )?)
 }
 
 #[cfg(test)]

@@ -36,6 +36,11 @@ pub struct ReportParams {
     /// Free text placed under the title.
     #[serde(default)]
     pub notes: String,
+    /// Whether the summary shows the mean wall time per point (`mean_wall_time_ms`). Default
+    /// false: the report then holds no number of this machine, and a rerun elsewhere rewrites it
+    /// unchanged (a tracked report stays clean in git).
+    #[serde(default)]
+    pub timings: bool,
 }
 
 impl ReportParams {
@@ -178,22 +183,29 @@ pub fn run(ctx: &Job<'_>, p: &ReportParams) -> Result<()> {
     let mut lf = scan_all(ctx.input_files("tables"))?;
     check_schema(ctx, &mut lf, p)?;
     let group: Vec<Expr> = p.group_by.iter().map(|c| col(c.as_str())).collect();
-    let summary = lf
-        .clone()
-        .group_by(group.clone())
-        .agg([
-            len().alias("points"),
-            col("status")
-                .eq(lit(drapelab_core::solve::Status::Converged.as_str()))
-                .sum()
-                .alias("converged"),
+    let mut aggs = vec![
+        len().alias("points"),
+        col("status")
+            .eq(lit(drapelab_core::solve::Status::Converged.as_str()))
+            .sum()
+            .alias("converged"),
+    ];
+    if p.timings {
+        aggs.push(
             (col("wall_time_s") * lit(1000.0))
                 .mean()
                 .alias("mean_wall_time_ms"),
-            col("iterations").mean().alias("mean_iterations"),
-            col(p.y.as_str()).min().alias(format!("min_{}", p.y)),
-            col(p.y.as_str()).max().alias(format!("max_{}", p.y)),
-        ])
+        );
+    }
+    aggs.extend([
+        col("iterations").mean().alias("mean_iterations"),
+        col(p.y.as_str()).min().alias(format!("min_{}", p.y)),
+        col(p.y.as_str()).max().alias(format!("max_{}", p.y)),
+    ]);
+    let summary = lf
+        .clone()
+        .group_by(group.clone())
+        .agg(aggs)
         .sort(p.group_by.clone(), SortMultipleOptions::default())
         .collect()?;
     ctx.item_done();

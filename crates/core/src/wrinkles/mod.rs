@@ -4,7 +4,7 @@
 //! amplitudes in geometric progression a_{i−1}/a_i = Q (Eq. 5) from the upper boundary a_n to the lower
 //! boundary a₀; out of plane, line i sits at z = ±z_max cos(πx/l), alternating from line to line (Eq. 4).
 //!
-//! The seed's text is garbled in its equations; drapelab reads them as follows (README "Wrinkles"):
+//! The seed's text is garbled in its equations; drapelab reads them as follows (docs/src/science/wrinkles.md):
 //! - Eq. 7, enforced with equality: w h (Q − 1)/(t (Q + 1)) = σ_c = c E t² / (l² (1 − ν²)), so the
 //!   critical ratio is Q_c = (1 + s)/(1 − s) with s = c E t³ / (w h l² (1 − ν²)); s ≥ 1 means the
 //!   sheet is stiff enough not to wrinkle (n = 0). The load constant c is not given by the seed.
