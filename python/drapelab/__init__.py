@@ -50,6 +50,7 @@ PathLike = Union[str, "os.PathLike[str]"]
 #: Every file a simulation may write into its folder (``drapelab simulate --out``).
 SIMULATE_FILES = (
     "run.json",
+    "iterations.parquet",
     "particles.parquet",
     "last_state.parquet",
     "triangles.parquet",
@@ -418,7 +419,8 @@ def calibrate(edges: PathLike, sample: str, *, samples: PathLike, scene: PathLik
 
 
 def run_pipeline(path: PathLike, until: Optional[str] = None,
-                 force: Optional[Sequence[str]] = None) -> Dict[str, Any]:
+                 force: Optional[Sequence[str]] = None,
+                 progress: Optional[Callable[[str, str, int, int], Any]] = None) -> Dict[str, Any]:
     """Runs a pipeline make-style, as ``drapelab run`` does: only stale stages run.
 
     Args:
@@ -427,8 +429,11 @@ def run_pipeline(path: PathLike, until: Optional[str] = None,
             as for the command line.
         until: run only this stage and what it depends on.
         force: rerun these stages and their dependents even when up to date.
+        progress: called as ``progress(stage, event, done, total)`` with event ``"started"``,
+            ``"item"`` (one of a stage's ``total`` items done), ``"finished"`` or ``"skipped"``;
+            an exception it raises is raised when the run ends.
 
     Returns:
         ``{"pipeline", "run_dir", "ran": [...], "up_to_date": [...], "failed": {stage: why}, "ok"}``.
     """
-    return json.loads(_drapelab.run_pipeline(os.fspath(path), until, list(force or [])))
+    return json.loads(_drapelab.run_pipeline(os.fspath(path), until, list(force or []), progress))

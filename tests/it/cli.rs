@@ -122,6 +122,19 @@ fn set_overrides_reach_the_solve_and_outputs_are_written() {
         serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(run["status"], "converged");
     assert_eq!(run["scene"]["cloth"]["nx"], 7);
+    // How the solve went, an iteration a row: as many rows as iterations plus the start, the
+    // residual at the last one the report's.
+    let history: Vec<drapelab::io::IterationRow> =
+        drapelab::io::read_table(&out.join("iterations.parquet")).unwrap();
+    let iterations = run["report"]["iterations"].as_u64().unwrap();
+    assert_eq!(history.len() as u64, iterations + 1);
+    assert!(history.iter().enumerate().all(|(k, r)| r.index == k as u64));
+    let last = history.last().unwrap().max_residual_N;
+    let reported = run["report"]["max_residual_N"].as_f64().unwrap();
+    assert!(
+        (last - reported).abs() <= 1e-9 * reported.max(1e-300),
+        "{last} {reported}"
+    );
     // No temporary files are left behind.
     for e in std::fs::read_dir(&out).unwrap() {
         let name = e.unwrap().file_name().to_string_lossy().to_string();
@@ -357,7 +370,9 @@ fn every_physical_number_out_of_range_is_refused_naming_its_key() {
             for v in bad {
                 match with_value(&scene, &key, v, "mutated") {
                     Ok(_) => panic!("{}: {key} = {v} was accepted", file.display()),
-                    Err(e) => assert_eq!(e.key, key, "{}: {key} = {v}: {e}", file.display()),
+                    Err(e) => {
+                        assert_eq!(e.key, named(&key), "{}: {key} = {v}: {e}", file.display())
+                    }
                 }
                 refused += 1;
             }
@@ -379,10 +394,33 @@ fn every_physical_number_out_of_range_is_refused_naming_its_key() {
                 Path::new("--set"),
                 Path::new(&format!("{key}=1e300")),
             ],
-            &[key.as_str()],
+            &[named(key).as_str()],
         );
         assert!(!out.exists(), "{key}: a refused run left {}", out.display());
     }
+}
+
+/// A dotted `--set` key as scene errors name it: a list of tables' entry in brackets
+/// (`loads.0.magnitude_N` → `loads[0].magnitude_N`), a list of numbers as a whole
+/// (`cloth.origin_m.1` → `cloth.origin_m`).
+fn named(key: &str) -> String {
+    let parts: Vec<&str> = key.split('.').collect();
+    let numeric = |p: &str| p.parse::<usize>().is_ok();
+    let mut out = String::new();
+    for (k, p) in parts.iter().enumerate() {
+        if numeric(p) {
+            if parts.get(k + 1).is_some_and(|n| !numeric(n)) {
+                out.push_str(&format!("[{p}]"));
+                continue;
+            }
+            break;
+        }
+        if !out.is_empty() {
+            out.push('.');
+        }
+        out.push_str(p);
+    }
+    out
 }
 
 #[test]

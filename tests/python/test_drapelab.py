@@ -89,7 +89,7 @@ def test_the_table_carries_its_run_metadata_in_the_arrow_schema(tmp_path):
     assert meta[b"scene"] == b"hang4"
     assert meta[b"drapelab_version"] == drapelab.__version__.encode()
     assert meta[b"solver"].decode() == r.report["solver"]
-    assert sorted(p.name for p in saved.iterdir()) == ["particles.parquet", "run.json", "triangles.parquet"]
+    assert sorted(p.name for p in saved.iterdir()) == ["iterations.parquet", "particles.parquet", "run.json", "triangles.parquet"]
     assert json.loads((saved / "run.json").read_text())["status"] == "converged"
     df = r.to_polars()
     assert df.columns == ["i", "j", "x_m", "y_m", "z_m", "present"]
@@ -257,8 +257,20 @@ def test_run_pipeline_is_make_style(project, monkeypatch):
     monkeypatch.chdir(root)
     again = drapelab.run_pipeline("pipelines/p.toml")
     assert again["ran"] == [] and sorted(again["up_to_date"]) == ["fit4", "sim"], again
-    forced = drapelab.run_pipeline("pipelines/p.toml", force=["sim"])
+    events = []
+    forced = drapelab.run_pipeline("pipelines/p.toml", force=["sim"],
+                                   progress=lambda *e: events.append(e))
     assert forced["ran"] == ["sim"] and forced["up_to_date"] == ["fit4"]
+    # The callback saw the skip, the forced stage start and finish.
+    assert ("fit4", "skipped", 0, 0) in events, events
+    kinds = [e[1] for e in events if e[0] == "sim"]
+    assert kinds[0] == "started" and kinds[-1] == "finished", events
+
+    def fail(*_):
+        raise RuntimeError("from the callback")
+
+    with pytest.raises(RuntimeError, match="from the callback"):
+        drapelab.run_pipeline("pipelines/p.toml", force=["sim"], progress=fail)
     assert (root / "runs/p/sim/particles.parquet").exists()
     with pytest.raises(drapelab.InputError, match="nope.toml"):
         drapelab.run_pipeline("pipelines/nope.toml")

@@ -40,6 +40,7 @@ pub fn tables_markdown() -> anyhow::Result<String> {
     let sections = [
         md::<drapelab_record::ParticleRow>()?,
         md::<drapelab_record::TriangleRow>()?,
+        md::<drapelab_record::IterationRow>()?,
         md::<drapelab_record::SensitivityRow>()?,
         md::<drapelab_record::EdgeRow>()?,
         md::<crate::sweep_table::SweepPoint>()?,

@@ -537,7 +537,8 @@ impl Scene {
     }
 
     /// Every physical number of the scene (its solver and recording options aside) is finite and
-    /// zero or of a size drapelab computes in ([`MAGNITUDES`]); the error names the dotted key.
+    /// zero or of a size drapelab computes in ([`MAGNITUDES`]); the error names the key as the other
+    /// checks do (`loads[0].magnitude_N`, `obstacles[1].centre_m`).
     fn check_magnitudes(&self, ck: &Check<'_>) -> Result<(), InputError> {
         fn walk(ck: &Check<'_>, key: &str, v: &toml::Value) -> Result<(), InputError> {
             match v {
@@ -559,10 +560,12 @@ in the key's unit (SI)",
                 toml::Value::Table(t) => t
                     .iter()
                     .try_for_each(|(k, v)| walk(ck, &format!("{key}.{k}"), v)),
-                toml::Value::Array(a) => a
-                    .iter()
-                    .enumerate()
-                    .try_for_each(|(i, v)| walk(ck, &format!("{key}.{i}"), v)),
+                // A list of tables names its entry as the other checks do (`loads[0].magnitude_N`);
+                // a list of numbers (a point, a profile) is named as a whole.
+                toml::Value::Array(a) => a.iter().enumerate().try_for_each(|(i, v)| match v {
+                    toml::Value::Table(_) => walk(ck, &format!("{key}[{i}]"), v),
+                    _ => walk(ck, key, v),
+                }),
                 _ => Ok(()),
             }
         }

@@ -235,12 +235,13 @@ fn calibrate_lm(
 
 /// Runs a pipeline make-style (`drapelab run`); the summary as JSON text.
 #[pyfunction]
-#[pyo3(signature = (path, until, force))]
+#[pyo3(signature = (path, until, force, progress=None))]
 fn run_pipeline(
     py: Python<'_>,
     path: &str,
     until: Option<String>,
     force: Vec<String>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let registry = drapelab_stages::registry();
     let plan = drapelab_pipeline::load_checked_plan(Path::new(path), &registry).map_err(to_py)?;
@@ -249,9 +250,12 @@ fn run_pipeline(
         force,
         ..Default::default()
     };
-    let summary = py
-        .detach(|| drapelab_pipeline::run_pipeline(&plan, &opts, &interrupt::StageLines))
-        .map_err(to_py)?;
+    let lines = interrupt::StageLines::with(progress);
+    let summary = py.detach(|| drapelab_pipeline::run_pipeline(&plan, &opts, &lines));
+    if let Some(e) = lines.into_error() {
+        return Err(e);
+    }
+    let summary = summary.map_err(to_py)?;
     let failed: serde_json::Map<String, serde_json::Value> = summary
         .failed
         .iter()

@@ -41,8 +41,9 @@ struct RunRecord<'a> {
 }
 
 /// Every file `simulate` may write into its folder.
-pub const SIMULATE_FILES: [&str; 8] = [
+pub const SIMULATE_FILES: [&str; 9] = [
     "run.json",
+    "iterations.parquet",
     "particles.parquet",
     "last_state.parquet",
     "triangles.parquet",
@@ -233,8 +234,9 @@ fn simulate_into(
         }
         _ => false,
     };
+    let mut history = crate::History::default();
     let report = {
-        let mut obs: Vec<&mut dyn Observer> = vec![progress];
+        let mut obs: Vec<&mut dyn Observer> = vec![progress, &mut history];
         if let Some(t) = timeline.as_mut() {
             obs.push(t);
         }
@@ -250,7 +252,8 @@ fn simulate_into(
         drapelab_core::simulate::check_crossings(scene, &grid, &model, &x, &mut r);
         r
     };
-    let mut outputs = vec!["run.json"];
+    let mut outputs = vec!["run.json", "iterations.parquet"];
+    history.write(&out.join("iterations.parquet"))?;
     finish_recorders(&report, &x, (timeline, rrd), &mut outputs)?;
     let state = (&grid, absent.as_slice(), x.as_slice());
     state_files(scene, state, &report, extras.obj, out, &mut outputs)?;
