@@ -270,6 +270,10 @@ pub struct LmRow {
     pub stiffness_N_per_m: f64,
     /// Natural length, m.
     pub natural_length_m: f64,
+    /// 2σ half-width of the stiffness from JᵀJ, N/m (None where JᵀJ is singular).
+    pub stiffness_2sigma_N_per_m: Option<f64>,
+    /// 2σ half-width of the natural length from JᵀJ, m.
+    pub natural_length_2sigma_m: Option<f64>,
     /// Mean curve distance over the measured edges, % of the side.
     pub curve_distance_pct: f64,
     /// Equilibrium solves over the three topologies (the warm-start lattice not counted).
@@ -296,6 +300,8 @@ pub fn calibrate_one_lm(
         topology: format!("{:?}", r.best.topology).to_lowercase(),
         stiffness_N_per_m: r.best.stiffness_N_per_m,
         natural_length_m: r.best.natural_length_m,
+        stiffness_2sigma_N_per_m: r.half_width_2sigma[0],
+        natural_length_2sigma_m: r.half_width_2sigma[1],
         curve_distance_pct: r.best_cost_pct,
         solves: r.solves as u64,
         steps: r.iterations as u64,

@@ -112,6 +112,14 @@ pub struct ComparisonRow {
     pub evaluations: u64,
     /// Best cost, % of the side.
     pub best_cost_pct: f64,
+    /// Levenberg–Marquardt's stiffness, N/m (null for the other optimizers).
+    pub stiffness_N_per_m: Option<f64>,
+    /// Its 2σ half-width from JᵀJ (residuals taken as independent), N/m.
+    pub stiffness_2sigma_N_per_m: Option<f64>,
+    /// Levenberg–Marquardt's natural length, m.
+    pub natural_length_m: Option<f64>,
+    /// Its 2σ half-width from JᵀJ, m.
+    pub natural_length_2sigma_m: Option<f64>,
 }
 
 impl Table for ComparisonRow {
@@ -128,6 +136,10 @@ impl ComparisonRow {
             run: r.run,
             evaluations: r.evaluations,
             best_cost_pct: r.best_cost_pct,
+            stiffness_N_per_m: r.estimate.map(|e| e[0].0),
+            stiffness_2sigma_N_per_m: r.estimate.and_then(|e| e[0].1),
+            natural_length_m: r.estimate.map(|e| e[1].0),
+            natural_length_2sigma_m: r.estimate.and_then(|e| e[1].1),
         }
     }
 }

@@ -50,6 +50,9 @@ pub struct LmReport {
     /// JᵀJ at the best point in (N/m, m) coordinates, residuals in % of the side: the Gauss–Newton
     /// curvature of half the residuals' sum of squares, for intervals.
     pub jtj: [[f64; 2]; 2],
+    /// 2σ half-widths of the stiffness (N/m) and natural length (m) from JᵀJ ([`two_sigma`]); None
+    /// where JᵀJ is singular.
+    pub half_width_2sigma: [Option<f64>; 2],
     /// Why the best topology's run stopped.
     pub stop: String,
 }
@@ -203,6 +206,24 @@ impl Problem {
     }
 }
 
+/// 2σ half-widths of the two parameters from the Gauss–Newton covariance σ̂² (JᵀJ)⁻¹ (`jtj` in the
+/// parameters' units), σ̂² = Σr²/(m − 2) over the `m` residuals taken as independent. They are
+/// samples along the same few curves, so these intervals come out narrower than the
+/// curvature-based ones, which count 5 degrees of freedom per edge. None where JᵀJ is singular.
+pub fn two_sigma(jtj: &[[f64; 2]; 2], sum_sq: f64, m: usize) -> [Option<f64>; 2] {
+    let a = Matrix2::new(jtj[0][0], jtj[0][1], jtj[1][0], jtj[1][1]);
+    match (a.try_inverse(), m > 2) {
+        (Some(inv), true) => {
+            let s2 = sum_sq / (m - 2) as f64;
+            [0, 1].map(|i| {
+                let v = s2 * inv[(i, i)];
+                (v.is_finite() && v >= 0.0).then(|| 2.0 * v.sqrt())
+            })
+        }
+        _ => [None; 2],
+    }
+}
+
 /// JᵀJ and Jᵀr of a point.
 fn normal_equations(p: &Point) -> (Matrix2<f64>, Vector2<f64>) {
     let mut a = Matrix2::zeros();
@@ -289,6 +310,7 @@ impl Problem {
                     best_cost_pct: self.mean_distance(&p.r),
                     solves,
                     iterations,
+                    half_width_2sigma: two_sigma(&jtj, p.sum_sq(), p.r.len()),
                     jtj,
                     stop,
                 }
@@ -299,6 +321,7 @@ impl Problem {
                 solves,
                 iterations,
                 jtj: [[0.0; 2]; 2],
+                half_width_2sigma: [None; 2],
                 stop: "no topology gave a converged drape with every edge".into(),
             },
         }
@@ -382,5 +405,51 @@ impl Problem {
             }
         };
         (Some(p), accepted, solves, stop)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_jtj_intervals_of_a_straight_line_are_those_of_least_squares() {
+        // y = 2 + 3x + noise at 8 points: the Gauss–Newton covariance of (intercept, slope) at the
+        // least-squares optimum is the textbook one, se(slope)² = s²/Σ(x − x̄)².
+        let x: Vec<f64> = (0..8).map(|i| i as f64 * 0.5).collect();
+        let noise = [0.1, -0.2, 0.05, 0.15, -0.1, 0.0, -0.05, 0.12];
+        let y: Vec<f64> = x
+            .iter()
+            .zip(noise)
+            .map(|(x, e)| 2.0 + 3.0 * x + e)
+            .collect();
+        let n = x.len() as f64;
+        let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+        let sxx: f64 = x.iter().map(|x| (x - mx).powi(2)).sum();
+        let slope: f64 = x
+            .iter()
+            .zip(&y)
+            .map(|(x, y)| (x - mx) * (y - my))
+            .sum::<f64>()
+            / sxx;
+        let intercept = my - slope * mx;
+        let sum_sq: f64 = x
+            .iter()
+            .zip(&y)
+            .map(|(x, y)| (intercept + slope * x - y).powi(2))
+            .sum();
+        let jtj = [
+            [n, x.iter().sum::<f64>()],
+            [x.iter().sum::<f64>(), x.iter().map(|x| x * x).sum::<f64>()],
+        ];
+        let [a, b] = super::two_sigma(&jtj, sum_sq, x.len());
+        let s2 = sum_sq / (n - 2.0);
+        let se_slope = (s2 / sxx).sqrt();
+        let se_intercept = (s2 * (1.0 / n + mx * mx / sxx)).sqrt();
+        assert!((b.unwrap() - 2.0 * se_slope).abs() < 1e-12 * se_slope);
+        assert!((a.unwrap() - 2.0 * se_intercept).abs() < 1e-12 * se_intercept);
+        // A singular JᵀJ (the parameters not separable) has no interval.
+        assert_eq!(
+            super::two_sigma(&[[1.0, 1.0], [1.0, 1.0]], 1.0, 8),
+            [None, None]
+        );
     }
 }

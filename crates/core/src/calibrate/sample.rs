@@ -60,6 +60,9 @@ pub struct OptimizerRun {
     pub evaluations: u64,
     /// Best cost, % of the side.
     pub best_cost_pct: f64,
+    /// Levenberg–Marquardt's estimate with its 2σ half-widths from JᵀJ: (stiffness N/m, ±),
+    /// (natural length m, ±); None for the other optimizers.
+    pub estimate: Option<[(f64, Option<f64>); 2]>,
 }
 
 /// What the calibration of one sample found.
@@ -132,6 +135,7 @@ pub fn calibrate_sample(
             run: r as u32,
             evaluations: report.evaluations as u64,
             best_cost_pct: report.best_cost,
+            estimate: None,
         });
         if s.baseline_cmaes {
             let fresh = problem.fresh();
@@ -146,6 +150,7 @@ pub fn calibrate_sample(
                 run: r as u32,
                 evaluations: cm.evaluations as u64,
                 best_cost_pct: cm.best_cost,
+                estimate: None,
             });
         }
         if best.as_ref().is_none_or(|b| report.best_cost < b.0) {
@@ -192,6 +197,10 @@ fn levenberg_marquardt_run(problem: &Problem) -> OptimizerRun {
         run: 0,
         evaluations: lm.solves as u64,
         best_cost_pct: lm.best_cost_pct,
+        estimate: Some([
+            (lm.best.stiffness_N_per_m, lm.half_width_2sigma[0]),
+            (lm.best.natural_length_m, lm.half_width_2sigma[1]),
+        ]),
     }
 }
 
