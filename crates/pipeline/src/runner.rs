@@ -318,7 +318,7 @@ pub fn load_checked_plan(file: &Path, registry: &crate::Registry) -> Result<Plan
     let plan = crate::load_plan(file, registry)?;
     let silent = Silent;
     for s in &plan.stages {
-        let (ctx, _) = stage_context(&plan, s, &silent);
+        let ctx = context(&plan, s, slot_inputs(&plan, s), &silent);
         let all_there = s.input_patterns.keys().all(|k| {
             ctx.inputs
                 .get(k)
@@ -356,7 +356,18 @@ fn stage_context<'a>(
         .into_iter()
         .map(|(p, h)| (p, h.unwrap_or_default()))
         .collect();
-    let ctx = StageContext {
+    (context(plan, s, slots, progress), inputs)
+}
+
+/// The context of stage `s` over its input files `slots` (paths relative to the root), without
+/// hashing them.
+fn context<'a>(
+    plan: &Plan,
+    s: &PlannedStage,
+    slots: BTreeMap<String, BTreeSet<String>>,
+    progress: &'a dyn Progress,
+) -> StageContext<'a> {
+    StageContext {
         pipeline: plan.name.clone(),
         pipeline_file: plan
             .file
@@ -377,8 +388,7 @@ fn stage_context<'a>(
             .map(|(k, o)| (k.clone(), plan.root.join(o)))
             .collect(),
         progress,
-    };
-    (ctx, inputs)
+    }
 }
 
 /// The key of a stage's parts: its up-to-date key and the build (parts of another build are

@@ -22,19 +22,19 @@ pub struct IterationRow {
 
 impl Table for IterationRow {
     const FILE: &'static str = "iterations.parquet";
-    const ROW: &'static str = "One Newton iteration (static) or time step (dynamic) of a `simulate` run, as its observers see them: the first Newton run of a continuation (its load steps included; later contact rounds and friction updates are counted in run.json), or every step of a dynamic solve.";
+    const ROW: &'static str = "One Newton iteration (static) or time step (dynamic) of a `simulate` run, as its observers see them: every iteration of the first Newton run of a continuation (its load steps included; later contact rounds and friction updates are counted in run.json), or every `solver.dynamic.check_every`-th step of a dynamic solve (where it checks its state anyway).";
 }
 
-/// An observer that keeps every iteration's residual and energy.
-#[derive(Default)]
+/// An observer that keeps every `every`-th iteration's residual and energy.
 pub struct History {
+    every: usize,
     /// The rows so far.
     pub rows: Vec<IterationRow>,
 }
 
 impl Observer for History {
-    fn wants(&self, _index: usize) -> bool {
-        true
+    fn wants(&self, index: usize) -> bool {
+        index.is_multiple_of(self.every)
     }
     fn observe(&mut self, ev: &StateEvent<'_>) -> anyhow::Result<()> {
         self.rows.push(IterationRow {
@@ -48,6 +48,15 @@ impl Observer for History {
 }
 
 impl History {
+    /// Every `every`-th iteration or step (at least every one): a static solve's every iteration
+    /// costs nothing more (its residual and energy are at hand), a dynamic one's would cost an
+    /// energy per step, so it keeps the steps its solver checks.
+    pub fn every(every: usize) -> Self {
+        Self {
+            every: every.max(1),
+            rows: Vec::new(),
+        }
+    }
     /// Writes `iterations.parquet` at `path`.
     pub fn write(&self, path: &Path) -> Result<()> {
         write_table(path, &self.rows)

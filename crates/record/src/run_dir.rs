@@ -234,7 +234,10 @@ fn simulate_into(
         }
         _ => false,
     };
-    let mut history = crate::History::default();
+    let mut history = crate::History::every(match scene.solver.kind.integrator() {
+        Some(_) => scene.solver.dynamic.check_every,
+        None => 1,
+    });
     let report = {
         let mut obs: Vec<&mut dyn Observer> = vec![progress, &mut history];
         if let Some(t) = timeline.as_mut() {

@@ -346,10 +346,16 @@ pub fn solve_dynamic(
     loop {
         let want = observer.wants(step);
         model.gradient(x, 1.0, &mut g);
-        if (step.is_multiple_of(check) || want || step == limits.max_steps)
-            && let Some((reason, message)) =
-                limits.check(model, x, v, &g, step, want.then_some(&mut *observer))
-        {
+        // The stopping criteria are checked every `check_every` steps whether or not anyone
+        // watches: an observer sees states between them without moving where the run stops.
+        let stop = if step.is_multiple_of(check) || step == limits.max_steps {
+            limits.check(model, x, v, &g, step, want.then_some(&mut *observer))
+        } else if want {
+            limits.observe(model, x, v, &g, step, observer)
+        } else {
+            None
+        };
+        if let Some((reason, message)) = stop {
             match reason {
                 Stop::Diverged(d) => report.diverge(step, Some(dt), d),
                 Stop::Reason(r) => report.stop_for(r),
@@ -529,6 +535,42 @@ impl Limits {
         }
     }
 
+    /// Hands the state at `step` (residual `r` N, total energy `etot` J) to `obs`; a stop when it
+    /// fails.
+    fn event(
+        &self,
+        obs: &mut dyn Observer,
+        x: &[Vector3<f64>],
+        (step, r, etot): (usize, f64, f64),
+    ) -> Option<(Stop, String)> {
+        let event = StateEvent {
+            index: step,
+            time_s: Some(step as f64 * self.dt),
+            x,
+            max_residual_N: r,
+            energy_J: etot,
+        };
+        obs.observe(&event).err().map(|err| {
+            let msg = format!("an observer failed at step {step}: {err:#}");
+            (Stop::Reason(StopReason::Observer), msg)
+        })
+    }
+
+    /// The state at `step` handed to `observer` between the checks of [`Limits::check`]; a stop
+    /// only when the observer fails.
+    fn observe(
+        &self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        v: &[Vector3<f64>],
+        g: &[Vector3<f64>],
+        step: usize,
+        observer: &mut dyn Observer,
+    ) -> Option<(Stop, String)> {
+        let etot = model.energy(x, 1.0) + kinetic_energy(model, v);
+        self.event(observer, x, (step, model.max_residual(g), etot))
+    }
+
     /// Whether to stop at `step` (the gradient `g` is current), and why, in words too; the observer,
     /// when given, sees the state first.
     fn check(
@@ -546,16 +588,9 @@ impl Limits {
         let etot = model.energy(x, 1.0) + kinetic_energy(model, v);
         let time = step as f64 * dt;
         if let Some(obs) = observer
-            && let Err(err) = obs.observe(&StateEvent {
-                index: step,
-                time_s: Some(time),
-                x,
-                max_residual_N: r,
-                energy_J: etot,
-            })
+            && let Some(failed) = self.event(obs, x, (step, r, etot))
         {
-            let msg = format!("an observer failed at step {step}: {err:#}");
-            return Some((Stop::Reason(StopReason::Observer), msg));
+            return Some(failed);
         }
         let divergence = if !etot.is_finite() || !r.is_finite() {
             Some(DivergenceReason::NonFinite)
