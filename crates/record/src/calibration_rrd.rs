@@ -5,6 +5,7 @@
 //! drawn in the camera plane just in front of the sheet.
 
 use crate::Staged;
+use crate::rerun;
 use anyhow::Result;
 use drapelab_core::cloth::Grid;
 use drapelab_core::edges::EdgeFit;

@@ -3,6 +3,7 @@
 //! on a grid 0.4 m apart, Z up.
 
 use crate::Staged;
+use crate::rerun;
 use anyhow::Result;
 use nalgebra::Vector3;
 use std::path::Path;

@@ -14,6 +14,7 @@ mod mesh_out;
 mod particles;
 mod parts;
 mod photo;
+mod rerun;
 mod rrd;
 mod run_dir;
 mod sampled;

@@ -2,6 +2,7 @@
 //! recording, per item) into the stage's outputs: rows in part order with one schema, and one
 //! recording holding every part's chunks.
 
+use crate::rerun;
 use crate::table::write_parquet;
 use anyhow::{Context, Result, bail};
 use arrow::array::RecordBatch;

@@ -2,6 +2,7 @@
 //! (dynamics) timeline, the pinned points, and the residual and energy as scalars.
 
 use crate::Staged;
+use crate::rerun;
 use crate::sampled::{Sampled, StateSink};
 use anyhow::Result;
 use drapelab_core::cloth::Grid;

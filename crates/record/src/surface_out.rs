@@ -2,6 +2,7 @@
 //! three.js, any glTF viewer) and a rerun recording (Mesh3D with texture coordinates and the albedo
 //! texture).
 
+use crate::rerun;
 use crate::{Staged, write_atomic};
 use anyhow::Result;
 use drapelab_core::surface::SurfaceMesh;

@@ -2,6 +2,7 @@
 //! height along z).
 
 use crate::Staged;
+use crate::rerun;
 use anyhow::Result;
 use drapelab_core::wrinkles::WrinkleMesh;
 use std::path::Path;
