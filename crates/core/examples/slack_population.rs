@@ -3,14 +3,17 @@
 //! each from the nearest drape of the calibration's warm-start lattice, then from that drape's
 //! tangent prediction (the lattice stores each node's sensitivities). Prints both tables, the
 //! lattice's own solve time, and the floor of one solve: the time of one numeric factorization of
-//! the net's Hessian and of one whole iteration's assembly (medians of 200).
+//! the net's Hessian and of one whole iteration's assembly (medians of 200); last, how far the
+//! evaluations' drapes, solved to the calibration's looser evaluation tolerance, lie from the same
+//! drapes solved to the scene's own.
 //!
 //! cargo run --release -p drapelab-core --example slack_population -- datasets/scenes/hang4.toml [N]
 
 use drapelab_core::benchmark::{min_median_max, population_table, warm_start_population_with};
+use drapelab_core::calibrate::EVALUATION_TOL_REL;
 use drapelab_core::physics::HessianBlocks;
 use drapelab_core::scene::Scene;
-use drapelab_core::simulate::solve_scene;
+use drapelab_core::simulate::{solve_scene, solve_scene_from};
 use drapelab_core::solve::{DofMap, NoObserver, SparseSpd};
 use std::time::Instant;
 
@@ -33,7 +36,39 @@ fn main() -> anyhow::Result<()> {
         print!("{}", population_table(&rows));
     }
     floor(&scene);
+    tolerance_error(&scene, n);
     Ok(())
+}
+
+/// How far an evaluation's drape, solved to the calibration's evaluation tolerance
+/// ([`EVALUATION_TOL_REL`]), lies from the same drape solved on to the scene's own tolerance.
+fn tolerance_error(scene: &Scene, n: usize) {
+    let mut net = scene.regridded(14, 14);
+    net.solver.kind = drapelab_core::scene::SolverKind::Static;
+    let problem = drapelab_core::calibrate::Problem::new(net.clone(), vec![], 50.0);
+    let design = drapelab_core::optim::latin_hypercube(n, 3, 9);
+    let worst = (0..n)
+        .filter_map(|k| {
+            let mut u = vec![0.5; 5];
+            for (axis, &dim) in design.iter().zip(&[0usize, 3, 4]) {
+                u[dim] = axis[k];
+            }
+            let (sol, _) = problem.drape(&u);
+            let tight = problem.scene_for(&problem.bounds.decode(&u));
+            let fine = solve_scene_from(&tight, &sol.x, &mut NoObserver);
+            (sol.report.is_converged() && fine.report.is_converged()).then(|| {
+                sol.x
+                    .iter()
+                    .zip(&fine.x)
+                    .map(|(a, b)| (a - b).norm())
+                    .fold(0.0, f64::max)
+            })
+        })
+        .fold(0.0, f64::max);
+    println!(
+        "\nevaluation tolerance {EVALUATION_TOL_REL:e} of the lightest weight against the scene's {:e}: largest particle distance {worst:.2e} m over {n} points",
+        net.solver.static_.residual_tol_rel
+    );
 }
 
 /// Median time of one factorization and of one assembly (energy, gradient, Hessian) of the 14 × 14

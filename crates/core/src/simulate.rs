@@ -253,7 +253,9 @@ pub fn solve_model_warm(
     let lm = &mut warm.solver.static_.lm_damping_initial;
     *lm = lm.min(WARM_LM_DAMPING);
     let mut report = static_or_dynamic(&warm, grid, model, x, observer);
-    check_minimum(model, x, &mut report);
+    if scene.solver.static_.check_minimum {
+        check_minimum(model, x, &mut report);
+    }
     report
 }
 

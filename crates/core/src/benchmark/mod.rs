@@ -36,6 +36,8 @@ pub struct BenchRow {
     pub linear_solves: usize,
     /// Numeric factorizations attempted (failed ones on an indefinite matrix included).
     pub factorizations: usize,
+    /// Triangular solves with a factor (back-substitutions).
+    pub back_substitutions: usize,
     /// Wall time of the factorizations and triangular solves alone, s.
     pub factor_time_s: f64,
     /// Simulated time a dynamic point reached (its settle time when converged), s; None for static.
@@ -247,6 +249,7 @@ fn bench_point(s: &Scene, reference: &Reference, log: &mut impl FnMut(&str)) -> 
         iterations: sol.report.iterations,
         linear_solves: sol.report.linear_solves,
         factorizations: sol.report.factorizations,
+        back_substitutions: sol.report.back_substitutions,
         factor_time_s: sol.report.factor_time_s,
         sim_time_s: sol.report.sim_time_s,
         error_m: error_m.is_finite().then_some(error_m),
@@ -309,11 +312,11 @@ pub fn hang4_rows(
 /// The rows as a Markdown table.
 pub fn markdown_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| scene | particles | solver | tolerance | status | wall time (ms) | iterations/steps | linear solves | factorizations | factorization time (ms) | error vs finest static (m) | peak RSS (MB) | self-contact | self-contact time (ms) | crossing edges |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| scene | particles | solver | tolerance | status | wall time (ms) | iterations/steps | linear solves | factorizations | back-substitutions | factorization time (ms) | error vs finest static (m) | peak RSS (MB) | self-contact | self-contact time (ms) | crossing edges |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s += &format!(
-            "| {} | {n}×{n} | {:?} | {:.0e} | {} | {:.3} | {} | {} | {} | {:.3} | {:.2e} | {} | {:?} | {:.3} | {} |\n",
+            "| {} | {n}×{n} | {:?} | {:.0e} | {} | {:.3} | {} | {} | {} | {} | {:.3} | {:.2e} | {} | {:?} | {:.3} | {} |\n",
             r.scene,
             r.solver,
             r.tol,
@@ -322,6 +325,7 @@ pub fn markdown_table(rows: &[BenchRow]) -> String {
             r.iterations,
             r.linear_solves,
             r.factorizations,
+            r.back_substitutions,
             r.factor_time_s * 1e3,
             r.error_m.unwrap_or(f64::NAN),
             r.peak_rss_bytes
@@ -354,6 +358,8 @@ pub struct PopulationRow {
     pub iterations: usize,
     /// Numeric factorizations attempted.
     pub factorizations: usize,
+    /// Triangular solves with a factor.
+    pub back_substitutions: usize,
     /// Wall time of the solve, s.
     pub wall_time_s: f64,
     /// Wall time of its factorizations and triangular solves alone, s.
@@ -385,6 +391,7 @@ impl PopulationRow {
             status: report.status,
             iterations: report.iterations,
             factorizations: report.factorizations,
+            back_substitutions: report.back_substitutions,
             wall_time_s,
             factor_time_s: report.factor_time_s,
         }
@@ -513,9 +520,10 @@ pub fn population_table(rows: &[PopulationRow]) -> String {
         rows.len()
     );
     type Line<'a> = (&'a str, &'a dyn Fn(&PopulationRow) -> f64, f64);
-    let lines: [Line; 4] = [
+    let lines: [Line; 5] = [
         ("Newton iterations", &|r| r.iterations as f64, 1.0),
         ("factorizations", &|r| r.factorizations as f64, 1.0),
+        ("back-substitutions", &|r| r.back_substitutions as f64, 1.0),
         ("wall time (ms)", &|r| r.wall_time_s, 1e3),
         ("factorization time (ms)", &|r| r.factor_time_s, 1e3),
     ];

@@ -283,6 +283,8 @@ pub struct SparseSpd {
     mem: MemBuffer,
     /// Number of numeric factorizations done.
     pub factorizations: usize,
+    /// Number of triangular solves (back-substitutions) with a factor.
+    pub back_substitutions: usize,
     /// Symbolic analyses this solver had to do (0 when every pattern came from the cache).
     pub analyses: usize,
     /// Wall time of those analyses (ordering and symbolic factorization), s.
@@ -307,6 +309,7 @@ impl SparseSpd {
             l_values: Vec::new(),
             mem: MemBuffer::new(StackReq::empty()),
             factorizations: 0,
+            back_substitutions: 0,
             analyses: 0,
             analysis_time_s: 0.0,
             factor_time_s: 0.0,
@@ -400,6 +403,7 @@ impl SparseSpd {
             return;
         };
         let start = Instant::now();
+        self.back_substitutions += 1;
         let llt = LltRef::new(&pattern.structure.symbolic, &self.l_values);
         llt.solve_in_place_with_conj(
             Conj::No,

@@ -66,6 +66,17 @@ pub struct StaticOptions {
     /// old boolean `reuse_factorization` is read as this key.
     #[serde(default)]
     pub factor_reuse: FactorReuse,
+    /// Whether a converged solve checks that its equilibrium is a minimum: one more factorization,
+    /// of the exact Hessian ([`is_minimum`]; the report's `minimum`, absent when not checked).
+    /// Default true. Off only where the status alone is read and the start is a stable
+    /// neighbour's drape: the calibration's warm-started evaluations, where the check was a third
+    /// of the factorizations.
+    #[serde(default = "default_check_minimum")]
+    pub check_minimum: bool,
+}
+
+fn default_check_minimum() -> bool {
+    true
 }
 
 fn default_shift_max() -> f64 {
@@ -101,6 +112,7 @@ impl Default for StaticOptions {
             shift_max_rel: default_shift_max(),
             regularization: Regularization::default(),
             factor_reuse: FactorReuse::default(),
+            check_minimum: default_check_minimum(),
         }
     }
 }
@@ -325,6 +337,7 @@ fn finish_report(
     report.iterations = iter;
     report.globalization = ws.stats;
     report.factor_time_s = ws.spd.factor_time_s;
+    report.back_substitutions = ws.spd.back_substitutions;
     report.analyses = ws.spd.analyses;
     report.analysis_time_s = ws.spd.analysis_time_s;
     report.max_residual_N = model.max_residual(&ws.g);

@@ -197,6 +197,10 @@ pub struct SolveReport {
     /// Numeric Cholesky factorizations attempted, those that failed (an indefinite matrix) included.
     #[serde(default)]
     pub factorizations: usize,
+    /// Triangular solves with a factor (back-substitutions): one per Newton or chord step and one
+    /// per geodesic acceleration.
+    #[serde(default)]
+    pub back_substitutions: usize,
     /// Wall time of the factorizations and triangular solves alone, s.
     #[serde(default)]
     pub factor_time_s: f64,
@@ -247,6 +251,7 @@ impl SolveReport {
             linear_solves: 0,
             inner_iterations: 0,
             factorizations: 0,
+            back_substitutions: 0,
             factor_time_s: 0.0,
             analyses: 0,
             analysis_time_s: 0.0,
@@ -299,6 +304,7 @@ impl SolveReport {
     pub fn merge(&mut self, part: &SolveReport, how: Part) {
         self.linear_solves += part.linear_solves;
         self.factorizations += part.factorizations;
+        self.back_substitutions += part.back_substitutions;
         self.factor_time_s += part.factor_time_s;
         self.analyses += part.analyses;
         self.analysis_time_s += part.analysis_time_s;
