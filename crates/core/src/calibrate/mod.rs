@@ -307,7 +307,7 @@ impl Problem {
 pub const EVALUATION_TOL_REL: f64 = 1e-6;
 
 /// Deterministic warm starts for one sample: the static drapes at a fixed lattice of Table 3's box
-/// (every topology × 3 stiffnesses × 41 natural lengths, 0.5 mm apart), solved by continuation in the natural length
+/// (every topology × 5 stiffnesses × 41 natural lengths, 0.5 mm apart), solved by continuation in the natural length
 /// from the sagged start along each (topology, stiffness) in a fixed order, so that
 /// an evaluation's start — and with it the equilibrium a slack net lands on — depends on its own
 /// parameters only, never on which evaluations came before or on the thread count.
