@@ -253,9 +253,7 @@ pub fn solve_model_warm(
     let lm = &mut warm.solver.static_.lm_damping_initial;
     *lm = lm.min(WARM_LM_DAMPING);
     let mut report = static_or_dynamic(&warm, grid, model, x, observer);
-    if scene.solver.static_.check_minimum {
-        check_minimum(model, x, &mut report);
-    }
+    check_minimum(scene.solver.static_.check_minimum, model, x, &mut report);
     report
 }
 
@@ -277,7 +275,7 @@ fn static_or_dynamic(
             let mut v = vec![Vector3::zeros(); x.len()];
             let mut report =
                 solve_dynamic(model, integ, x, &mut v, &scene.solver.dynamic, observer);
-            check_minimum(model, x, &mut report);
+            check_minimum(true, model, x, &mut report);
             report
         }
     }
@@ -285,9 +283,14 @@ fn static_or_dynamic(
 
 /// Stability of a converged (or settled) state, checked once: after every load increment and contact
 /// round of a static solve, at the end of a dynamic one (a heavily damped sheet can come to rest on a
-/// saddle it would leave only slowly).
-fn check_minimum(model: &crate::physics::Model, x: &[Vector3<f64>], report: &mut SolveReport) {
-    if report.is_converged() && report.minimum.is_none() {
+/// saddle it would leave only slowly); not when `wanted` is false (`solver.static.check_minimum`).
+fn check_minimum(
+    wanted: bool,
+    model: &crate::physics::Model,
+    x: &[Vector3<f64>],
+    report: &mut SolveReport,
+) {
+    if wanted && report.is_converged() && report.minimum.is_none() {
         let minimum = crate::solve::is_minimum(model, x);
         report.minimum = Some(minimum);
         if !minimum {
@@ -328,7 +331,7 @@ pub fn solve_model(
             grid.ny.div_ceil(2)
         );
     }
-    check_minimum(model, x, &mut report);
+    check_minimum(scene.solver.static_.check_minimum, model, x, &mut report);
     report
 }
 

@@ -302,8 +302,9 @@ impl Problem {
 /// the scene's own when that is looser. On seed 000's 14 × 14 net the drapes solved to 1e-6 lie
 /// within 1.2e-8 m of the same drapes solved on to hang4's 1e-9 (largest particle distance over 50
 /// Latin-hypercube points of Table 3's box; `crates/core/examples/slack_population.rs` prints it),
-/// some 10⁴ times below what a photo's edge resolves, for about a fifth fewer Newton iterations. The lattice's own drapes, which seed every start and
-/// carry the tangents, keep the scene's tolerance.
+/// some 10⁴ times below what a photo's edge resolves, for about a fifth fewer Newton iterations.
+/// The lattice's own drapes, which seed every start and carry the tangents, keep the scene's
+/// tolerance.
 pub const EVALUATION_TOL_REL: f64 = 1e-6;
 
 /// Deterministic warm starts for one sample: the static drapes at a fixed lattice of Table 3's box
