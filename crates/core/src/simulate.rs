@@ -176,7 +176,7 @@ pub fn self_contact_summary(
 /// checked first ([`Scene::validated`]): an invalid one gives a solution with status invalid, the
 /// bad key in its message, and no particles.
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
-    solve_built(scene, &[], observer)
+    solve_built(scene, &[], None, observer)
 }
 
 /// Solves a validated scene statically or dynamically from the given positions of all particles
@@ -187,22 +187,29 @@ pub fn solve_scene_from(
     x0: &[Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, &[x0], observer)
+    solve_built(scene, &[x0], None, observer)
 }
 
 /// [`solve_scene_from`] the candidate start with the lowest energy in the scene's model (e.g. a
 /// neighbouring drape and its tangent prediction): the model is built once for the choice and the
 /// solve. Candidates that do not match the model's particle count are passed over; with none left,
-/// the scene's own start.
+/// the scene's own start. `candidates`, a self-contact candidate set from the neighbour's solve
+/// ([`crate::physics::Model::candidates`]), seeds the model's broad phase where it fits.
 pub fn solve_scene_from_lowest(
     scene: &Scene,
     starts: &[&[Vector3<f64>]],
+    candidates: Option<&crate::physics::CandidateSet>,
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, starts, observer)
+    solve_built(scene, starts, candidates, observer)
 }
 
-fn solve_built(scene: &Scene, starts: &[&[Vector3<f64>]], observer: &mut dyn Observer) -> Solution {
+fn solve_built(
+    scene: &Scene,
+    starts: &[&[Vector3<f64>]],
+    candidates: Option<&crate::physics::CandidateSet>,
+    observer: &mut dyn Observer,
+) -> Solution {
     // Only a checked scene is built; one changed in code into an invalid one is a status, not a panic.
     let scene = match scene.clone().validated() {
         Ok(v) => v,
@@ -214,6 +221,9 @@ fn solve_built(scene: &Scene, starts: &[&[Vector3<f64>]], observer: &mut dyn Obs
         mut model,
         x0: mut x,
     } = build_scene(scene);
+    if let Some(set) = candidates {
+        model.seed_candidates(set);
+    }
     let start = starts
         .iter()
         .filter(|s| s.len() == x.len())

@@ -445,7 +445,7 @@ pub fn population_section(rows: &[drapelab_core::benchmark::PopulationRow]) -> S
 hypercube over Table 3's stiffness and natural length, the three topologies and Table 2's densities (what a \
 calibration asks thousands of times), from the sagged start: {}\nThe same net as the calibration solves it: \
 {} points over stiffness, natural length and topology at 45 g/m², each from the drape at the nearest node of \
-the calibration's warm-start lattice (`calibrate::StartLattice`): {}",
+the calibration's warm-start lattice (`calibrate::SharedLattice`): {}",
         sagged.len(),
         drapelab_core::benchmark::population_table(&sagged),
         lattice.len(),

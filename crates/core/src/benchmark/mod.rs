@@ -440,7 +440,7 @@ pub fn slack_net_population(scene: &Scene, samples: usize, seed: u64) -> Vec<Pop
 /// What a calibration asks of the solver: the 14 × 14 net of `scene` (its density) at `samples`
 /// Latin-hypercube points of Table 3's stiffness, natural length and topology, each solved from the
 /// drape at the nearest node of the calibration's warm-start lattice
-/// ([`crate::calibrate::StartLattice`]). Returns the rows and the lattice's own solve time in s.
+/// ([`crate::calibrate::SharedLattice`]). Returns the rows and the lattice's own solve time in s.
 pub fn warm_start_population(
     scene: &Scene,
     samples: usize,

@@ -7,7 +7,7 @@
 //! Each step's drape starts from the tangent prediction x* + (dx*/dθ)Δθ. Solves are what it costs:
 //! ICA spends thousands per sample.
 
-use super::{Params, Problem, StartLattice, TANGENT_KEYS};
+use super::{Params, Problem, SharedLattice, TANGENT_KEYS};
 use crate::edges::{EdgeFit, scene_view, simulated_edges};
 use crate::material::Topology;
 use crate::solve::NoObserver;
@@ -139,7 +139,8 @@ impl Problem {
         let mut straight = scene.clone();
         straight.solver.static_.direction = crate::solve::Direction::Straight;
         straight.solver.static_.factor_reuse = crate::solve::FactorReuse::Chord;
-        let sol = crate::simulate::solve_scene_from_lowest(&straight, starts, &mut NoObserver);
+        let sol =
+            crate::simulate::solve_scene_from_lowest(&straight, starts, None, &mut NoObserver);
         if !sol.report.is_converged() {
             return None;
         }
@@ -265,14 +266,14 @@ impl Problem {
     /// Solves the warm-start lattice now (it is otherwise solved at the first evaluation that needs
     /// it), so that its cost can be timed apart.
     pub fn warm_start_lattice(&self) {
-        self.lattice.get_or_init(|| StartLattice::solve(self));
+        self.lattice();
     }
 
     /// Levenberg–Marquardt calibration of the stiffness and natural length, for each topology from
     /// its best node of the warm-start lattice (the drapes every optimizer of the problem shares);
     /// the best topology's result.
     pub fn run_lm(&self, settings: &LmSettings) -> LmReport {
-        let lattice = self.lattice.get_or_init(|| StartLattice::solve(self));
+        let lattice = self.lattice();
         let mut best: Option<(Topology, Point, String)> = None;
         let (mut solves, mut iterations) = (0, 0);
         for topology in [Topology::A, Topology::B, Topology::C] {
@@ -331,35 +332,29 @@ impl Problem {
     /// coordinates, with its drape.
     fn best_node(
         &self,
-        lattice: &StartLattice,
+        lattice: &SharedLattice,
         topology: Topology,
     ) -> Option<(Vector2<f64>, Vec<Vector3<f64>>)> {
         let b = &self.bounds;
         let unit = |(lo, hi): (f64, f64), v: f64| (v - lo) / (hi - lo);
         let mut best: Option<(f64, Vector2<f64>, Vec<Vector3<f64>>)> = None;
-        for &k in &lattice.stiffness_N_per_m {
-            for &l in &lattice.natural_length_m {
-                let u = Vector2::new(unit(b.stiffness_N_per_m, k), unit(b.natural_length_m, l));
-                let p = self.lm_params(&u, topology);
-                let Some((node, _, _)) = lattice.nearest(&p) else {
-                    continue;
-                };
-                let scene = self.scene_for(&p);
-                let grid = scene.grid();
-                let Some(r) = self.edge_residuals(&scene, &grid, &node.x) else {
-                    continue;
-                };
-                let ss: f64 = r.iter().map(|v| v * v).sum();
-                if best.as_ref().is_none_or(|(s, _, _)| ss < *s) {
-                    best = Some((ss, u, node.x.clone()));
-                }
+        for (k, l, x) in lattice.nodes(self, topology) {
+            let u = Vector2::new(unit(b.stiffness_N_per_m, k), unit(b.natural_length_m, l));
+            let scene = self.scene_for(&self.lm_params(&u, topology));
+            let grid = scene.grid();
+            let Some(r) = self.edge_residuals(&scene, &grid, &x) else {
+                continue;
+            };
+            let ss: f64 = r.iter().map(|v| v * v).sum();
+            if best.as_ref().is_none_or(|(s, _, _)| ss < *s) {
+                best = Some((ss, u, x));
             }
         }
         best.map(|(_, u, x)| (u, x))
     }
 
     /// Levenberg–Marquardt for one topology from its best lattice node.
-    fn lm_topology(&self, lattice: &StartLattice, topology: Topology, s: &LmSettings) -> Run {
+    fn lm_topology(&self, lattice: &SharedLattice, topology: Topology, s: &LmSettings) -> Run {
         let Some((u0, x0)) = self.best_node(lattice, topology) else {
             return (None, 0, 0, "no lattice node".into());
         };

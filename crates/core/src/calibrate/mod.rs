@@ -3,9 +3,11 @@
 //! the measured ones (cached, non-convergence penalised and counted), and one ICA run per call.
 
 mod gradient;
+mod lattice;
 mod sample;
 
 pub use gradient::{LmReport, LmSettings};
+pub use lattice::SharedLattice;
 pub use sample::{
     EvaluatedCountry, OptimizerRun, SampleCalibration, SampleSettings, calibrate_sample,
 };
@@ -105,7 +107,7 @@ pub struct Problem {
     /// the cache saves).
     pub caching: bool,
     /// Start every evaluation from the drape at the nearest node of a fixed lattice over
-    /// (topology, stiffness, natural length), solved once per problem ([`StartLattice`]); off, from
+    /// (topology, specific stiffness, natural length), solved once per process ([`SharedLattice`]); off, from
     /// the sagged start. Either way the cost stays a pure function of the parameter vector.
     /// Default true.
     pub warm_start: bool,
@@ -119,7 +121,7 @@ pub struct Problem {
     /// How the photo's camera projected the drape (from the measured edges; orthographic if they
     /// say nothing): the simulated drape is projected the same way.
     pub projection: Projection,
-    lattice: std::sync::Arc<std::sync::OnceLock<StartLattice>>,
+    lattice: std::sync::Arc<std::sync::OnceLock<std::sync::Arc<SharedLattice>>>,
     cache: Mutex<HashMap<Vec<u64>, Evaluation>>,
     /// Simulations run (cache misses).
     pub simulations: AtomicUsize,
@@ -241,14 +243,16 @@ impl Problem {
     pub fn drape(&self, u: &[f64]) -> (crate::simulate::Solution, Option<Vec<EdgeFit>>) {
         let params = self.bounds.decode(u);
         let scene = self.scene_for(&params);
-        let starts = match self.warm_start {
-            true => self
-                .lattice
-                .get_or_init(|| StartLattice::solve(self))
-                .starts(&params, self.tangent_start),
-            false => Vec::new(),
+        let warm = match self.warm_start {
+            true => self.lattice().starts(
+                &params,
+                self.scene.cloth.areal_density_kg_per_m2,
+                self.tangent_start,
+            ),
+            false => WarmStart::default(),
         };
-        let starts: Vec<&[nalgebra::Vector3<f64>]> = starts.iter().map(Vec::as_slice).collect();
+        let starts: Vec<&[nalgebra::Vector3<f64>]> =
+            warm.starts.iter().map(Vec::as_slice).collect();
         let sol = match starts.is_empty() {
             // Warm-started next to an equilibrium, a curved step's two extra gradients buy nothing:
             // straight steps there took the knitted calibration from 377 s to 264 s with the same
@@ -264,7 +268,12 @@ impl Problem {
                 straight.solver.static_.check_minimum = false;
                 let tol = &mut straight.solver.static_.residual_tol_rel;
                 *tol = tol.max(EVALUATION_TOL_REL);
-                crate::simulate::solve_scene_from_lowest(&straight, &starts, &mut NoObserver)
+                crate::simulate::solve_scene_from_lowest(
+                    &straight,
+                    &starts,
+                    warm.candidates.as_ref(),
+                    &mut NoObserver,
+                )
             }
             true => solve_scene(&scene, &mut NoObserver),
         };
@@ -307,23 +316,23 @@ impl Problem {
 /// tolerance.
 pub const EVALUATION_TOL_REL: f64 = 1e-6;
 
-/// Deterministic warm starts for one sample: the static drapes at a fixed lattice of Table 3's box
-/// (every topology × 5 stiffnesses × 41 natural lengths, 0.5 mm apart), solved by continuation in the natural length
-/// from the sagged start along each (topology, stiffness) in a fixed order, so that
-/// an evaluation's start — and with it the equilibrium a slack net lands on — depends on its own
-/// parameters only, never on which evaluations came before or on the thread count.
-pub struct StartLattice {
-    stiffness_N_per_m: Vec<f64>,
-    natural_length_m: Vec<f64>,
-    /// Per topology (A, B, C), per stiffness, per natural length: the converged drape, if it converged.
-    drapes: Vec<Option<LatticeDrape>>,
-}
-
 /// One node's drape and, where it is an isolated minimum, its tangents: the sensitivities to the
 /// stiffness and the natural length ([`crate::sensitivity`]), m per N/m and m per m.
 struct LatticeDrape {
     x: Vec<nalgebra::Vector3<f64>>,
     tangents: Option<[Vec<nalgebra::Vector3<f64>>; 2]>,
+    /// Its self-contact candidate set: an evaluation nearby starts without a broad phase.
+    candidates: Option<crate::physics::CandidateSet>,
+}
+
+/// Where an evaluation starts: the candidate starts (a lattice drape and its tangent prediction)
+/// and the node's self-contact candidate set.
+#[derive(Default)]
+pub struct WarmStart {
+    /// Candidate start positions, m; the solve takes the one of lowest energy.
+    pub starts: Vec<Vec<nalgebra::Vector3<f64>>>,
+    /// The node's self-contact candidate set.
+    pub candidates: Option<crate::physics::CandidateSet>,
 }
 
 /// The two keys of the lattice's tangents.
@@ -350,109 +359,11 @@ impl LatticeDrape {
             let [a, b] = TANGENT_KEYS.map(|k| eq.sensitivity(k).ok().map(|s| s.dx));
             Some([a?, b?])
         });
-        Some(Self { x: sol.x, tangents })
-    }
-}
-
-impl StartLattice {
-    const STIFFNESSES: usize = 5;
-    const LENGTHS: usize = 41;
-
-    fn solve(problem: &Problem) -> Self {
-        use rayon::prelude::*;
-        let b = &problem.bounds;
-        let nodes = |(lo, hi): (f64, f64), n: usize| -> Vec<f64> {
-            (0..n)
-                .map(|k| lo + (hi - lo) * k as f64 / (n - 1) as f64)
-                .collect()
-        };
-        let k = nodes(b.stiffness_N_per_m, Self::STIFFNESSES);
-        let l = nodes(b.natural_length_m, Self::LENGTHS);
-        let topologies = [Topology::A, Topology::B, Topology::C];
-        let chains: Vec<(Topology, f64)> = topologies
-            .iter()
-            .flat_map(|&t| k.iter().map(move |&kk| (t, kk)))
-            .collect();
-        // One chain per (topology, stiffness), in parallel; along a chain, continuation in the
-        // natural length (each node from the previous node's drape, the first from the sagged start).
-        let drapes: Vec<Vec<Option<LatticeDrape>>> = chains
-            .par_iter()
-            .map(|&(topology, kk)| {
-                let mut prev: Option<Vec<nalgebra::Vector3<f64>>> = None;
-                l.iter()
-                    .map(|&ll| {
-                        let scene = problem.scene_for(&Params {
-                            stiffness_N_per_m: kk,
-                            damping_Ns_per_m: b.damping_Ns_per_m.0,
-                            elongation_rate: b.elongation_rate.0,
-                            natural_length_m: ll,
-                            topology,
-                        });
-                        let sol = match &prev {
-                            Some(x0) => {
-                                crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver)
-                            }
-                            None => solve_scene(&scene, &mut NoObserver),
-                        };
-                        let node = LatticeDrape::of(&scene, sol);
-                        if let Some(n) = &node {
-                            prev = Some(n.x.clone());
-                        }
-                        node
-                    })
-                    .collect()
-            })
-            .collect();
-        let drapes = drapes.into_iter().flatten().collect();
-        Self {
-            stiffness_N_per_m: k,
-            natural_length_m: l,
-            drapes,
-        }
-    }
-
-    /// The starts of an evaluation at `p`: the drape at the nearest lattice node and, where the
-    /// node has tangents and `tangent` is on, its tangent prediction x(θ₀) + (dx/dθ)(θ − θ₀)
-    /// (within O(|θ − θ₀|²) of the answer); the solve takes the one of lower energy in `p`'s
-    /// model. A function of `p` alone.
-    fn starts(&self, p: &Params, tangent: bool) -> Vec<Vec<nalgebra::Vector3<f64>>> {
-        let Some((node, k0, l0)) = self.nearest(p) else {
-            return Vec::new();
-        };
-        let mut v = vec![node.x.clone()];
-        if let (true, Some([dk, dl])) = (tangent, &node.tangents) {
-            let (a, b) = (p.stiffness_N_per_m - k0, p.natural_length_m - l0);
-            v.push(
-                node.x
-                    .iter()
-                    .zip(dk.iter().zip(dl))
-                    .map(|(x, (u, w))| x + u * a + w * b)
-                    .collect(),
-            );
-        }
-        v
-    }
-
-    /// The lattice node nearest to `p` (in the box's unit coordinates), if its drape converged, with
-    /// the node's stiffness and natural length.
-    fn nearest(&self, p: &Params) -> Option<(&LatticeDrape, f64, f64)> {
-        let index = |nodes: &[f64], v: f64| {
-            let (lo, hi) = (nodes[0], nodes[nodes.len() - 1]);
-            let t = ((v - lo) / (hi - lo)).clamp(0.0, 1.0);
-            (t * (nodes.len() - 1) as f64).round() as usize
-        };
-        let t = match p.topology {
-            Topology::A => 0,
-            Topology::B => 1,
-            Topology::C => 2,
-        };
-        let (nk, nl) = (self.stiffness_N_per_m.len(), self.natural_length_m.len());
-        let (ik, il) = (
-            index(&self.stiffness_N_per_m, p.stiffness_N_per_m),
-            index(&self.natural_length_m, p.natural_length_m),
-        );
-        let node = self.drapes.get((t * nk + ik) * nl + il)?.as_ref()?;
-        Some((node, self.stiffness_N_per_m[ik], self.natural_length_m[il]))
+        Some(Self {
+            candidates: sol.model.candidates(),
+            x: sol.x,
+            tangents,
+        })
     }
 }
 
@@ -476,6 +387,16 @@ impl StaticSubspace {
 }
 
 impl Problem {
+    /// The warm-start lattice of this problem's scene (shared with every problem whose scene differs
+    /// only in density), its chains over this problem's box solved on first use, in parallel.
+    fn lattice(&self) -> &SharedLattice {
+        self.lattice.get_or_init(|| {
+            let l = SharedLattice::for_problem(self);
+            l.prepare(self);
+            l
+        })
+    }
+
     /// Polishes an optimum: Nelder–Mead (argmin) over stiffness and natural length from `u` (topology,
     /// damping and elongation rate held), with at most `max_iters` iterations (a few evaluations each).
     /// ICA finds the valley of the cost; the valley is long and narrow (stiffness and natural length

@@ -22,7 +22,7 @@ pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
 pub use kernel::{Kernel, Local, Potential};
 pub use loads::{Gravity, LoadKernel, PointLoads};
 pub use mesh_bending::{hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending};
-pub use self_contact::{SelfContact, SelfContactState};
+pub use self_contact::{CandidateSet, SelfContact, SelfContactState};
 pub use shear::{CellShear, ShearKernel};
 pub use springs::{SpringFamily, SpringKernel, Springs};
 
@@ -131,6 +131,15 @@ pub trait EnergyTerm: Send + Sync {
     }
     /// Whether this is the sheet's self-contact term.
     fn is_self_contact(&self) -> bool {
+        false
+    }
+    /// The term's candidate set (self-contact's broad phase), to seed a model solved nearby.
+    fn candidates(&self) -> Option<CandidateSet> {
+        None
+    }
+    /// Takes a candidate set from a model solved nearby ([`EnergyTerm::candidates`]); true when
+    /// it fits the term.
+    fn seed_candidates(&self, _set: &CandidateSet) -> bool {
         false
     }
     /// The term's coefficients, flat: the numbers its stencils are built over from the scene's
@@ -301,6 +310,15 @@ impl Model {
     /// Names of the terms that were built.
     pub fn term_names(&self) -> Vec<String> {
         self.terms.iter().map(|t| t.name()).collect()
+    }
+    /// The candidate set of the model's self-contact, when it has one and a broad phase ran.
+    pub fn candidates(&self) -> Option<CandidateSet> {
+        self.terms.iter().find_map(|t| t.candidates())
+    }
+    /// Seeds the model's self-contact with `set` from a model solved nearby (on the same mesh);
+    /// true when a term took it.
+    pub fn seed_candidates(&self, set: &CandidateSet) -> bool {
+        self.terms.iter().any(|t| t.seed_candidates(set))
     }
 }
 

@@ -34,7 +34,7 @@ pub struct SelfContactState {
     pub time_s: f64,
 }
 
-#[derive(Default)]
+#[derive(Default, Clone)]
 struct Cache {
     /// Per particle, the box its vertex may move in while `pairs` stays complete.
     region: Vec<Aabb>,
@@ -48,6 +48,20 @@ struct Cache {
     valid: bool,
     broad_phases: usize,
     time_s: f64,
+}
+
+/// A self-contact term's candidate set as data (ipc-toolkit's collision set): the broad phase's
+/// pairs with the region each vertex may move in while the list stays complete. Taken from a
+/// solved neighbour (a calibration lattice's drape), it seeds a new model's term so that a solve
+/// starting nearby runs no broad phase until a vertex leaves its region; the pairs a seeded term
+/// measures are those a fresh broad phase would keep within range, in the same order.
+#[derive(Clone)]
+pub struct CandidateSet {
+    /// The activation distance ξ + d̂ the list was built for, m.
+    activation_m: f64,
+    /// Vertices and triangles of the mesh it was built on.
+    size: (usize, usize),
+    cache: Cache,
 }
 
 /// Self-contact between the primitives of a triangulated sheet.
@@ -106,6 +120,43 @@ impl SelfContact {
     /// The activation distance ξ + d̂, m.
     pub fn activation_m(&self) -> f64 {
         self.thickness_m + self.band_m
+    }
+
+    /// The candidate set at hand, when a broad phase has run.
+    pub fn candidates(&self) -> Option<CandidateSet> {
+        let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        c.valid.then(|| CandidateSet {
+            activation_m: self.activation_m(),
+            size: (c.region.len(), self.topo.triangles.len()),
+            cache: Cache {
+                moved: Vec::new(),
+                broad_phases: 0,
+                time_s: 0.0,
+                ..c.clone()
+            },
+        })
+    }
+
+    /// Takes `set` as this term's candidate set where it was built for the same mesh and
+    /// activation distance (true); else leaves the term as it is (false).
+    pub fn seed(&self, set: &CandidateSet) -> bool {
+        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        let fits = set.activation_m == self.activation_m()
+            && set.size.1 == self.topo.triangles.len()
+            && self
+                .topo
+                .vertices
+                .iter()
+                .all(|&v| (v as usize) < set.size.0);
+        if fits {
+            let (phases, time) = (c.broad_phases, c.time_s);
+            *c = Cache {
+                broad_phases: phases,
+                time_s: time,
+                ..set.cache.clone()
+            };
+        }
+        fits
     }
 
     /// The mesh's primitives.
@@ -414,6 +465,12 @@ impl EnergyTerm for SelfContact {
     fn is_self_contact(&self) -> bool {
         true
     }
+    fn candidates(&self) -> Option<CandidateSet> {
+        SelfContact::candidates(self)
+    }
+    fn seed_candidates(&self, set: &CandidateSet) -> bool {
+        self.seed(set)
+    }
 }
 
 #[cfg(test)]
@@ -491,6 +548,38 @@ mod tests {
         fresh.add_gradient(&y, &mut g_fresh);
         assert_eq!(g_kept, g_fresh);
         assert_eq!(kept.state(&y).broad_phases, 1);
+    }
+
+    #[test]
+    fn a_seeded_term_measures_what_a_fresh_one_does_without_a_broad_phase() {
+        let (x, tris) = stacked(2.2e-3);
+        let solved = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        assert_eq!(solved.energy(&x), 0.0);
+        let set = solved.candidates().expect("a broad phase ran");
+        // A new model's term (another weight, so another κ), seeded, at a state moved within the
+        // set's margin into range.
+        let y: Vec<Vector3<f64>> = x
+            .iter()
+            .enumerate()
+            .map(|(p, v)| match p >= 9 {
+                true => v + Vector3::new(0.0, 0.0, -6e-4 - 1.5e-2 * v.x),
+                false => *v,
+            })
+            .collect();
+        let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 2e-3);
+        assert!(seeded.seed(&set));
+        let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 2e-3);
+        assert!(fresh.energy(&y) > 0.0);
+        assert_eq!(seeded.energy(&y), fresh.energy(&y));
+        let (mut g_seeded, mut g_fresh) = (vec![Vector3::zeros(); 18], vec![Vector3::zeros(); 18]);
+        seeded.add_gradient(&y, &mut g_seeded);
+        fresh.add_gradient(&y, &mut g_fresh);
+        assert_eq!(g_seeded, g_fresh);
+        let phases = seeded.cache.lock().expect("cache").broad_phases;
+        assert_eq!(phases, 0, "the seeded list covered the move");
+        // A set built for another activation distance does not fit.
+        let thicker = SelfContact::new(tris, &x, 6e-4, 1e-3, 1e-3);
+        assert!(!thicker.seed(&set));
     }
 
     #[test]

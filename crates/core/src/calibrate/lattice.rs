@@ -1,0 +1,206 @@
+//! Deterministic warm starts for a calibration: one lattice of static drapes for every sample,
+//! where each sample had its own (a quarter of the main job's time).
+//!
+//! A slack net has several equilibria, so an evaluation cannot start from whatever solution came
+//! before (its cost would depend on the order of evaluation and the thread count): it starts from
+//! the nearest node of a fixed lattice, or that node's tangent prediction. The static drape of a mass-spring net under gravity depends on the spring stiffness k and the
+//! areal density ρ only through the specific stiffness s = k/ρ: every term of its energy scales with
+//! one of them (springs ∝ k, gravity and the self-contact barrier's κ ∝ ρ, the barrier's distances
+//! unchanged), and so do the solver's residual tolerance (relative to a weight) and its damping
+//! (relative to the Hessian's diagonal). So the drape of (k, ρ) is the drape of (k·ρ_ref/ρ, ρ_ref),
+//! and one lattice at the reference density ρ_ref serves every sample whose scene differs only in
+//! its density. Its stiffness nodes are a geometric ladder K_i = K_REF·R^i (i any integer), each
+//! chain (topology, i) solved lazily, the first time an evaluation needs it, by continuation in the
+//! natural length as before: a chain is a pure function of (scene without density, topology, i), so
+//! an evaluation's start still depends on its own parameters only.
+
+use super::{LatticeDrape, Params, Problem, WarmStart};
+use crate::material::Topology;
+use crate::scene::Scene;
+use crate::solve::NoObserver;
+use nalgebra::Vector3;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Natural-length nodes of a chain, 0.5 mm apart over Table 3's 40–60 mm.
+const LENGTHS: usize = 41;
+/// The reference areal density of every shared lattice, kg/m².
+const RHO_REF: f64 = 0.05;
+/// The first rung of the stiffness ladder at the reference density, N/m.
+const K_REF: f64 = 1000.0;
+/// The ratio of two rungs: ±10 % at most from an evaluation's specific stiffness to its node's, as
+/// the per-sample lattice of five stiffnesses over 500–1200 N/m had.
+const R: f64 = 1.2;
+
+type Chain = Arc<OnceLock<Vec<Option<LatticeDrape>>>>;
+
+/// The lattice shared by every problem whose scene differs only in density (and stiffness).
+pub struct SharedLattice {
+    /// The scene at the reference density (stiffness and natural length set per node).
+    reference: Scene,
+    /// The natural-length nodes, m.
+    lengths: Vec<f64>,
+    chains: Mutex<HashMap<(Topology, i32), Chain>>,
+}
+
+/// Every shared lattice of the process, by the hash of its reference scene.
+static LATTICES: Mutex<Vec<(u64, Arc<SharedLattice>)>> = Mutex::new(Vec::new());
+
+impl SharedLattice {
+    /// The lattice for `problem`'s scene, made on first use.
+    pub fn for_problem(problem: &Problem) -> Arc<SharedLattice> {
+        let b = &problem.bounds;
+        let mut reference = problem.scene_for(&Params {
+            stiffness_N_per_m: K_REF,
+            damping_Ns_per_m: b.damping_Ns_per_m.0,
+            elongation_rate: b.elongation_rate.0,
+            natural_length_m: b.natural_length_m.0,
+            topology: Topology::A,
+        });
+        reference.cloth.areal_density_kg_per_m2 = RHO_REF;
+        let lengths: Vec<f64> = (0..LENGTHS)
+            .map(|k| {
+                let (lo, hi) = b.natural_length_m;
+                lo + (hi - lo) * k as f64 / (LENGTHS - 1) as f64
+            })
+            .collect();
+        let key = {
+            let text = serde_json::to_string(&(&reference, &lengths)).unwrap_or_default();
+            u64::from_le_bytes(
+                blake3::hash(text.as_bytes()).as_bytes()[..8]
+                    .try_into()
+                    .unwrap_or([0; 8]),
+            )
+        };
+        let mut all = LATTICES.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, l)) = all.iter().find(|(k, _)| *k == key) {
+            return l.clone();
+        }
+        let l = Arc::new(SharedLattice {
+            reference,
+            lengths,
+            chains: Mutex::new(HashMap::new()),
+        });
+        all.push((key, l.clone()));
+        l
+    }
+
+    /// The reference scene at stiffness `k`, natural length `l`, topology `t`.
+    fn scene(&self, k: f64, l: f64, t: Topology) -> Scene {
+        let mut s = self.reference.clone();
+        let ms = s.material.mass_spring.get_or_insert_with(Default::default);
+        ms.stiffness_N_per_m = k;
+        ms.natural_length_m = Some(l);
+        ms.topology = t;
+        s
+    }
+
+    /// Chain (t, i), solved on first use: continuation in the natural length from the sagged start.
+    fn chain(&self, t: Topology, i: i32) -> Chain {
+        let chain = {
+            let mut chains = self.chains.lock().unwrap_or_else(|e| e.into_inner());
+            chains.entry((t, i)).or_default().clone()
+        };
+        chain.get_or_init(|| {
+            let k = K_REF * R.powi(i);
+            let mut prev: Option<Vec<Vector3<f64>>> = None;
+            self.lengths
+                .iter()
+                .map(|&l| {
+                    let scene = self.scene(k, l, t);
+                    let sol = match &prev {
+                        Some(x0) => crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver),
+                        None => crate::simulate::solve_scene(&scene, &mut NoObserver),
+                    };
+                    let node = LatticeDrape::of(&scene, sol);
+                    if let Some(n) = &node {
+                        prev = Some(n.x.clone());
+                    }
+                    node
+                })
+                .collect()
+        });
+        chain
+    }
+
+    /// The rung nearest to reference stiffness `k`.
+    fn rung(k: f64) -> i32 {
+        ((k / K_REF).ln() / R.ln()).round() as i32
+    }
+
+    /// The rungs a problem's stiffness bounds reach at its density.
+    fn rungs(problem: &Problem) -> std::ops::RangeInclusive<i32> {
+        let scale = RHO_REF / problem.scene.cloth.areal_density_kg_per_m2;
+        let (lo, hi) = problem.bounds.stiffness_N_per_m;
+        Self::rung(lo * scale)..=Self::rung(hi * scale)
+    }
+
+    /// Solves every chain `problem`'s box reaches, in parallel (those solved already are kept).
+    pub fn prepare(&self, problem: &Problem) {
+        use rayon::prelude::*;
+        let chains: Vec<(Topology, i32)> = [Topology::A, Topology::B, Topology::C]
+            .into_iter()
+            .flat_map(|t| Self::rungs(problem).map(move |i| (t, i)))
+            .collect();
+        chains.par_iter().for_each(|&(t, i)| {
+            self.chain(t, i);
+        });
+    }
+
+    /// Every converged node of `topology` within `problem`'s box, as (stiffness at the problem's
+    /// density N/m, natural length m, drape).
+    pub fn nodes(
+        &self,
+        problem: &Problem,
+        topology: Topology,
+    ) -> Vec<(f64, f64, Vec<Vector3<f64>>)> {
+        let scale = problem.scene.cloth.areal_density_kg_per_m2 / RHO_REF;
+        let (lo, hi) = problem.bounds.stiffness_N_per_m;
+        let mut out = Vec::new();
+        for i in Self::rungs(problem) {
+            let k = K_REF * R.powi(i) * scale;
+            if !(lo..=hi).contains(&k) {
+                continue;
+            }
+            let chain = self.chain(topology, i);
+            for (node, &l) in chain.get().into_iter().flatten().zip(&self.lengths) {
+                if let Some(n) = node {
+                    out.push((k, l, n.x.clone()));
+                }
+            }
+        }
+        out
+    }
+
+    /// The starts of an evaluation at `p` on a sheet of density `rho`: its nearest node's drape
+    /// and, with `tangent`, the node's tangent prediction at the equivalent reference stiffness
+    /// k·ρ_ref/ρ.
+    pub fn starts(&self, p: &Params, rho: f64, tangent: bool) -> WarmStart {
+        let k = p.stiffness_N_per_m * RHO_REF / rho;
+        let i = Self::rung(k);
+        let k0 = K_REF * R.powi(i);
+        let (lo, hi) = (self.lengths[0], self.lengths[self.lengths.len() - 1]);
+        let t = ((p.natural_length_m - lo) / (hi - lo)).clamp(0.0, 1.0);
+        let j = (t * (self.lengths.len() - 1) as f64).round() as usize;
+        let l0 = self.lengths[j];
+        let chain = self.chain(p.topology, i);
+        let Some(Some(node)) = chain.get().and_then(|c| c.get(j)) else {
+            return WarmStart::default();
+        };
+        let mut v = vec![node.x.clone()];
+        if let (true, Some([dk, dl])) = (tangent, &node.tangents) {
+            let (a, b) = (k - k0, p.natural_length_m - l0);
+            v.push(
+                node.x
+                    .iter()
+                    .zip(dk.iter().zip(dl))
+                    .map(|(x, (u, w))| x + u * a + w * b)
+                    .collect(),
+            );
+        }
+        WarmStart {
+            starts: v,
+            candidates: node.candidates.clone(),
+        }
+    }
+}
