@@ -182,18 +182,15 @@ fn envelope(segments: &[Segment], samples: &[f64], lower: bool) -> Vec<Option<f6
         let (lo, hi) = (sa.min(sb), sa.max(sb));
         let k0 = ((lo - s0) / ds).ceil().max(0.0) as usize;
         let k1 = (((hi - s0) / ds).floor().max(-1.0) + 1.0) as usize;
-        for (k, o) in out
-            .iter_mut()
-            .enumerate()
-            .take(k1.min(samples.len()))
-            .skip(k0)
-        {
-            let s = samples[k];
-            let t = if (sb - sa).abs() < 1e-12 {
-                if lower { ta.min(tb) } else { ta.max(tb) }
-            } else {
-                ta + (tb - ta) * (s - sa) / (sb - sa)
-            };
+        let span = &mut out[k0.min(samples.len())..k1.min(samples.len())];
+        let at = &samples[k0.min(samples.len())..k1.min(samples.len())];
+        // t(s) along the segment: its slope once, not a division per sample.
+        let (slope, flat) = match (sb - sa).abs() < 1e-12 {
+            true => (0.0, Some(if lower { ta.min(tb) } else { ta.max(tb) })),
+            false => ((tb - ta) / (sb - sa), None),
+        };
+        for (o, &s) in span.iter_mut().zip(at) {
+            let t = flat.unwrap_or(ta + slope * (s - sa));
             *o = Some(match *o {
                 None => t,
                 Some(v) if lower => v.min(t),
@@ -220,12 +217,17 @@ pub fn edges_from_silhouette(
     projection: Projection,
 ) -> Vec<(String, Vec<(f64, f64)>)> {
     let (cm, span) = camera_cm(grid, x, corners, projection);
-    let mut along_up: Vec<Segment> = Vec::new();
-    for t in crate::cloth::grid_triangles(grid) {
-        for k in 0..3 {
-            along_up.push((cm[t[k] as usize], cm[t[(k + 1) % 3] as usize]));
-        }
-    }
+    // Each mesh edge once (an inner edge borders two triangles).
+    let mut edges: Vec<(u32, u32)> = crate::cloth::grid_triangles(grid)
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let along_up: Vec<Segment> = edges
+        .iter()
+        .map(|&(a, b)| (cm[a as usize], cm[b as usize]))
+        .collect();
     let n = 64 * (grid.nx.max(grid.ny) - 1);
     let xs = linspace(0.0, span, n);
     let curve = |lower: bool| -> Vec<(f64, f64)> {
