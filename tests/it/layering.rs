@@ -72,7 +72,7 @@ const NOT_IN_CORE: [&str; 8] = [
 ];
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank.
-const CORE_RANKS: [(&str, u8); 26] = [
+const CORE_RANKS: [(&str, u8); 27] = [
     ("error", 0),
     ("provenance", 0),
     ("atomic", 0),
@@ -84,6 +84,7 @@ const CORE_RANKS: [(&str, u8); 26] = [
     ("raster", 0),
     ("config", 1),
     ("cloth", 1),
+    ("pattern", 1),
     ("physics", 1),
     ("solve", 2),
     ("scene", 3),

@@ -26,6 +26,7 @@ pub mod material;
 pub mod measure;
 pub mod optim;
 pub mod params;
+pub mod pattern;
 pub mod physics;
 pub mod provenance;
 pub mod raster;

@@ -1,6 +1,9 @@
 //! From a scene to a [`Model`]: the springs the topology asks for, or the continuum terms, the
 //! lumped masses, pins and clamps. Terms a scene does not need are never built.
 
+mod pattern;
+pub use pattern::{PatternSheet, pattern_builder};
+
 use crate::cloth::{Grid, tributary_lengths};
 use crate::material::Rigidities;
 use crate::physics::{

@@ -1,0 +1,407 @@
+//! A flat pattern piece as the sheet: a triangle mesh read from a Wavefront OBJ file (what CLO,
+//! Marvelous Designer, Blender and the IPC and BDP examples exchange), checked once so that the
+//! physics can rely on it: one flat, connected, manifold piece of triangles with area, oriented
+//! alike. Polygons are split into fans; `g`/`o` groups name vertex sets (the vertices of the
+//! group's faces and `l` polylines) that pins and clamps can address.
+
+use std::collections::{BTreeMap, HashMap};
+
+/// A checked flat pattern: rest positions in its own plane (m) and counter-clockwise triangles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pattern {
+    /// Rest positions in the pattern's plane, m (the file's x and y times its unit).
+    pub rest_m: Vec<[f64; 2]>,
+    /// Triangles, counter-clockwise seen from +z.
+    pub triangles: Vec<[usize; 3]>,
+    /// Vertex sets by group name (`g` and `o` lines), sorted.
+    pub groups: BTreeMap<String, Vec<usize>>,
+}
+
+/// What is wrong with a pattern file, in one line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Defect {
+    /// The key to name in the error: `line N` or what is wrong overall.
+    pub key: String,
+    /// What is wrong and what to do.
+    pub message: String,
+}
+
+fn defect(key: impl Into<String>, message: impl Into<String>) -> Defect {
+    Defect {
+        key: key.into(),
+        message: message.into(),
+    }
+}
+
+/// Relative tolerance of flatness and area against the pattern's extent.
+const FLAT_REL: f64 = 1e-6;
+const AREA_REL: f64 = 1e-10;
+
+/// What the parser collects before the checks.
+#[derive(Default)]
+struct Raw {
+    v: Vec<[f64; 3]>,
+    faces: Vec<([usize; 3], usize)>,
+    groups: BTreeMap<String, Vec<usize>>,
+}
+
+/// Reads a pattern from OBJ text; `unit_m` is the file's unit in metres (1 for m, 0.01 for cm).
+pub fn parse_obj(text: &str, unit_m: f64) -> Result<Pattern, Defect> {
+    let raw = parse(text)?;
+    check(raw, unit_m)
+}
+
+/// Reads and checks `path` ([`parse_obj`]); errors name the file and the line or defect.
+pub fn read_obj(path: &std::path::Path, unit_m: f64) -> anyhow::Result<Pattern> {
+    use crate::error::InputError;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
+    parse_obj(&text, unit_m).map_err(|d| InputError::new(path, d.key, d.message).into())
+}
+
+/// The vertex index of an OBJ face or line token (`7`, `7/2`, `7//3`, `-1`), 0-based.
+fn index(token: &str, count: usize, line: usize) -> Result<usize, Defect> {
+    let first = token.split('/').next().unwrap_or("");
+    let at = format!("line {line}");
+    let i: i64 = first
+        .parse()
+        .map_err(|_| defect(&at, format!("`{token}` is not a vertex index")))?;
+    let resolved = if i < 0 { count as i64 + i } else { i - 1 };
+    if i == 0 || resolved < 0 || resolved >= count as i64 {
+        return Err(defect(
+            at,
+            format!("refers to vertex {i}; the file has {count} vertices before this line"),
+        ));
+    }
+    Ok(resolved as usize)
+}
+
+fn parse(text: &str) -> Result<Raw, Defect> {
+    let mut raw = Raw::default();
+    let mut current: Vec<String> = Vec::new();
+    for (k, line) in text.lines().enumerate() {
+        let n = k + 1;
+        let mut it = line.split_whitespace();
+        let Some(tag) = it.next() else { continue };
+        let rest: Vec<&str> = it.collect();
+        match tag {
+            "v" => {
+                let c: Vec<f64> = rest.iter().take(3).filter_map(|t| t.parse().ok()).collect();
+                match c[..] {
+                    [x, y, z] if c.iter().all(|v| v.is_finite()) => raw.v.push([x, y, z]),
+                    _ => {
+                        return Err(defect(
+                            format!("line {n}"),
+                            "a vertex (`v`) needs three finite numbers",
+                        ));
+                    }
+                }
+            }
+            "f" | "l" => {
+                let idx: Vec<usize> = rest
+                    .iter()
+                    .map(|t| index(t, raw.v.len(), n))
+                    .collect::<Result<_, _>>()?;
+                for g in &current {
+                    raw.groups.entry(g.clone()).or_default().extend(&idx);
+                }
+                if tag == "l" {
+                    continue;
+                }
+                if idx.len() < 3 {
+                    return Err(defect(
+                        format!("line {n}"),
+                        "a face (`f`) needs three vertices",
+                    ));
+                }
+                for j in 1..idx.len() - 1 {
+                    raw.faces.push(([idx[0], idx[j], idx[j + 1]], n));
+                }
+            }
+            "g" | "o" => current = rest.iter().map(|s| s.to_string()).collect(),
+            _ => {}
+        }
+    }
+    Ok(raw)
+}
+
+/// The checks, in the order a user would fix them; then the pattern in metres.
+fn check(raw: Raw, unit_m: f64) -> Result<Pattern, Defect> {
+    if raw.faces.is_empty() {
+        return Err(defect(
+            "faces",
+            "the file has no faces (`f` lines): nothing to drape",
+        ));
+    }
+    let extent = extent(&raw.v);
+    let z0 = raw.v[raw.faces[0].0[0]][2];
+    if let Some((k, p)) = raw
+        .v
+        .iter()
+        .enumerate()
+        .find(|(_, p)| (p[2] - z0).abs() > FLAT_REL * extent)
+    {
+        return Err(defect(
+            "vertices",
+            format!(
+                "not a flat pattern: vertex {} lies {:.3e} off the plane z = {z0} of the first face (give the piece flat, z constant)",
+                k + 1,
+                p[2] - z0
+            ),
+        ));
+    }
+    unused_vertex(&raw)?;
+    let triangles = oriented(&raw, extent)?;
+    manifold(&raw, &triangles)?;
+    connected(raw.v.len(), &triangles)?;
+    Ok(Pattern {
+        rest_m: raw
+            .v
+            .iter()
+            .map(|p| [p[0] * unit_m, p[1] * unit_m])
+            .collect(),
+        triangles,
+        groups: raw
+            .groups
+            .into_iter()
+            .map(|(g, mut v)| {
+                v.sort_unstable();
+                v.dedup();
+                (g, v)
+            })
+            .collect(),
+    })
+}
+
+fn extent(v: &[[f64; 3]]) -> f64 {
+    let span = |c: usize| {
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[c]), hi.max(p[c]))
+            });
+        hi - lo
+    };
+    span(0).max(span(1)).max(f64::MIN_POSITIVE)
+}
+
+/// Every vertex must belong to a face (a vertex in none would be a particle with no mass).
+fn unused_vertex(raw: &Raw) -> Result<(), Defect> {
+    let mut used = vec![false; raw.v.len()];
+    for (t, _) in &raw.faces {
+        t.iter().for_each(|&v| used[v] = true);
+    }
+    match used.iter().position(|u| !u) {
+        Some(k) => Err(defect(
+            "vertices",
+            format!("vertex {} is in no face: remove it or connect it", k + 1),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The triangles counter-clockwise: every face must have area and the same orientation as the
+/// first (all clockwise is turned over as a whole).
+fn oriented(raw: &Raw, extent: f64) -> Result<Vec<[usize; 3]>, Defect> {
+    let signed = |t: &[usize; 3]| {
+        let [a, b, c] = t.map(|i| raw.v[i]);
+        0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
+    };
+    let sign = signed(&raw.faces[0].0).signum();
+    let mut out = Vec::with_capacity(raw.faces.len());
+    for (t, line) in &raw.faces {
+        let s = signed(t);
+        if s.abs() <= AREA_REL * extent * extent {
+            return Err(defect(
+                format!("line {line}"),
+                "a face without area (its vertices are collinear or repeated)",
+            ));
+        }
+        if s.signum() != sign {
+            return Err(defect(
+                format!("line {line}"),
+                "an inverted face: its vertices run the other way round from the first face's (a folded or flipped pattern)",
+            ));
+        }
+        out.push(if sign > 0.0 { *t } else { [t[0], t[2], t[1]] });
+    }
+    Ok(out)
+}
+
+/// Each edge in at most two faces, and each vertex's faces one fan.
+fn manifold(raw: &Raw, tris: &[[usize; 3]]) -> Result<(), Defect> {
+    let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
+    for (t, (_, line)) in tris.iter().zip(&raw.faces) {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let e = edges.entry((a.min(b), a.max(b))).or_default();
+            *e += 1;
+            if *e > 2 {
+                return Err(defect(
+                    format!("line {line}"),
+                    format!(
+                        "a non-manifold edge: vertices {} and {} are shared by three or more faces",
+                        a + 1,
+                        b + 1
+                    ),
+                ));
+            }
+        }
+    }
+    // Around each vertex, its faces joined through shared edges must be one fan (no bow-tie).
+    let mut around: Vec<Vec<usize>> = vec![Vec::new(); raw.v.len()];
+    for (f, t) in tris.iter().enumerate() {
+        t.iter().for_each(|&v| around[v].push(f));
+    }
+    for (v, faces) in around.iter().enumerate() {
+        let shares = |f: usize, g: usize| {
+            tris[f]
+                .iter()
+                .filter(|&&a| a != v && tris[g].contains(&a))
+                .count()
+                > 0
+        };
+        if components(faces.len(), |i, j| shares(faces[i], faces[j])) > 1 {
+            return Err(defect(
+                "vertices",
+                format!(
+                    "a non-manifold vertex: the faces around vertex {} meet only at it (a bow-tie); split it in two",
+                    v + 1
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// One piece: every vertex reachable from the first through faces.
+fn connected(n: usize, tris: &[[usize; 3]]) -> Result<(), Defect> {
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for t in tris {
+        for k in 1..3 {
+            let (a, b) = (root(&mut parent, t[0]), root(&mut parent, t[k]));
+            parent[a] = b;
+        }
+    }
+    let r0 = root(&mut parent, 0);
+    let pieces: std::collections::BTreeSet<usize> = (0..n).map(|i| root(&mut parent, i)).collect();
+    match (0..n).find(|&i| root(&mut parent, i) != r0) {
+        Some(k) => Err(defect(
+            "faces",
+            format!(
+                "{} disconnected pieces (vertex {} is not joined to vertex 1): give one piece per file",
+                pieces.len(),
+                k + 1
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Connected components of `n` items under the relation `joined`.
+fn components(n: usize, joined: impl Fn(usize, usize) -> bool) -> usize {
+    let mut seen = vec![false; n];
+    let mut count = 0;
+    for s in 0..n {
+        if seen[s] {
+            continue;
+        }
+        count += 1;
+        let mut stack = vec![s];
+        seen[s] = true;
+        while let Some(i) = stack.pop() {
+            for (j, s) in seen.iter_mut().enumerate() {
+                if !*s && joined(i, j) {
+                    *s = true;
+                    stack.push(j);
+                }
+            }
+        }
+    }
+    count
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SQUARE: &str = "o panel\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\ng hem\nl 1 2\n";
+
+    #[test]
+    fn a_quad_becomes_two_counter_clockwise_triangles_with_its_groups() {
+        let p = parse_obj(SQUARE, 0.01).unwrap();
+        assert_eq!(p.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(p.rest_m[2], [0.01, 0.01]);
+        assert_eq!(p.groups["panel"], vec![0, 1, 2, 3]);
+        assert_eq!(p.groups["hem"], vec![0, 1]);
+        // Clockwise as a whole is turned over, with the same vertices.
+        let cw = parse_obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 3 2\n", 1.0).unwrap();
+        assert_eq!(cw.triangles, vec![[0, 1, 2]]);
+    }
+
+    /// Each malformed file with the defect its message must name.
+    pub(crate) const MALFORMED: [(&str, &str, &str); 10] = [
+        ("no_faces", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no faces"),
+        (
+            "bad_vertex",
+            "v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            "three finite numbers",
+        ),
+        (
+            "out_of_range",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+            "refers to vertex 4",
+        ),
+        (
+            "short_face",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n",
+            "needs three vertices",
+        ),
+        (
+            "not_flat",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0.2\nf 1 2 3\n",
+            "not a flat pattern",
+        ),
+        (
+            "degenerate",
+            "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 4\nf 1 2 3\n",
+            "without area",
+        ),
+        (
+            "inverted",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 4 3\n",
+            "inverted face",
+        ),
+        (
+            "non_manifold_edge",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 2 1 0\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+            "non-manifold edge",
+        ),
+        (
+            "disconnected",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\nf 1 2 3\nf 4 5 6\n",
+            "disconnected pieces",
+        ),
+        (
+            "bow_tie",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n",
+            "non-manifold vertex",
+        ),
+    ];
+
+    #[test]
+    fn each_malformed_pattern_is_refused_naming_its_defect() {
+        for (name, text, says) in MALFORMED {
+            let err = parse_obj(text, 1.0).expect_err(name);
+            assert!(err.message.contains(says), "{name}: {err:?}");
+            assert!(!err.message.contains('\n'), "{name}: one line");
+        }
+    }
+}
