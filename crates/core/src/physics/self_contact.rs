@@ -524,21 +524,24 @@ mod tests {
     /// The pairs left unmeasured because their vertices have not moved far enough to reach the
     /// activation distance are exactly those out of range: moved within the region its list
     /// covers, a term keeps the energy and gradient of a term whose list is built afresh.
-    #[test]
-    fn pruned_pairs_are_the_ones_out_of_range() {
-        let (x, tris) = stacked(2.2e-3);
-        let kept = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
-        assert_eq!(kept.energy(&x), 0.0);
-        // The upper layer comes down 0.6–0.9 mm, tilted (within the 1 mm margin: no new broad
-        // phase), into the 1.5 mm activation distance at one side.
-        let y: Vec<Vector3<f64>> = x
-            .iter()
+    /// The upper layer of [`stacked`] brought down 0.6–0.9 mm, tilted (within the 1 mm margin:
+    /// no new broad phase), into the 1.5 mm activation distance at one side.
+    fn lowered(x: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+        x.iter()
             .enumerate()
             .map(|(p, v)| match p >= 9 {
                 true => v + Vector3::new(0.0, 0.0, -6e-4 - 1.5e-2 * v.x),
                 false => *v,
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn pruned_pairs_are_the_ones_out_of_range() {
+        let (x, tris) = stacked(2.2e-3);
+        let kept = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        assert_eq!(kept.energy(&x), 0.0);
+        let y = lowered(&x);
         let fresh = SelfContact::new(tris, &y, 5e-4, 1e-3, 1e-3);
         let (e_kept, e_fresh) = (kept.energy(&y), fresh.energy(&y));
         assert!(e_fresh > 0.0);
@@ -558,14 +561,7 @@ mod tests {
         let set = solved.candidates().expect("a broad phase ran");
         // A new model's term (another weight, so another κ), seeded, at a state moved within the
         // set's margin into range.
-        let y: Vec<Vector3<f64>> = x
-            .iter()
-            .enumerate()
-            .map(|(p, v)| match p >= 9 {
-                true => v + Vector3::new(0.0, 0.0, -6e-4 - 1.5e-2 * v.x),
-                false => *v,
-            })
-            .collect();
+        let y = lowered(&x);
         let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 2e-3);
         assert!(seeded.seed(&set));
         let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 2e-3);
