@@ -131,6 +131,11 @@ pub struct Equilibrium<'a> {
 }
 
 impl<'a> Equilibrium<'a> {
+    /// The factor of the exact Hessian at the equilibrium.
+    pub fn factor(&self) -> &EquilibriumFactor {
+        &self.factor
+    }
+
     /// The factor of the solved scene's `model` at `x`; none unless the report says converged.
     /// `source` names where the keys come from in errors (a flag, a file).
     pub fn new(

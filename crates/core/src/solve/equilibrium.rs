@@ -203,6 +203,12 @@ impl EquilibriumFactor {
     }
 
     /// Whether particle `p` is free (has coordinates in the factor).
+    /// The Cholesky factor itself (of H + σI, held components decoupled).
+    pub fn factor(&self) -> &SparseSpd {
+        &self.spd
+    }
+
+    /// Whether particle `p` is free.
     pub fn is_free(&self, p: usize) -> bool {
         self.dofs.dof(p).is_some()
     }
@@ -279,6 +285,44 @@ mod tests {
         }
         assert_eq!(s[0], Vector3::zeros());
         assert!(s[1].z < 0.0, "more mass sags lower");
+    }
+
+    #[test]
+    fn a_neighbours_factor_solves_the_next_equilibrium_without_a_factorization() {
+        // The chain at 10 g, its factor; then the chain at 10.5 g and at 40 g (its Hessian a
+        // multiple of the first's where only gravity changes, so the factor scaled by 10/40 is exact
+        // to first order) solved from the first drape with that factor.
+        let (mut model, mut x) = chain(0.01);
+        equilibrium(&mut model, &mut x);
+        let f = EquilibriumFactor::new(&model, &x).expect("a minimum");
+        let shared = std::sync::Arc::new(f.factor().copy());
+        for (m, scale) in [(0.0105, 1.0), (0.04, 0.25)] {
+            let (mut plain, mut xp) = chain(m);
+            xp.copy_from_slice(&x);
+            equilibrium(&mut plain, &mut xp);
+            let (mut seeded, mut xs) = chain(m);
+            xs.copy_from_slice(&x);
+            let opts = crate::solve::StaticOptions {
+                residual_tol_rel: 1e-12,
+                neighbour_factor: Some(crate::solve::NeighbourFactor {
+                    factor: shared.clone(),
+                    scale,
+                }),
+                ..Default::default()
+            };
+            let r = crate::solve::solve_static(
+                &mut seeded,
+                &mut xs,
+                &opts,
+                &mut crate::solve::NoObserver,
+            );
+            assert!(r.is_converged(), "{}", r.message);
+            assert_eq!(r.factorizations, 0, "mass {m}: {r:?}");
+            assert!(r.globalization.krylov_steps > 0);
+            for p in 0..4 {
+                assert!((xs[p] - xp[p]).norm() < 1e-9, "mass {m}, particle {p}");
+            }
+        }
     }
 
     #[test]

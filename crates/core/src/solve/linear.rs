@@ -291,6 +291,9 @@ pub struct SparseSpd {
     pub analysis_time_s: f64,
     /// Wall time spent in numeric factorizations and triangular solves, s.
     pub factor_time_s: f64,
+    /// A factor to multiply every solve by (a neighbour's factor of a model that differs by a
+    /// scale); 1 after each factorization.
+    pub scale: f64,
 }
 
 impl Default for SparseSpd {
@@ -313,7 +316,25 @@ impl SparseSpd {
             analyses: 0,
             analysis_time_s: 0.0,
             factor_time_s: 0.0,
+            scale: 1.0,
         }
+    }
+
+    /// A copy of the last factorization (no counts), for another solve to start its chord steps
+    /// with.
+    pub fn copy(&self) -> Self {
+        let mut out = Self::new();
+        if let Some(pattern) = &self.pattern {
+            let symbolic = &pattern.structure.symbolic;
+            out.mem = MemBuffer::new(StackReq::any_of(&[
+                symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+                symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+            ]));
+            out.pattern = Some(pattern.clone());
+            out.l_values = self.l_values.clone();
+            out.values = vec![0.0; self.values.len()];
+        }
+        out
     }
 
     fn entries(dofs: &DofMap, h: &HessianBlocks, mut visit: impl FnMut(usize, usize, f64)) {
@@ -380,6 +401,7 @@ impl SparseSpd {
         let structure = &pattern.structure;
         let mat = SparseColMatRef::new(structure.sym.as_ref(), values);
         self.factorizations += 1;
+        self.scale = 1.0;
         let ok = structure
             .symbolic
             .factorize_numeric_llt(
@@ -411,6 +433,9 @@ impl SparseSpd {
             Par::Seq,
             MemStack::new(&mut self.mem),
         );
+        if self.scale != 1.0 {
+            rhs.iter_mut().for_each(|v| *v *= self.scale);
+        }
         self.factor_time_s += start.elapsed().as_secs_f64();
     }
 }

@@ -22,7 +22,7 @@ pub use dynamic::{
 pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use linear::{DofMap, SparseSpd};
-pub use newton::{StaticOptions, is_minimum, solve_static, solve_static_loads};
+pub use newton::{NeighbourFactor, StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{
     Divergence, DivergenceReason, Globalization, Part, SolveReport, Status, StopReason,
 };

@@ -73,6 +73,35 @@ pub struct StaticOptions {
     /// of the factorizations.
     #[serde(default = "default_check_minimum")]
     pub check_minimum: bool,
+    /// The factor of a neighbouring equilibrium's Hessian (set in code, never read from a file):
+    /// each Newton step is then solved by conjugate gradients preconditioned with it, with no
+    /// factorization of its own while that converges ([`NeighbourFactor`]). The calibration sets it
+    /// to its lattice node's.
+    #[serde(skip)]
+    pub neighbour_factor: Option<NeighbourFactor>,
+}
+
+/// A neighbouring equilibrium's factor and the scale of its solves for this model (a model whose
+/// energy is a multiple c of the neighbour's takes 1/c).
+#[derive(Clone)]
+pub struct NeighbourFactor {
+    /// The factor, shared.
+    pub factor: std::sync::Arc<super::SparseSpd>,
+    /// What its solves are multiplied by.
+    pub scale: f64,
+}
+
+impl std::fmt::Debug for NeighbourFactor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "NeighbourFactor(scale {})", self.scale)
+    }
+}
+
+/// Two options are equal whatever neighbour factor they carry (it is a start, not a setting).
+impl PartialEq for NeighbourFactor {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 fn default_check_minimum() -> bool {
@@ -113,6 +142,7 @@ impl Default for StaticOptions {
             regularization: Regularization::default(),
             factor_reuse: FactorReuse::default(),
             check_minimum: default_check_minimum(),
+            neighbour_factor: None,
         }
     }
 }

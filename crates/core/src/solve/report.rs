@@ -162,6 +162,10 @@ pub struct Globalization {
     /// `FactorReuse::Chord`; counted among the full steps too).
     #[serde(default)]
     pub chord_steps: usize,
+    /// Iterations whose step was solved by conjugate gradients preconditioned with a neighbour's
+    /// factor (`StaticOptions::neighbour_factor`; no factorization of their own).
+    #[serde(default)]
+    pub krylov_steps: usize,
 }
 
 impl Globalization {
@@ -175,6 +179,7 @@ impl Globalization {
         self.rejected_trials += o.rejected_trials;
         self.skipped_shifts += o.skipped_shifts;
         self.chord_steps += o.chord_steps;
+        self.krylov_steps += o.krylov_steps;
     }
 }
 

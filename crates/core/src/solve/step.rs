@@ -117,7 +117,18 @@ pub(super) struct Workspace {
     last_step: Taken,
     /// What the globalization did so far.
     pub(super) stats: Globalization,
+    /// Whether steps are solved by conjugate gradients preconditioned with a neighbour's factor
+    /// ([`StaticOptions::neighbour_factor`]); off for the rest of the run once that fails.
+    krylov: bool,
 }
+
+/// Conjugate-gradient iterations of one Newton step with a neighbour's factor before the step
+/// falls back to a factorization of its own.
+const KRYLOV_ITERATIONS: usize = 40;
+
+/// The forcing term of a Krylov step: CG stops when the residual of the Newton system is below
+/// this fraction of the gradient (an inexact Newton step, Eisenstat & Walker's fixed choice).
+const KRYLOV_FORCING: f64 = 1e-2;
 
 /// The largest geodesic acceleration taken, relative to the step: |½ a| ≤ |dx|.
 const ACCELERATION_MAX: f64 = 1.0;
@@ -162,6 +173,16 @@ const MU_MIN: f64 = 1e-8;
 
 impl Workspace {
     pub(super) fn new(model: &Model, x: &[Vector3<f64>], opts: &StaticOptions) -> Self {
+        let mut ws = Self::fresh(model, x, opts);
+        if let Some(nf) = &opts.neighbour_factor {
+            ws.spd = nf.factor.copy();
+            ws.spd.scale = nf.scale;
+            ws.krylov = true;
+        }
+        ws
+    }
+
+    fn fresh(model: &Model, x: &[Vector3<f64>], opts: &StaticOptions) -> Self {
         let dofs = DofMap::new(&model.fixed);
         let held = held_dofs(model, &dofs);
         let n = dofs.n;
@@ -191,6 +212,7 @@ impl Workspace {
             r_prev: f64::INFINITY,
             last_step: Taken::Partial,
             stats: Globalization::default(),
+            krylov: false,
         }
     }
 
@@ -427,6 +449,14 @@ impl Workspace {
         (r, tol): (f64, f64),
         report: &mut SolveReport,
     ) -> bool {
+        if self.krylov {
+            if self.krylov_step(model, x, load, e, r, report) {
+                return true;
+            }
+            // The neighbour's factor no longer serves: factorize from here on.
+            self.krylov = false;
+            self.last_step = Taken::Partial;
+        }
         // Shamanskii: while whole steps halve the residual, the factor at hand serves again.
         let chord = self.parts.factor_reuse == FactorReuse::Chord
             && self.last_step == Taken::Whole
@@ -479,6 +509,91 @@ impl Workspace {
             }
         }
         false
+    }
+
+    /// The Newton step by conjugate gradients on this iteration's exact Hessian, preconditioned by
+    /// the factor at hand (a neighbour's), then the line search. False (and `x` as it was) on
+    /// negative curvature, no convergence in [`KRYLOV_ITERATIONS`] or no accepted step.
+    fn krylov_step(
+        &mut self,
+        model: &Model,
+        x: &mut [Vector3<f64>],
+        load: f64,
+        e: &mut f64,
+        r: f64,
+        report: &mut SolveReport,
+    ) -> bool {
+        model.hessian(x, &mut self.h, false);
+        let Some(d) = self.krylov_direction(model) else {
+            return false;
+        };
+        report.linear_solves += 1;
+        let slope: f64 = self.g.iter().zip(&d).map(|(a, b)| a.dot(b)).sum();
+        if slope.is_nan() || slope >= 0.0 {
+            return false;
+        }
+        self.dx = d;
+        self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
+        let bound = model.max_step(x, &self.dx);
+        match self.line_search(model, x, load, (e, r), (bound.min(1.0), slope)) {
+            Some(alpha) => {
+                self.count(alpha, bound, (false, false));
+                self.stats.krylov_steps += 1;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Preconditioned conjugate gradients for H d = −g (H in `h`), over the free, unheld
+    /// components, to [`KRYLOV_FORCING`]; None on negative curvature or no convergence.
+    fn krylov_direction(&mut self, model: &Model) -> Option<Vec<Vector3<f64>>> {
+        let n = self.g.len();
+        let free = |p: usize, c: usize| self.dofs.dof(p).is_some() && !model.is_held(p, c);
+        let mask: Vec<[bool; 3]> = (0..n).map(|p| [0, 1, 2].map(|c| free(p, c))).collect();
+        let masked = |v: &mut [Vector3<f64>]| {
+            for (vp, m) in v.iter_mut().zip(&mask) {
+                (0..3).filter(|&c| !m[c]).for_each(|c| vp[c] = 0.0);
+            }
+        };
+        let dot = |a: &[Vector3<f64>], b: &[Vector3<f64>]| -> f64 {
+            a.iter().zip(b).map(|(u, v)| u.dot(v)).sum()
+        };
+        // solve_for gives −M⁻¹ f: M⁻¹ r is solve_for(−r).
+        let mut res: Vec<Vector3<f64>> = self.g.iter().map(|v| -v).collect();
+        masked(&mut res);
+        let goal = KRYLOV_FORCING * dot(&res, &res).sqrt();
+        let mut neg: Vec<Vector3<f64>> = self.g.clone();
+        let mut z = vec![Vector3::zeros(); n];
+        self.solve_for(&neg, &mut z);
+        let (mut d, mut p) = (vec![Vector3::zeros(); n], z.clone());
+        let mut rz = dot(&res, &z);
+        for _ in 0..KRYLOV_ITERATIONS {
+            let mut q = vec![Vector3::zeros(); n];
+            self.h.mul_add(&p, &mut q);
+            masked(&mut q);
+            let pq = dot(&p, &q);
+            if pq <= 0.0 || !pq.is_finite() {
+                return None;
+            }
+            let alpha = rz / pq;
+            for k in 0..n {
+                d[k] += p[k] * alpha;
+                res[k] -= q[k] * alpha;
+            }
+            if dot(&res, &res).sqrt() <= goal {
+                return Some(d);
+            }
+            neg.iter_mut().zip(&res).for_each(|(a, b)| *a = -b);
+            self.solve_for(&neg, &mut z);
+            let rz_new = dot(&res, &z);
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for k in 0..n {
+                p[k] = z[k] + p[k] * beta;
+            }
+        }
+        None
     }
 
     /// The chord step −H₀⁻¹ g with the factorization at hand, taken whole when no term bounds it and
