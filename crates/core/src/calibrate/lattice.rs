@@ -198,12 +198,9 @@ impl SharedLattice {
                     .collect(),
             );
         }
-        // The evaluation's energy is ρ/ρ_ref times the node's at the same specific stiffness, so
-        // its Hessian's inverse is ρ_ref/ρ times the node's.
-        let factor = node.factor.as_ref().map(|f| crate::solve::NeighbourFactor {
-            factor: f.clone(),
-            scale: RHO_REF / rho,
-        });
+        // The evaluation's energy is ρ/ρ_ref times the node's at the same specific stiffness: the
+        // node's factor preconditions its steps as it is.
+        let factor = node.factor.clone().map(crate::solve::NeighbourFactor);
         WarmStart {
             starts: v,
             candidates: node.candidates.clone(),

@@ -291,9 +291,6 @@ pub struct SparseSpd {
     pub analysis_time_s: f64,
     /// Wall time spent in numeric factorizations and triangular solves, s.
     pub factor_time_s: f64,
-    /// A factor to multiply every solve by (a neighbour's factor of a model that differs by a
-    /// scale); 1 after each factorization.
-    pub scale: f64,
 }
 
 impl Default for SparseSpd {
@@ -316,11 +313,10 @@ impl SparseSpd {
             analyses: 0,
             analysis_time_s: 0.0,
             factor_time_s: 0.0,
-            scale: 1.0,
         }
     }
 
-    /// A copy of the last factorization (no counts), for another solve to start its chord steps
+    /// A copy of the last factorization (no counts), for another solve to precondition its steps
     /// with.
     pub fn copy(&self) -> Self {
         let mut out = Self::new();
@@ -401,7 +397,6 @@ impl SparseSpd {
         let structure = &pattern.structure;
         let mat = SparseColMatRef::new(structure.sym.as_ref(), values);
         self.factorizations += 1;
-        self.scale = 1.0;
         let ok = structure
             .symbolic
             .factorize_numeric_llt(
@@ -433,9 +428,6 @@ impl SparseSpd {
             Par::Seq,
             MemStack::new(&mut self.mem),
         );
-        if self.scale != 1.0 {
-            rhs.iter_mut().for_each(|v| *v *= self.scale);
-        }
         self.factor_time_s += start.elapsed().as_secs_f64();
     }
 }

@@ -81,19 +81,14 @@ pub struct StaticOptions {
     pub neighbour_factor: Option<NeighbourFactor>,
 }
 
-/// A neighbouring equilibrium's factor and the scale of its solves for this model (a model whose
-/// energy is a multiple c of the neighbour's takes 1/c).
+/// A neighbouring equilibrium's factor, shared. As a preconditioner of conjugate gradients it
+/// needs no scale: a model whose energy is a multiple of the neighbour's takes the same steps.
 #[derive(Clone)]
-pub struct NeighbourFactor {
-    /// The factor, shared.
-    pub factor: std::sync::Arc<super::SparseSpd>,
-    /// What its solves are multiplied by.
-    pub scale: f64,
-}
+pub struct NeighbourFactor(pub std::sync::Arc<super::SparseSpd>);
 
 impl std::fmt::Debug for NeighbourFactor {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "NeighbourFactor(scale {})", self.scale)
+        write!(f, "NeighbourFactor")
     }
 }
 

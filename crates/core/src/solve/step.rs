@@ -175,8 +175,7 @@ impl Workspace {
     pub(super) fn new(model: &Model, x: &[Vector3<f64>], opts: &StaticOptions) -> Self {
         let mut ws = Self::fresh(model, x, opts);
         if let Some(nf) = &opts.neighbour_factor {
-            ws.spd = nf.factor.copy();
-            ws.spd.scale = nf.scale;
+            ws.spd = nf.0.copy();
             ws.krylov = true;
         }
         ws
