@@ -332,15 +332,15 @@ struct LatticeDrape {
     factor: Option<std::sync::Arc<crate::solve::SparseSpd>>,
 }
 
-/// Where an evaluation starts: the candidate starts (a lattice drape and its tangent prediction)
-/// and the node's self-contact candidate set.
+/// Where an evaluation starts: the candidate starts (a lattice drape and its tangent prediction),
+/// the node's self-contact candidate set and its factor.
 #[derive(Default)]
 pub struct WarmStart {
     /// Candidate start positions, m; the solve takes the one of lowest energy.
     pub starts: Vec<Vec<nalgebra::Vector3<f64>>>,
     /// The node's self-contact candidate set.
     pub candidates: Option<crate::physics::CandidateSet>,
-    /// The node's factor, scaled for the evaluation's model.
+    /// The node's factor, the preconditioner of the evaluation's Newton steps.
     pub factor: Option<crate::solve::NeighbourFactor>,
 }
 
