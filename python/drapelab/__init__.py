@@ -83,10 +83,12 @@ class Result:
         status: ``"converged"``, or why the solve stopped (``"max-iterations"``, ``"diverged"``,
             ``"stalled"``, ...); the positions of a solve that did not converge are its last state,
             never a result.
-        positions: ``(n, 3)`` float64 array, m, grid order ``j * nx + i``.
+        positions: ``(n, 3)`` float64 array, m, grid order ``j * nx + i``; of a mesh sheet
+            (``cloth.mesh``), the OBJ file's vertex order (then ``nx = n``, ``ny = 1``).
         present: ``(n,)`` bool array: False for particles outside the sheet's shape (a disc's
             corners), which take no part in the solve.
-        triangles: ``(m, 3)`` int64 array of the grid's triangles (indices into ``positions``).
+        triangles: ``(m, 3)`` int64 array of the sheet's triangles (indices into ``positions``):
+            the grid's over its present particles, or the mesh's.
         nx, ny: particles along x and y.
         report: the solve's report (dict): ``iterations``, ``energy_J``, ``max_residual_N``,
             ``wall_time_s``, ``solver``, ``status``, ``globalization``, ...

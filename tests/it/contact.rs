@@ -115,7 +115,7 @@ fn the_drape_coefficient_is_100_for_a_flat_sheet_and_0_for_one_hanging_straight_
         ],
     );
     let sol = converged(&flat);
-    let m = drape_measures(&flat, &sol.grid, &sol.x);
+    let m = drape_measures(&flat, &sol.x);
     let dc = m.drape_coefficient_pct.unwrap();
     assert!((dc - 100.0).abs() < 1.0, "flat: DC {dc} %");
     assert_eq!(m.folds, Some(0));
@@ -130,14 +130,14 @@ fn the_drape_coefficient_is_100_for_a_flat_sheet_and_0_for_one_hanging_straight_
         ],
     );
     let sol = converged(&limp);
-    let dc = drape_measures(&limp, &sol.grid, &sol.x)
+    let dc = drape_measures(&limp, &sol.x)
         .drape_coefficient_pct
         .unwrap();
     assert!(dc.abs() < 5.0, "hanging: DC {dc} %");
     // And the wool between them, with folds.
     let wool = scene("pedestal_wool.toml", &[]);
     let sol = solve_scene(&wool, &mut NoObserver);
-    let m = drape_measures(&wool, &sol.grid, &sol.x);
+    let m = drape_measures(&wool, &sol.x);
     let dc = m.drape_coefficient_pct.unwrap();
     eprintln!("wool on the pedestal: DC {dc:.1} %, {:?} folds", m.folds);
     assert!(dc > 10.0 && dc < 90.0 && m.folds.unwrap() >= 4, "{m:?}");
@@ -392,7 +392,7 @@ fn the_rendered_view_from_above_covers_the_measured_vertical_projection() {
     // raster (src/measure.rs) and the shaded rendering seen from straight above (src/edges/render.rs).
     let s = scene("table_wool.toml", &[]);
     let sol = converged(&s);
-    let d = drapelab::measure::drape_measures(&s, &sol.grid, &sol.x);
+    let d = drapelab::measure::drape_measures(&s, &sol.x);
     let present = vec![true; sol.grid.len()];
     let px_per_cm = 20.0;
     let img = drapelab::edges::render_view(&sol.grid, &sol.x, &present, 0.0, 90.0, px_per_cm, 5);

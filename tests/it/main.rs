@@ -12,6 +12,7 @@ mod engine;
 mod equilibria;
 mod layering;
 mod loads;
+mod patterns;
 mod pipeline;
 mod recordings;
 mod runs;

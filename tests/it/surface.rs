@@ -140,7 +140,7 @@ fn the_trimmed_skirt_covers_its_own_mesh_and_nothing_outside_it() {
         "pattern-plane area {:.5} against the mesh's {kept_param:.5}",
         param_area(&mesh)
     );
-    let shadow_mesh = drapelab_core::measure::vertical_projection(&grid, &x, &present, 1000);
+    let shadow_mesh = drapelab_core::measure::vertical_projection(&x, &kept, 1000);
     let mut shadow = drapelab_core::measure::Projection::empty(
         shadow_mesh.nx,
         shadow_mesh.ny,

@@ -103,9 +103,10 @@ impl SweepOutcome {
         let zs: Vec<f64> = sol.grid_positions().iter().map(|p| p.z).collect();
         let c = |corner: Corner, k: usize| {
             let (i, j) = corner.ij(g);
-            ok.then(|| sol.at(i, j)[k])
+            // A mesh sheet has no corners by grid index.
+            (ok && !scene.cloth.is_mesh()).then(|| sol.at(i, j)[k])
         };
-        let d = ok.then(|| drapelab_core::measure::drape_measures(scene, g, &sol.x));
+        let d = ok.then(|| drapelab_core::measure::drape_measures(scene, &sol.x));
         let fin = |v: f64| v.is_finite().then_some(v);
         SweepOutcome {
             particles: g.len() as u32,

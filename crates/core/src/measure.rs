@@ -2,7 +2,6 @@
 //! draped specimen, the drape coefficient DC = (S − S_s)/(S_f − S_s) (S the projected area, S_s the
 //! support's, S_f the flat specimen's), and the number of folds (nodes) around a pedestal.
 
-use crate::cloth::Grid;
 use nalgebra::Vector3;
 
 /// A binary image of a vertical projection: `covered[row * nx + col]`, pixel size `pixel_m`, lower-left
@@ -36,16 +35,12 @@ impl Projection {
     }
 }
 
-/// The vertical projection of the grid's triangles (two per cell; a triangle with an absent vertex,
-/// `present[p] == false`, is left out) on a raster of `pixels` across the larger side of the bounding box.
-pub fn vertical_projection(
-    grid: &Grid,
-    x: &[Vector3<f64>],
-    present: &[bool],
-    pixels: usize,
-) -> Projection {
-    let n = grid.len();
-    let pts: Vec<&Vector3<f64>> = (0..n).filter(|&p| present[p]).map(|p| &x[p]).collect();
+/// The vertical projection of the sheet's `triangles` (indices into `x`; [`crate::build::scene_triangles`])
+/// on a raster of `pixels` across the larger side of their bounding box.
+pub fn vertical_projection(x: &[Vector3<f64>], triangles: &[[u32; 3]], pixels: usize) -> Projection {
+    let mut used = vec![false; x.len()];
+    triangles.iter().flatten().for_each(|&v| used[v as usize] = true);
+    let pts: Vec<&Vector3<f64>> = (0..x.len()).filter(|&p| used[p]).map(|p| &x[p]).collect();
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in &pts {
         lo = [lo[0].min(p.x), lo[1].min(p.y)];
@@ -63,11 +58,7 @@ pub fn vertical_projection(
         origin_m: origin,
         covered: vec![false; nx * ny],
     };
-    let tris = crate::cloth::grid_triangles(grid)
-        .into_iter()
-        .map(|t| t.map(|v| v as usize))
-        .filter(|t| t.iter().all(|&v| present[v]));
-    proj.fill_triangles(x, tris);
+    proj.fill_triangles(x, triangles.iter().map(|t| t.map(|v| v as usize)));
     proj
 }
 
@@ -252,9 +243,9 @@ mod tests {
 
     #[test]
     fn the_projected_area_of_a_flat_square_is_its_area() {
-        let g = Grid::uniform(11, 11, 0.2, 0.2);
+        let g = crate::cloth::Grid::uniform(11, 11, 0.2, 0.2);
         let x = g.flat_positions();
-        let p = vertical_projection(&g, &x, &vec![true; g.len()], 800);
+        let p = vertical_projection(&x, &crate::cloth::grid_triangles(&g), 800);
         assert!((p.area_m2() - 0.04).abs() < 0.005 * 0.04, "{}", p.area_m2());
         assert!((drape_coefficient_pct(p.area_m2(), 0.04, 0.01) - 100.0).abs() < 1.0);
     }
@@ -280,21 +271,17 @@ pub struct DrapeMeasures {
 /// Pixels across a projection.
 const PIXELS: usize = 600;
 
-/// The drape coefficient, folds and penetration of a drape `x` of `scene` on `grid`. The support is the
+/// The drape coefficient, folds and penetration of a drape `x` of `scene` (its sheet's triangles). The support is the
 /// first pedestal or box among the obstacles (its area: the part of the flat specimen above it); folds
 /// are counted about its centre (outline in 360
 /// sectors smoothed over ±3°, prominence 8 % of the mean radius: more than the steps of a disc cut
 /// from a square grid, far less than a fold).
-pub fn drape_measures(
-    scene: &crate::scene::Scene,
-    grid: &Grid,
-    x: &[Vector3<f64>],
-) -> DrapeMeasures {
+pub fn drape_measures(scene: &crate::scene::Scene, x: &[Vector3<f64>]) -> DrapeMeasures {
     use crate::contact::Obstacle;
     let x0 = crate::build::initial_positions(scene);
-    let present = crate::build::present_particles(scene);
-    let proj = vertical_projection(grid, x, &present, PIXELS);
-    let flat_proj = vertical_projection(grid, &x0, &present, PIXELS);
+    let triangles = crate::build::scene_triangles(scene);
+    let proj = vertical_projection(x, &triangles, PIXELS);
+    let flat_proj = vertical_projection(&x0, &triangles, PIXELS);
     // The support: the first table or pedestal; its area is the part of the flat specimen above its
     // top face (on the same raster, so that a flat specimen reads DC = 100 % exactly).
     let support = scene
@@ -327,7 +314,7 @@ pub fn drape_measures(
     let s = proj.area_m2() * factor;
     let flat = flat_proj.area_m2() * factor;
     let support = support.map(|(a, c)| (a * factor, c));
-    let n = grid.len();
+    let n = x0.len();
     DrapeMeasures {
         projected_area_m2: s,
         flat_area_m2: flat,

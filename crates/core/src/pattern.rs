@@ -52,11 +52,41 @@ pub fn parse_obj(text: &str, unit_m: f64) -> Result<Pattern, Defect> {
 }
 
 /// Reads and checks `path` ([`parse_obj`]); errors name the file and the line or defect.
-pub fn read_obj(path: &std::path::Path, unit_m: f64) -> anyhow::Result<Pattern> {
+pub fn read_obj(
+    path: &std::path::Path,
+    unit_m: f64,
+) -> Result<Pattern, crate::error::InputError> {
     use crate::error::InputError;
     let text = std::fs::read_to_string(path)
         .map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
-    parse_obj(&text, unit_m).map_err(|d| InputError::new(path, d.key, d.message).into())
+    parse_obj(&text, unit_m).map_err(|d| InputError::new(path, d.key, d.message))
+}
+
+impl Pattern {
+    /// The shortest edge of a triangle, m.
+    pub fn shortest_edge_m(&self) -> f64 {
+        let len = |a: usize, b: usize| {
+            let (p, q) = (self.rest_m[a], self.rest_m[b]);
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+        };
+        self.triangles
+            .iter()
+            .flat_map(|&[a, b, c]| [len(a, b), len(b, c), len(c, a)])
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The smallest box (m) holding the rest positions: ([x_min, y_min], [x_max, y_max]).
+    pub fn bounds_m(&self) -> ([f64; 2], [f64; 2]) {
+        self.rest_m.iter().fold(
+            ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+            |(lo, hi), p| {
+                (
+                    [lo[0].min(p[0]), lo[1].min(p[1])],
+                    [hi[0].max(p[0]), hi[1].max(p[1])],
+                )
+            },
+        )
+    }
 }
 
 /// The vertex index of an OBJ face or line token (`7`, `7/2`, `7//3`, `-1`), 0-based.

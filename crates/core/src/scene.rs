@@ -12,18 +12,46 @@ use crate::solve::{DynamicOptions, Integrator, StaticOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+mod mesh;
+
 /// The sheet: size, resolution, spacing and areal density.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClothSpec {
-    /// Side along x in m, 1e-4 to 100 ([`SHEET_SIDE_M`]).
+    /// Side along x in m, 1e-4 to 100 ([`SHEET_SIDE_M`]); a grid sheet's (leave out with `mesh`).
+    #[serde(default)]
     pub size_x_m: f64,
-    /// Side along y in m, 1e-4 to 100.
+    /// Side along y in m, 1e-4 to 100; a grid sheet's.
+    #[serde(default)]
     pub size_y_m: f64,
-    /// Particles along x (≥ 2).
+    /// Particles along x (≥ 2); a grid sheet's.
+    #[serde(default)]
     pub nx: usize,
-    /// Particles along y (≥ 2).
+    /// Particles along y (≥ 2); a grid sheet's.
+    #[serde(default)]
     pub ny: usize,
+    /// A flat pattern piece as the sheet instead of the grid: a Wavefront OBJ file of triangles or
+    /// polygons at z = 0 in its own frame (relative paths from the scene file's folder), checked once
+    /// ([`crate::pattern`]); its `g`/`o` groups name vertex sets for `boundary.pin_groups`. Needs
+    /// `[material.continuum]`. Default none (the grid).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<PathBuf>,
+    /// The mesh file's length unit in m: 1 for metres (default), 0.01 for centimetres, 0.001 for
+    /// millimetres.
+    #[serde(default = "default_unit", skip_serializing_if = "is_one")]
+    pub mesh_unit_m: f64,
+    /// The warp's direction in the mesh's plane, degrees from its +x towards +y (default 0: warp
+    /// along x, as on the grid). Change it for a panel cut on the bias (45) or across the roll (90).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub warp_angle_deg: f64,
+    /// The mesh's placement: rotations about x, then y, then z (degrees, right-handed) of the
+    /// pattern's plane, before `origin_m` is added. Default [0, 0, 0] (flat, horizontal). [90, 0, 0]
+    /// stands a pattern in the x–z plane (a curtain hung from its top).
+    #[serde(default, skip_serializing_if = "is_zero3")]
+    pub rotation_deg: [f64; 3],
+    /// The pattern read from `mesh` (set when the scene is loaded).
+    #[serde(skip)]
+    pub pattern: Option<std::sync::Arc<crate::pattern::Pattern>>,
     /// "uniform" (default) or "graded" (finer towards the edges).
     #[serde(default)]
     pub spacing: Spacing,
@@ -58,6 +86,22 @@ fn default_grading() -> f64 {
     0.5
 }
 
+fn default_unit() -> f64 {
+    1.0
+}
+
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+fn is_zero3(v: &[f64; 3]) -> bool {
+    v.iter().all(|c| *c == 0.0)
+}
+
 /// Boundary conditions.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -75,6 +119,10 @@ pub struct BoundarySpec {
     /// to the edge and the bending across it is mirrored. Continuum model and static solver only.
     #[serde(default)]
     pub symmetry_edges: Vec<Edge>,
+    /// Every vertex of these groups of the mesh (`cloth.mesh`, its `g`/`o` names) pinned where it
+    /// lies. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pin_groups: Vec<String>,
     /// `[[boundary.holds]]`: some coordinates of some particles held where they start (a sheet
     /// supported vertically round its edge, a corner restrained in the plane: seed 003 §10.5). Static
     /// solver only. Default none.
@@ -389,8 +437,12 @@ pub struct LoadedScene {
 }
 
 impl Scene {
-    /// The grid of the scene (uniform or graded, refined towards `cloth.refine_x_m`/`refine_y_m`).
+    /// The grid of the scene (uniform or graded, refined towards `cloth.refine_x_m`/`refine_y_m`);
+    /// of a mesh sheet, its vertices as one row ([`Grid::vertex_row`](crate::cloth::Grid::vertex_row)).
     pub fn grid(&self) -> crate::cloth::Grid {
+        if let Some(p) = self.pattern() {
+            return crate::cloth::Grid::vertex_row(p.rest_m.len());
+        }
         let c = &self.cloth;
         let local =
             |lines: &[f64], origin: f64| lines.iter().map(|v| v - origin).collect::<Vec<_>>();
@@ -414,8 +466,12 @@ impl Scene {
     }
 
     /// Initial positions of the grid particles: the flat sheet at `cloth.origin_m`, with the optional
-    /// perturbation z += a·sin(πu)·sin(πw)·w (u, w the fractions along x and y).
+    /// perturbation z += a·sin(πu)·sin(πw)·w (u, w the fractions along x and y); of a mesh sheet, its
+    /// placed vertices.
     pub fn initial_positions(&self) -> Vec<nalgebra::Vector3<f64>> {
+        if let Some(p) = self.pattern() {
+            return self.mesh_positions(p);
+        }
         let c = &self.cloth;
         let o = nalgebra::Vector3::new(c.origin_m[0], c.origin_m[1], c.origin_m[2]);
         self.grid()
@@ -492,7 +548,9 @@ impl Scene {
                 set_dotted(&mut table, k, v.clone()).map_err(|m| InputError::new(path, k, m))?;
             }
             read_renamed_keys(&mut table).map_err(|(k, m)| InputError::new(path, k, m))?;
-            from_table(path, "", table)
+            let mut scene: Scene = from_table(path, "", table)?;
+            scene.cloth.read_mesh(path)?;
+            Ok(scene)
         };
         let mut scene = with(&|_| true)?;
         if overrides.iter().any(|(k, _)| is_grid(k)) {
@@ -579,6 +637,10 @@ in the key's unit (SI)",
 
     /// The cloth: sizes, density, grid, grading and refined lines.
     fn check_cloth(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        if self.cloth.is_mesh() {
+            return self.check_mesh_cloth(ck);
+        }
+        self.check_grid_given(ck)?;
         let c = &self.cloth;
         ck.within("cloth.size_x_m", c.size_x_m, SHEET_SIDE_M)?;
         ck.within("cloth.size_y_m", c.size_y_m, SHEET_SIDE_M)?;
@@ -710,6 +772,9 @@ in the key's unit (SI)",
 
     /// Pins, holds, point loads, clamps: inside the grid and enough to hold the sheet.
     fn check_boundary(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        if self.cloth.is_mesh() {
+            self.check_mesh_boundary(ck)?;
+        }
         let c = &self.cloth;
         for (n, p) in self.boundary.pin_particles.iter().enumerate() {
             if p[0] >= c.nx || p[1] >= c.ny {
@@ -764,6 +829,7 @@ in the key's unit (SI)",
             && self.boundary.pin_particles.is_empty()
             && self.boundary.clamp_edges.is_empty()
             && self.boundary.holds.is_empty()
+            && self.boundary.pin_groups.is_empty()
             && (!self.contact.fix_supported || self.obstacles.is_empty())
         {
             return ck.err(
@@ -822,7 +888,7 @@ in the key's unit (SI)",
         )?;
         if let Some(t) = self.contact.self_thickness_m {
             ck.pos("contact.self_thickness_m", t)?;
-            let h = self.grid().min_spacing_m();
+            let h = self.sheet_spacing_m();
             if t > 0.2 * h {
                 return ck.err(
                     "contact.self_thickness_m",
@@ -852,7 +918,6 @@ would already touch itself; use a coarser grid or a thinner sheet"
         if self.obstacles.is_empty() {
             return Ok(());
         }
-        let c = &self.cloth;
         let flat = self.initial_positions();
         for (k, o) in self.obstacles.iter().enumerate() {
             o.check()
@@ -867,10 +932,9 @@ would already touch itself; use a coarser grid or a thinner sheet"
                 return ck.err(
                     &format!("obstacles[{k}]"),
                     format!(
-                        "the sheet starts inside this obstacle (particle [{}, {}] is {:.3e} m deep): \
+                        "the sheet starts inside this obstacle (particle {} is {:.3e} m deep): \
                          move the obstacle down or the sheet up (cloth.origin_m)",
-                        p % c.nx,
-                        p / c.nx,
+                        self.particle_name(p),
                         -d
                     ),
                 );

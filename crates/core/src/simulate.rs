@@ -117,7 +117,7 @@ pub fn check_crossings(
     if !report.is_converged() || model.models_self_contact() || x.len() < grid.len() {
         return;
     }
-    let n = crossing_edges(scene, grid, x);
+    let n = crossing_edges(scene, x);
     if n > 0 {
         report.stop_for(crate::solve::StopReason::PassesThroughItself);
         report.message += &format!(
@@ -132,14 +132,10 @@ pub fn check_crossings(
     }
 }
 
-/// Mesh edges of the triangulated grid at `x` that cross a triangle sharing no vertex with them.
-fn crossing_edges(scene: &Scene, grid: &Grid, x: &[Vector3<f64>]) -> usize {
-    let absent: Vec<bool> = crate::build::present_particles(scene)
-        .iter()
-        .map(|p| !p)
-        .collect();
+/// Mesh edges of the sheet at `x` that cross a triangle sharing no vertex with them.
+fn crossing_edges(scene: &Scene, x: &[Vector3<f64>]) -> usize {
     let topo = crate::contact::proximity::MeshTopology::from_triangles(
-        crate::build::sheet_triangles(grid, &absent),
+        crate::build::scene_triangles(scene),
     );
     crate::contact::proximity::edge_triangle_crossings(&topo, x)
         .iter()
@@ -151,11 +147,10 @@ fn crossing_edges(scene: &Scene, grid: &Grid, x: &[Vector3<f64>]) -> usize {
 /// The self-contact summary of a solved model at `x`.
 pub fn self_contact_summary(
     scene: &Scene,
-    grid: &Grid,
     model: &crate::physics::Model,
     x: &[Vector3<f64>],
 ) -> SelfContactSummary {
-    let crossing_edges = crossing_edges(scene, grid, x);
+    let crossing_edges = crossing_edges(scene, x);
     let state = model.self_contact(x);
     let xi = state.map(|_| crate::build::self_thickness_m(scene));
     SelfContactSummary {

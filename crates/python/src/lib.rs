@@ -98,7 +98,7 @@ fn simulate<'py>(
         .map_err(|e| PyRuntimeError::new_err(format!("cannot read run.json: {e}")))?;
     let xyz: Vec<f64> = s.x.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
     let present: Vec<u8> = s.absent.iter().map(|&a| u8::from(!a)).collect();
-    let tris: Vec<u32> = drapelab_core::cloth::grid_triangles(&s.grid)
+    let tris: Vec<u32> = drapelab_core::build::scene_triangles(&loaded.scene)
         .into_iter()
         .flatten()
         .collect();

@@ -12,9 +12,10 @@ use std::path::Path;
 /// One particle of a solved sheet: its grid indices and position.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ParticleRow {
-    /// Column index along x (0 at the −x edge).
+    /// Column index along x (0 at the −x edge); of a mesh sheet (`cloth.mesh`), the OBJ file's
+    /// vertex, 0-based.
     pub i: u32,
-    /// Row index along y (0 at the −y edge).
+    /// Row index along y (0 at the −y edge); 0 on a mesh sheet.
     pub j: u32,
     /// Position, m.
     pub x_m: f64,

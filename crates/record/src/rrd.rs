@@ -5,7 +5,6 @@ use crate::Staged;
 use crate::rerun;
 use crate::sampled::{Sampled, StateSink};
 use anyhow::Result;
-use drapelab_core::cloth::Grid;
 use drapelab_core::solve::StateEvent;
 use std::path::Path;
 
@@ -17,11 +16,12 @@ pub struct RerunRecorder {
 }
 
 impl RerunRecorder {
-    /// Starts a recording at `path`; `pins` are the fixed grid particles.
+    /// Starts a recording at `path` of the sheet's `particles` first particles and its
+    /// `triangles`; `pins` are its fixed particles.
     pub fn new(
         path: &Path,
         app: &str,
-        grid: &Grid,
+        (particles, triangles): (usize, &[[u32; 3]]),
         x0: &[nalgebra::Vector3<f64>],
         pins: &[usize],
         every: usize,
@@ -31,7 +31,7 @@ impl RerunRecorder {
             format!("drapelab_{app}"),
         ))
         .save(staged.path())?;
-        let tris = drapelab_core::cloth::grid_triangles(grid);
+        let tris = triangles;
         // Z is up in drapelab (gravity along −z).
         rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
         // The mesh topology is static; only the positions change over time.
@@ -42,7 +42,7 @@ impl RerunRecorder {
         rec.log_static(
             "cloth/rest",
             &rerun::Mesh3D::new(
-                x0[..grid.len()]
+                x0[..particles]
                     .iter()
                     .map(|p| [p.x as f32, p.y as f32, p.z as f32]),
             )
@@ -60,7 +60,7 @@ impl RerunRecorder {
             Self {
                 rec: Some(rec),
                 staged: Some(staged),
-                n_grid: grid.len(),
+                n_grid: particles,
             },
             every,
         ))

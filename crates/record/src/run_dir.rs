@@ -190,10 +190,12 @@ fn recorders(
     x0: &[nalgebra::Vector3<f64>],
 ) -> Result<Recorders> {
     let pins: Vec<usize> = (0..grid.len()).filter(|&p| model.fixed[p]).collect();
+    let triangles = drapelab_core::build::scene_triangles(scene);
+    let sheet = (grid.len(), triangles.as_slice());
     let every = scene.record.every;
     let timeline = if scene.record.timeline {
         Some(
-            TimelineRecorder::new(&out.join("timeline.mcap"), grid, every)?
+            TimelineRecorder::new(&out.join("timeline.mcap"), sheet, every)?
                 .at_frame_rate(scene.record.frame_rate_hz),
         )
     } else {
@@ -201,7 +203,7 @@ fn recorders(
     };
     let rrd = if scene.record.rerun {
         Some(
-            RerunRecorder::new(&out.join("drape.rrd"), &scene.name, grid, x0, &pins, every)?
+            RerunRecorder::new(&out.join("drape.rrd"), &scene.name, sheet, x0, &pins, every)?
                 .at_frame_rate(scene.record.frame_rate_hz),
         )
     } else {
@@ -278,8 +280,8 @@ fn simulate_into(
         particles: grid.len(),
         outputs,
         drape: (report.is_converged() && !scene.obstacles.is_empty())
-            .then(|| drapelab_core::measure::drape_measures(scene, &grid, &x)),
-        self_contact: drapelab_core::simulate::self_contact_summary(scene, &grid, &model, &x),
+            .then(|| drapelab_core::measure::drape_measures(scene, &x)),
+        self_contact: drapelab_core::simulate::self_contact_summary(scene, &model, &x),
         sensitivity,
         start_file: extras.start.as_ref().map(|s| s.1.clone()),
         scene,
@@ -333,7 +335,7 @@ fn state_files(
     };
     write_particles(&out.join(file), grid, x, absent, &meta)?;
     outputs.push(file);
-    let tris = drapelab_core::build::sheet_triangles(grid, absent);
+    let tris = drapelab_core::build::scene_triangles(scene);
     crate::write_triangles(&out.join("triangles.parquet"), &tris)?;
     outputs.push("triangles.parquet");
     if obj && report.is_converged() {

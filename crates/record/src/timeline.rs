@@ -6,7 +6,6 @@
 use crate::Staged;
 use crate::sampled::{Sampled, StateSink};
 use anyhow::Result;
-use drapelab_core::cloth::Grid;
 use drapelab_core::solve::StateEvent;
 use mcap::records::MessageHeader;
 use serde_json::json;
@@ -31,8 +30,13 @@ pub struct TimelineRecorder {
 }
 
 impl TimelineRecorder {
-    /// Starts recording to `path`, keeping every `every`-th state.
-    pub fn new(path: &Path, grid: &Grid, every: usize) -> Result<Sampled<Self>> {
+    /// Starts recording to `path` the sheet's `particles` first particles and its `triangles`
+    /// ([`drapelab_core::build::scene_triangles`]), keeping every `every`-th state.
+    pub fn new(
+        path: &Path,
+        (particles, triangles): (usize, &[[u32; 3]]),
+        every: usize,
+    ) -> Result<Sampled<Self>> {
         let staged = Staged::new(path)?;
         let file = staged.path().to_path_buf();
         let f = std::fs::OpenOptions::new()
@@ -58,11 +62,8 @@ impl TimelineRecorder {
                 cloth,
                 stats,
                 seq: 0,
-                n_grid: grid.len(),
-                indices: drapelab_core::cloth::grid_triangles(grid)
-                    .into_iter()
-                    .flatten()
-                    .collect(),
+                n_grid: particles,
+                indices: triangles.iter().flatten().copied().collect(),
             },
             every,
         ))

@@ -146,7 +146,7 @@ the seed's are on a Pentium II/266.\n\n## Scenes\n\n",
             .coarse
             .report
             .is_converged()
-            .then(|| drape_measures(&s.scene, &s.coarse.grid, &s.coarse.x));
+            .then(|| drape_measures(&s.scene, &s.coarse.x));
         let _ = writeln!(
             md,
             "| {} | {}×{} | {} | {} | {} | {:.2} | {:.2} | {} | {} | {} | {} | {} |",

@@ -238,7 +238,7 @@ fn bench_point(s: &Scene, reference: &Reference, log: &mut impl FnMut(&str)) -> 
         sol.report.status.as_str(),
     ));
     let sc = (!sol.x.is_empty())
-        .then(|| crate::simulate::self_contact_summary(s, &sol.grid, &sol.model, &sol.x));
+        .then(|| crate::simulate::self_contact_summary(s, &sol.model, &sol.x));
     BenchRow {
         scene: s.name.clone(),
         n,

@@ -26,7 +26,7 @@ pub struct BuiltScene {
 /// hundredth of the spacing, so that the circle's four extreme points stay); none for a square sheet.
 pub fn absent_particles(scene: &Scene, x0: &[Vector3<f64>]) -> Vec<bool> {
     let c = &scene.cloth;
-    let n = c.nx * c.ny;
+    let n = scene.grid().len();
     if c.shape != crate::scene::SheetShape::Disc {
         return vec![false; n];
     }
@@ -70,9 +70,9 @@ pub fn check_something_free(
         &loaded.path,
         "boundary",
         format!(
-            "no free particle with mass on the {} × {} grid: every particle is pinned, clamped or \
-outside the sheet; pin fewer or use a finer grid (cloth.nx, cloth.ny)",
-            loaded.scene.cloth.nx, loaded.scene.cloth.ny
+            "no free particle with mass on the {} particles of the sheet: every particle is pinned, \
+clamped or outside the sheet; pin fewer or use a finer sheet (cloth.nx, cloth.ny, or the mesh)",
+            loaded.scene.grid().len()
         ),
     ))
 }
@@ -80,6 +80,9 @@ outside the sheet; pin fewer or use a finer grid (cloth.nx, cloth.ny)",
 /// Builds the model of a validated scene ([`ModelBuilder`]: the material's terms on the grid, then
 /// gravity, point loads, the obstacles' barrier and self-contact).
 pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
+    if let Some(p) = scene.pattern() {
+        return pattern::build_mesh_scene(scene, p);
+    }
     let c = &scene.cloth;
     let grid = scene.grid();
     let mut x0 = initial_positions(scene);
@@ -205,7 +208,7 @@ fn mass_spring_terms(
 
 /// The scene's `[[loads]]` as one term (only when it has some): a load given by position goes to the
 /// nearest present particle.
-fn point_loads(
+pub(crate) fn point_loads(
     scene: &Scene,
     grid: &Grid,
     absent: &[bool],
@@ -261,7 +264,7 @@ fn holds(scene: &Scene, grid: &Grid, held: &mut Vec<[bool; 3]>) {
 /// form (a skirt's waist), are fixed (seed 003 §10.5, §10.7.2.3); with
 /// the barrier method every other particle gets the barrier term (the vertical-gap method works in the
 /// solver instead, [`crate::simulate`]).
-fn contact_terms(scene: &Scene, x0: &[Vector3<f64>], b: &mut ModelBuilder) {
+pub(crate) fn contact_terms(scene: &Scene, x0: &[Vector3<f64>], b: &mut ModelBuilder) {
     use crate::contact::Obstacle;
     use crate::scene::ContactMethod;
     if scene.obstacles.is_empty() {
@@ -325,8 +328,20 @@ pub fn self_thickness_m(scene: &Scene) -> f64 {
             .as_ref()
             .and_then(|c| c.thickness_m)
             .unwrap_or(1e-3);
-        t.min(0.2 * scene.grid().min_spacing_m())
+        t.min(0.2 * scene.sheet_spacing_m())
     })
+}
+
+/// The sheet's triangles (indices of its particles): a mesh's, or the grid's whose three particles
+/// are all present. The one source of the sheet's triangles for self-contact, measures and records.
+pub fn scene_triangles(scene: &Scene) -> Vec<[u32; 3]> {
+    match scene.pattern() {
+        Some(p) => p.triangles.iter().map(|t| t.map(|v| v as u32)).collect(),
+        None => {
+            let absent = absent_particles(scene, &scene.initial_positions());
+            sheet_triangles(&scene.grid(), &absent)
+        }
+    }
 }
 
 /// The triangles of the grid whose three particles are all present (not `absent`).

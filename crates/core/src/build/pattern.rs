@@ -71,6 +71,45 @@ pub fn pattern_builder(
     Ok(b)
 }
 
+/// Builds the model of a validated scene whose sheet is a mesh (`cloth.mesh`): the pattern's
+/// builder ([`pattern_builder`]) with the scene's continuum rigidities, warp angle and pinned groups,
+/// then the scene's point loads, obstacles and self-contact, as for a grid sheet.
+pub(super) fn build_mesh_scene(
+    scene: &crate::scene::ValidatedScene,
+    pattern: &Pattern,
+) -> super::BuiltScene {
+    let r = scene
+        .material
+        .continuum
+        .as_ref()
+        .and_then(|c| c.rigidities().ok())
+        .expect("validated mesh scene: continuum material");
+    let sheet = PatternSheet {
+        pattern,
+        rigidities: &r,
+        warp_angle_rad: scene.cloth.warp_angle_deg.to_radians(),
+        areal_density_kg_per_m2: scene.cloth.areal_density_kg_per_m2,
+    };
+    let pinned = scene.pinned_group_vertices();
+    let mut b = pattern_builder(&sheet, scene.gravity.g_m_per_s2, &pinned)
+        .expect("a checked pattern's triangles have area");
+    let x0 = scene.initial_positions();
+    let grid = scene.grid();
+    let absent = vec![false; grid.len()];
+    super::point_loads(scene, &grid, &absent, &x0, &mut b.terms);
+    super::contact_terms(scene, &x0, &mut b);
+    if scene.solver.kind.self_contact(scene.contact.self_contact) {
+        let xi = super::self_thickness_m(scene);
+        let triangles = super::scene_triangles(scene);
+        b.self_contact(triangles, &x0, (xi, xi), super::kappa_gravity(scene));
+    }
+    super::BuiltScene {
+        grid,
+        model: b.build(),
+        x0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

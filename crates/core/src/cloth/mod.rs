@@ -131,6 +131,17 @@ impl Grid {
             ys: line_coordinates(ny, ly, spacing, grading, refine_at[1]),
         }
     }
+    /// A mesh sheet's particles as one row: particle p is (p, 0), so that tables keyed by grid
+    /// indices read `i` as the mesh's vertex (0-based). Its lines are the indices themselves, not
+    /// positions: a mesh sheet's geometry is its pattern's ([`crate::pattern::Pattern`]).
+    pub fn vertex_row(n: usize) -> Self {
+        Self {
+            nx: n,
+            ny: 1,
+            xs: (0..n).map(|i| i as f64).collect(),
+            ys: vec![0.0],
+        }
+    }
     /// Number of particles.
     pub fn len(&self) -> usize {
         self.nx * self.ny
