@@ -130,9 +130,7 @@ fn the_drape_coefficient_is_100_for_a_flat_sheet_and_0_for_one_hanging_straight_
         ],
     );
     let sol = converged(&limp);
-    let dc = drape_measures(&limp, &sol.x)
-        .drape_coefficient_pct
-        .unwrap();
+    let dc = drape_measures(&limp, &sol.x).drape_coefficient_pct.unwrap();
     assert!(dc.abs() < 5.0, "hanging: DC {dc} %");
     // And the wool between them, with folds.
     let wool = scene("pedestal_wool.toml", &[]);

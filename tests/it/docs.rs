@@ -38,11 +38,18 @@ fn the_reference_pages_match_the_code() {
     generated("tables.md", &drapelab::app::tables_markdown().unwrap());
     generated("kinds.md", &drapelab::cli::kinds_text());
     generated("cli.md", &drapelab::cli::cli_reference());
-    let mut scenes: Vec<PathBuf> =
-        glob::glob(&root().join("datasets/scenes/*.toml").to_string_lossy())
+    let mut scenes: Vec<PathBuf> = ["scenes", "patterns"]
+        .iter()
+        .flat_map(|d| {
+            glob::glob(
+                &root()
+                    .join(format!("datasets/{d}/*.toml"))
+                    .to_string_lossy(),
+            )
             .unwrap()
             .map(Result::unwrap)
-            .collect();
+        })
+        .collect();
     scenes.sort();
     generated(
         "scene-keys.md",

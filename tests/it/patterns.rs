@@ -9,7 +9,15 @@ use std::path::Path;
 
 /// The grid keys a mesh scene leaves out.
 const GRID_KEYS: [&str; 9] = [
-    "size_x_m", "size_y_m", "nx", "ny", "spacing", "grading", "refine_x_m", "refine_y_m", "shape",
+    "size_x_m",
+    "size_y_m",
+    "nx",
+    "ny",
+    "spacing",
+    "grading",
+    "refine_x_m",
+    "refine_y_m",
+    "shape",
 ];
 
 /// The bundled grid scene `name` as the same sheet from a mesh: its flat grid written as OBJ
@@ -54,7 +62,10 @@ fn mesh_twin(name: &str, dir: &Path) -> Scene {
     }
     let file = dir.join(name);
     std::fs::write(&file, out).unwrap();
-    Scene::load(&file, &[]).expect("mesh twin").scene.into_inner()
+    Scene::load(&file, &[])
+        .expect("mesh twin")
+        .scene
+        .into_inner()
 }
 
 /// table_wool and sphere_wool re-run as triangulated meshes of the same sheets (the membrane and
@@ -73,7 +84,10 @@ fn a_grid_sheet_and_its_triangulated_mesh_drape_alike() {
         );
         assert!(a.report.is_converged(), "{name} grid: {}", a.report.message);
         assert!(b.report.is_converged(), "{name} mesh: {}", b.report.message);
-        let (ma, mb) = (drape_measures(&on_grid, &a.x), drape_measures(&on_mesh, &b.x));
+        let (ma, mb) = (
+            drape_measures(&on_grid, &a.x),
+            drape_measures(&on_mesh, &b.x),
+        );
         let pct = |m: &drapelab::measure::DrapeMeasures| {
             m.drape_coefficient_pct
                 .unwrap_or(100.0 * m.projected_area_m2 / m.flat_area_m2)
@@ -88,7 +102,10 @@ fn a_grid_sheet_and_its_triangulated_mesh_drape_alike() {
         // Issue 49 asks 1 point; measured 3.6 (table) and 1.7 (sphere): the hinge bending's bias
         // on structured triangulations (alternating the diagonals moves the sphere by 3.5
         // points). This guards the agreement reached until a shape-operator bending replaces it.
-        assert!((pct(&ma) - pct(&mb)).abs() < 5.0, "{name}: {ma:?} against {mb:?}");
+        assert!(
+            (pct(&ma) - pct(&mb)).abs() < 5.0,
+            "{name}: {ma:?} against {mb:?}"
+        );
         assert_eq!(ma.folds, mb.folds, "{name}");
     }
 }
@@ -101,7 +118,13 @@ fn simulate_pattern(name: &str, out: &Path) -> serde_json::Value {
         .arg(root().join("datasets/patterns").join(name))
         .arg("--out")
         .arg(out)
-        .args(["--obj", "--set", "record.timeline=true", "--set", "record.rerun=true"])
+        .args([
+            "--obj",
+            "--set",
+            "record.timeline=true",
+            "--set",
+            "record.rerun=true",
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -109,7 +132,7 @@ fn simulate_pattern(name: &str, out: &Path) -> serde_json::Value {
 }
 
 /// The L-shaped panel and the Cusick template, each read from OBJ, draped over bundled obstacles
-/// (a sphere, the tester's pedestal) with self-contact: converged, nowhere through themselves, no
+/// (a sphere, a table, the tester's pedestal) with self-contact: converged, nowhere through themselves, no
 /// vertex inside the obstacle, and written as every run is — particles (one per vertex), the
 /// file's triangles, drape.obj, the MCAP timeline and the rerun recording. The Cusick drape folds
 /// and hangs below the flat specimen (0 < DC < 100 %).
@@ -118,6 +141,7 @@ fn patterns_from_obj_drape_over_obstacles_and_are_recorded() {
     let dir = tempfile::tempdir().unwrap();
     for (name, obj) in [
         ("l_panel_sphere.toml", "l_panel.obj"),
+        ("l_panel_table.toml", "l_panel.obj"),
         ("cusick_disc_pedestal.toml", "cusick_disc.obj"),
     ] {
         let out = dir.path().join(name);
@@ -131,8 +155,17 @@ fn patterns_from_obj_drape_over_obstacles_and_are_recorded() {
         let count = |tag: &str| text.lines().filter(|l| l.starts_with(tag)).count();
         assert_eq!(run["particles"], count("v ") as u64, "{name}");
         let tris = drapelab::io::read_triangles(&out.join("triangles.parquet")).unwrap();
-        assert_eq!(tris.len(), count("f "), "{name}: the file's faces are triangles");
-        for f in ["particles.parquet", "drape.obj", "timeline.mcap", "drape.rrd"] {
+        assert_eq!(
+            tris.len(),
+            count("f "),
+            "{name}: the file's faces are triangles"
+        );
+        for f in [
+            "particles.parquet",
+            "drape.obj",
+            "timeline.mcap",
+            "drape.rrd",
+        ] {
             assert!(out.join(f).metadata().unwrap().len() > 0, "{name}: {f}");
         }
     }
@@ -148,7 +181,7 @@ fn patterns_from_obj_drape_over_obstacles_and_are_recorded() {
 #[test]
 fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
     let dir = tempfile::tempdir().unwrap();
-    let base = std::fs::read_to_string(root().join("datasets/patterns/l_panel_sphere.toml"))
+    let base = std::fs::read_to_string(root().join("datasets/patterns/l_panel_table.toml"))
         .unwrap()
         .replace(
             "mesh = \"l_panel.obj\"",
@@ -160,32 +193,54 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
     let bowtie = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 2 1 0\nv 2 2 0\nf 1 2 3\nf 3 4 5\n";
     std::fs::write(dir.path().join("bowtie.obj"), bowtie).unwrap();
     let cases: Vec<(String, &str, &str)> = vec![
-        (base.replace("l_panel.obj", "missing.obj"), "cloth.mesh", "scene.toml"),
+        (
+            base.replace("l_panel.obj", "missing.obj"),
+            "cloth.mesh",
+            "scene.toml",
+        ),
         (
             base.replace(
-                &root().join("datasets/patterns/l_panel.obj").display().to_string(),
+                &root()
+                    .join("datasets/patterns/l_panel.obj")
+                    .display()
+                    .to_string(),
                 "bowtie.obj",
             ),
             "vertex",
             "bowtie.obj",
         ),
-        (base.replace("[cloth]", "[cloth]\nnx = 11"), "cloth.nx", "scene.toml"),
         (
-            base.replace("[\"corner\"]", "[\"waist\"]"),
+            base.replace("[cloth]", "[cloth]\nnx = 11"),
+            "cloth.nx",
+            "scene.toml",
+        ),
+        (
+            base.replace(
+                "[[obstacles]]",
+                "[boundary]\npin_groups = [\"waist\"]\n[[obstacles]]",
+            ),
             "boundary.pin_groups[0]",
             "scene.toml",
         ),
         (
-            base.replace("pin_groups = [\"corner\"]", "pin_particles = [[0, 0]]"),
+            base.replace(
+                "[[obstacles]]",
+                "[boundary]\npin_particles = [[0, 0]]\n[[obstacles]]",
+            ),
             "boundary.pin_particles",
             "scene.toml",
         ),
         (
-            base.replace("[material.continuum]", "[material.mass_spring]\nstiffness_N_per_m = 100.0\n[unused]")
-                .lines()
-                .filter(|l| !l.contains("_gf_") && !l.starts_with("thickness_m") && !l.starts_with("[unused]"))
-                .collect::<Vec<_>>()
-                .join("\n"),
+            base.replace(
+                "[material.continuum]",
+                "[material.mass_spring]\nstiffness_N_per_m = 100.0\n[unused]",
+            )
+            .lines()
+            .filter(|l| {
+                !l.contains("_gf_") && !l.starts_with("thickness_m") && !l.starts_with("[unused]")
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
             "material",
             "scene.toml",
         ),
@@ -205,7 +260,73 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
         let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
         assert_eq!(o.status.code(), Some(2), "{key}: {err}");
         assert_eq!(lines.len(), 1, "{key}: {err}");
-        assert!(lines[0].contains(key) && lines[0].contains(file), "{key}: {err}");
+        assert!(
+            lines[0].contains(key) && lines[0].contains(file),
+            "{key}: {err}"
+        );
         assert!(!out.exists(), "{key}: {} left behind", out.display());
+    }
+}
+
+/// The sensitivities of a mesh sheet's drape (the membrane's and the hinges' coefficients, the
+/// areal density, the file's unit, which scales the pattern) agree with central differences of
+/// two solves: the L panel on the table, each key moved by 10⁻⁴ of its value (at 10⁻³ the unit
+/// moves a particle across the table's edge: a kink), the solves started from the equilibrium.
+/// Relative to the largest displacement, within 2 % (measured: 0.00 %; the unit's was 12 % off
+/// before the membrane's rest shape joined its coefficients).
+#[test]
+fn a_mesh_sheets_sensitivities_are_the_differences_of_its_drapes() {
+    use drapelab::params::with_value;
+    use drapelab::sensitivity::Equilibrium;
+    use drapelab::simulate::solve_scene_from;
+    let file = root().join("datasets/patterns/l_panel_table.toml");
+    let sets = [drapelab::config::parse_override("cloth.mesh_unit_m=1.0").unwrap()];
+    let mut base = Scene::load(&file, &sets).unwrap().scene.into_inner();
+    base.cloth.mesh_unit_m = 1.0 + 1e-9; // serialized, so a key
+    // Differences of drapes need drapes converged far below their difference.
+    base.solver.static_.residual_tol_rel = 1e-11;
+    let scene = base.validated().unwrap();
+    let sol = solve_scene(&scene, &mut drapelab::solve::NoObserver);
+    assert!(sol.report.is_converged(), "{}", sol.report.message);
+    let mut eq = Equilibrium::new(&scene, &sol.model, &sol.x, &sol.report, "test").unwrap();
+    for key in [
+        "material.continuum.bending_warp_gf_cm2_per_cm",
+        "material.continuum.tensile_weft_gf_per_cm",
+        "cloth.areal_density_kg_per_m2",
+        "cloth.mesh_unit_m",
+    ] {
+        let s = eq.sensitivity(key).unwrap();
+        let h = 1e-4 * s.value;
+        let solve_at = |v: f64| {
+            let moved = with_value(&scene, key, v, "test").unwrap();
+            // From the drape, the fixed particles where the changed scene puts them (the unit
+            // scales the whole pattern).
+            let built = drapelab::build::build_scene(&moved);
+            let start: Vec<_> = (0..sol.x.len())
+                .map(|p| {
+                    if built.model.fixed[p] {
+                        built.x0[p]
+                    } else {
+                        sol.x[p]
+                    }
+                })
+                .collect();
+            let r = solve_scene_from(&moved, &start, &mut drapelab::solve::NoObserver);
+            assert!(r.report.is_converged(), "{key} = {v}: {}", r.report.message);
+            r.x
+        };
+        let (xp, xm) = (solve_at(s.value + h), solve_at(s.value - h));
+        let scale = s.dx.iter().map(|d| d.norm()).fold(0.0, f64::max);
+        let worst = (0..xp.len())
+            .map(|p| ((xp[p] - xm[p]) / (2.0 * h) - s.dx[p]).norm())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "{key}: |dx| {scale:.3e}, worst difference {:.2} %",
+            100.0 * worst / scale
+        );
+        assert!(
+            scale > 0.0 && worst < 0.02 * scale,
+            "{key}: {worst:e} against {scale:e}"
+        );
     }
 }

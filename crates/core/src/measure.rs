@@ -37,9 +37,16 @@ impl Projection {
 
 /// The vertical projection of the sheet's `triangles` (indices into `x`; [`crate::build::scene_triangles`])
 /// on a raster of `pixels` across the larger side of their bounding box.
-pub fn vertical_projection(x: &[Vector3<f64>], triangles: &[[u32; 3]], pixels: usize) -> Projection {
+pub fn vertical_projection(
+    x: &[Vector3<f64>],
+    triangles: &[[u32; 3]],
+    pixels: usize,
+) -> Projection {
     let mut used = vec![false; x.len()];
-    triangles.iter().flatten().for_each(|&v| used[v as usize] = true);
+    triangles
+        .iter()
+        .flatten()
+        .for_each(|&v| used[v as usize] = true);
     let pts: Vec<&Vector3<f64>> = (0..x.len()).filter(|&p| used[p]).map(|p| &x[p]).collect();
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in &pts {

@@ -143,7 +143,8 @@ pub fn with_value(
     let mut t = as_table(scene, source)?;
     crate::config::set_dotted(&mut t, key, toml::Value::Float(v))
         .map_err(|m| InputError::new(source, key, m))?;
-    let changed: Scene = crate::config::from_table(std::path::Path::new(source), "", t)?;
+    let mut changed: Scene = crate::config::from_table(std::path::Path::new(source), "", t)?;
+    changed.cloth.carry_pattern(&scene.cloth);
     changed.validate(std::path::Path::new(source))?;
     changed
         .validated()

@@ -52,10 +52,7 @@ pub fn parse_obj(text: &str, unit_m: f64) -> Result<Pattern, Defect> {
 }
 
 /// Reads and checks `path` ([`parse_obj`]); errors name the file and the line or defect.
-pub fn read_obj(
-    path: &std::path::Path,
-    unit_m: f64,
-) -> Result<Pattern, crate::error::InputError> {
+pub fn read_obj(path: &std::path::Path, unit_m: f64) -> Result<Pattern, crate::error::InputError> {
     use crate::error::InputError;
     let text = std::fs::read_to_string(path)
         .map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;

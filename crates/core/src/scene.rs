@@ -19,16 +19,16 @@ mod mesh;
 #[serde(deny_unknown_fields)]
 pub struct ClothSpec {
     /// Side along x in m, 1e-4 to 100 ([`SHEET_SIDE_M`]); a grid sheet's (leave out with `mesh`).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub size_x_m: f64,
     /// Side along y in m, 1e-4 to 100; a grid sheet's.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub size_y_m: f64,
     /// Particles along x (≥ 2); a grid sheet's.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero_count")]
     pub nx: usize,
     /// Particles along y (≥ 2); a grid sheet's.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero_count")]
     pub ny: usize,
     /// A flat pattern piece as the sheet instead of the grid: a Wavefront OBJ file of triangles or
     /// polygons at z = 0 in its own frame (relative paths from the scene file's folder), checked once
@@ -96,6 +96,10 @@ fn is_one(v: &f64) -> bool {
 
 fn is_zero(v: &f64) -> bool {
     *v == 0.0
+}
+
+fn is_zero_count(v: &usize) -> bool {
+    *v == 0
 }
 
 fn is_zero3(v: &[f64; 3]) -> bool {

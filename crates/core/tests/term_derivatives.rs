@@ -12,15 +12,34 @@ use drapelab_core::solve::NoObserver;
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 
+/// The bundled scenes: the grid scenes, then the patterns read from OBJ (issue 49).
 fn scenes() -> Vec<std::path::PathBuf> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets/scenes");
-    let mut v: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    v.sort();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets");
+    let mut v = Vec::new();
+    for dir in ["scenes", "patterns"] {
+        let mut d: Vec<_> = std::fs::read_dir(root.join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        d.sort();
+        v.extend(d);
+    }
     v
+}
+
+/// A scene on the harness's 11 × 11 grid, or a pattern as its file has it, with `extra` set.
+fn load(
+    path: &std::path::Path,
+    extra: &[(String, toml::Value)],
+) -> Option<drapelab_core::scene::LoadedScene> {
+    let mut set = Vec::new();
+    if !path.parent().is_some_and(|d| d.ends_with("patterns")) {
+        set.push(("cloth.nx".to_string(), toml::Value::Integer(11)));
+        set.push(("cloth.ny".to_string(), toml::Value::Integer(11)));
+    }
+    set.extend(extra.iter().cloned());
+    Scene::load(path, &set).ok()
 }
 
 fn dot(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
@@ -134,21 +153,17 @@ fn every_terms_gradient_and_hessian_match_central_differences_in_every_bundled_s
             Some(friction),
         )));
     for (path, extra) in runs {
-        let mut set = vec![
-            ("cloth.nx".to_string(), toml::Value::Integer(11)),
-            ("cloth.ny".to_string(), toml::Value::Integer(11)),
-            (
-                "solver.static.max_iterations".to_string(),
-                toml::Value::Integer(150),
-            ),
-        ];
+        let mut set = vec![(
+            "solver.static.max_iterations".to_string(),
+            toml::Value::Integer(150),
+        )];
         set.extend(extra);
-        let Ok(loaded) = Scene::load(&path, &set) else {
+        let Some(loaded) = load(&path, &set) else {
             continue;
         };
         let name = loaded.scene.name.clone();
         let mut sol = solve_scene(&loaded.scene, &mut NoObserver);
-        let spacing = sol.grid.min_spacing_m();
+        let spacing = loaded.scene.sheet_spacing_m();
         // Off the equilibrium by a thousandth of the spacing: every spring strained, so that the
         // differences test the derivatives and not a stationary point's round-off.
         let x: Vec<Vector3<f64>> = sol
@@ -353,15 +368,11 @@ fn every_terms_derivatives_in_its_coefficients_match_central_differences() {
         checked.insert(t.name());
     };
     for path in scenes() {
-        let set = [
-            ("cloth.nx".to_string(), toml::Value::Integer(11)),
-            ("cloth.ny".to_string(), toml::Value::Integer(11)),
-        ];
-        let Ok(loaded) = Scene::load(&path, &set) else {
+        let Some(loaded) = load(&path, &[]) else {
             continue;
         };
         let mut built = drapelab_core::build::build_scene(&loaded.scene);
-        let spacing = built.grid.min_spacing_m();
+        let spacing = loaded.scene.sheet_spacing_m();
         let x: Vec<Vector3<f64>> = built
             .x0
             .iter()

@@ -237,8 +237,8 @@ fn bench_point(s: &Scene, reference: &Reference, log: &mut impl FnMut(&str)) -> 
         s.contact.self_contact,
         sol.report.status.as_str(),
     ));
-    let sc = (!sol.x.is_empty())
-        .then(|| crate::simulate::self_contact_summary(s, &sol.model, &sol.x));
+    let sc =
+        (!sol.x.is_empty()).then(|| crate::simulate::self_contact_summary(s, &sol.model, &sol.x));
     BenchRow {
         scene: s.name.clone(),
         n,

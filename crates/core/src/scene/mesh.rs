@@ -52,6 +52,25 @@ impl ClothSpec {
     }
 }
 
+impl ClothSpec {
+    /// Takes `from`'s pattern over to this copy of its cloth (a scene rebuilt from its table, where
+    /// the pattern is not serialized): the same file, rescaled when `mesh_unit_m` changed.
+    pub fn carry_pattern(&mut self, from: &ClothSpec) {
+        if self.mesh != from.mesh {
+            return;
+        }
+        self.pattern = from.pattern.as_ref().map(|p| {
+            let s = self.mesh_unit_m / from.mesh_unit_m;
+            if s == 1.0 {
+                return p.clone();
+            }
+            let mut q = Pattern::clone(p);
+            q.rest_m.iter_mut().for_each(|v| *v = v.map(|c| c * s));
+            std::sync::Arc::new(q)
+        });
+    }
+}
+
 impl Scene {
     /// The pattern of a mesh sheet (read when the scene was loaded); none for a grid sheet.
     pub fn pattern(&self) -> Option<&Pattern> {
@@ -155,7 +174,10 @@ from the file: leave it out"
         let mesh_keys = [
             ("cloth.mesh_unit_m", c.mesh_unit_m != 1.0),
             ("cloth.warp_angle_deg", c.warp_angle_deg != 0.0),
-            ("cloth.rotation_deg", c.rotation_deg.iter().any(|r| *r != 0.0)),
+            (
+                "cloth.rotation_deg",
+                c.rotation_deg.iter().any(|r| *r != 0.0),
+            ),
             ("boundary.pin_groups", !self.boundary.pin_groups.is_empty()),
         ];
         if let Some((key, _)) = mesh_keys.iter().find(|(_, given)| *given) {
