@@ -410,3 +410,19 @@ def test_set_is_the_old_name_of_overrides():
     assert np.array_equal(a.positions, b.positions)
     with pytest.raises(drapelab.InputError, match="set"):
         drapelab.simulate(HANG4, overrides={}, set={})
+
+
+def test_a_mesh_scene_simulates_with_the_files_vertices_and_triangles():
+    # Issue 49: the Cusick specimen read from OBJ; positions in the file's vertex order, its
+    # triangles, and the tester's measures of the result agree with the run's own.
+    scene = ROOT / "datasets/patterns/cusick_disc_pedestal.toml"
+    obj = (ROOT / "datasets/patterns/cusick_disc.obj").read_text().splitlines()
+    n_v = sum(1 for l in obj if l.startswith("v "))
+    n_f = sum(1 for l in obj if l.startswith("f "))
+    r = drapelab.simulate(scene)
+    assert r.status == "converged"
+    assert r.positions.shape == (n_v, 3) and (r.nx, r.ny) == (n_v, 1)
+    assert r.triangles.shape == (n_f, 3) and r.present.all()
+    assert r.run["self_contact"]["crossing_edges"] == 0
+    m = drapelab.measure_drape(r)
+    assert abs(m["drape_coefficient_pct"] - r.run["drape"]["drape_coefficient_pct"]) < 1.0
