@@ -1,7 +1,7 @@
 //! Issue 49: a flat pattern read from OBJ as the sheet — bundled pattern scenes draped over
 //! obstacles, grid scenes re-run as triangulated meshes of the same sheets, malformed files refused.
 
-use crate::support::{drapelab, root, scene};
+use crate::support::{drapelab, root, scene, simulate_recorded};
 use drapelab::measure::drape_measures;
 use drapelab::scene::Scene;
 use drapelab::simulate::solve_scene;
@@ -113,20 +113,11 @@ fn a_grid_sheet_and_its_triangulated_mesh_drape_alike() {
 /// `drapelab simulate` of a bundled pattern scene into a fresh folder, recording asked: the run
 /// record as JSON.
 fn simulate_pattern(name: &str, out: &Path) -> serde_json::Value {
-    let o = drapelab()
-        .arg("simulate")
-        .arg(root().join("datasets/patterns").join(name))
-        .arg("--out")
-        .arg(out)
-        .args([
-            "--obj",
-            "--set",
-            "record.timeline=true",
-            "--set",
-            "record.rerun=true",
-        ])
-        .output()
-        .unwrap();
+    let o = simulate_recorded(
+        &root().join("datasets/patterns").join(name),
+        out,
+        &["--obj"],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap()
 }

@@ -2,7 +2,7 @@
 //! `timeline.mcap`, `rerun-sdk` loads `drape.rrd`, and pyarrow reads `particles.parquet` with the
 //! documented columns and types. A failure here means a user's viewer or dataframe cannot open a run.
 
-use crate::support::{drapelab, root, run_python};
+use crate::support::{root, run_python};
 
 fn simulate_recorded(extra: &[&str]) -> tempfile::TempDir {
     let (tmp, o) = simulate_hang4_recorded(extra);
@@ -15,20 +15,8 @@ fn simulate_recorded(extra: &[&str]) -> tempfile::TempDir {
 pub(crate) fn simulate_hang4_recorded(extra: &[&str]) -> (tempfile::TempDir, std::process::Output) {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("o");
-    let o = drapelab()
-        .arg("simulate")
-        .arg(root().join("datasets/scenes/hang4.toml"))
-        .arg("--out")
-        .arg(&out)
-        .args([
-            "--set",
-            "record.timeline=true",
-            "--set",
-            "record.rerun=true",
-        ])
-        .args(extra)
-        .output()
-        .unwrap();
+    let o =
+        crate::support::simulate_recorded(&root().join("datasets/scenes/hang4.toml"), &out, extra);
     (tmp, o)
 }
 

@@ -4,7 +4,7 @@
 //! against every triangle sharing no vertex with it, and brute-force distances between vertices and
 //! triangles and between edges.
 
-use crate::support::{drapelab, root, run_python, scene};
+use crate::support::{root, run_python, scene};
 use drapelab::scene::Scene;
 use drapelab::simulate::{Solution, solve_scene};
 use drapelab::solve::{NoObserver, Observer, StateEvent};
@@ -381,19 +381,7 @@ fn a_sheet_folding_onto_itself_stays_apart_at_every_accepted_step_and_is_recorde
     // Recorded: the CLI's timeline.mcap, read by the Python mcap reader, holds every accepted step,
     // each without crossings by the checks here; drape.rrd loads in rerun.
     let out = tmp.path().join("o");
-    let o = drapelab()
-        .args(["simulate"])
-        .arg(&path)
-        .arg("--out")
-        .arg(&out)
-        .args([
-            "--set",
-            "record.timeline=true",
-            "--set",
-            "record.rerun=true",
-        ])
-        .output()
-        .unwrap();
+    let o = crate::support::simulate_recorded(&path, &out, &[]);
     // Half a second of the fall is recorded; the sheet still swings (status max-iterations, exit 1).
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();

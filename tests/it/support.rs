@@ -27,6 +27,25 @@ pub fn drapelab() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_drapelab"))
 }
 
+/// `drapelab simulate SCENE --out OUT` with both recordings asked (the MCAP timeline and the rerun
+/// file) and `extra` arguments.
+pub fn simulate_recorded(scene: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    drapelab()
+        .arg("simulate")
+        .arg(scene)
+        .arg("--out")
+        .arg(out)
+        .args([
+            "--set",
+            "record.timeline=true",
+            "--set",
+            "record.rerun=true",
+        ])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
 /// The Python interpreter with the readers installed: $DRAPELAB_PYTHON, or `.venv/` in the
 /// repository, created on first use from `tests/requirements.txt` (mcap, rerun-sdk, pyarrow, polars).
 pub fn python() -> PathBuf {
