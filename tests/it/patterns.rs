@@ -236,6 +236,23 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
             "scene.toml",
         ),
     ];
+    // The smooth surface needs a grid: a mesh scene is refused in one line, nothing written.
+    let out = dir.path().join("surface");
+    let o = drapelab()
+        .arg("surface")
+        .arg(root().join("datasets/patterns/l_panel_table.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(
+        err.lines().filter(|l| !l.trim().is_empty()).count(),
+        1,
+        "{err}"
+    );
+    assert!(err.contains("cloth.mesh") && !out.exists(), "{err}");
     for (text, key, file) in cases {
         let scene = dir.path().join("scene.toml");
         std::fs::write(&scene, &text).unwrap();

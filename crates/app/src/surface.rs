@@ -27,6 +27,17 @@ pub struct Drape {
     pub present: Vec<bool>,
 }
 
+/// The error for a mesh sheet: the smooth surface is fitted over a grid's rows and columns.
+fn mesh_sheet(file: &Path, key: &str) -> InputError {
+    InputError::new(
+        file,
+        key,
+        "the smooth surface (seed 003 §10.8) is fitted over a grid's rows and columns; a mesh \
+sheet's drape is its own triangles: `drapelab simulate --obj` writes drape.obj, and \
+triangles.parquet holds them",
+    )
+}
+
 /// The drape of a run folder (or its `run.json`): the scene recorded in `run.json` and the
 /// positions of `particles.parquet`; an error when the run did not converge.
 pub fn load_run(path: &Path) -> Result<Drape> {
@@ -49,6 +60,9 @@ pub fn load_run(path: &Path) -> Result<Drape> {
     }
     let scene: Scene = serde_json::from_value(v["scene"].clone())
         .map_err(|e| InputError::new(&json, "scene", e.to_string()))?;
+    if scene.cloth.is_mesh() {
+        return Err(mesh_sheet(&json, "scene.cloth.mesh").into());
+    }
     let scene = scene
         .validated()
         .map_err(|e| InputError::new(&json, format!("scene.{}", e.key), e.message))?;
@@ -75,6 +89,9 @@ pub fn load_run(path: &Path) -> Result<Drape> {
 /// converge.
 pub fn solve_drape(loaded: &LoadedScene, observer: &mut dyn Observer) -> Result<Drape> {
     let scene = &loaded.scene;
+    if scene.cloth.is_mesh() {
+        return Err(mesh_sheet(&loaded.path, "cloth.mesh").into());
+    }
     let built = build_scene(scene);
     let (grid, mut model, mut x) = (built.grid, built.model, built.x0);
     let report = drapelab_core::simulate::solve_model(scene, &grid, &mut model, &mut x, observer);
