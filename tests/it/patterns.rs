@@ -236,11 +236,21 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
             "scene.toml",
         ),
     ];
-    // The smooth surface needs a grid: a mesh scene is refused in one line, nothing written.
+    // A mesh scene's run folder does not hold its pattern: `surface RUN` says so in one line.
+    let run = dir.path().join("run");
+    assert!(
+        simulate_recorded(
+            &root().join("datasets/patterns/l_panel_table.toml"),
+            &run,
+            &[]
+        )
+        .status
+        .success()
+    );
     let out = dir.path().join("surface");
     let o = drapelab()
         .arg("surface")
-        .arg(root().join("datasets/patterns/l_panel_table.toml"))
+        .arg(&run)
         .arg("--out")
         .arg(&out)
         .output()
@@ -337,4 +347,29 @@ fn a_mesh_sheets_sensitivities_are_the_differences_of_its_drapes() {
             "{key}: {worst:e} against {scale:e}"
         );
     }
+}
+
+/// A mesh scene dressed on its own triangles (`drapelab surface SCENE`): drape.glb passes the
+/// Khronos validator with no errors and holds the pattern's vertices and triangles; the texture
+/// lies on the flat pattern.
+#[test]
+fn a_mesh_drape_is_dressed_on_its_own_triangles_as_valid_gltf() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("surface");
+    let o = drapelab()
+        .arg("surface")
+        .arg(root().join("datasets/patterns/cusick_disc_pedestal.toml"))
+        .args(["--repeats", "6,6", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("surface.json")).unwrap()).unwrap();
+    let obj = std::fs::read_to_string(root().join("datasets/patterns/cusick_disc.obj")).unwrap();
+    let count = |tag: &str| obj.lines().filter(|l| l.starts_with(tag)).count() as u64;
+    assert_eq!(summary["vertices"], count("v "));
+    assert_eq!(summary["triangles"], count("f "));
+    let report = crate::surface::gltf_validate(&out.join("drape.glb"));
+    assert_eq!(report["issues"]["numErrors"], 0, "{report}");
 }

@@ -201,7 +201,7 @@ fn the_trimmed_skirt_covers_its_own_mesh_and_nothing_outside_it() {
 
 /// Installs the Khronos glTF validator (tests/gltf, `npm ci`) once per test process and validates
 /// `glb`: the report's JSON (issues and info).
-fn gltf_validate(glb: &std::path::Path) -> serde_json::Value {
+pub(crate) fn gltf_validate(glb: &std::path::Path) -> serde_json::Value {
     static READY: std::sync::OnceLock<()> = std::sync::OnceLock::new();
     let dir = root().join("tests/gltf");
     READY.get_or_init(|| {

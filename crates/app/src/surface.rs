@@ -27,14 +27,13 @@ pub struct Drape {
     pub present: Vec<bool>,
 }
 
-/// The error for a mesh sheet: the smooth surface is fitted over a grid's rows and columns.
+/// The error for a run of a mesh sheet: its pattern is a file beside the scene, not in the run.
 fn mesh_sheet(file: &Path, key: &str) -> InputError {
     InputError::new(
         file,
         key,
-        "the smooth surface (seed 003 §10.8) is fitted over a grid's rows and columns; a mesh \
-sheet's drape is its own triangles: `drapelab simulate --obj` writes drape.obj, and \
-triangles.parquet holds them",
+        "a mesh sheet's run does not hold its pattern (the OBJ file beside the scene): dress the \
+scene file itself (`drapelab surface SCENE.toml`), which solves it",
     )
 }
 
@@ -89,9 +88,6 @@ pub fn load_run(path: &Path) -> Result<Drape> {
 /// converge.
 pub fn solve_drape(loaded: &LoadedScene, observer: &mut dyn Observer) -> Result<Drape> {
     let scene = &loaded.scene;
-    if scene.cloth.is_mesh() {
-        return Err(mesh_sheet(&loaded.path, "cloth.mesh").into());
-    }
     let built = build_scene(scene);
     let (grid, mut model, mut x) = (built.grid, built.model, built.x0);
     let report = drapelab_core::simulate::solve_model(scene, &grid, &mut model, &mut x, observer);
@@ -109,6 +105,74 @@ pub fn solve_drape(loaded: &LoadedScene, observer: &mut dyn Observer) -> Result<
         x,
         present: build::present_particles(scene),
     })
+}
+
+/// A mesh sheet dressed on its own triangles: the drape's vertices with area-weighted normals, the
+/// texture laid on the flat pattern (its material coordinates: the rest positions in the warp
+/// frame), so that a panel's print follows its cut; `resolution` does not apply.
+fn dress_mesh(
+    drape: &Drape,
+    pattern: &drapelab_core::pattern::Pattern,
+    params: &SurfaceParams,
+    texture_name: &str,
+) -> Dressed {
+    let (s, c) = drape.scene.cloth.warp_angle_deg.to_radians().sin_cos();
+    let material: Vec<[f64; 2]> = pattern
+        .rest_m
+        .iter()
+        .map(|p| [c * p[0] + s * p[1], -s * p[0] + c * p[1]])
+        .collect();
+    let (lo, hi) = material.iter().fold(
+        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+        |(lo, hi), m| {
+            (
+                [lo[0].min(m[0]), lo[1].min(m[1])],
+                [hi[0].max(m[0]), hi[1].max(m[1])],
+            )
+        },
+    );
+    let extent = (lo, [hi[0] - lo[0], hi[1] - lo[1]]);
+    let triangles: Vec<[u32; 3]> = pattern
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| v as u32))
+        .collect();
+    let x = &drape.x[..pattern.rest_m.len()];
+    let mut normals = vec![Vector3::zeros(); x.len()];
+    for t in &triangles {
+        let [a, b, c] = t.map(|v| x[v as usize]);
+        let n = (b - a).cross(&(c - a));
+        t.iter().for_each(|&v| normals[v as usize] += n);
+    }
+    normals.iter_mut().for_each(|n| *n = n.normalize());
+    let map = TextureMapping {
+        repeats: params.repeats,
+        rotation_deg: params.rotation_deg,
+    };
+    let st = material.iter().map(|m| map.texcoord(*m, extent)).collect();
+    let mesh = SurfaceMesh {
+        positions: x.to_vec(),
+        normals,
+        params: material
+            .iter()
+            .map(|m| [(m[0] - lo[0]) / extent.1[0], (m[1] - lo[1]) / extent.1[1]])
+            .collect(),
+        material_m: material,
+        triangles,
+    };
+    let summary = SurfaceSummary {
+        scene: drape.scene.name.clone(),
+        vertices: mesh.positions.len(),
+        triangles: mesh.triangles.len(),
+        trimmed: false,
+        area_m2: mesh.area_m2(),
+        projected_area_m2: mesh.projected_area_m2(),
+        mesh_projected_area_m2: projected_area(x, &mesh.triangles),
+        max_node_distance_m: 0.0,
+        params: params.clone(),
+        texture: texture_name.to_string(),
+    };
+    Dressed { mesh, st, summary }
 }
 
 /// How to dress a drape: validated once from the command line or a stage's parameters.
@@ -247,6 +311,9 @@ pub struct Dressed {
 
 /// The surface of `drape` evaluated as `params` say (uniform knots, as seed 003).
 pub fn dress(drape: &Drape, params: &SurfaceParams, texture_name: &str) -> Result<Dressed> {
+    if let Some(pattern) = drape.scene.pattern() {
+        return Ok(dress_mesh(drape, pattern, params, texture_name));
+    }
     let grid = drape.scene.grid();
     let surf = DrapeSurface::new(&grid, &drape.x, &drape.present, Parametrization::Uniform)
         .with_context(|| {
