@@ -287,7 +287,8 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
 }
 
 /// The sensitivities of a mesh sheet's drape (the membrane's and the hinges' coefficients, the
-/// areal density, the file's unit, which scales the pattern) agree with central differences of
+/// areal density, the file's unit, which scales the pattern, the warp's angle, which turns the
+/// membrane's and the hinges' rigidities) agree with central differences of
 /// two solves: the L panel on the table, each key moved by 10⁻⁴ of its value (at 10⁻³ the unit
 /// moves a particle across the table's edge: a kink), the solves started from the equilibrium.
 /// Relative to the largest displacement, within 2 % (measured: 0.00 %; the unit's was 12 % off
@@ -301,6 +302,7 @@ fn a_mesh_sheets_sensitivities_are_the_differences_of_its_drapes() {
     let sets = [drapelab::config::parse_override("cloth.mesh_unit_m=1.0").unwrap()];
     let mut base = Scene::load(&file, &sets).unwrap().scene.into_inner();
     base.cloth.mesh_unit_m = 1.0 + 1e-9; // serialized, so a key
+    base.cloth.warp_angle_deg = 10.0; // likewise
     // Differences of drapes need drapes converged far below their difference.
     base.solver.static_.residual_tol_rel = 1e-11;
     let scene = base.validated().unwrap();
@@ -312,6 +314,7 @@ fn a_mesh_sheets_sensitivities_are_the_differences_of_its_drapes() {
         "material.continuum.tensile_weft_gf_per_cm",
         "cloth.areal_density_kg_per_m2",
         "cloth.mesh_unit_m",
+        "cloth.warp_angle_deg",
     ] {
         let s = eq.sensitivity(key).unwrap();
         let h = 1e-4 * s.value;
