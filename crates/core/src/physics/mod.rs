@@ -79,6 +79,22 @@ impl HessianBlocks {
             }
         }
     }
+    /// The same matrix with its diagonal blocks summed per particle (first, one per particle of
+    /// `n`) and its off-diagonal blocks as they are: a cheaper [`Self::mul_add`] for a solver that
+    /// multiplies by one Hessian several times (every spring pushes two diagonal blocks).
+    pub fn compacted(&self, n: usize) -> HessianBlocks {
+        let mut out = HessianBlocks {
+            pairs: (0..n as u32).map(|p| (p, p)).collect(),
+            blocks: self.diagonal(n),
+        };
+        for (&(p, q), b) in self.pairs.iter().zip(&self.blocks) {
+            if p != q {
+                out.pairs.push((p, q));
+                out.blocks.push(*b);
+            }
+        }
+        out
+    }
     /// The 3×3 diagonal blocks summed per particle.
     pub fn diagonal(&self, n: usize) -> Vec<Matrix3<f64>> {
         let mut d = vec![Matrix3::zeros(); n];

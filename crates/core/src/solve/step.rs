@@ -567,9 +567,10 @@ impl Workspace {
         self.solve_for(&neg, &mut z);
         let (mut d, mut p) = (vec![Vector3::zeros(); n], z.clone());
         let mut rz = dot(&res, &z);
+        let h = self.h.compacted(n);
         for _ in 0..KRYLOV_ITERATIONS {
             let mut q = vec![Vector3::zeros(); n];
-            self.h.mul_add(&p, &mut q);
+            h.mul_add(&p, &mut q);
             masked(&mut q);
             let pq = dot(&p, &q);
             if pq <= 0.0 || !pq.is_finite() {
