@@ -109,7 +109,9 @@ pub fn solve_drape(loaded: &LoadedScene, observer: &mut dyn Observer) -> Result<
 
 /// A mesh sheet dressed on its own triangles: the drape's vertices with area-weighted normals, the
 /// texture laid on the flat pattern (its material coordinates: the rest positions in the warp
-/// frame), so that a panel's print follows its cut; `resolution` does not apply.
+/// frame), so that a panel's print follows its cut; `resolution` does not apply. The surface's
+/// vertices are the rest vertices (a garment's seam vertex once per piece, at one position, so that
+/// each piece keeps its own print).
 fn dress_mesh(
     drape: &Drape,
     pattern: &drapelab_core::pattern::Pattern,
@@ -133,25 +135,30 @@ fn dress_mesh(
     );
     let extent = (lo, [hi[0] - lo[0], hi[1] - lo[1]]);
     let triangles: Vec<[u32; 3]> = pattern
-        .triangles
+        .rest_triangles
         .iter()
         .map(|t| t.map(|v| v as u32))
         .collect();
-    let x = &drape.x[..pattern.rest_m.len()];
-    let mut normals = vec![Vector3::zeros(); x.len()];
-    for t in &triangles {
-        let [a, b, c] = t.map(|v| x[v as usize]);
+    let x = &drape.x[..pattern.vertex_count()];
+    let mut vertex_normals = vec![Vector3::zeros(); x.len()];
+    for t in &pattern.triangles {
+        let [a, b, c] = t.map(|v| x[v]);
         let n = (b - a).cross(&(c - a));
-        t.iter().for_each(|&v| normals[v as usize] += n);
+        t.iter().for_each(|&v| vertex_normals[v] += n);
     }
-    normals.iter_mut().for_each(|n| *n = n.normalize());
+    let positions: Vec<Vector3<f64>> = pattern.vertex_of_rest.iter().map(|&v| x[v]).collect();
+    let normals = pattern
+        .vertex_of_rest
+        .iter()
+        .map(|&v| vertex_normals[v].normalize())
+        .collect();
     let map = TextureMapping {
         repeats: params.repeats,
         rotation_deg: params.rotation_deg,
     };
     let st = material.iter().map(|m| map.texcoord(*m, extent)).collect();
     let mesh = SurfaceMesh {
-        positions: x.to_vec(),
+        positions,
         normals,
         params: material
             .iter()
@@ -167,7 +174,7 @@ fn dress_mesh(
         trimmed: false,
         area_m2: mesh.area_m2(),
         projected_area_m2: mesh.projected_area_m2(),
-        mesh_projected_area_m2: projected_area(x, &mesh.triangles),
+        mesh_projected_area_m2: projected_area(&mesh.positions, &mesh.triangles),
         max_node_distance_m: 0.0,
         params: params.clone(),
         texture: texture_name.to_string(),

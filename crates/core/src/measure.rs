@@ -263,7 +263,7 @@ mod tests {
 pub struct DrapeMeasures {
     /// Area of the vertical projection, m² (of the whole sheet, for a quarter or half model).
     pub projected_area_m2: f64,
-    /// Area of the flat specimen's projection on the same raster, m².
+    /// Area of the flat specimen's projection on the same raster, m² (a garment's: its pattern's area).
     pub flat_area_m2: f64,
     /// Area of the support's top face (pedestal or table), m²; None without one.
     pub support_area_m2: Option<f64>,
@@ -319,7 +319,11 @@ pub fn drape_measures(scene: &crate::scene::Scene, x: &[Vector3<f64>]) -> DrapeM
     let k = scene.boundary.symmetry_edges.len();
     let factor = (1u32 << k) as f64;
     let s = proj.area_m2() * factor;
-    let flat = flat_proj.area_m2() * factor;
+    // A garment starts placed in 3D: its flat area is its pattern's.
+    let flat = match scene.pattern().filter(|p| !p.is_flat()) {
+        Some(p) => p.rest_area_m2(),
+        None => flat_proj.area_m2() * factor,
+    };
     let support = support.map(|(a, c)| (a * factor, c));
     let n = x0.len();
     DrapeMeasures {

@@ -1,18 +1,33 @@
-//! A flat pattern piece as the sheet: a triangle mesh read from a Wavefront OBJ file (what CLO,
-//! Marvelous Designer, Blender and the IPC and BDP examples exchange), checked once so that the
-//! physics can rely on it: one flat, connected, manifold piece of triangles with area, oriented
-//! alike. Polygons are split into fans; `g`/`o` groups name vertex sets (the vertices of the
-//! group's faces and `l` polylines) that pins and clamps can address.
+//! A pattern as the sheet: a triangle mesh read from a Wavefront OBJ file (what CLO, Marvelous
+//! Designer, Blender and the IPC and BDP examples exchange), checked once so that the physics can
+//! rely on it: one connected, manifold mesh of triangles with area, oriented alike. Two layouts:
+//! - a **flat pattern**: the vertices (`v`) lie in one plane z = const and are the rest shape and
+//!   the start;
+//! - a **sewn garment** (the layout garment tools export): the vertices are the pieces placed in 3D
+//!   (the start), and every face corner names its flat pattern position as texture coordinates
+//!   (`f v/vt`): the rest shape is the pieces laid flat. A vertex shared by faces of two pieces is a
+//!   seam (identified vertices): it has one position and a rest position in each piece.
+//!
+//! Polygons are split into fans; `g`/`o` groups name vertex sets (the vertices of the group's faces
+//! and `l` polylines) that pins and clamps can address.
 
 use std::collections::{BTreeMap, HashMap};
 
-/// A checked flat pattern: rest positions in its own plane (m) and counter-clockwise triangles.
+/// A checked pattern: the sheet's vertices (its particles) with their start positions, and the
+/// rest shape laid flat, per rest vertex (a seam's vertex has one in each piece).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pattern {
-    /// Rest positions in the pattern's plane, m (the file's x and y times its unit).
+    /// Rest positions in the pattern's plane, m (a flat pattern's x and y, or a garment's texture
+    /// coordinates, times the file's unit), one per rest vertex.
     pub rest_m: Vec<[f64; 2]>,
-    /// Triangles, counter-clockwise seen from +z.
+    /// The triangles over rest vertices, counter-clockwise in the pattern's plane.
+    pub rest_triangles: Vec<[usize; 3]>,
+    /// The same triangles over the sheet's vertices (particles).
     pub triangles: Vec<[usize; 3]>,
+    /// The vertex (particle) of each rest vertex.
+    pub vertex_of_rest: Vec<usize>,
+    /// Start positions of the vertices in the file's frame, m (z = 0 for a flat pattern).
+    pub start_m: Vec<[f64; 3]>,
     /// Vertex sets by group name (`g` and `o` lines), sorted.
     pub groups: BTreeMap<String, Vec<usize>>,
 }
@@ -41,7 +56,10 @@ const AREA_REL: f64 = 1e-10;
 #[derive(Default)]
 struct Raw {
     v: Vec<[f64; 3]>,
+    vt: Vec<[f64; 2]>,
     faces: Vec<([usize; 3], usize)>,
+    /// Each face's texture coordinates, where every corner gave one.
+    face_vt: Vec<Option<[usize; 3]>>,
     groups: BTreeMap<String, Vec<usize>>,
 }
 
@@ -60,13 +78,42 @@ pub fn read_obj(path: &std::path::Path, unit_m: f64) -> Result<Pattern, crate::e
 }
 
 impl Pattern {
+    /// The number of vertices (the sheet's particles).
+    pub fn vertex_count(&self) -> usize {
+        self.start_m.len()
+    }
+
+    /// Whether the rest vertices are the vertices (a flat pattern, no seams).
+    pub fn is_flat(&self) -> bool {
+        self.rest_triangles == self.triangles
+    }
+
+    /// Scales every length (rest and start) by `s`.
+    pub fn scaled(&self, s: f64) -> Pattern {
+        let mut q = self.clone();
+        q.rest_m.iter_mut().for_each(|v| *v = v.map(|c| c * s));
+        q.start_m.iter_mut().for_each(|v| *v = v.map(|c| c * s));
+        q
+    }
+
+    /// The area of the rest shape (the pieces laid flat), m².
+    pub fn rest_area_m2(&self) -> f64 {
+        self.rest_triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| self.rest_m[v]);
+                0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])).abs()
+            })
+            .sum()
+    }
+
     /// The shortest edge of a triangle, m.
     pub fn shortest_edge_m(&self) -> f64 {
         let len = |a: usize, b: usize| {
             let (p, q) = (self.rest_m[a], self.rest_m[b]);
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
         };
-        self.triangles
+        self.rest_triangles
             .iter()
             .flat_map(|&[a, b, c]| [len(a, b), len(b, c), len(c, a)])
             .fold(f64::INFINITY, f64::min)
@@ -89,15 +136,27 @@ impl Pattern {
 /// The vertex index of an OBJ face or line token (`7`, `7/2`, `7//3`, `-1`), 0-based.
 fn index(token: &str, count: usize, line: usize) -> Result<usize, Defect> {
     let first = token.split('/').next().unwrap_or("");
+    resolve(first, token, count, line, "vertex")
+}
+
+/// The texture-coordinate index of a face token (`7/2` → 1), if it has one.
+fn texture_index(token: &str, count: usize, line: usize) -> Result<Option<usize>, Defect> {
+    match token.split('/').nth(1) {
+        Some(t) if !t.is_empty() => resolve(t, token, count, line, "texture coordinate").map(Some),
+        _ => Ok(None),
+    }
+}
+
+fn resolve(text: &str, token: &str, count: usize, line: usize, what: &str) -> Result<usize, Defect> {
     let at = format!("line {line}");
-    let i: i64 = first
+    let i: i64 = text
         .parse()
-        .map_err(|_| defect(&at, format!("`{token}` is not a vertex index")))?;
+        .map_err(|_| defect(&at, format!("`{token}` is not a {what} index")))?;
     let resolved = if i < 0 { count as i64 + i } else { i - 1 };
     if i == 0 || resolved < 0 || resolved >= count as i64 {
         return Err(defect(
             at,
-            format!("refers to vertex {i}; the file has {count} vertices before this line"),
+            format!("refers to {what} {i}; the file has {count} before this line"),
         ));
     }
     Ok(resolved as usize)
@@ -124,10 +183,26 @@ fn parse(text: &str) -> Result<Raw, Defect> {
                     }
                 }
             }
+            "vt" => {
+                let c: Vec<f64> = rest.iter().take(2).filter_map(|t| t.parse().ok()).collect();
+                match c[..] {
+                    [u, w] if c.iter().all(|v| v.is_finite()) => raw.vt.push([u, w]),
+                    _ => {
+                        return Err(defect(
+                            format!("line {n}"),
+                            "a texture coordinate (`vt`) needs two finite numbers",
+                        ));
+                    }
+                }
+            }
             "f" | "l" => {
                 let idx: Vec<usize> = rest
                     .iter()
                     .map(|t| index(t, raw.v.len(), n))
+                    .collect::<Result<_, _>>()?;
+                let tex: Vec<Option<usize>> = rest
+                    .iter()
+                    .map(|t| texture_index(t, raw.vt.len(), n))
                     .collect::<Result<_, _>>()?;
                 for g in &current {
                     raw.groups.entry(g.clone()).or_default().extend(&idx);
@@ -143,6 +218,11 @@ fn parse(text: &str) -> Result<Raw, Defect> {
                 }
                 for j in 1..idx.len() - 1 {
                     raw.faces.push(([idx[0], idx[j], idx[j + 1]], n));
+                    let t = [tex[0], tex[j], tex[j + 1]];
+                    raw.face_vt.push(match t {
+                        [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                        _ => None,
+                    });
                 }
             }
             "g" | "o" => current = rest.iter().map(|s| s.to_string()).collect(),
@@ -160,34 +240,17 @@ fn check(raw: Raw, unit_m: f64) -> Result<Pattern, Defect> {
             "the file has no faces (`f` lines): nothing to drape",
         ));
     }
-    let extent = extent(&raw.v);
-    let z0 = raw.v[raw.faces[0].0[0]][2];
-    if let Some((k, p)) = raw
-        .v
-        .iter()
-        .enumerate()
-        .find(|(_, p)| (p[2] - z0).abs() > FLAT_REL * extent)
-    {
-        return Err(defect(
-            "vertices",
-            format!(
-                "not a flat pattern: vertex {} lies {:.3e} off the plane z = {z0} of the first face (give the piece flat, z constant)",
-                k + 1,
-                p[2] - z0
-            ),
-        ));
-    }
     unused_vertex(&raw)?;
-    let triangles = oriented(&raw, extent)?;
+    let rest = rest_layout(&raw)?;
+    let (rest_triangles, triangles) = oriented(&raw, &rest)?;
     manifold(&raw, &triangles)?;
     connected(raw.v.len(), &triangles)?;
     Ok(Pattern {
-        rest_m: raw
-            .v
-            .iter()
-            .map(|p| [p[0] * unit_m, p[1] * unit_m])
-            .collect(),
+        rest_m: rest.points.iter().map(|p| p.map(|c| c * unit_m)).collect(),
+        rest_triangles,
         triangles,
+        vertex_of_rest: rest.vertex_of,
+        start_m: raw.v.iter().map(|p| p.map(|c| c * unit_m)).collect(),
         groups: raw
             .groups
             .into_iter()
@@ -198,6 +261,75 @@ fn check(raw: Raw, unit_m: f64) -> Result<Pattern, Defect> {
             })
             .collect(),
     })
+}
+
+/// The rest shape before its checks: flat positions, the faces over them, and each one's vertex.
+struct Rest {
+    points: Vec<[f64; 2]>,
+    faces: Vec<[usize; 3]>,
+    vertex_of: Vec<usize>,
+}
+
+/// A flat file's vertices are its rest shape; a garment's (vertices not in one plane) are its
+/// faces' texture coordinates, each used by one vertex only.
+fn rest_layout(raw: &Raw) -> Result<Rest, Defect> {
+    let extent = extent(&raw.v);
+    let z0 = raw.v[raw.faces[0].0[0]][2];
+    let off = raw
+        .v
+        .iter()
+        .enumerate()
+        .find(|(_, p)| (p[2] - z0).abs() > FLAT_REL * extent);
+    let Some((k, p)) = off else {
+        return Ok(Rest {
+            points: raw.v.iter().map(|p| [p[0], p[1]]).collect(),
+            faces: raw.faces.iter().map(|f| f.0).collect(),
+            vertex_of: (0..raw.v.len()).collect(),
+        });
+    };
+    if let Some(f) = raw.face_vt.iter().position(Option::is_none) {
+        return Err(defect(
+            "vertices",
+            format!(
+                "not a flat pattern: vertex {} lies {:.3e} off the plane z = {z0} of the first face; give the piece flat (z constant), or a garment with every face corner's flat position as texture coordinates (`f v/vt`; the face on line {} has none)",
+                k + 1,
+                p[2] - z0,
+                raw.faces[f].1
+            ),
+        ));
+    }
+    // Rest vertices: the texture coordinates the faces use, numbered in order of first use.
+    let mut number: HashMap<usize, usize> = HashMap::new();
+    let mut rest = Rest {
+        points: Vec::new(),
+        faces: Vec::with_capacity(raw.faces.len()),
+        vertex_of: Vec::new(),
+    };
+    for ((v, line), vt) in raw.faces.iter().zip(&raw.face_vt) {
+        let vt = vt.expect("checked above");
+        let mut face = [0; 3];
+        for k in 0..3 {
+            let r = *number.entry(vt[k]).or_insert_with(|| {
+                rest.points.push(raw.vt[vt[k]]);
+                rest.vertex_of.push(v[k]);
+                rest.points.len() - 1
+            });
+            if rest.vertex_of[r] != v[k] {
+                return Err(defect(
+                    format!("line {line}"),
+                    format!(
+                        "texture coordinate {} is the flat position of vertices {} and {}: give each piece's corner its own `vt`",
+                        vt[k] + 1,
+                        rest.vertex_of[r] + 1,
+                        v[k] + 1
+                    ),
+                ));
+            }
+            face[k] = r;
+        }
+        rest.faces.push(face);
+    }
+    Ok(rest)
 }
 
 fn extent(v: &[[f64; 3]]) -> f64 {
@@ -227,16 +359,22 @@ fn unused_vertex(raw: &Raw) -> Result<(), Defect> {
     }
 }
 
-/// The triangles counter-clockwise: every face must have area and the same orientation as the
-/// first (all clockwise is turned over as a whole).
-fn oriented(raw: &Raw, extent: f64) -> Result<Vec<[usize; 3]>, Defect> {
+/// The triangles counter-clockwise in the rest plane: every face must have area there and the
+/// same orientation as the first (all clockwise is turned over as a whole). Returns the triangles
+/// over rest vertices and over vertices, turned alike.
+#[allow(clippy::type_complexity)]
+fn oriented(raw: &Raw, rest: &Rest) -> Result<(Vec<[usize; 3]>, Vec<[usize; 3]>), Defect> {
+    let extent = {
+        let v: Vec<[f64; 3]> = rest.points.iter().map(|p| [p[0], p[1], 0.0]).collect();
+        extent(&v)
+    };
     let signed = |t: &[usize; 3]| {
-        let [a, b, c] = t.map(|i| raw.v[i]);
+        let [a, b, c] = t.map(|i| rest.points[i]);
         0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
     };
-    let sign = signed(&raw.faces[0].0).signum();
-    let mut out = Vec::with_capacity(raw.faces.len());
-    for (t, line) in &raw.faces {
+    let sign = signed(&rest.faces[0]).signum();
+    let (mut rest_out, mut out) = (Vec::new(), Vec::new());
+    for (t, (v, line)) in rest.faces.iter().zip(&raw.faces) {
         let s = signed(t);
         if s.abs() <= AREA_REL * extent * extent {
             return Err(defect(
@@ -250,9 +388,11 @@ fn oriented(raw: &Raw, extent: f64) -> Result<Vec<[usize; 3]>, Defect> {
                 "an inverted face: its vertices run the other way round from the first face's (a folded or flipped pattern)",
             ));
         }
-        out.push(if sign > 0.0 { *t } else { [t[0], t[2], t[1]] });
+        let turn = |t: &[usize; 3]| if sign > 0.0 { *t } else { [t[0], t[2], t[1]] };
+        rest_out.push(turn(t));
+        out.push(turn(v));
     }
-    Ok(out)
+    Ok((rest_out, out))
 }
 
 /// Each edge in at most two faces, and each vertex's faces one fan.
@@ -323,7 +463,7 @@ fn connected(n: usize, tris: &[[usize; 3]]) -> Result<(), Defect> {
         Some(k) => Err(defect(
             "faces",
             format!(
-                "{} disconnected pieces (vertex {} is not joined to vertex 1): give one piece per file",
+                "{} disconnected pieces (vertex {} is not joined to vertex 1): give one piece per file, or sew the pieces (faces of both pieces sharing the seam's vertices)",
                 pieces.len(),
                 k + 1
             ),

@@ -445,7 +445,7 @@ impl Scene {
     /// of a mesh sheet, its vertices as one row ([`Grid::vertex_row`](crate::cloth::Grid::vertex_row)).
     pub fn grid(&self) -> crate::cloth::Grid {
         if let Some(p) = self.pattern() {
-            return crate::cloth::Grid::vertex_row(p.rest_m.len());
+            return crate::cloth::Grid::vertex_row(p.vertex_count());
         }
         let c = &self.cloth;
         let local =

@@ -6,7 +6,7 @@
 
 use crate::material::Rigidities;
 use crate::pattern::Pattern;
-use crate::physics::{Membrane, MembraneError, ModelBuilder, orthotropic_hinge_bending};
+use crate::physics::{Membrane, MembraneError, ModelBuilder, SewnSheet, sewn_hinge_bending};
 
 /// A pattern and its fabric.
 pub struct PatternSheet<'a> {
@@ -21,12 +21,12 @@ pub struct PatternSheet<'a> {
 }
 
 impl PatternSheet<'_> {
-    /// Lumped masses: a third of each triangle's mass to each of its vertices, kg.
+    /// Lumped masses: a third of each triangle's mass (its rest area's) to each of its vertices, kg.
     pub fn lumped_masses(&self) -> Vec<f64> {
         let p = self.pattern;
-        let mut m = vec![0.0; p.rest_m.len()];
-        for t in &p.triangles {
-            let [a, b, c] = t.map(|v| p.rest_m[v]);
+        let mut m = vec![0.0; p.vertex_count()];
+        for (t, r) in p.triangles.iter().zip(&p.rest_triangles) {
+            let [a, b, c] = r.map(|v| p.rest_m[v]);
             let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])).abs();
             for &v in t {
                 m[v] += self.areal_density_kg_per_m2 * area / 3.0;
@@ -45,7 +45,7 @@ pub fn pattern_builder(
 ) -> Result<ModelBuilder, MembraneError> {
     let p = sheet.pattern;
     let r = sheet.rigidities;
-    let mut fixed = vec![false; p.rest_m.len()];
+    let mut fixed = vec![false; p.vertex_count()];
     pinned.iter().for_each(|&v| fixed[v] = true);
     let mut b = ModelBuilder::new(sheet.lumped_masses(), fixed, g_m_per_s2);
     let y = [
@@ -53,18 +53,24 @@ pub fn pattern_builder(
         r.tensile_weft_N_per_m,
         r.shear_N_per_m,
     ];
-    b.term(Box::new(Membrane::new(
+    b.term(Box::new(Membrane::sewn(
         &p.rest_m,
+        &p.rest_triangles,
         &p.triangles,
         sheet.warp_angle_rad,
         y,
     )?));
     if r.bending_warp_N_m > 0.0 || r.bending_weft_N_m > 0.0 {
-        b.term(Box::new(orthotropic_hinge_bending(
-            &p.rest_m,
-            &p.triangles,
+        let sewn = SewnSheet {
+            rest: &p.rest_m,
+            rest_triangles: &p.rest_triangles,
+            triangles: &p.triangles,
+        };
+        b.term(Box::new(sewn_hinge_bending(
+            &sewn,
             [r.bending_warp_N_m, r.bending_weft_N_m],
             sheet.warp_angle_rad,
+            f64::INFINITY,
         )));
     }
     b.gravity();

@@ -51,26 +51,64 @@ pub fn saturating_hinge_bending(
     warp_angle_rad: f64,
     kappa0_per_m: f64,
 ) -> super::QuadraticStencil<4> {
+    let sheet = SewnSheet {
+        rest,
+        rest_triangles: triangles,
+        triangles,
+    };
+    sewn_hinge_bending(&sheet, rigidity_N_m, warp_angle_rad, kappa0_per_m)
+}
+
+/// A sheet whose triangles have their rest shapes over rest vertices and their particles over
+/// vertices: a seam's vertex has a rest vertex in each piece ([`crate::pattern::Pattern`]).
+pub struct SewnSheet<'a> {
+    /// Rest positions in the pattern's plane, m.
+    pub rest: &'a [[f64; 2]],
+    /// Triangles over rest vertices.
+    pub rest_triangles: &'a [[usize; 3]],
+    /// The same triangles over particles.
+    pub triangles: &'a [[usize; 3]],
+}
+
+/// [`saturating_hinge_bending`] on a sewn sheet: a hinge on every edge two triangles share in the
+/// particles (a seam's edge included), its rest geometry the two triangles unfolded about that
+/// edge, each with its own piece's rest shape (the second laid beside the first, across the edge).
+pub fn sewn_hinge_bending(
+    sheet: &SewnSheet<'_>,
+    rigidity_N_m: [f64; 2],
+    warp_angle_rad: f64,
+    kappa0_per_m: f64,
+) -> super::QuadraticStencil<4> {
     let (ws, wc) = warp_angle_rad.sin_cos();
     let mean = 0.5 * (rigidity_N_m[0] + rigidity_N_m[1]);
-    let p3 = |v: usize| Vector3::new(rest[v][0], rest[v][1], 0.0);
+    let p3 = |r: usize| Vector3::new(sheet.rest[r][0], sheet.rest[r][1], 0.0);
     let cot = |a: Vector3<f64>, b: Vector3<f64>| a.dot(&b) / a.cross(&b).norm().max(1e-300);
-    // Each undirected edge → (opposite vertex, triangle area) of its triangles.
-    let mut sides: BTreeMap<(usize, usize), Vec<(usize, f64)>> = BTreeMap::new();
-    for t in triangles {
-        let a = 0.5 * (p3(t[1]) - p3(t[0])).cross(&(p3(t[2]) - p3(t[0]))).norm();
+    // Each undirected particle edge → (opposite particle, triangle area, rest vertices of the edge's
+    // two ends and the opposite vertex) of its triangles.
+    type Side = (usize, f64, [usize; 3]);
+    let mut sides: BTreeMap<(usize, usize), Vec<Side>> = BTreeMap::new();
+    for (t, r) in sheet.triangles.iter().zip(sheet.rest_triangles) {
+        let a = 0.5 * (p3(r[1]) - p3(r[0])).cross(&(p3(r[2]) - p3(r[0]))).norm();
         for k in 0..3 {
             let (i, j, o) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
-            sides.entry((i.min(j), i.max(j))).or_default().push((o, a));
+            let (ri, rj, ro) = (r[k], r[(k + 1) % 3], r[(k + 2) % 3]);
+            // The corners in the order (smaller particle, larger particle, opposite).
+            let c = if i < j { [ri, rj, ro] } else { [rj, ri, ro] };
+            sides.entry((i.min(j), i.max(j))).or_default().push((o, a, c));
         }
     }
     let (mut stencils, mut coef, mut stiff, mut u0) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (&(i0, i1), opp) in &sides {
-        let [(i2, a0), (i3, a1)] = opp.as_slice() else {
+        let [(i2, a0, c0), (i3, a1, c1)] = opp.as_slice() else {
             continue;
         };
-        let (x0, x1, x2, x3) = (p3(i0), p3(i1), p3(*i2), p3(*i3));
+        let (x0, x1, x2) = (p3(c0[0]), p3(c0[1]), p3(c0[2]));
+        // One piece: the second triangle's own corner; across a seam, laid beside the first.
+        let x3 = match c0[..2] == c1[..2] {
+            true => p3(c1[2]),
+            false => unfolded(&c0.map(p3), &c1.map(p3)),
+        };
         let (e0, e1, e2, e3, e4) = (x1 - x0, x2 - x0, x3 - x0, x2 - x1, x3 - x1);
         let (c01, c02, c03, c04) = (cot(e0, e1), cot(e0, e2), cot(-e0, e3), cot(-e0, e4));
         stencils.push([i0, i1, *i2, *i3]);
@@ -88,6 +126,22 @@ pub fn saturating_hinge_bending(
     } else {
         term
     }
+}
+
+/// The second triangle's opposite vertex laid in the first's rest plane across their shared edge:
+/// `a` and `b` are (edge start, edge end, opposite) of each in its own piece. For two triangles of
+/// one flat piece this is the second's own rest corner.
+fn unfolded(a: &[Vector3<f64>; 3], b: &[Vector3<f64>; 3]) -> Vector3<f64> {
+    let (eb, qb) = (b[1] - b[0], b[2] - b[0]);
+    let t = qb.dot(&eb) / eb.norm_squared();
+    let h = eb.cross(&qb).norm() / eb.norm();
+    let ea = a[1] - a[0];
+    let side = a[2] - a[0];
+    let mut n = Vector3::new(-ea.y, ea.x, 0.0).normalize();
+    if n.dot(&side) > 0.0 {
+        n = -n;
+    }
+    a[0] + ea * t + n * h
 }
 
 #[cfg(test)]

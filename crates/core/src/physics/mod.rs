@@ -23,7 +23,10 @@ pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
 pub use kernel::{Kernel, Local, Potential};
 pub use loads::{Gravity, LoadKernel, PointLoads};
 pub use membrane::{Membrane, MembraneError, MembraneKernel};
-pub use mesh_bending::{hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending};
+pub use mesh_bending::{
+    SewnSheet, hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending,
+    sewn_hinge_bending,
+};
 pub use self_contact::{CandidateSet, SelfContact, SelfContactState};
 pub use shear::{CellShear, ShearKernel};
 pub use springs::{SpringFamily, SpringKernel, Springs};

@@ -64,9 +64,7 @@ impl ClothSpec {
             if s == 1.0 {
                 return p.clone();
             }
-            let mut q = Pattern::clone(p);
-            q.rest_m.iter_mut().for_each(|v| *v = v.map(|c| c * s));
-            std::sync::Arc::new(q)
+            std::sync::Arc::new(p.scaled(s))
         });
     }
 }
@@ -77,9 +75,10 @@ impl Scene {
         self.cloth.pattern.as_deref()
     }
 
-    /// Start positions of the mesh's vertices: the pattern with the optional perturbation along its
-    /// normal (`initial_perturbation_m`, the grid's formula over the pattern's bounding box), rotated
-    /// about x, y, then z by `rotation_deg` and moved by `origin_m`.
+    /// Start positions of the mesh's vertices: the file's (a flat pattern with the optional
+    /// perturbation along its normal, `initial_perturbation_m`, the grid's formula over the
+    /// pattern's bounding box; a garment's pieces as placed), rotated about x, y, then z by
+    /// `rotation_deg` and moved by `origin_m`.
     pub(super) fn mesh_positions(&self, p: &Pattern) -> Vec<Vector3<f64>> {
         let c = &self.cloth;
         let [rx, ry, rz] = c.rotation_deg.map(f64::to_radians);
@@ -87,13 +86,17 @@ impl Scene {
         let origin = Vector3::from(c.origin_m);
         let (lo, hi) = p.bounds_m();
         let pi = std::f64::consts::PI;
-        p.rest_m
+        let flat = p.is_flat();
+        p.start_m
             .iter()
             .map(|q| {
                 let u = (q[0] - lo[0]) / (hi[0] - lo[0]).max(f64::MIN_POSITIVE);
                 let w = (q[1] - lo[1]) / (hi[1] - lo[1]).max(f64::MIN_POSITIVE);
-                let dz = c.initial_perturbation_m * (pi * u).sin() * (pi * w).sin() * w;
-                origin + rotation * Vector3::new(q[0], q[1], dz)
+                let dz = match flat {
+                    true => c.initial_perturbation_m * (pi * u).sin() * (pi * w).sin() * w,
+                    false => 0.0,
+                };
+                origin + rotation * Vector3::new(q[0], q[1], q[2] + dz)
             })
             .collect()
     }
@@ -156,6 +159,12 @@ from the file: leave it out"
             if !v.is_finite() {
                 return ck.err(key, format!("must be finite, got {v}"));
             }
+        }
+        if !p.is_flat() && c.initial_perturbation_m != 0.0 {
+            return ck.err(
+                "cloth.initial_perturbation_m",
+                "perturbs a flat pattern along its normal; a garment (pieces placed in 3D) starts as the file places it: leave it out".into(),
+            );
         }
         let (lo, hi) = p.bounds_m();
         let side = (hi[0] - lo[0]).max(hi[1] - lo[1]);
