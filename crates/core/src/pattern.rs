@@ -147,7 +147,13 @@ fn texture_index(token: &str, count: usize, line: usize) -> Result<Option<usize>
     }
 }
 
-fn resolve(text: &str, token: &str, count: usize, line: usize, what: &str) -> Result<usize, Defect> {
+fn resolve(
+    text: &str,
+    token: &str,
+    count: usize,
+    line: usize,
+    what: &str,
+) -> Result<usize, Defect> {
     let at = format!("line {line}");
     let i: i64 = text
         .parse()
@@ -514,7 +520,7 @@ mod tests {
     }
 
     /// Each malformed file with the defect its message must name.
-    pub(crate) const MALFORMED: [(&str, &str, &str); 10] = [
+    pub(crate) const MALFORMED: [(&str, &str, &str); 12] = [
         ("no_faces", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no faces"),
         (
             "bad_vertex",
@@ -557,11 +563,48 @@ mod tests {
             "disconnected pieces",
         ),
         (
+            "garment_without_texture",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0.2\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3\n",
+            "texture coordinates",
+        ),
+        (
+            "texture_shared_by_two_vertices",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0.2\nv 1 1 0.2\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\nf 2/2 4/3 3/3\n",
+            "flat position of vertices",
+        ),
+        (
             "bow_tie",
             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n",
             "non-manifold vertex",
         ),
     ];
+
+    /// Two pieces sewn along one edge, folded at it in 3D: vertices 2 and 3 are the seam's, each
+    /// with a rest vertex in both pieces (the second piece laid elsewhere in the pattern's plane).
+    pub(crate) const SEWN: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0.5 0.5 0.7\n\
+vt 0 0\nvt 1 0\nvt 0 1\nvt 5 0\nvt 4 1\nvt 5 1\n\
+g front\nf 1/1 2/2 3/3\ng back\nf 2/4 4/6 3/5\n";
+
+    #[test]
+    fn a_garment_keeps_its_placed_vertices_and_its_pieces_flat_rest_shapes() {
+        let p = parse_obj(SEWN, 1.0).unwrap();
+        assert!(!p.is_flat());
+        assert_eq!(p.vertex_count(), 4);
+        assert_eq!(p.start_m[3], [0.5, 0.5, 0.7]);
+        assert_eq!(p.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+        assert_eq!(p.rest_triangles, vec![[0, 1, 2], [3, 4, 5]]);
+        // The seam's vertices 2 and 3 (0-based 1, 2) have a rest vertex in each piece.
+        assert_eq!(p.vertex_of_rest, vec![0, 1, 2, 1, 3, 2]);
+        assert!((p.rest_area_m2() - 1.0).abs() < 1e-12);
+        // A flat file with texture coordinates (a print) keeps its vertices as its rest shape.
+        let printed = parse_obj(
+            "v 0 0 0\nv 2 0 0\nv 0 2 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+            1.0,
+        )
+        .unwrap();
+        assert!(printed.is_flat());
+        assert_eq!(printed.rest_m[1], [2.0, 0.0]);
+    }
 
     #[test]
     fn each_malformed_pattern_is_refused_naming_its_defect() {

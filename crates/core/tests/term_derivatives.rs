@@ -271,7 +271,8 @@ fn check_contact_coefficients(
         // of each particle's gap: a particle in contact near a vertex of a solid of revolution's
         // profile sees the kink between the segment's and the vertex's regions within that step
         // (5e-4 of the gradient on skirt_form, whose hem rests on the form's hips).
-        let shape_only = dc[..tail].iter().all(|v| *v == 0.0) && !dc[tail..].iter().all(|v| *v == 0.0);
+        let shape_only =
+            dc[..tail].iter().all(|v| *v == 0.0) && !dc[tail..].iter().all(|v| *v == 0.0);
         let tol = if shape_only { 1e-3 } else { 1e-6 };
         assert!(e <= tol, "{name}: {}: ∂g/∂c off by {e:e}", t.name());
         assert!(

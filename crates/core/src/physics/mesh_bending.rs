@@ -94,7 +94,10 @@ pub fn sewn_hinge_bending(
             let (ri, rj, ro) = (r[k], r[(k + 1) % 3], r[(k + 2) % 3]);
             // The corners in the order (smaller particle, larger particle, opposite).
             let c = if i < j { [ri, rj, ro] } else { [rj, ri, ro] };
-            sides.entry((i.min(j), i.max(j))).or_default().push((o, a, c));
+            sides
+                .entry((i.min(j), i.max(j)))
+                .or_default()
+                .push((o, a, c));
         }
     }
     let (mut stencils, mut coef, mut stiff, mut u0) =
@@ -147,6 +150,55 @@ fn unfolded(a: &[Vector3<f64>; 3], b: &[Vector3<f64>; 3]) -> Vector3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A flat strip cut along its interior edges into pieces, each moved and turned in the
+    /// pattern's plane, and sewn back (its rest vertices mapped to the strip's vertices): the
+    /// same hinges, so the same energy at any deformation, as the uncut strip.
+    #[test]
+    fn a_sheet_cut_and_sewn_back_bends_as_the_uncut_sheet() {
+        let rest: Vec<[f64; 2]> = (0..8)
+            .map(|k| [(k / 2) as f64 * 0.01, (k % 2) as f64 * 0.01])
+            .collect();
+        let tris: Vec<[usize; 3]> = (0..3)
+            .flat_map(|c| {
+                let (a, b, d, e) = (2 * c, 2 * c + 2, 2 * c + 3, 2 * c + 1);
+                [[a, b, d], [a, d, e]]
+            })
+            .collect();
+        use crate::physics::EnergyTerm;
+        let x: Vec<Vector3<f64>> = rest
+            .iter()
+            .enumerate()
+            .map(|(k, p)| Vector3::new(p[0], p[1], 0.004 * ((k * 7 % 5) as f64 - 2.0)))
+            .collect();
+        // Each triangle its own piece, moved by k·5 cm (the grain kept: orthotropic), or also
+        // turned by 0.3·k rad (which turns its grain: isotropic).
+        for (turn, rigidity) in [(0.0, [2e-5, 1e-5]), (0.3, [1.5e-5, 1.5e-5])] {
+            let (mut sewn_rest, mut rest_tris) = (Vec::new(), Vec::new());
+            for (k, t) in tris.iter().enumerate() {
+                let (s, c) = (turn * k as f64).sin_cos();
+                let mut r = [0; 3];
+                for (slot, &v) in t.iter().enumerate() {
+                    let [px, py] = rest[v];
+                    sewn_rest.push([c * px - s * py + 0.05 * k as f64, s * px + c * py]);
+                    r[slot] = sewn_rest.len() - 1;
+                }
+                rest_tris.push(r);
+            }
+            let whole = saturating_hinge_bending(&rest, &tris, rigidity, 0.0, f64::INFINITY);
+            let sheet = SewnSheet {
+                rest: &sewn_rest,
+                rest_triangles: &rest_tris,
+                triangles: &tris,
+            };
+            let cut = sewn_hinge_bending(&sheet, rigidity, 0.0, f64::INFINITY);
+            let (a, b) = (whole.energy(&x), cut.energy(&x));
+            assert!(
+                a > 0.0 && (a - b).abs() <= 1e-9 * a,
+                "turn {turn}: {a} vs {b}"
+            );
+        }
+    }
 
     /// A flat rectangle `lx` × `ly` of `nx` × `ny` points, cells cut along alternating diagonals.
     fn sheet(nx: usize, ny: usize, lx: f64, ly: f64) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
