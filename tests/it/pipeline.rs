@@ -455,3 +455,41 @@ fn a_panicking_stage_fails_alone_and_the_run_exits_1() {
     }
     assert!(!tmp.path().join("reports/ab.md").exists());
 }
+
+/// A mesh scene's OBJ (`cloth.mesh`) is an input of every stage that reads the scene: a changed
+/// pattern makes the stage stale and names the file, an unchanged one does not.
+#[test]
+fn a_changed_mesh_file_makes_the_stage_that_reads_its_scene_stale() {
+    let (tmp, file) = temp_project(
+        &[
+            "datasets/patterns/l_panel_table.toml",
+            "datasets/patterns/l_panel.obj",
+        ],
+        "t.toml",
+        r#"
+name = "t"
+[stages.panel]
+kind = "simulate"
+inputs.scene = "datasets/patterns/l_panel_table.toml"
+outputs.particles = "{run}/panel/particles.parquet"
+outputs.run = "{run}/panel/run.json"
+"#,
+    );
+    let first = run(&file, RunOptions::default());
+    assert!(first.failed.is_empty(), "{:?}", first.failed);
+    let plan = load_plan(&file, &drapelab::stages::registry()).unwrap();
+    assert_eq!(stage_states(&plan)[0].1, StageState::UpToDate);
+    // Move one vertex of the pattern by 1 mm.
+    let obj = tmp.path().join("datasets/patterns/l_panel.obj");
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let moved = text.replacen("v 0.015000 0.000000 0", "v 0.016000 0.000000 0", 1);
+    assert_ne!(moved, text);
+    std::fs::write(&obj, moved).unwrap();
+    let plan = load_plan(&file, &drapelab::stages::registry()).unwrap();
+    assert!(matches!(
+        &stage_states(&plan)[0].1,
+        StageState::Stale(StaleReason::InputChanged(w)) if w.contains("l_panel.obj")
+    ));
+    let second = run(&file, RunOptions::default());
+    assert_eq!(second.ran, ["panel"]);
+}

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 mod mesh;
+pub use mesh::mesh_file_of;
 
 /// The sheet: size, resolution, spacing and areal density.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -102,15 +102,23 @@ fn current_inputs(plan: &Plan, s: &PlannedStage) -> BTreeMap<String, Option<Stri
     hashed(plan, &slot_inputs(plan, s))
 }
 
-/// The files of every slot with their content hashes (None when missing).
+/// The files of every slot with their content hashes (None when missing), and the files they
+/// name: a scene's mesh file (`cloth.mesh`) is read with it, so it is an input too.
 fn hashed(
     plan: &Plan,
     slots: &BTreeMap<String, BTreeSet<String>>,
 ) -> BTreeMap<String, Option<String>> {
-    slots
-        .values()
-        .flatten()
-        .cloned()
+    let named = slots.values().flatten().filter_map(|p| {
+        let path = plan.root.join(p);
+        let mesh = path
+            .extension()
+            .is_some_and(|e| e == "toml")
+            .then(|| drapelab_core::scene::mesh_file_of(&path))??;
+        Some(rel(&plan.root, &mesh))
+    });
+    let files: BTreeSet<String> = slots.values().flatten().cloned().chain(named).collect();
+    files
+        .into_iter()
         .map(|p| {
             let h = hash_file(&plan.root.join(&p)).ok();
             (p, h)

@@ -9,6 +9,20 @@ use crate::pattern::Pattern;
 use nalgebra::{Rotation3, Vector3};
 use std::path::Path;
 
+/// The mesh file a scene file names (`cloth.mesh`, relative to the scene file's folder), read from
+/// its TOML without loading the scene: a pipeline hashes it with the scene, so that a changed OBJ
+/// makes the stages that read the scene stale. None for a grid scene or a file that is not a scene.
+pub fn mesh_file_of(scene_path: &Path) -> Option<std::path::PathBuf> {
+    let text = std::fs::read_to_string(scene_path).ok()?;
+    let table: toml::Table = text.parse().ok()?;
+    let mesh = table.get("cloth")?.get("mesh")?.as_str()?;
+    let file = Path::new(mesh);
+    Some(match scene_path.parent() {
+        Some(dir) if file.is_relative() => dir.join(file),
+        _ => file.to_path_buf(),
+    })
+}
+
 impl ClothSpec {
     /// Whether the sheet is a mesh (`cloth.mesh`) rather than the grid.
     pub fn is_mesh(&self) -> bool {
