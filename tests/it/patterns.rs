@@ -358,24 +358,29 @@ fn a_mesh_sheets_sensitivities_are_the_differences_of_its_drapes() {
 /// lies on the flat pattern.
 #[test]
 fn a_mesh_drape_is_dressed_on_its_own_triangles_as_valid_gltf() {
+    let summary = dressed(&root().join("datasets/patterns/cusick_disc_pedestal.toml"));
+    let obj = std::fs::read_to_string(root().join("datasets/patterns/cusick_disc.obj")).unwrap();
+    let count = |tag: &str| obj.lines().filter(|l| l.starts_with(tag)).count() as u64;
+    assert_eq!(summary["vertices"], count("v "));
+    assert_eq!(summary["triangles"], count("f "));
+}
+
+/// `drapelab surface` of a pattern scene (solved there) into a fresh folder: its drape.glb valid
+/// (Khronos validator, 0 errors) and its surface.json returned.
+fn dressed(scene: &Path) -> serde_json::Value {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("surface");
     let o = drapelab()
         .arg("surface")
-        .arg(root().join("datasets/patterns/cusick_disc_pedestal.toml"))
+        .arg(scene)
         .args(["--repeats", "6,6", "--out"])
         .arg(&out)
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("surface.json")).unwrap()).unwrap();
-    let obj = std::fs::read_to_string(root().join("datasets/patterns/cusick_disc.obj")).unwrap();
-    let count = |tag: &str| obj.lines().filter(|l| l.starts_with(tag)).count() as u64;
-    assert_eq!(summary["vertices"], count("v "));
-    assert_eq!(summary["triangles"], count("f "));
     let report = crate::surface::gltf_validate(&out.join("drape.glb"));
     assert_eq!(report["issues"]["numErrors"], 0, "{report}");
+    serde_json::from_str(&std::fs::read_to_string(out.join("surface.json")).unwrap()).unwrap()
 }
 
 /// Issue 49's garment: the two-panel skirt (`skirt.obj`: front and back panels placed on a cone
@@ -426,21 +431,8 @@ fn a_two_panel_skirt_sewn_at_its_side_seams_drapes_on_the_form_and_is_dressed() 
     assert_eq!(checked, 80);
     let lowest = |x: &[nalgebra::Vector3<f64>]| x.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
     assert!(lowest(&sol.x) < lowest(&scene.initial_positions()) - 0.005);
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("surface");
-    let o = drapelab()
-        .arg("surface")
-        .arg(&path)
-        .args(["--repeats", "6,6", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("surface.json")).unwrap()).unwrap();
     // The surface's vertices are the rest vertices: a seam's vertex once per panel.
+    let summary = dressed(&path);
     assert_eq!(summary["vertices"], p.rest_m.len() as u64);
     assert_eq!(p.rest_m.len(), p.vertex_count() + seam.len());
-    let report = crate::surface::gltf_validate(&out.join("drape.glb"));
-    assert_eq!(report["issues"]["numErrors"], 0, "{report}");
 }

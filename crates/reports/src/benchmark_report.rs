@@ -283,8 +283,8 @@ dynamic point).\n\n| scene | solver | converged | max-iterations | diverged | in
 }
 
 /// The static solves' work per scene and grid at the tightest tolerance: Newton iterations,
-/// factorizations, wall time, the factorizations' own time and what is left (assembly, line
-/// search, energy and gradient evaluations).
+/// factorizations, back-substitutions, wall time, the factorizations' own time and what is left
+/// (assembly, line search, energy and gradient evaluations).
 pub fn newton_work_section(bench: &DataFrame) -> Result<String> {
     let tols = bench.column("tolerance_rel")?.f64()?.clone();
     let tightest = (0..tols.len())
@@ -293,9 +293,10 @@ pub fn newton_work_section(bench: &DataFrame) -> Result<String> {
     let mut md = format!(
         "\n## Newton iterations and factorizations per solve\n\nStatic solves at tolerance {tightest:.0e}, \
 from the flat sheet (a coarse or sagged start included in the counts). Factorizations count the failed ones \
-too (an indefinite exact Hessian, retried projected); the factorization time is that of the numeric \
-Cholesky factorizations and triangular solves alone, the rest is assembly, line search and the \
-coarse start's own overhead.\n\n| scene | particles | status | iterations | factorizations | wall time (ms) | factorization time (ms) | rest (ms) |\n|---|---|---|---|---|---|---|---|\n"
+too (an indefinite exact Hessian, retried projected); back-substitutions are the triangular solves with \
+a factor (a Newton step, a chord step, a preconditioner's application); the factorization time is that of \
+the numeric Cholesky factorizations and triangular solves alone, the rest is assembly, line search and \
+the coarse start's own overhead.\n\n| scene | particles | status | iterations | factorizations | back-substitutions | wall time (ms) | factorization time (ms) | rest (ms) |\n|---|---|---|---|---|---|---|---|---|\n"
     );
     let col = |c: &str| bench.column(c).map(|c| c.as_materialized_series().clone());
     let (scene, solver, status, n, tol, wall, it, fact, ft) = (
@@ -309,6 +310,7 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
         col("factorizations")?,
         col("factor_time_s")?,
     );
+    let back = col("back_substitutions")?;
     for r in 0..bench.height() {
         if solver.str()?.get(r) != Some(STATIC)
             || tol
@@ -325,11 +327,12 @@ coarse start's own overhead.\n\n| scene | particles | status | iterations | fact
         let k = n.u64()?.get(r).unwrap_or(0);
         let _ = writeln!(
             md,
-            "| {} | {k}×{k} | {} | {} | {} | {:.3} | {:.3} | {:.3} |",
+            "| {} | {k}×{k} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} |",
             scene.str()?.get(r).unwrap_or(""),
             status.str()?.get(r).unwrap_or(""),
             it.u64()?.get(r).unwrap_or(0),
             fact.u64()?.get(r).unwrap_or(0),
+            back.u64()?.get(r).unwrap_or(0),
             w * 1e3,
             f * 1e3,
             (w - f) * 1e3
