@@ -15,6 +15,7 @@ use drapelab_core::cusick::{
     SpecimenTargets, Tester, calibrate_and_predict, height_profile, histogram, histogram_label,
     polar_disc, sector_angle_rad, subdivide_disc, two_fold,
 };
+use drapelab_core::measure::median;
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
 use drapelab_record::{NamedMesh, read_table, write_cusick_drapes, write_table};
 use nalgebra::Vector3;
@@ -127,15 +128,6 @@ pub fn mean_sd(v: &[f64]) -> (f64, f64) {
     (m, var.sqrt())
 }
 
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
 /// Per ring, the mean and SD over `profiles` (None where no profile has the ring).
 pub fn ring_stats(profiles: &[Vec<f64>], bins: usize) -> Vec<Option<(f64, f64)>> {
     (0..bins)
@@ -204,7 +196,7 @@ pub fn targets(rows: &[&ShadowRow]) -> Targets {
         specimen: SpecimenTargets {
             dc_pct,
             dc_se_pct: sd / (own.len().max(1) as f64).sqrt(),
-            nodes: median(own.iter().map(|r| r.nodes_photo as f64).collect()),
+            nodes: median(&own.iter().map(|r| r.nodes_photo as f64).collect::<Vec<_>>()),
         },
         others: others
             .iter()
@@ -212,7 +204,12 @@ pub fn targets(rows: &[&ShadowRow]) -> Targets {
             .collect(),
         dc_mean_pct,
         dc_sd_pct,
-        nodes_median: median(others.iter().map(|r| r.nodes_photo as f64).collect()),
+        nodes_median: median(
+            &others
+                .iter()
+                .map(|r| r.nodes_photo as f64)
+                .collect::<Vec<_>>(),
+        ),
         nodes_sd: mean_sd(
             &others
                 .iter()

@@ -210,6 +210,18 @@ pub fn count_rises(s: &[f64], threshold: f64) -> usize {
     count
 }
 
+/// The median of the finite values of `v` (the mean of the middle two for an even count); NaN when
+/// none is finite.
+pub fn median(v: &[f64]) -> f64 {
+    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    s.sort_by(f64::total_cmp);
+    match s.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => s[n / 2],
+        n => 0.5 * (s[n / 2 - 1] + s[n / 2]),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -90,13 +90,6 @@ impl std::fmt::Debug for PlannedStage {
     }
 }
 
-impl PlannedStage {
-    /// Every input pattern, over all slots.
-    pub fn all_input_patterns(&self) -> impl Iterator<Item = &String> {
-        self.input_patterns.values().flatten()
-    }
-}
-
 /// A validated pipeline.
 #[derive(Debug, Clone)]
 pub struct Plan {

@@ -495,13 +495,7 @@ pub fn min_median_max(v: &[f64]) -> (f64, f64, f64) {
         return (f64::NAN, f64::NAN, f64::NAN);
     }
     s.sort_by(f64::total_cmp);
-    let m = s.len();
-    let median = if m % 2 == 1 {
-        s[m / 2]
-    } else {
-        0.5 * (s[m / 2 - 1] + s[m / 2])
-    };
-    (s[0], median, s[m - 1])
+    (s[0], crate::measure::median(&s), s[s.len() - 1])
 }
 
 /// The population as a Markdown summary: converged count, then min / median / max of iterations,
