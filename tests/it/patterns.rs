@@ -436,3 +436,39 @@ fn a_two_panel_skirt_sewn_at_its_side_seams_drapes_on_the_form_and_is_dressed() 
     assert_eq!(summary["vertices"], p.rest_m.len() as u64);
     assert_eq!(p.rest_m.len(), p.vertex_count() + seam.len());
 }
+
+/// A flat pattern lies in its own plane: a file at a constant z = 0.3 is placed by `origin_m`
+/// alone, as one at z = 0; a garment starts where its file places it.
+#[test]
+fn a_flat_pattern_is_placed_by_its_origin_whatever_its_files_constant_z() {
+    let dir = tempfile::tempdir().unwrap();
+    let base =
+        std::fs::read_to_string(root().join("datasets/patterns/l_panel_table.toml")).unwrap();
+    let obj = std::fs::read_to_string(root().join("datasets/patterns/l_panel.obj")).unwrap();
+    let lifted: String = obj
+        .lines()
+        .map(|l| match l.strip_suffix(" 0") {
+            Some(v) if l.starts_with("v ") => format!("{v} 0.3\n"),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    assert_ne!(lifted, obj);
+    std::fs::write(dir.path().join("l_panel.obj"), lifted).unwrap();
+    std::fs::write(dir.path().join("scene.toml"), &base).unwrap();
+    let scene = Scene::load(&dir.path().join("scene.toml"), &[])
+        .unwrap()
+        .scene;
+    let z: Vec<f64> = scene.initial_positions().iter().map(|p| p.z).collect();
+    assert!(z.iter().all(|&v| v == 0.0), "{:?}", &z[..3]);
+    let skirt = Scene::load(&root().join("datasets/patterns/skirt_form.toml"), &[])
+        .unwrap()
+        .scene;
+    let start = skirt.initial_positions();
+    let p = skirt.pattern().unwrap();
+    assert!(
+        start
+            .iter()
+            .zip(&p.start_m)
+            .all(|(a, b)| (a.z - b[2]).abs() < 1e-12)
+    );
+}

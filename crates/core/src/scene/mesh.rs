@@ -106,11 +106,12 @@ impl Scene {
             .map(|q| {
                 let u = (q[0] - lo[0]) / (hi[0] - lo[0]).max(f64::MIN_POSITIVE);
                 let w = (q[1] - lo[1]) / (hi[1] - lo[1]).max(f64::MIN_POSITIVE);
-                let dz = match flat {
+                // A flat pattern lies in its own plane z = 0 (whatever constant z the file has).
+                let z = match flat {
                     true => c.initial_perturbation_m * (pi * u).sin() * (pi * w).sin() * w,
-                    false => 0.0,
+                    false => q[2],
                 };
-                origin + rotation * Vector3::new(q[0], q[1], q[2] + dz)
+                origin + rotation * Vector3::new(q[0], q[1], z)
             })
             .collect()
     }
