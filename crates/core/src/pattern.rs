@@ -83,9 +83,10 @@ impl Pattern {
         self.start_m.len()
     }
 
-    /// Whether the rest vertices are the vertices (a flat pattern, no seams).
+    /// Whether the file's vertices lie in one plane (a flat pattern: its vertices are its rest
+    /// shape), rather than a garment's pieces placed in 3D.
     pub fn is_flat(&self) -> bool {
-        self.rest_triangles == self.triangles
+        off_plane(&self.start_m).is_none()
     }
 
     /// Scales every length (rest and start) by `s`.
@@ -279,14 +280,8 @@ struct Rest {
 /// A flat file's vertices are its rest shape; a garment's (vertices not in one plane) are its
 /// faces' texture coordinates, each used by one vertex only.
 fn rest_layout(raw: &Raw) -> Result<Rest, Defect> {
-    let extent = extent(&raw.v);
-    let z0 = raw.v[raw.faces[0].0[0]][2];
-    let off = raw
-        .v
-        .iter()
-        .enumerate()
-        .find(|(_, p)| (p[2] - z0).abs() > FLAT_REL * extent);
-    let Some((k, p)) = off else {
+    let z0 = raw.v[0][2];
+    let Some((k, p)) = off_plane(&raw.v) else {
         return Ok(Rest {
             points: raw.v.iter().map(|p| [p[0], p[1]]).collect(),
             faces: raw.faces.iter().map(|f| f.0).collect(),
@@ -297,7 +292,7 @@ fn rest_layout(raw: &Raw) -> Result<Rest, Defect> {
         return Err(defect(
             "vertices",
             format!(
-                "not a flat pattern: vertex {} lies {:.3e} off the plane z = {z0} of the first face; give the piece flat (z constant), or a garment with every face corner's flat position as texture coordinates (`f v/vt`; the face on line {} has none)",
+                "not a flat pattern: vertex {} lies {:.3e} off the plane z = {z0} of vertex 1; give the piece flat (z constant), or a garment with every face corner's flat position as texture coordinates (`f v/vt`; the face on line {} has none)",
                 k + 1,
                 p[2] - z0,
                 raw.faces[f].1
@@ -336,6 +331,17 @@ fn rest_layout(raw: &Raw) -> Result<Rest, Defect> {
         rest.faces.push(face);
     }
     Ok(rest)
+}
+
+/// The first vertex off the plane z = const of vertex 1 (by more than [`FLAT_REL`] of the
+/// extent), with its position; none for a flat set.
+fn off_plane(v: &[[f64; 3]]) -> Option<(usize, [f64; 3])> {
+    let extent = extent(v);
+    let z0 = v.first()?[2];
+    v.iter()
+        .enumerate()
+        .find(|(_, p)| (p[2] - z0).abs() > FLAT_REL * extent)
+        .map(|(k, p)| (k, *p))
 }
 
 fn extent(v: &[[f64; 3]]) -> f64 {
@@ -596,6 +602,15 @@ g front\nf 1/1 2/2 3/3\ng back\nf 2/4 4/6 3/5\n";
         // The seam's vertices 2 and 3 (0-based 1, 2) have a rest vertex in each piece.
         assert_eq!(p.vertex_of_rest, vec![0, 1, 2, 1, 3, 2]);
         assert!((p.rest_area_m2() - 1.0).abs() < 1e-12);
+        // One piece placed in 3D whose texture coordinates are numbered as its vertices is a
+        // garment still: it starts where the file places it.
+        let folded = parse_obj(
+            "v 0 0 0\nv 1 0 0\nv 0 1 0.3\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+            1.0,
+        )
+        .unwrap();
+        assert!(!folded.is_flat());
+        assert_eq!(folded.rest_triangles, folded.triangles);
         // A flat file with texture coordinates (a print) keeps its vertices as its rest shape.
         let printed = parse_obj(
             "v 0 0 0\nv 2 0 0\nv 0 2 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",

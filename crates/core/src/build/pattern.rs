@@ -53,19 +53,13 @@ pub fn pattern_builder(
         r.tensile_weft_N_per_m,
         r.shear_N_per_m,
     ];
-    b.term(Box::new(Membrane::sewn(
-        &p.rest_m,
-        &p.rest_triangles,
-        &p.triangles,
-        sheet.warp_angle_rad,
-        y,
-    )?));
+    let sewn = SewnSheet {
+        rest: &p.rest_m,
+        rest_triangles: &p.rest_triangles,
+        triangles: &p.triangles,
+    };
+    b.term(Box::new(Membrane::sewn(&sewn, sheet.warp_angle_rad, y)?));
     if r.bending_warp_N_m > 0.0 || r.bending_weft_N_m > 0.0 {
-        let sewn = SewnSheet {
-            rest: &p.rest_m,
-            rest_triangles: &p.rest_triangles,
-            triangles: &p.triangles,
-        };
         b.term(Box::new(sewn_hinge_bending(
             &sewn,
             [r.bending_warp_N_m, r.bending_weft_N_m],

@@ -50,22 +50,26 @@ impl Membrane {
         warp_angle_rad: f64,
         rigidity_N_per_m: [f64; 3],
     ) -> Result<Self, MembraneError> {
-        Self::sewn(rest, triangles, triangles, warp_angle_rad, rigidity_N_per_m)
+        let sheet = super::SewnSheet {
+            rest,
+            rest_triangles: triangles,
+            triangles,
+        };
+        Self::sewn(&sheet, warp_angle_rad, rigidity_N_per_m)
     }
 
-    /// [`Self::new`] for a sewn sheet: each triangle's rest shape from `rest_triangles` (over rest
-    /// vertices, a seam's vertex having one in each piece), its particles from `triangles`.
+    /// [`Self::new`] for a sewn sheet: each triangle's rest shape from its piece (over rest
+    /// vertices, a seam's vertex having one in each piece), its particles from the sheet's.
     pub fn sewn(
-        rest: &[[f64; 2]],
-        rest_triangles: &[[usize; 3]],
-        triangles: &[[usize; 3]],
+        sheet: &super::SewnSheet<'_>,
         warp_angle_rad: f64,
         rigidity_N_per_m: [f64; 3],
     ) -> Result<Self, MembraneError> {
+        let (rest, triangles) = (sheet.rest, sheet.triangles);
         let (s, c) = warp_angle_rad.sin_cos();
         let frame = |p: [f64; 2]| Vector2::new(c * p[0] + s * p[1], -s * p[0] + c * p[1]);
         let mut shapes = Vec::with_capacity(triangles.len());
-        for (k, t) in rest_triangles.iter().enumerate() {
+        for (k, t) in sheet.rest_triangles.iter().enumerate() {
             let [a, b, cc] = t.map(|v| frame(rest[v]));
             let dm = Matrix2::from_columns(&[b - a, cc - a]);
             let area = 0.5 * dm.determinant().abs();
