@@ -176,6 +176,20 @@ pub fn segment_segment_distance(p0: &V3, p1: &V3, q0: &V3, q1: &V3) -> (f64, f64
     (d, s, t)
 }
 
+/// A pair's vertex moves `dx` relative to their mean, and l, the most they can bring the pair's two
+/// primitives together per unit of time (additive CCD's bound: the longest relative move on each
+/// side, summed).
+pub fn relative_motion(point_triangle: bool, dx: &[V3; 4]) -> ([V3; 4], f64) {
+    let mean = (dx[0] + dx[1] + dx[2] + dx[3]) * 0.25;
+    let p: [V3; 4] = std::array::from_fn(|k| dx[k] - mean);
+    let l = if point_triangle {
+        p[0].norm() + p[1].norm().max(p[2].norm()).max(p[3].norm())
+    } else {
+        p[0].norm().max(p[1].norm()) + p[2].norm().max(p[3].norm())
+    };
+    (p, l)
+}
+
 /// The first time t ∈ (0, `t_max`] at which the pair, its vertices moving from `x` by `t·dx`, comes
 /// within `xi` + `share`·(d₀ − `xi`) of itself (d₀ its distance at t = 0), or infinity when it does not
 /// before `t_max` (additive CCD). Conservative: every point before the returned time keeps the pair
@@ -188,13 +202,7 @@ pub fn additive_ccd(
     share: f64,
     t_max: f64,
 ) -> f64 {
-    let mean = (dx[0] + dx[1] + dx[2] + dx[3]) * 0.25;
-    let p: [V3; 4] = std::array::from_fn(|k| dx[k] - mean);
-    let l = if point_triangle {
-        p[0].norm() + p[1].norm().max(p[2].norm()).max(p[3].norm())
-    } else {
-        p[0].norm().max(p[1].norm()) + p[2].norm().max(p[3].norm())
-    };
+    let (p, l) = relative_motion(point_triangle, dx);
     if l <= 0.0 {
         return f64::INFINITY;
     }
@@ -206,6 +214,11 @@ pub fn additive_ccd(
     }
     let target = share * g0;
     let (mut t, mut tl) = (0.0, (1.0 - share) * g0 / l);
+    // The first bound already passes t_max: no impact (what the loop would find after one more
+    // distance).
+    if tl > t_max {
+        return f64::INFINITY;
+    }
     for _ in 0..10_000 {
         for k in 0..4 {
             y[k] += p[k] * tl;

@@ -14,7 +14,7 @@
 use super::contact::{barrier, barrier_band_derivatives};
 use super::{EnergyTerm, HessianBlocks, Vecs};
 use crate::contact::proximity::{
-    Aabb, MeshTopology, Pair, additive_ccd, candidate_pairs, pair_distance,
+    Aabb, MeshTopology, Pair, additive_ccd, candidate_pairs, pair_distance, relative_motion,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Mutex;
@@ -254,6 +254,47 @@ impl SelfContact {
         c.time_s += start.elapsed().as_secs_f64();
     }
 
+    /// The first impact time in (0, 1] of the candidate pairs moving from `x` by `seg`
+    /// ([`additive_ccd`], keeping a tenth of each pair's gap), infinity when none. A pair is passed
+    /// over when additive CCD would return at its first bound: its distance is at least its gap at
+    /// the list's anchor less its vertices' moves since, so (1 − 0.1)(d − ξ)/l > 1 holds without
+    /// measuring d. The same result, without the distance computations that were a quarter of a
+    /// settling implicit run's time (issue 47).
+    fn piece_impact(&self, c: &mut Cache, x: &Vecs, seg: &Vecs) -> f64 {
+        const SHARE: f64 = 0.1;
+        let Cache {
+            pairs,
+            gaps,
+            anchor,
+            moved,
+            ..
+        } = c;
+        moved.clear();
+        moved.extend(x.iter().zip(anchor.iter()).map(|(p, q)| (p - q).norm()));
+        let act = self.activation_m();
+        let mut toi = f64::INFINITY;
+        for (&pair, &gap) in pairs.iter().zip(gaps.iter()) {
+            let idx = pair.vertices(&self.topo);
+            let reach = |k: std::ops::Range<usize>| k.map(|i| moved[idx[i]]).fold(0.0, f64::max);
+            let split = if pair.is_point_triangle() { 1 } else { 2 };
+            let lower = gap + act - reach(0..split) - reach(split..4) - self.thickness_m;
+            let (_, l) = relative_motion(pair.is_point_triangle(), &idx.map(|k| seg[k]));
+            if l <= 0.0 || (lower > 0.0 && (1.0 - SHARE) * lower > l) {
+                continue;
+            }
+            let t = additive_ccd(
+                pair.is_point_triangle(),
+                &idx.map(|k| x[k]),
+                &idx.map(|k| seg[k]),
+                self.thickness_m,
+                SHARE,
+                1.0,
+            );
+            toi = toi.min(t);
+        }
+        toi
+    }
+
     /// The state of self-contact at `x`: smallest distance between primitives sharing no vertex
     /// (searched within the longest edge), active pairs, and the work done so far.
     pub fn state(&self, x: &Vecs) -> SelfContactState {
@@ -395,21 +436,7 @@ impl EnergyTerm for SelfContact {
                 }
             }
             self.ensure(&mut c, &xk, Some(&seg));
-            let toi = c
-                .pairs
-                .iter()
-                .map(|&pair| {
-                    let idx = pair.vertices(&self.topo);
-                    additive_ccd(
-                        pair.is_point_triangle(),
-                        &idx.map(|k| xk[k]),
-                        &idx.map(|k| seg[k]),
-                        self.thickness_m,
-                        0.1,
-                        1.0,
-                    )
-                })
-                .fold(f64::INFINITY, f64::min);
+            let toi = self.piece_impact(&mut c, &xk, &seg);
             if toi.is_finite() {
                 bound = (k as f64 + toi) * share;
                 break;
@@ -590,5 +617,49 @@ mod tests {
         let y: Vec<Vector3<f64>> = x.iter().zip(&dx).map(|(p, d)| p + d * a).collect();
         assert!(term.state(&y).min_distance_m > 5e-4);
         assert!(term.energy(&y).is_finite());
+    }
+
+    /// The pairs the step bound passes over without measuring them are ones additive CCD finds no
+    /// impact for: over steps of every size and direction, from a state moved off the list's
+    /// anchor, the bound equals additive CCD run on every candidate pair.
+    #[test]
+    fn the_step_bound_passes_over_only_pairs_without_an_impact() {
+        let (x, tris) = stacked(2.2e-3);
+        let term = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
+        assert_eq!(term.energy(&x), 0.0);
+        let y = lowered(&x);
+        let (mut passed, mut cut) = (0, 0);
+        for k in 0..200 {
+            let f = |a: usize| (((k * 13 + a * 7) % 17) as f64 / 8.0 - 1.0);
+            let size = 1e-4 * 1.05f64.powi(k as i32 % 60);
+            let dx: Vec<Vector3<f64>> = (0..18)
+                .map(|p| Vector3::new(f(p), f(p + 5), f(p + 11) - 0.5) * size)
+                .collect();
+            let bound = term.max_step(&y, &dx);
+            let c = term.cache.lock().expect("cache");
+            let every = c
+                .pairs
+                .iter()
+                .map(|&pair| {
+                    let idx = pair.vertices(&term.topo);
+                    additive_ccd(
+                        pair.is_point_triangle(),
+                        &idx.map(|q| y[q]),
+                        &idx.map(|q| dx[q]),
+                        term.thickness_m,
+                        0.1,
+                        1.0,
+                    )
+                })
+                .fold(f64::INFINITY, f64::min);
+            if dx.iter().map(|d| d.norm()).fold(0.0, f64::max) <= term.piece_m {
+                assert_eq!(bound, every, "step {k} of {size:.1e} m");
+            }
+            match bound.is_finite() {
+                true => cut += 1,
+                false => passed += 1,
+            }
+        }
+        assert!(passed > 10 && cut > 10, "{passed} free steps, {cut} cut");
     }
 }

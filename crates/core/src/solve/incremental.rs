@@ -10,8 +10,9 @@
 //! v = (x − xₙ)/h is backward Euler. Steps adapt: they grow while Newton converges in few iterations
 //! and are halved and retried when it does not, and land on every frame time a recorder asks for.
 
-use super::newton::{StaticOptions, solve_static_loads};
-use super::{DivergenceReason, NoObserver, Observer, SolveReport, StateEvent, StopReason};
+use super::FactorReuse;
+use super::newton::StaticOptions;
+use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
 use crate::physics::{EnergyTerm, HessianBlocks, Model, Vecs};
 use nalgebra::{Matrix3, Vector3};
 use std::time::Instant;
@@ -155,6 +156,7 @@ fn step(
     v: &mut [Vector3<f64>],
     h: f64,
     s: &ImplicitSettings,
+    carried: &mut Option<super::NeighbourFactor>,
     report: &mut SolveReport,
 ) -> Attempt {
     let x_n = x.to_vec();
@@ -184,9 +186,17 @@ fn step(
         // The Hessian changes little over one step's iterations: chord steps save factorizations
         // (37 % over eight scenes, reports/newton_iterations.md).
         factor_reuse: s.factor_reuse,
+        // The last step's factor preconditions this step's Newton steps (conjugate gradients): one
+        // step of a settling sheet changes its Hessian little, and the factorizations were most of
+        // a step's cost (issue 47's stress box: 29,608 of them in 3,539 steps of one run).
+        // Only where factors are reused at all (`"chord"`, the default).
+        neighbour_factor: carried
+            .take()
+            .filter(|_| s.factor_reuse == FactorReuse::Chord),
         ..StaticOptions::default()
     };
-    let r = solve_static_loads(model, x, &opts, &[1.0], &mut NoObserver);
+    let (r, factor) = super::newton::solve_static_keeping_factor(model, x, &opts);
+    *carried = factor;
     model.terms.pop();
     report.merge(&r, super::Part::InnerSolve);
     if r.is_converged() && x.iter().all(|p| p.iter().all(|c| c.is_finite())) {
@@ -197,8 +207,10 @@ fn step(
                 (x[p] - x_n[p]) / h
             };
         }
-        // The step grows with Newton's factorizing iterations (its cost); chord steps are cheap.
-        Attempt::Accepted(r.iterations - r.globalization.chord_steps)
+        // The step grows with Newton's factorizing iterations (its cost); chord and Krylov steps
+        // are cheap.
+        let g = &r.globalization;
+        Attempt::Accepted(r.iterations.saturating_sub(g.chord_steps + g.krylov_steps))
     } else if let Some(d) = r.divergence.filter(|_| r.status == super::Status::Diverged) {
         Attempt::Diverged(d.reason)
     } else {
@@ -252,6 +264,7 @@ pub fn integrate_implicit(
     let (mut largest, mut cooldown, mut last_dt) = (0.0f64, 0usize, 0.0f64);
     // Whether the state is at a frame time (t = 0 is one).
     let mut at_frame = true;
+    let mut carried = None;
     loop {
         model.gradient(x, 1.0, &mut g);
         let r = model.max_residual(&g);
@@ -283,7 +296,7 @@ pub fn integrate_implicit(
         if let Some(tf) = next_frame {
             dt = dt.min(tf - t);
         }
-        match step(model, x, v, dt, s, report) {
+        match step(model, x, v, dt, s, &mut carried, report) {
             Attempt::Accepted(iterations) => {
                 steps += 1;
                 last_dt = dt;

@@ -316,6 +316,11 @@ impl SparseSpd {
         }
     }
 
+    /// Whether a factorization has been made (or copied in) to solve with.
+    pub fn has_factor(&self) -> bool {
+        self.pattern.is_some()
+    }
+
     /// A copy of the last factorization (no counts), for another solve to precondition its steps
     /// with.
     pub fn copy(&self) -> Self {

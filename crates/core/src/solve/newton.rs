@@ -168,6 +168,30 @@ pub fn solve_static_loads(
     super::execute(model, x, opts, &mut LoadRamp::new(loads), observer)
 }
 
+/// [`solve_static_loads`] at full load that also hands back the run's last factor when it
+/// converged: the preconditioner of the next solve of a nearby model ([`NeighbourFactor`]), as the
+/// next step of implicit Euler is.
+pub fn solve_static_keeping_factor(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    opts: &StaticOptions,
+) -> (SolveReport, Option<NeighbourFactor>) {
+    let mut run = match NewtonRun::new(model, x, opts) {
+        Ok(r) => r,
+        Err(invalid) => return (*invalid, None),
+    };
+    let reached = run.stage(
+        model,
+        x,
+        opts,
+        (1.0, Goal::Tolerance),
+        &mut super::NoObserver,
+    );
+    let factor = (reached && run.ws.spd.has_factor())
+        .then(|| NeighbourFactor(std::sync::Arc::new(run.ws.spd.copy())));
+    (run.finish(model, x), factor)
+}
+
 /// Incremental loading (seed 003 §10.3.3) as a continuation: the external loads raised through the
 /// given factors within one Newton run, the last solved to the tolerance.
 pub struct LoadRamp {
