@@ -630,7 +630,7 @@ mod tests {
         let y = lowered(&x);
         let (mut passed, mut cut) = (0, 0);
         for k in 0..200 {
-            let f = |a: usize| (((k * 13 + a * 7) % 17) as f64 / 8.0 - 1.0);
+            let f = |a: usize| ((k * 13 + a * 7) % 17) as f64 / 8.0 - 1.0;
             let size = 1e-4 * 1.05f64.powi(k as i32 % 60);
             let dx: Vec<Vector3<f64>> = (0..18)
                 .map(|p| Vector3::new(f(p), f(p + 5), f(p + 11) - 0.5) * size)
