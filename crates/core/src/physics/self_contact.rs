@@ -50,6 +50,29 @@ struct Cache {
     time_s: f64,
 }
 
+impl Cache {
+    /// Each vertex's distance from the list's anchor, into `moved`.
+    fn measure_moves(&mut self, x: &Vecs) {
+        self.moved.clear();
+        let moves = x
+            .iter()
+            .zip(self.anchor.iter())
+            .map(|(p, q)| (p - q).norm());
+        self.moved.extend(moves);
+    }
+
+    /// A lower bound on what is left of `pair`'s `gap` (its distance beyond the activation
+    /// distance at the anchor) after the moves [`Cache::measure_moves`] took: vertices moved by at
+    /// most δ move a primitive's every point by at most the largest δ (its points are convex
+    /// combinations of them), so the distance falls by at most δ_A + δ_B.
+    fn gap_left(&self, topo: &MeshTopology, pair: Pair, gap: f64) -> f64 {
+        let idx = pair.vertices(topo);
+        let reach = |k: std::ops::Range<usize>| k.map(|i| self.moved[idx[i]]).fold(0.0, f64::max);
+        let split = if pair.is_point_triangle() { 1 } else { 2 };
+        gap - reach(0..split) - reach(split..4)
+    }
+}
+
 /// A self-contact term's candidate set as data (ipc-toolkit's collision set): the broad phase's
 /// pairs with the region each vertex may move in while the list stays complete. Taken from a
 /// solved neighbour (a calibration lattice's drape), it seeds a new model's term so that a solve
@@ -227,25 +250,14 @@ impl SelfContact {
         let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
         self.ensure(&mut c, x, None);
         let act = self.activation_m();
-        let Cache {
-            pairs,
-            gaps,
-            anchor,
-            moved,
-            ..
-        } = &mut *c;
-        moved.clear();
-        moved.extend(x.iter().zip(anchor.iter()).map(|(p, q)| (p - q).norm()));
-        for (&pair, &gap) in pairs.iter().zip(gaps.iter()) {
-            let idx = pair.vertices(&self.topo);
-            // Vertices moved by at most δ move a primitive's every point by at most the largest
-            // δ (its points are convex combinations of them), so the distance falls by at most
-            // δ_A + δ_B: a pair whose gap exceeds that is still out of range, unmeasured.
-            let reach = |k: std::ops::Range<usize>| k.map(|i| moved[idx[i]]).fold(0.0, f64::max);
-            let split = if pair.is_point_triangle() { 1 } else { 2 };
-            if gap >= reach(0..split) + reach(split..4) {
+        c.measure_moves(x);
+        let list = &*c;
+        for (&pair, &gap) in list.pairs.iter().zip(list.gaps.iter()) {
+            // A pair whose gap still exceeds its vertices' moves is out of range, unmeasured.
+            if list.gap_left(&self.topo, pair, gap) >= 0.0 {
                 continue;
             }
+            let idx = pair.vertices(&self.topo);
             let (d, coef) = pair_distance(pair.is_point_triangle(), &idx.map(|k| x[k]));
             if d < act {
                 f(idx, d, coef);
@@ -262,25 +274,17 @@ impl SelfContact {
     /// settling implicit run's time (issue 47).
     fn piece_impact(&self, c: &mut Cache, x: &Vecs, seg: &Vecs) -> f64 {
         const SHARE: f64 = 0.1;
-        let Cache {
-            pairs,
-            gaps,
-            anchor,
-            moved,
-            ..
-        } = c;
-        moved.clear();
-        moved.extend(x.iter().zip(anchor.iter()).map(|(p, q)| (p - q).norm()));
+        c.measure_moves(x);
         let act = self.activation_m();
         let mut toi = f64::INFINITY;
-        for (&pair, &gap) in pairs.iter().zip(gaps.iter()) {
+        for (&pair, &gap) in c.pairs.iter().zip(c.gaps.iter()) {
             let idx = pair.vertices(&self.topo);
-            let reach = |k: std::ops::Range<usize>| k.map(|i| moved[idx[i]]).fold(0.0, f64::max);
-            let split = if pair.is_point_triangle() { 1 } else { 2 };
-            let lower = gap + act - reach(0..split) - reach(split..4) - self.thickness_m;
-            let (_, l) = relative_motion(pair.is_point_triangle(), &idx.map(|k| seg[k]));
-            if l <= 0.0 || (lower > 0.0 && (1.0 - SHARE) * lower > l) {
-                continue;
+            let lower = c.gap_left(&self.topo, pair, gap) + act - self.thickness_m;
+            if lower > 0.0 {
+                let (_, l) = relative_motion(pair.is_point_triangle(), &idx.map(|k| seg[k]));
+                if (1.0 - SHARE) * lower > l {
+                    continue;
+                }
             }
             let t = additive_ccd(
                 pair.is_point_triangle(),
