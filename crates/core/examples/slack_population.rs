@@ -1,7 +1,8 @@
 //! Seed 000's slack-net population as the calibration solves it (the benchmark stage's second
 //! population table): the 14 × 14 net of a scene at `N` Latin-hypercube points of Table 3's box,
-//! each from the nearest drape of the calibration's warm-start lattice, then from that drape's
-//! tangent prediction (the lattice stores each node's sensitivities). Prints both tables, the
+//! each from the nearest drape of the calibration's warm-start lattice, then from the lowest-energy
+//! of that drape, its tangent prediction and the cubic Hermite prediction between the two length
+//! nodes around the point (the lattice stores each node's sensitivities). Prints both tables, the
 //! lattice's own solve time, and the floor of one solve: the time of one numeric factorization of
 //! the net's Hessian and of one whole iteration's assembly (medians of 200); last, how far the
 //! evaluations' drapes, solved to the calibration's looser evaluation tolerance, lie from the same
@@ -28,7 +29,7 @@ fn main() -> anyhow::Result<()> {
         (false, "from the nearest lattice node's drape"),
         (
             true,
-            "from the nearest node's tangent prediction x(θ₀) + (dx/dθ)(θ − θ₀)",
+            "from the nearest node's tangent prediction x(θ₀) + (dx/dθ)(θ − θ₀) or the Hermite prediction between its two length nodes",
         ),
     ] {
         let (rows, lattice_s) = warm_start_population_with(&scene, n, 9, tangent);

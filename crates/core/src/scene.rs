@@ -603,16 +603,22 @@ impl Scene {
     /// zero or of a size drapelab computes in ([`MAGNITUDES`]); the error names the key as the other
     /// checks do (`loads[0].magnitude_N`, `obstacles[1].centre_m`).
     fn check_magnitudes(&self, ck: &Check<'_>) -> Result<(), InputError> {
-        fn walk(ck: &Check<'_>, key: &str, v: &toml::Value) -> Result<(), InputError> {
+        // The key is spelled only for an error: a scene is checked once per solve, and a
+        // calibration solves tens of thousands.
+        fn walk(
+            ck: &Check<'_>,
+            key: &dyn Fn() -> String,
+            v: &toml::Value,
+        ) -> Result<(), InputError> {
             match v {
                 toml::Value::Float(f) if !f.is_finite() => {
-                    ck.err(key, format!("must be a finite number, got {f}"))
+                    ck.err(&key(), format!("must be a finite number, got {f}"))
                 }
                 toml::Value::Float(f)
                     if *f != 0.0 && !(MAGNITUDES.0..=MAGNITUDES.1).contains(&f.abs()) =>
                 {
                     ck.err(
-                        key,
+                        &key(),
                         format!(
                             "{f} is outside the sizes drapelab computes in: zero, or {:e} to {:e} \
 in the key's unit (SI)",
@@ -622,11 +628,11 @@ in the key's unit (SI)",
                 }
                 toml::Value::Table(t) => t
                     .iter()
-                    .try_for_each(|(k, v)| walk(ck, &format!("{key}.{k}"), v)),
+                    .try_for_each(|(k, v)| walk(ck, &|| format!("{}.{k}", key()), v)),
                 // A list of tables names its entry as the other checks do (`loads[0].magnitude_N`);
                 // a list of numbers (a point, a profile) is named as a whole.
                 toml::Value::Array(a) => a.iter().enumerate().try_for_each(|(i, v)| match v {
-                    toml::Value::Table(_) => walk(ck, &format!("{key}[{i}]"), v),
+                    toml::Value::Table(_) => walk(ck, &|| format!("{}[{i}]", key()), v),
                     _ => walk(ck, key, v),
                 }),
                 _ => Ok(()),
@@ -637,7 +643,7 @@ in the key's unit (SI)",
         };
         t.iter()
             .filter(|(k, _)| !["solver", "record"].contains(&k.as_str()))
-            .try_for_each(|(k, v)| walk(ck, k, v))
+            .try_for_each(|(k, v)| walk(ck, &|| k.clone(), v))
     }
 
     /// The cloth: sizes, density, grid, grading and refined lines.

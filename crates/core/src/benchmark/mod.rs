@@ -449,8 +449,8 @@ pub fn warm_start_population(
     warm_start_population_with(scene, samples, seed, true)
 }
 
-/// [`warm_start_population`], each solve from its lattice node's tangent prediction or (`tangent`
-/// false) from the node's drape itself.
+/// [`warm_start_population`], each solve from its lattice node's tangent and Hermite predictions
+/// (`SharedLattice::starts`) or (`tangent` false) from the node's drape itself.
 pub fn warm_start_population_with(
     scene: &Scene,
     samples: usize,

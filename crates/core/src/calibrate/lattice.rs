@@ -103,6 +103,11 @@ impl SharedLattice {
         };
         chain.get_or_init(|| {
             let k = K_REF * R.powi(i);
+            // An evaluation's node is its nearest rung (within a factor √R) and length node.
+            let reach = [
+                k * (R.sqrt() - 1.0),
+                0.5 * (self.lengths[1] - self.lengths[0]),
+            ];
             let mut prev: Option<Vec<Vector3<f64>>> = None;
             self.lengths
                 .iter()
@@ -112,7 +117,7 @@ impl SharedLattice {
                         Some(x0) => crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver),
                         None => crate::simulate::solve_scene(&scene, &mut NoObserver),
                     };
-                    let node = LatticeDrape::of(&scene, sol);
+                    let node = LatticeDrape::of(&scene, sol, reach);
                     if let Some(n) = &node {
                         prev = Some(n.x.clone());
                     }
@@ -174,7 +179,7 @@ impl SharedLattice {
 
     /// The starts of an evaluation at `p` on a sheet of density `rho`: its nearest node's drape
     /// and, with `tangent`, the node's tangent prediction at the equivalent reference stiffness
-    /// k·ρ_ref/ρ.
+    /// k·ρ_ref/ρ and the Hermite prediction between the two length nodes around it.
     pub fn starts(&self, p: &Params, rho: f64, tangent: bool) -> WarmStart {
         let k = p.stiffness_N_per_m * RHO_REF / rho;
         let i = Self::rung(k);
@@ -184,7 +189,10 @@ impl SharedLattice {
         let j = (t * (self.lengths.len() - 1) as f64).round() as usize;
         let l0 = self.lengths[j];
         let chain = self.chain(p.topology, i);
-        let Some(Some(node)) = chain.get().and_then(|c| c.get(j)) else {
+        let Some(nodes) = chain.get() else {
+            return WarmStart::default();
+        };
+        let Some(Some(node)) = nodes.get(j) else {
             return WarmStart::default();
         };
         let mut v = vec![node.x.clone()];
@@ -197,6 +205,7 @@ impl SharedLattice {
                     .map(|(x, (u, w))| x + u * a + w * b)
                     .collect(),
             );
+            v.extend(self.hermite(nodes, p.natural_length_m, k - k0));
         }
         // The evaluation's energy is ρ/ρ_ref times the node's at the same specific stiffness: the
         // node's factor preconditions its steps as it is.
@@ -206,5 +215,39 @@ impl SharedLattice {
             candidates: node.candidates.clone(),
             factor,
         }
+    }
+
+    /// The cubic Hermite prediction at natural length `l` from the two nodes of `chain` around it
+    /// (their drapes and length tangents), plus their stiffness tangents interpolated linearly times
+    /// `dk`: within O(h⁴) of the drape in the length (h the nodes' spacing) where the tangent
+    /// prediction is within O(h²) — the main job's evaluations took a median of 3 Newton iterations
+    /// from the tangent prediction and 2 from this (`examples/slack_population.rs`). None where
+    /// either node lacks its tangents (a fold between them, say).
+    fn hermite(
+        &self,
+        chain: &[Option<LatticeDrape>],
+        l: f64,
+        dk: f64,
+    ) -> Option<Vec<Vector3<f64>>> {
+        let h = self.lengths[1] - self.lengths[0];
+        let j0 =
+            (((l - self.lengths[0]) / h).floor().max(0.0) as usize).min(self.lengths.len() - 2);
+        let t = ((l - self.lengths[j0]) / h).clamp(0.0, 1.0);
+        let (a, b) = (chain.get(j0)?.as_ref()?, chain.get(j0 + 1)?.as_ref()?);
+        let ([ka, la], [kb, lb]) = (a.tangents.as_ref()?, b.tangents.as_ref()?);
+        let (t2, t3) = (t * t, t * t * t);
+        let (h00, h10) = (2.0 * t3 - 3.0 * t2 + 1.0, (t3 - 2.0 * t2 + t) * h);
+        let (h01, h11) = (3.0 * t2 - 2.0 * t3, (t3 - t2) * h);
+        Some(
+            (0..a.x.len())
+                .map(|q| {
+                    a.x[q] * h00
+                        + la[q] * h10
+                        + b.x[q] * h01
+                        + lb[q] * h11
+                        + (ka[q] * (1.0 - t) + kb[q] * t) * dk
+                })
+                .collect(),
+        )
     }
 }

@@ -353,8 +353,12 @@ const TANGENT_KEYS: [&str; 2] = [
 ];
 
 impl LatticeDrape {
-    /// The node's drape with its tangents at that drape, when it has them.
-    fn of(scene: &Scene, sol: crate::simulate::Solution) -> Option<Self> {
+    /// The node's drape with its tangents at that drape, when it has them. `reach` is how far
+    /// (stiffness N/m, natural length m) an evaluation's parameters may lie from the node's: the
+    /// node's self-contact candidate set covers every tangent prediction within it, so that an
+    /// evaluation starts without a broad phase (a quarter of the evaluations ran one, 7 % of the
+    /// main job's calibrate stage, when the set covered the node's drape alone).
+    fn of(scene: &Scene, sol: crate::simulate::Solution, reach: [f64; 2]) -> Option<Self> {
         if !sol.report.is_converged() {
             return None;
         }
@@ -372,9 +376,20 @@ impl LatticeDrape {
             let [a, b] = TANGENT_KEYS.map(|k| eq.sensitivity(k).ok().map(|s| s.dx));
             Some([a?, b?])
         });
+        let candidates = match &tangents {
+            Some([dk, dl]) => {
+                let spread: Vec<f64> = dk
+                    .iter()
+                    .zip(dl)
+                    .map(|(u, w)| u.norm() * reach[0] + w.norm() * reach[1])
+                    .collect();
+                sol.model.candidates_covering(&sol.x, &spread)
+            }
+            None => sol.model.candidates(),
+        };
         Some(Self {
             factor,
-            candidates: sol.model.candidates(),
+            candidates,
             x: sol.x,
             tangents,
         })

@@ -158,6 +158,10 @@ pub trait EnergyTerm: Send + Sync {
     fn candidates(&self) -> Option<CandidateSet> {
         None
     }
+    /// A candidate set at `x` valid while each vertex v stays within `spread[v]` (m) of it.
+    fn candidates_covering(&self, _x: &Vecs, _spread: &[f64]) -> Option<CandidateSet> {
+        None
+    }
     /// Takes a candidate set from a model solved nearby ([`EnergyTerm::candidates`]); true when
     /// it fits the term.
     fn seed_candidates(&self, _set: &CandidateSet) -> bool {
@@ -335,6 +339,13 @@ impl Model {
     /// The candidate set of the model's self-contact, when it has one and a broad phase ran.
     pub fn candidates(&self) -> Option<CandidateSet> {
         self.terms.iter().find_map(|t| t.candidates())
+    }
+    /// The candidate set of the model's self-contact at `x`, valid while each vertex v stays within
+    /// `spread[v]` (m) of it; None without self-contact.
+    pub fn candidates_covering(&self, x: &Vecs, spread: &[f64]) -> Option<CandidateSet> {
+        self.terms
+            .iter()
+            .find_map(|t| t.candidates_covering(x, spread))
     }
     /// Seeds the model's self-contact with `set` from a model solved nearby (on the same mesh);
     /// true when a term took it.

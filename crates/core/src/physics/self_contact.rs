@@ -89,7 +89,7 @@ pub struct CandidateSet {
 
 /// Self-contact between the primitives of a triangulated sheet.
 pub struct SelfContact {
-    topo: MeshTopology,
+    topo: std::sync::Arc<MeshTopology>,
     /// Thickness ξ, m: the closest two layers' mid-surfaces may come.
     pub thickness_m: f64,
     /// Barrier band d̂ beyond the thickness, m: the force starts at ξ + d̂.
@@ -113,7 +113,7 @@ impl SelfContact {
         band_m: f64,
         weight_N: f64,
     ) -> Self {
-        let topo = MeshTopology::from_triangles(triangles);
+        let topo = MeshTopology::shared(triangles);
         let shortest = topo
             .edges
             .iter()
@@ -204,6 +204,12 @@ impl SelfContact {
         if inside {
             return;
         }
+        self.broad_phase(c, x, reach);
+    }
+
+    /// The broad phase at `x`: each vertex's box is `reach(v)` grown by the margin, and the list keeps
+    /// the pairs that could come within the activation distance anywhere inside their boxes.
+    fn broad_phase(&self, c: &mut Cache, x: &Vecs, reach: impl Fn(usize) -> Aabb) {
         c.region = vec![Aabb::point(&Vector3::zeros()); x.len()];
         for &v in &self.topo.vertices {
             c.region[v as usize] = reach(v as usize).inflate(self.margin_m);
@@ -241,6 +247,24 @@ impl SelfContact {
         c.anchor = x.to_vec();
         c.valid = true;
         c.broad_phases += 1;
+    }
+
+    /// The candidate set at `x` that stays valid while each vertex v moves less than `spread[v]`
+    /// (m) from it (and the margin beyond): a start anywhere in that reach begins without a broad
+    /// phase. A calibration lattice node gives it for the reach of its tangent predictions.
+    pub fn candidates_covering(&self, x: &Vecs, spread: &[f64]) -> CandidateSet {
+        let mut c = Cache::default();
+        self.broad_phase(&mut c, x, |v| {
+            Aabb::point(&x[v]).inflate(spread.get(v).copied().unwrap_or(0.0))
+        });
+        CandidateSet {
+            activation_m: self.activation_m(),
+            size: (c.region.len(), self.topo.triangles.len()),
+            cache: Cache {
+                broad_phases: 0,
+                ..c
+            },
+        }
     }
 
     /// Calls `f(vertices, distance, coefficients)` for every candidate pair within the activation
@@ -502,6 +526,9 @@ impl EnergyTerm for SelfContact {
     fn seed_candidates(&self, set: &CandidateSet) -> bool {
         self.seed(set)
     }
+    fn candidates_covering(&self, x: &Vecs, spread: &[f64]) -> Option<CandidateSet> {
+        Some(SelfContact::candidates_covering(self, x, spread))
+    }
 }
 
 #[cfg(test)]
@@ -607,6 +634,36 @@ mod tests {
         // A set built for another activation distance does not fit.
         let thicker = SelfContact::new(tris, &x, 6e-4, 1e-3, 1e-3);
         assert!(!thicker.seed(&set));
+    }
+
+    #[test]
+    fn a_set_covering_a_spread_serves_a_move_beyond_the_margin_without_a_broad_phase() {
+        // The upper layer 5 mm up, far out of range, then brought down 4.4–4.7 mm into range: a
+        // move beyond the 1 mm margin, which a set covering the node alone would not serve.
+        let (x, tris) = stacked(6e-3);
+        let node = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        let y: Vec<Vector3<f64>> = lowered(&x)
+            .iter()
+            .enumerate()
+            .map(|(p, v)| v - Vector3::z() * if p >= 9 { 3.8e-3 } else { 0.0 })
+            .collect();
+        let spread: Vec<f64> = (0..18).map(|p| if p >= 9 { 5e-3 } else { 0.0 }).collect();
+        let set = node.candidates_covering(&x, &spread);
+        let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        assert!(seeded.seed(&set));
+        let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 1e-3);
+        assert!(fresh.energy(&y) > 0.0);
+        assert_eq!(seeded.energy(&y), fresh.energy(&y));
+        let (mut g_seeded, mut g_fresh) = (vec![Vector3::zeros(); 18], vec![Vector3::zeros(); 18]);
+        seeded.add_gradient(&y, &mut g_seeded);
+        fresh.add_gradient(&y, &mut g_fresh);
+        assert_eq!(g_seeded, g_fresh);
+        assert_eq!(seeded.cache.lock().expect("cache").broad_phases, 0);
+        // Without the spread the same move needs a broad phase of its own.
+        let narrow = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
+        assert!(narrow.seed(&node.candidates_covering(&x, &[0.0; 18])));
+        assert_eq!(narrow.energy(&y), fresh.energy(&y));
+        assert_eq!(narrow.cache.lock().expect("cache").broad_phases, 1);
     }
 
     #[test]
