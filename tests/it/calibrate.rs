@@ -521,3 +521,49 @@ fn levenberg_marquardt_recovers_the_synthetic_sample_in_a_few_dozen_solves() {
     assert!((b - c).abs() <= 1e-12 * (b.abs() + c.abs()) && a >= 0.0 && d >= 0.0);
     assert!(a * d - b * c >= -1e-9 * a * d);
 }
+
+/// Midway between two natural-length nodes of the warm-start lattice, the cubic Hermite start (both
+/// nodes' drapes and length tangents) lies far nearer the drape than the nearer node's tangent
+/// prediction: within O(h⁴) of it against O(h²), h the nodes' 0.5 mm spacing.
+#[test]
+fn the_hermite_start_between_two_length_nodes_is_nearer_the_drape_than_the_tangent_prediction() {
+    use drapelab::calibrate::{Params, SharedLattice};
+    use drapelab::solve::NoObserver;
+    let problem = sample_8_problem(vec![]);
+    let lattice = SharedLattice::for_problem(&problem);
+    let rho = problem.scene.cloth.areal_density_kg_per_m2;
+    for l_mm in [45.25, 48.75, 52.25] {
+        // A rung's stiffness (1000 N/m at the lattice's 0.05 kg/m²): only the length differs.
+        let p = Params {
+            stiffness_N_per_m: 1000.0 * rho / 0.05,
+            damping_Ns_per_m: problem.bounds.damping_Ns_per_m.0,
+            elongation_rate: problem.bounds.elongation_rate.0,
+            natural_length_m: l_mm * 1e-3,
+            topology: drapelab::material::Topology::A,
+        };
+        let starts = lattice.starts(&p, rho, true).starts;
+        assert_eq!(
+            starts.len(),
+            3,
+            "drape, tangent and Hermite starts at {l_mm} mm"
+        );
+        let sol = drapelab::simulate::solve_scene_from(
+            &problem.scene_for(&p),
+            &starts[1],
+            &mut NoObserver,
+        );
+        assert!(sol.report.is_converged(), "{}", sol.report.message);
+        let off = |s: &[nalgebra::Vector3<f64>]| {
+            s.iter()
+                .zip(&sol.x)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max)
+        };
+        let (tangent, hermite) = (off(&starts[1]), off(&starts[2]));
+        assert!(
+            hermite < 0.2 * tangent,
+            "{l_mm} mm: Hermite start {hermite:.3e} m from the drape, tangent start {tangent:.3e} m"
+        );
+        eprintln!("{l_mm} mm: tangent {tangent:.3e} m, Hermite {hermite:.3e} m");
+    }
+}

@@ -171,7 +171,7 @@ pub fn self_contact_summary(
 /// checked first ([`Scene::validated`]): an invalid one gives a solution with status invalid, the
 /// bad key in its message, and no particles.
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
-    solve_built(scene, &[], None, observer)
+    solve_built(scene, &[], None, Choice::Lowest, observer)
 }
 
 /// Solves a validated scene statically or dynamically from the given positions of all particles
@@ -182,7 +182,7 @@ pub fn solve_scene_from(
     x0: &[Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, &[x0], None, observer)
+    solve_built(scene, &[x0], None, Choice::Lowest, observer)
 }
 
 /// [`solve_scene_from`] the candidate start with the lowest energy in the scene's model (e.g. a
@@ -196,13 +196,35 @@ pub fn solve_scene_from_lowest(
     candidates: Option<&crate::physics::CandidateSet>,
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, starts, candidates, observer)
+    solve_built(scene, starts, candidates, Choice::Lowest, observer)
+}
+
+/// [`solve_scene_from_lowest`], but from the first candidate whose energy is finite: the starts come
+/// in order of preference (a prediction known to lie close to the drape first, as the calibration's
+/// Hermite start), and the energies of the others are not taken (each is a pass over the model).
+pub fn solve_scene_from_first(
+    scene: &Scene,
+    starts: &[&[Vector3<f64>]],
+    candidates: Option<&crate::physics::CandidateSet>,
+    observer: &mut dyn Observer,
+) -> Solution {
+    solve_built(scene, starts, candidates, Choice::FirstFinite, observer)
+}
+
+/// How a solve picks among its candidate starts.
+#[derive(Clone, Copy, PartialEq)]
+enum Choice {
+    /// The one of lowest energy.
+    Lowest,
+    /// The first of finite energy.
+    FirstFinite,
 }
 
 fn solve_built(
     scene: &Scene,
     starts: &[&[Vector3<f64>]],
     candidates: Option<&crate::physics::CandidateSet>,
+    choice: Choice,
     observer: &mut dyn Observer,
 ) -> Solution {
     // Only a checked scene is built; one changed in code into an invalid one is a status, not a panic.
@@ -219,13 +241,17 @@ fn solve_built(
     if let Some(set) = candidates {
         model.seed_candidates(set);
     }
-    let start = starts
+    let mut scored = starts
         .iter()
         .filter(|s| s.len() == x.len())
-        .map(|s| (model.energy(s, 1.0), *s))
-        .filter(|(e, _)| !e.is_nan())
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, s)| s);
+        .map(|s| (model.energy(s, 1.0), *s));
+    let start = match choice {
+        Choice::FirstFinite => scored.find(|(e, _)| e.is_finite()),
+        Choice::Lowest => scored
+            .filter(|(e, _)| !e.is_nan())
+            .min_by(|a, b| a.0.total_cmp(&b.0)),
+    }
+    .map(|(_, s)| s);
     let report = match start {
         Some(x0) => {
             x.copy_from_slice(x0);

@@ -196,22 +196,34 @@ impl SharedLattice {
             return WarmStart::default();
         };
         let mut v = vec![node.x.clone()];
+        let mut ordered = false;
         if let (true, Some([dk, dl])) = (tangent, &node.tangents) {
-            let (a, b) = (k - k0, p.natural_length_m - l0);
-            v.push(
-                node.x
-                    .iter()
-                    .zip(dk.iter().zip(dl))
-                    .map(|(x, (u, w))| x + u * a + w * b)
-                    .collect(),
-            );
-            v.extend(self.hermite(nodes, p.natural_length_m, k - k0));
+            // The Hermite start first, the node's drape behind it in case the Hermite start is not
+            // admissible (infinite energy: a pair within the thickness); else the lower-energy of the
+            // node's drape and its tangent prediction.
+            match self.hermite(nodes, p.natural_length_m, k - k0) {
+                Some(h) => {
+                    v.insert(0, h);
+                    ordered = true;
+                }
+                None => {
+                    let (a, b) = (k - k0, p.natural_length_m - l0);
+                    v.push(
+                        node.x
+                            .iter()
+                            .zip(dk.iter().zip(dl))
+                            .map(|(x, (u, w))| x + u * a + w * b)
+                            .collect(),
+                    );
+                }
+            }
         }
         // The evaluation's energy is ρ/ρ_ref times the node's at the same specific stiffness: the
         // node's factor preconditions its steps as it is.
         let factor = node.factor.clone().map(crate::solve::NeighbourFactor);
         WarmStart {
             starts: v,
+            ordered,
             candidates: node.candidates.clone(),
             factor,
         }

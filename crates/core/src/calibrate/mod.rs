@@ -272,7 +272,11 @@ impl Problem {
                 straight.solver.static_.neighbour_factor = warm.factor.clone();
                 let tol = &mut straight.solver.static_.residual_tol_rel;
                 *tol = tol.max(EVALUATION_TOL_REL);
-                crate::simulate::solve_scene_from_lowest(
+                let solve = match warm.ordered {
+                    true => crate::simulate::solve_scene_from_first,
+                    false => crate::simulate::solve_scene_from_lowest,
+                };
+                solve(
                     &straight,
                     &starts,
                     warm.candidates.as_ref(),
@@ -338,8 +342,11 @@ struct LatticeDrape {
 /// the node's self-contact candidate set and its factor.
 #[derive(Default)]
 pub struct WarmStart {
-    /// Candidate start positions, m; the solve takes the one of lowest energy.
+    /// Candidate start positions, m; the solve takes the one of lowest energy or, with `ordered`,
+    /// the first of finite energy.
     pub starts: Vec<Vec<nalgebra::Vector3<f64>>>,
+    /// Whether `starts` come in order of preference.
+    pub ordered: bool,
     /// The node's self-contact candidate set.
     pub candidates: Option<crate::physics::CandidateSet>,
     /// The node's factor, the preconditioner of the evaluation's Newton steps.
