@@ -181,41 +181,27 @@ impl SharedLattice {
     /// and, with `tangent`, the node's tangent prediction at the equivalent reference stiffness
     /// k·ρ_ref/ρ and the Hermite prediction between the two length nodes around it.
     pub fn starts(&self, p: &Params, rho: f64, tangent: bool) -> WarmStart {
-        let k = p.stiffness_N_per_m * RHO_REF / rho;
-        let i = Self::rung(k);
-        let k0 = K_REF * R.powi(i);
-        let (lo, hi) = (self.lengths[0], self.lengths[self.lengths.len() - 1]);
-        let t = ((p.natural_length_m - lo) / (hi - lo)).clamp(0.0, 1.0);
-        let j = (t * (self.lengths.len() - 1) as f64).round() as usize;
-        let l0 = self.lengths[j];
-        let chain = self.chain(p.topology, i);
-        let Some(nodes) = chain.get() else {
+        let Some((chain, j, dk)) = self.locate(p, rho) else {
             return WarmStart::default();
         };
-        let Some(Some(node)) = nodes.get(j) else {
+        let Some(Some(node)) = chain.get().and_then(|c| c.get(j)) else {
             return WarmStart::default();
         };
         let mut v = vec![node.x.clone()];
         let mut ordered = false;
-        if let (true, Some([dk, dl])) = (tangent, &node.tangents) {
+        if tangent {
             // The Hermite start first, the node's drape behind it in case the Hermite start is not
             // admissible (infinite energy: a pair within the thickness); else the lower-energy of the
             // node's drape and its tangent prediction.
-            match self.hermite(nodes, p.natural_length_m, k - k0) {
+            let hermite = chain
+                .get()
+                .and_then(|c| self.hermite(c, p.natural_length_m, dk));
+            match hermite {
                 Some(h) => {
                     v.insert(0, h);
                     ordered = true;
                 }
-                None => {
-                    let (a, b) = (k - k0, p.natural_length_m - l0);
-                    v.push(
-                        node.x
-                            .iter()
-                            .zip(dk.iter().zip(dl))
-                            .map(|(x, (u, w))| x + u * a + w * b)
-                            .collect(),
-                    );
-                }
+                None => v.extend(self.tangent_prediction(p, rho)),
             }
         }
         // The evaluation's energy is ρ/ρ_ref times the node's at the same specific stiffness: the
@@ -227,6 +213,34 @@ impl SharedLattice {
             candidates: node.candidates.clone(),
             factor,
         }
+    }
+
+    /// The chain of an evaluation at `p` on a sheet of density `rho`, its nearest length node and
+    /// the evaluation's reference stiffness less the chain's, N/m.
+    fn locate(&self, p: &Params, rho: f64) -> Option<(Chain, usize, f64)> {
+        let k = p.stiffness_N_per_m * RHO_REF / rho;
+        let i = Self::rung(k);
+        let (lo, hi) = (self.lengths[0], self.lengths[self.lengths.len() - 1]);
+        let t = ((p.natural_length_m - lo) / (hi - lo)).clamp(0.0, 1.0);
+        let j = (t * (self.lengths.len() - 1) as f64).round() as usize;
+        Some((self.chain(p.topology, i), j, k - K_REF * R.powi(i)))
+    }
+
+    /// The nearest node's tangent prediction x(θ₀) + (∂x/∂k)(k − k₀) + (∂x/∂L₀)(L₀ − L₀,₀) of the
+    /// drape at `p` on a sheet of density `rho` (k at the reference density); None where that node
+    /// has no tangents.
+    pub fn tangent_prediction(&self, p: &Params, rho: f64) -> Option<Vec<Vector3<f64>>> {
+        let (chain, j, a) = self.locate(p, rho)?;
+        let node = chain.get()?.get(j)?.as_ref()?;
+        let [dk, dl] = node.tangents.as_ref()?;
+        let b = p.natural_length_m - self.lengths[j];
+        Some(
+            node.x
+                .iter()
+                .zip(dk.iter().zip(dl))
+                .map(|(x, (u, w))| x + u * a + w * b)
+                .collect(),
+        )
     }
 
     /// The cubic Hermite prediction at natural length `l` from the two nodes of `chain` around it
