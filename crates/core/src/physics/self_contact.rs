@@ -611,6 +611,20 @@ mod tests {
         assert_eq!(kept.state(&y).broad_phases, 1);
     }
 
+    /// `a`, seeded from another state, measures at `y` (in range) the energy and gradient of `fresh`,
+    /// whose list was built at `y`, bit for bit.
+    fn assert_measures_alike(a: &SelfContact, fresh: &SelfContact, y: &[Vector3<f64>]) {
+        assert!(fresh.energy(y) > 0.0);
+        assert_eq!(a.energy(y), fresh.energy(y));
+        let (mut g_a, mut g_fresh) = (
+            vec![Vector3::zeros(); y.len()],
+            vec![Vector3::zeros(); y.len()],
+        );
+        a.add_gradient(y, &mut g_a);
+        fresh.add_gradient(y, &mut g_fresh);
+        assert_eq!(g_a, g_fresh);
+    }
+
     #[test]
     fn a_seeded_term_measures_what_a_fresh_one_does_without_a_broad_phase() {
         let (x, tris) = stacked(2.2e-3);
@@ -623,12 +637,7 @@ mod tests {
         let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 2e-3);
         assert!(seeded.seed(&set));
         let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 2e-3);
-        assert!(fresh.energy(&y) > 0.0);
-        assert_eq!(seeded.energy(&y), fresh.energy(&y));
-        let (mut g_seeded, mut g_fresh) = (vec![Vector3::zeros(); 18], vec![Vector3::zeros(); 18]);
-        seeded.add_gradient(&y, &mut g_seeded);
-        fresh.add_gradient(&y, &mut g_fresh);
-        assert_eq!(g_seeded, g_fresh);
+        assert_measures_alike(&seeded, &fresh, &y);
         let phases = seeded.cache.lock().expect("cache").broad_phases;
         assert_eq!(phases, 0, "the seeded list covered the move");
         // A set built for another activation distance does not fit.
@@ -652,12 +661,7 @@ mod tests {
         let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
         assert!(seeded.seed(&set));
         let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 1e-3);
-        assert!(fresh.energy(&y) > 0.0);
-        assert_eq!(seeded.energy(&y), fresh.energy(&y));
-        let (mut g_seeded, mut g_fresh) = (vec![Vector3::zeros(); 18], vec![Vector3::zeros(); 18]);
-        seeded.add_gradient(&y, &mut g_seeded);
-        fresh.add_gradient(&y, &mut g_fresh);
-        assert_eq!(g_seeded, g_fresh);
+        assert_measures_alike(&seeded, &fresh, &y);
         assert_eq!(seeded.cache.lock().expect("cache").broad_phases, 0);
         // Without the spread the same move needs a broad phase of its own.
         let narrow = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
