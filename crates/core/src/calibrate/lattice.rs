@@ -246,9 +246,9 @@ impl SharedLattice {
     /// The cubic Hermite prediction at natural length `l` from the two nodes of `chain` around it
     /// (their drapes and length tangents), plus their stiffness tangents interpolated linearly times
     /// `dk`: within O(h⁴) of the drape in the length (h the nodes' spacing) where the tangent
-    /// prediction is within O(h²) — the main job's evaluations took a median of 3 Newton iterations
-    /// from the tangent prediction and 2 from this (`examples/slack_population.rs`). None where
-    /// either node lacks its tangents (a fold between them, say).
+    /// prediction is within O(h²) — the slack population's evaluations took a median of 3 Newton
+    /// iterations from the tangent prediction and 2 from this (`examples/slack_population.rs`).
+    /// None where either node lacks its tangents (a fold between them, say).
     fn hermite(
         &self,
         chain: &[Option<LatticeDrape>],
