@@ -11,10 +11,12 @@ use crate::physics::HessianBlocks;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::supernodal::factorize_supernodal_numeric_llt;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
+use faer::sparse::utils::permute_self_adjoint_to_unsorted;
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 use std::hash::{Hash, Hasher};
@@ -64,6 +66,11 @@ struct Structure {
     blocks: Vec<(u32, u32)>,
     sym: SymbolicSparseColMat<usize>,
     symbolic: SymbolicCholesky<usize>,
+    /// The lower triangle in the fill-reducing order, as faer's supernodal factorization reads it
+    /// (columns unsorted), and where each entry of `sym` lands in it: the values are assembled
+    /// there directly, so a factorization does not permute the matrix (8 % of a Cusick drape's solve).
+    permuted: SymbolicSparseColMat<usize>,
+    to_permuted: Vec<u32>,
 }
 
 /// The structures analysed so far in this process, by their blocks (a handful: one per grid and
@@ -126,11 +133,14 @@ impl Structure {
         let symbolic =
             factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, SymmetricOrdering::Amd, params)
                 .ok()?;
+        let (permuted, to_permuted) = permute_once(&sym, &symbolic)?;
         Some(Self {
             first: dofs.first.clone(),
             blocks,
             sym,
             symbolic,
+            permuted,
+            to_permuted,
         })
     }
 
@@ -160,55 +170,60 @@ impl Structure {
     }
 }
 
+/// The lower triangle `sym` permuted by `symbolic`'s ordering (faer's own permutation, run once on
+/// the entries' indices) and the position of each entry of `sym` in it. None for a simplicial
+/// factor or no permutation (the structures here are supernodal with AMD).
+fn permute_once(
+    sym: &SymbolicSparseColMat<usize>,
+    symbolic: &SymbolicCholesky<usize>,
+) -> Option<(SymbolicSparseColMat<usize>, Vec<u32>)> {
+    let (n, nnz) = (sym.nrows(), sym.row_idx().len());
+    let perm = symbolic.perm()?;
+    let ids: Vec<f64> = (0..nnz).map(|k| k as f64).collect();
+    let (mut val, mut col_ptr, mut row_idx) = (vec![0.0; nnz], vec![0usize; n + 1], vec![0usize; nnz]);
+    let mut mem = MemBuffer::new(StackReq::new::<usize>(n));
+    let out = permute_self_adjoint_to_unsorted(
+        &mut val,
+        &mut col_ptr,
+        &mut row_idx,
+        SparseColMatRef::new(sym.as_ref(), &ids),
+        perm,
+        Side::Lower,
+        Side::Lower,
+        MemStack::new(&mut mem),
+    );
+    let nnz_per_col = out.symbolic().col_nnz().map(|c| c.to_vec());
+    let permuted = SymbolicSparseColMat::new_unsorted_checked(n, n, col_ptr, nnz_per_col, row_idx);
+    let mut to_permuted = vec![0u32; nnz];
+    for (k, &id) in val.iter().enumerate() {
+        to_permuted[id as usize] = k as u32;
+    }
+    Some((permuted, to_permuted))
+}
+
 /// Where the entries of one list of Hessian blocks land in a structure.
 struct Pattern {
     pairs: Vec<(u32, u32)>,
     structure: Arc<Structure>,
-    /// The entries ([`SparseSpd::entries`] order, then the diagonal shifts) in the order they are
-    /// summed: by column, then by (row, column) as faer's own assembly sorts them, so that the
-    /// summation order of duplicate entries (and with it every bit of the result) is faer's.
-    order: Vec<u32>,
-    /// For each entry of `order`, its position in the compressed values.
+    /// For each entry ([`SparseSpd::entries`] order, then the diagonal shifts), its position in
+    /// the compressed values: a factorization adds every entry straight into its slot, in that order.
     slot: Vec<u32>,
 }
 
 impl Pattern {
     /// The entries of `h` over `dofs` mapped into `structure` (which holds all of its blocks).
     fn map(dofs: &DofMap, h: &HessianBlocks, structure: Arc<Structure>) -> Self {
-        let n = dofs.n;
-        let mut idx: Vec<Pair<usize, usize>> = Vec::new();
-        SparseSpd::entries(dofs, h, |r, c, _| idx.push(Pair::new(r, c)));
-        idx.extend((0..n).map(|d| Pair::new(d, d)));
-        // Bucket the entries by column in their own order, then sort each column's by (row, col).
-        let mut start = vec![0usize; n + 1];
-        for p in &idx {
-            start[p.col + 1] += 1;
-        }
-        for c in 0..n {
-            start[c + 1] += start[c];
-        }
-        let mut fill = start.clone();
-        let mut order = vec![0usize; idx.len()];
-        for (i, p) in idx.iter().enumerate() {
-            order[fill[p.col]] = i;
-            fill[p.col] += 1;
-        }
-        for c in 0..n {
-            order[start[c]..start[c + 1]].sort_unstable_by_key(|&i| (idx[i].row, idx[i].col));
-        }
         let sym = &structure.sym;
         let position = |r: usize, c: usize| -> u32 {
             let (start, end) = (sym.col_ptr()[c], sym.col_ptr()[c + 1]);
             let k = sym.row_idx()[start..end].partition_point(|&i| i < r);
-            (start + k) as u32
+            structure.to_permuted[start + k]
         };
-        let slot: Vec<u32> = order
-            .iter()
-            .map(|&i| position(idx[i].row, idx[i].col))
-            .collect();
+        let mut slot = Vec::new();
+        SparseSpd::entries(dofs, h, |r, c, _| slot.push(position(r, c)));
+        slot.extend((0..dofs.n).map(|d| position(d, d)));
         Self {
             pairs: h.pairs.clone(),
-            order: order.into_iter().map(|i| i as u32).collect(),
             slot,
             structure,
         }
@@ -277,7 +292,6 @@ static PATTERNS: Mutex<Vec<(u64, Arc<Pattern>)>> = Mutex::new(Vec::new());
 /// with a shared symbolic analysis and numeric buffers kept between calls.
 pub struct SparseSpd {
     pattern: Option<Arc<Pattern>>,
-    raw: Vec<f64>,
     values: Vec<f64>,
     /// The factor's values, shared with the copies made of it until one factorizes on its own.
     l_values: Arc<Vec<f64>>,
@@ -307,7 +321,6 @@ impl SparseSpd {
     pub fn new() -> Self {
         Self {
             pattern: None,
-            raw: Vec::new(),
             values: Vec::new(),
             l_values: Arc::new(Vec::new()),
             mem: MemBuffer::new(StackReq::empty()),
@@ -402,34 +415,40 @@ impl SparseSpd {
             self.prepare_buffers(&pattern.structure.symbolic, nnz);
         }
         let start = Instant::now();
-        self.raw.clear();
-        let raw = &mut self.raw;
-        Self::entries(dofs, h, |_, _, v| raw.push(v));
-        raw.extend_from_slice(shift);
-        if raw.len() != pattern.order.len() {
+        // Every entry added straight into its slot (a gather through a buffer of the raw entries,
+        // several MB on a 2,700-vertex disc, was a fifth of a Cusick drape's solve).
+        let (values, slot) = (&mut self.values, &pattern.slot);
+        // The pattern was mapped from these very pairs over these DOFs: one slot per entry, then n.
+        if shift.len() != dofs.n || slot.len() < dofs.n {
             return false;
         }
-        let values = &mut self.values;
         values.fill(0.0);
-        for (&e, &slot) in pattern.order.iter().zip(&pattern.slot) {
-            values[slot as usize] += raw[e as usize];
+        let mut e = 0;
+        Self::entries(dofs, h, |_, _, v| {
+            values[slot[e] as usize] += v;
+            e += 1;
+        });
+        debug_assert_eq!(e + dofs.n, slot.len());
+        for (&s, &v) in slot[e..].iter().zip(shift) {
+            values[s as usize] += v;
         }
         let structure = &pattern.structure;
-        let mat = SparseColMatRef::new(structure.sym.as_ref(), values);
+        let SymbolicCholeskyRaw::Supernodal(supernodal) = structure.symbolic.raw() else {
+            return false;
+        };
+        let mat = SparseColMatRef::new(structure.permuted.as_ref(), values);
         self.factorizations += 1;
         let l_values = Arc::make_mut(&mut self.l_values);
-        let ok = structure
-            .symbolic
-            .factorize_numeric_llt(
-                l_values,
-                mat,
-                Side::Lower,
-                LltRegularization::default(),
-                Par::Seq,
-                MemStack::new(&mut self.mem),
-                Default::default(),
-            )
-            .is_ok();
+        let ok = factorize_supernodal_numeric_llt(
+            l_values,
+            mat,
+            LltRegularization::default(),
+            supernodal,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        )
+        .is_ok();
         self.factor_time_s += start.elapsed().as_secs_f64();
         ok
     }

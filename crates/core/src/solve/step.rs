@@ -16,14 +16,15 @@ use nalgebra::Vector3;
 
 /// Mean of the Hessian's diagonal over the free DOFs (the scale of the damping), 1 if empty.
 pub(super) fn mean_free_diagonal(h: &HessianBlocks, dofs: &DofMap, n: usize) -> f64 {
-    let diag = h.diagonal(n);
-    let (mut sum, mut cnt) = (0.0, 0usize);
-    for (p, d) in diag.iter().enumerate() {
-        if dofs.dof(p).is_some() {
-            sum += d.trace();
-            cnt += 3;
-        }
-    }
+    // Summed block by block (no per-particle buffer: it was 4 % of a Cusick drape's solve).
+    let sum: f64 = h
+        .pairs
+        .iter()
+        .zip(&h.blocks)
+        .filter(|&(&(p, q), _)| p == q && dofs.dof(p as usize).is_some())
+        .map(|(_, b)| b.trace())
+        .sum();
+    let cnt = 3 * (0..n).filter(|&p| dofs.dof(p).is_some()).count();
     if cnt > 0 && sum > 0.0 {
         sum / cnt as f64
     } else {
