@@ -19,7 +19,6 @@ use drapelab_core::measure::median;
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
 use drapelab_record::{NamedMesh, read_table, write_cusick_drapes, write_table};
 use nalgebra::Vector3;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -401,6 +400,30 @@ pub fn predict_fabric(
     out
 }
 
+/// `work(k)` for every k of `order`, started in that order by as many workers as rayon has threads
+/// (each takes the next k when it finishes one), returned by k.
+fn longest_first<T: Send>(order: &[usize], work: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let done = std::sync::Mutex::new(Vec::with_capacity(order.len()));
+    rayon::scope(|s| {
+        for _ in 0..rayon::current_num_threads().min(order.len()) {
+            s.spawn(|_| {
+                while let Some(&k) =
+                    order.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+                {
+                    let out = work(k);
+                    done.lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .push((k, out));
+                }
+            });
+        }
+    });
+    let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
+    done.sort_by_key(|d| d.0);
+    done.into_iter().map(|d| d.1).collect()
+}
+
 /// The outline rows of a simulated drape's shadow outline r(θ).
 pub fn simulated_outline(fabric: i32, seed: u64, outline_m: &[f64]) -> Vec<OutlineRow> {
     let n = outline_m.len();
@@ -455,25 +478,37 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>>
             .collect(),
     };
     ctx.started(data.fabrics.len());
-    let fabrics: Vec<FabricPrediction> = data
-        .fabrics
-        .par_iter()
-        .map(|f| {
-            let rows: Vec<&ShadowRow> = shadows.iter().filter(|r| r.fabric == f.fabric).collect();
-            let mut q = p.clone();
-            if let Some(w) = f.areal_density_kg_per_m2 {
-                q.drape.areal_density_kg_per_m2 = w;
-            }
-            let mesh = DiscMesh {
-                rest_xy: &model_mesh.0,
-                triangles: &model_mesh.1,
-            };
-            let density_known = f.areal_density_kg_per_m2.is_some();
-            let out = predict_fabric(f.fabric, density_known, &rows, &measured, mesh, &q);
-            ctx.item_done();
-            out
-        })
-        .collect();
+    let rows_of = |fabric: i32| -> Vec<&ShadowRow> {
+        shadows.iter().filter(|r| r.fabric == fabric).collect()
+    };
+    let predict = |k: usize| {
+        let f = &data.fabrics[k];
+        let mut q = p.clone();
+        if let Some(w) = f.areal_density_kg_per_m2 {
+            q.drape.areal_density_kg_per_m2 = w;
+        }
+        let mesh = DiscMesh {
+            rest_xy: &model_mesh.0,
+            triangles: &model_mesh.1,
+        };
+        let density_known = f.areal_density_kg_per_m2.is_some();
+        let out = predict_fabric(
+            f.fabric,
+            density_known,
+            &rows_of(f.fabric),
+            &measured,
+            mesh,
+            &q,
+        );
+        ctx.item_done();
+        out
+    };
+    // The limpest fabrics first (their drapes take the most Newton iterations), so that none is
+    // left to run alone at the end: the order changes no fabric's result.
+    let cost = |k: usize| targets(&rows_of(data.fabrics[k].fabric)).specimen.dc_pct;
+    let mut order: Vec<usize> = (0..data.fabrics.len()).collect();
+    order.sort_by(|&a, &b| cost(a).total_cmp(&cost(b)));
+    let fabrics = longest_first(&order, predict);
     let rows: Vec<PredictionRow> = fabrics.iter().map(|f| f.row.clone()).collect();
     write_table(ctx.output("predictions")?, &rows)?;
     let outlines: Vec<OutlineRow> = fabrics.iter().flat_map(|f| f.outlines.clone()).collect();

@@ -250,22 +250,38 @@ pub fn solve_drape_observed(
     tester: &Tester,
     observer: &mut dyn Observer,
 ) -> (SolveReport, Vec<Vector3<f64>>) {
+    let (report, x, _) = solve_drape_from(mesh, p, tester, None, observer);
+    (report, x)
+}
+
+/// [`solve_drape_observed`] from `start` (a drape continued from another bending length, see
+/// [`super::DrapeBranch`]) instead of the cone or the fall; the cone where `start` is none or its
+/// energy is not finite (a vertex moved into the pedestal or through the sheet). With whether the
+/// solve that counts had self-contact in its model.
+pub fn solve_drape_from(
+    mesh: DiscMesh<'_>,
+    p: &DrapeParams,
+    tester: &Tester,
+    start: Option<&[Vector3<f64>]>,
+    observer: &mut dyn Observer,
+) -> (SolveReport, Vec<Vector3<f64>>, bool) {
     let Some(xi) = p.self_thickness_m else {
-        return solve_drape_once(mesh, p, tester, observer);
+        let (report, x) = solve_drape_once(mesh, p, tester, start, observer);
+        return (report, x, false);
     };
     let without = DrapeParams {
         self_thickness_m: None,
         ..p.clone()
     };
-    let (report, x) = solve_drape_once(mesh, &without, tester, observer);
+    let (report, x) = solve_drape_once(mesh, &without, tester, start, observer);
     let tris: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| t.map(|v| v as u32)).collect();
     let topo = crate::contact::proximity::MeshTopology::from_triangles(tris.clone());
     let crossing = !crate::contact::proximity::edge_triangle_crossings(&topo, &x).is_empty();
     let probe = crate::physics::SelfContact::new(tris, &x, xi, xi, 1.0);
     if !crossing && probe.state(&x).min_distance_m >= 2.0 * xi {
-        return (report, x);
+        return (report, x, false);
     }
-    let (mut report, x) = solve_drape_once(mesh, p, tester, observer);
+    let (mut report, x) = solve_drape_once(mesh, p, tester, start, observer);
     report.message = format!(
         "{} (solved again with self-contact: without it the drape {})",
         report.message,
@@ -275,7 +291,7 @@ pub fn solve_drape_observed(
             "came within 2ξ of itself"
         }
     );
-    (report, x)
+    (report, x, true)
 }
 
 /// One solve of the drape with the model `p` describes (self-contact included when it asks).
@@ -283,12 +299,14 @@ fn solve_drape_once(
     mesh: DiscMesh<'_>,
     p: &DrapeParams,
     tester: &Tester,
+    start: Option<&[Vector3<f64>]>,
     observer: &mut dyn Observer,
 ) -> (SolveReport, Vec<Vector3<f64>>) {
     let mut model = drape_model(mesh, p, tester);
-    let mut x = drape_start(mesh, p, tester);
+    let given = start.filter(|x| x.len() == mesh.rest_xy.len() && model.energy(x, 1.0).is_finite());
+    let mut x = given.map_or_else(|| drape_start(mesh, p, tester), <[_]>::to_vec);
     let mut fall = None;
-    if p.start == DrapeStart::Fall {
+    if p.start == DrapeStart::Fall && given.is_none() {
         let mut r = SolveReport::unsolved("implicit-euler");
         let mut v = vec![Vector3::zeros(); x.len()];
         let s = ImplicitSettings {

@@ -10,8 +10,8 @@
 //! where it tells the laws apart, and the fit says when it does not (an identifiability flag).
 
 use super::{
-    DiscMesh, DrapeParams, Tester, bisect_bending_length, drape_dc, mesh_projection,
-    shadow_measures, solve_drape,
+    Continuation, DC_SLOPE_PRIOR_PCT, DiscMesh, DrapeParams, SecantSearch, Tester, mesh_projection,
+    secant_bending_length, shadow_measures, solve_drape,
 };
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -62,7 +62,7 @@ impl BendingLaw {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FabricSettings {
-    /// Bending laws tried; the first (its c found by bisection) is the simplest. Default: linear
+    /// Bending laws tried; the first (its c searched from the bracket's middle) is the simplest. Default: linear
     /// isotropic; linear with B_warp/B_weft = 2 and 4 (cantilever measurements of 618 fabrics,
     /// DrapeTester/ClothDrapeTester: 1.3–2.6 for the middle half, up to 4 for the top tenth);
     /// isotropic saturating at 2/c and 1/c. A list of one fits c alone.
@@ -70,12 +70,14 @@ pub struct FabricSettings {
     /// Perturbation seeds per law whose mean node count is compared with the target.
     /// Default 6 (the mean's standard error ~0.35 node).
     pub calibration_seeds: u64,
-    /// Bending lengths the first bisection searches, m. Default [0.005, 0.06] (with the pedestal an
+    /// Bending lengths the search may try, m. Default [0.005, 0.06] (with the pedestal an
     /// obstacle a limp fabric cannot hang inside it: the limpest bundled fabric, DC 15 %, needs c ≈ 6 mm).
     pub bracket_m: [f64; 2],
-    /// Relative width at which the bisection stops. Default 0.02.
+    /// The first law's search stops when c is within half this of its root at the prior slope
+    /// (|DC − target| ≤ 50 % · ln(1 + rel_tol) / 2, 0.5 points by default). Default 0.02.
     pub rel_tol: f64,
-    /// DC a later candidate's secant search must reach, points. Default 1.0.
+    /// DC a later law's secant search must reach, points (the first law's too, where tighter
+    /// than `rel_tol`'s). Default 1.0.
     pub dc_tol_pct: f64,
 }
 
@@ -257,10 +259,11 @@ pub struct FabricFit {
     pub solves: usize,
 }
 
-/// Calibrates a fabric on its calibration specimen: c by bisection on DC for the first law, by a
-/// secant in ln c for the others (starting from the previous c and slope); per law the mean node
-/// count over `calibration_seeds`; the law whose mean is nearest the target node count wins (ties
-/// to the earlier law). Err names what failed.
+/// Calibrates a fabric on its calibration specimen: per law, c by a secant on ln c over the seed-0
+/// drape continued through c ([`Continuation`]; the first law from the bracket's geometric middle,
+/// each later one from the previous law's c, slope and drape); per law the mean node count over
+/// `calibration_seeds` (each from the cone); the law whose mean is nearest the target node count
+/// wins (ties to the earlier law). Err names what failed.
 pub fn calibrate_fabric(
     mesh: DiscMesh<'_>,
     target: &SpecimenTargets,
@@ -268,31 +271,41 @@ pub fn calibrate_fabric(
     tester: &Tester,
     s: &FabricSettings,
 ) -> Result<FabricFit, String> {
-    let mut solves = 0usize;
-    let dc_at = |c: f64, law: &BendingLaw| -> Result<f64, String> {
-        drape_dc(mesh, &law.apply(base, c), tester)
-            .map(|r| r.0)
-            .ok_or_else(|| format!("the drape at c = {c:.4} m, {law:?} did not converge"))
-    };
     let first = s.laws.first().ok_or("no bending law to try")?;
-    let cal = bisect_bending_length(|c| dc_at(c, first), target.dc_pct, s.bracket_m, s.rel_tol)?;
-    solves += cal.evaluations.len();
-    let slope = cal.sensitivity_pct(1.3).unwrap_or(50.0);
-    let mut candidates = Vec::new();
+    let mut continuation = Continuation::default();
+    let mut search = SecantSearch {
+        target_dc_pct: target.dc_pct,
+        start_m: (s.bracket_m[0] * s.bracket_m[1]).sqrt(),
+        slope_pct: DC_SLOPE_PRIOR_PCT,
+        bracket_m: s.bracket_m,
+        dc_tol_pct: s
+            .dc_tol_pct
+            .min(DC_SLOPE_PRIOR_PCT * (1.0 + s.rel_tol).ln() / 2.0),
+        max_solves: 12,
+    };
+    let cal = secant_bending_length(
+        |c| continuation.dc(mesh, &first.apply(base, c), tester),
+        &search,
+    )?;
+    let slope = cal.sensitivity_pct(1.3).unwrap_or(DC_SLOPE_PRIOR_PCT);
+    let (mut candidates, mut seeded) = (Vec::new(), 0);
     let mut c = cal.bending_length_m;
     for (k, law) in s.laws.iter().enumerate() {
         if k > 0 {
-            // From the previous law's c; a law that cannot reach the target is left out.
-            match secant_bending_length(|c| dc_at(c, law), target.dc_pct, c, slope, s) {
-                Ok((found, n)) => {
-                    solves += n;
-                    c = found;
-                }
+            // From the previous law's c and drape; a law that cannot reach the target is left out.
+            continuation.keep_nearest(c);
+            search.start_m = c;
+            search.slope_pct = slope;
+            search.dc_tol_pct = s.dc_tol_pct;
+            search.max_solves = 7;
+            let dc = |c| continuation.dc(mesh, &law.apply(base, c), tester);
+            match secant_bending_length(dc, &search) {
+                Ok(found) => c = found.bending_length_m,
                 Err(_) => continue,
             }
         }
         let drapes = seeded_drapes(mesh, &law.apply(base, c), tester, 0..s.calibration_seeds);
-        solves += s.calibration_seeds as usize;
+        seeded += s.calibration_seeds as usize;
         let Some(d) = NodeDistribution::of(&drapes, s.calibration_seeds as usize) else {
             continue;
         };
@@ -302,6 +315,7 @@ pub fn calibrate_fabric(
             drapes: d,
         });
     }
+    let solves = continuation.solves + seeded;
     let miss = |r: &LawCandidate| (r.drapes.nodes_mean - target.nodes).abs();
     let best = candidates
         .iter()
@@ -374,42 +388,6 @@ pub fn calibrate_and_predict(
     })
 }
 
-/// The c where `dc(c)` meets `target` within `s.dc_tol_pct`: secant steps in ln c from `c0` with
-/// slope `slope` (%/unit ln c) at first, at most six solves, each step clamped to a factor 1.5 and
-/// to `s.bracket_m`. Returns (c, solves).
-fn secant_bending_length(
-    mut dc: impl FnMut(f64) -> Result<f64, String>,
-    target: f64,
-    c0: f64,
-    slope: f64,
-    s: &FabricSettings,
-) -> Result<(f64, usize), String> {
-    let (lo, hi) = (s.bracket_m[0].ln(), s.bracket_m[1].ln());
-    let mut l = c0.ln();
-    let mut d = dc(l.exp())?;
-    let mut slope = slope;
-    for n in 1..=6 {
-        if (d - target).abs() <= s.dc_tol_pct {
-            return Ok((l.exp(), n));
-        }
-        let next = (l + ((target - d) / slope).clamp(-0.4, 0.4)).clamp(lo, hi);
-        let dn = dc(next.exp())?;
-        let measured = (dn - d) / (next - l);
-        if measured.is_finite() && measured > 5.0 {
-            slope = measured;
-        }
-        (l, d) = (next, dn);
-    }
-    if (d - target).abs() <= 2.0 * s.dc_tol_pct {
-        Ok((l.exp(), 7))
-    } else {
-        Err(format!(
-            "the secant on c did not reach DC {target:.1} % (last {d:.1} % at c = {:.4} m)",
-            l.exp()
-        ))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -442,17 +420,5 @@ mod tests {
         assert!((n.dc_sd_pct - (5.0f64 / 3.0).sqrt()).abs() < 1e-12);
         assert_eq!((n.converged, n.tried), (4, 5));
         assert!(NodeDistribution::of(&[], 3).is_none());
-    }
-
-    #[test]
-    fn the_secant_finds_c_on_a_logarithmic_dc() {
-        // DC = 60 + 25 ln(c / 0.02): the secant lands within its tolerance in a few solves even from
-        // a wrong slope.
-        let s = FabricSettings::default();
-        let dc = |c: f64| Ok(60.0 + 25.0 * (c / 0.02).ln());
-        let (c, n) = secant_bending_length(dc, 70.0, 0.015, 60.0, &s).expect("found");
-        assert!((dc(c).unwrap() - 70.0).abs() <= 1.0, "{c}");
-        assert!(n <= 4, "{n} solves");
-        assert!(secant_bending_length(|_| Ok(10.0), 70.0, 0.02, 50.0, &s).is_err());
     }
 }

@@ -4,15 +4,22 @@
 //! measures are taken of a photo's silhouette, of a mesh's vertical projection and of a hem polygon,
 //! so that each can be checked against the others (data: Gong, Mao & Wang, CVPR 2024).
 
+mod branch;
 mod calibrate;
 mod drape;
 mod fabric;
 mod params;
 
-pub use calibrate::{BendingCalibration, bisect_bending_length, calibrate_bending_length};
+pub use branch::{
+    Continuation, DrapeBranch, MAX_CONTINUATION_LN, bending_length_tangent, continue_drape,
+};
+pub use calibrate::{
+    BendingCalibration, DC_SLOPE_PRIOR_PCT, SecantSearch, calibrate_bending_length,
+    secant_bending_length,
+};
 pub use drape::{
     DiscMesh, DrapeParams, DrapeStart, drape_dc, drape_model, drape_start, polar_disc, solve_drape,
-    solve_drape_observed, subdivide_disc,
+    solve_drape_from, solve_drape_observed, subdivide_disc,
 };
 pub use fabric::{
     BendingLaw, FabricFit, FabricOutcome, FabricSettings, LawCandidate, NodeDistribution,
