@@ -180,7 +180,8 @@ fn permute_once(
     let (n, nnz) = (sym.nrows(), sym.row_idx().len());
     let perm = symbolic.perm()?;
     let ids: Vec<f64> = (0..nnz).map(|k| k as f64).collect();
-    let (mut val, mut col_ptr, mut row_idx) = (vec![0.0; nnz], vec![0usize; n + 1], vec![0usize; nnz]);
+    let (mut val, mut col_ptr, mut row_idx) =
+        (vec![0.0; nnz], vec![0usize; n + 1], vec![0usize; nnz]);
     let mut mem = MemBuffer::new(StackReq::new::<usize>(n));
     let out = permute_self_adjoint_to_unsorted(
         &mut val,
