@@ -55,6 +55,13 @@ pub(crate) fn barrier_band_derivatives(d: f64, dh: f64) -> (f64, f64) {
 /// barrier's force, its round-off 10⁻¹⁶ |x|/(10⁻² d).
 const SHAPE_STEP_REL: f64 = 1e-2;
 
+/// The relative disagreement of a shape difference's two steps beyond which a kink lies between
+/// them (a smooth gap's two central differences differ by O(h²), ~10⁻⁴ of the derivative).
+const KINK_AGREEMENT: f64 = 1e-2;
+
+/// Times a shape difference's step shrinks (by 64) looking for two steps that agree.
+const KINK_RETRIES: usize = 4;
+
 impl BarrierContact {
     /// κ for a particle of weight `w` (N): the barrier's force reaches w at d ≈ d̂/10, so resting
     /// particles sit well inside the activation band and well away from the surface.
@@ -278,12 +285,26 @@ impl BarrierContact {
                 // moves its surface by the particle's distance along the axis).
                 let h0 = SHAPE_STEP_REL * d / (size * reach);
                 let dd = (moved(h0).signed_distance(xp).0 - d).abs();
-                let h = if dd > 0.0 {
+                let mut h = if dd > 0.0 {
                     h0 * (SHAPE_STEP_REL * d / dd).clamp(1e-3, 1e3)
                 } else {
                     h0
                 };
-                let ((e1, g1), (e2, g2)) = (central(h), central(0.5 * h));
+                // Richardson's extrapolation holds where the two steps agree; where they do not, a
+                // kink of the distance (the closest feature switching, a box's face to its edge)
+                // lies within the step: smaller steps until they agree (a particle on the kink
+                // itself has no derivative; it keeps the smallest step's).
+                let (mut e1, mut g1) = central(h);
+                let (mut e2, mut g2) = central(0.5 * h);
+                for _ in 0..KINK_RETRIES {
+                    let gap = (g1 - g2).norm();
+                    if gap <= KINK_AGREEMENT * g1.norm().max(g2.norm()) {
+                        break;
+                    }
+                    h *= 1.0 / 64.0;
+                    (e1, g1) = central(h);
+                    (e2, g2) = central(0.5 * h);
+                }
                 f(p, (4.0 * e2 - e1) / 3.0, (g2 * 4.0 - g1) / 3.0);
             }
         }
