@@ -51,6 +51,7 @@ impl Solution {
                 gravity_m_per_s2: scene.gravity.g_m_per_s2,
                 damping_Ns_per_m: 0.0,
                 elongation_rate: None,
+                constant_hessian: Default::default(),
             },
         }
     }

@@ -101,6 +101,7 @@ impl ModelBuilder {
             gravity_m_per_s2: self.g_m_per_s2,
             damping_Ns_per_m: self.damping_Ns_per_m,
             elongation_rate: self.elongation_rate,
+            constant_hessian: Default::default(),
         }
     }
 }

@@ -128,6 +128,10 @@ impl<const N: usize> Kernel<N> for QuadraticKernel<N> {
         let c = self.coef[k];
         std::array::from_fn(|m| u * c[m])
     }
+    /// Quadratic throughout (no saturation, or none finite): the block k I at every x.
+    fn hessian_is_constant(&self) -> bool {
+        self.saturation.iter().all(|u0| !u0.is_finite())
+    }
     fn stiffness_scale(&self) -> f64 {
         self.coef
             .iter()
@@ -143,7 +147,7 @@ impl<const N: usize> Kernel<N> for QuadraticKernel<N> {
         push: &mut impl FnMut(usize, usize, Matrix3<f64>),
     ) {
         // ∂²E/∂u² = s₁ I + s₃ u uᵀ, positive definite (s₁ + s₃|u|² = k/q³ > 0): no projection needed.
-        let block = if self.saturation.is_empty() {
+        let block = if self.hessian_is_constant() {
             Matrix3::identity() * self.stiffness[k]
         } else {
             let u = self.u(k, x);

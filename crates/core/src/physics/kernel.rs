@@ -61,6 +61,10 @@ pub trait Kernel<const N: usize>: Send + Sync {
     fn is_external_load(&self) -> bool {
         false
     }
+    /// Whether the Hessian is constant (see [`EnergyTerm::hessian_is_constant`]).
+    fn hessian_is_constant(&self) -> bool {
+        false
+    }
     /// Relative elongation of stencil `s` (springs; 0 for others).
     fn strain(&self, _s: usize, _x: &Local<N>) -> f64 {
         0.0
@@ -133,6 +137,9 @@ impl<K: Kernel<N>, const N: usize> EnergyTerm for Potential<K, N> {
     }
     fn is_external_load(&self) -> bool {
         self.kernel.is_external_load()
+    }
+    fn hessian_is_constant(&self) -> bool {
+        self.kernel.hessian_is_constant()
     }
     fn max_strain(&self, x: &Vecs) -> f64 {
         (0..self.len())

@@ -32,6 +32,7 @@ pub use shear::{CellShear, ShearKernel};
 pub use springs::{SpringFamily, SpringKernel, Springs};
 
 use nalgebra::{Matrix3, Vector3};
+use std::sync::Arc;
 
 /// Positions or vectors of all particles.
 pub type Vecs = [Vector3<f64>];
@@ -44,6 +45,10 @@ pub struct HessianBlocks {
     pub pairs: Vec<(u32, u32)>,
     /// The blocks, parallel to `pairs`.
     pub blocks: Vec<Matrix3<f64>>,
+    /// The blocks of the terms whose Hessian is constant ([`EnergyTerm::hessian_is_constant`]),
+    /// computed once per model and shared by every evaluation: part of the matrix, summed before
+    /// `pairs` ([`Self::all`]); a factorization keeps their assembled values between iterations.
+    pub constant: Option<Arc<HessianBlocks>>,
 }
 
 impl HessianBlocks {
@@ -51,6 +56,22 @@ impl HessianBlocks {
     pub fn clear(&mut self) {
         self.pairs.clear();
         self.blocks.clear();
+        self.constant = None;
+    }
+    /// Every block of the matrix: the constant part's, then this list's.
+    pub fn all(&self) -> impl Iterator<Item = (&(u32, u32), &Matrix3<f64>)> {
+        let constant = self
+            .constant
+            .as_deref()
+            .map(|c| c.pairs.iter().zip(&c.blocks));
+        constant
+            .into_iter()
+            .flatten()
+            .chain(self.pairs.iter().zip(&self.blocks))
+    }
+    /// The particle pairs of the constant part (empty without one).
+    pub fn constant_pairs(&self) -> &[(u32, u32)] {
+        self.constant.as_deref().map_or(&[], |c| &c.pairs)
     }
     /// Adds a block at (p, q); for p < q the transpose is stored at (q, p).
     #[inline]
@@ -74,7 +95,7 @@ impl HessianBlocks {
     }
     /// y += H x for the full symmetric matrix.
     pub fn mul_add(&self, x: &Vecs, y: &mut Vecs) {
-        for (&(p, q), b) in self.pairs.iter().zip(&self.blocks) {
+        for (&(p, q), b) in self.all() {
             let (p, q) = (p as usize, q as usize);
             y[p] += b * x[q];
             if p != q {
@@ -89,8 +110,9 @@ impl HessianBlocks {
         let mut out = HessianBlocks {
             pairs: (0..n as u32).map(|p| (p, p)).collect(),
             blocks: self.diagonal(n),
+            constant: None,
         };
-        for (&(p, q), b) in self.pairs.iter().zip(&self.blocks) {
+        for (&(p, q), b) in self.all() {
             if p != q {
                 out.pairs.push((p, q));
                 out.blocks.push(*b);
@@ -101,7 +123,7 @@ impl HessianBlocks {
     /// The 3×3 diagonal blocks summed per particle.
     pub fn diagonal(&self, n: usize) -> Vec<Matrix3<f64>> {
         let mut d = vec![Matrix3::zeros(); n];
-        for (&(p, q), b) in self.pairs.iter().zip(&self.blocks) {
+        for (&(p, q), b) in self.all() {
             if p == q {
                 d[p as usize] += b;
             }
@@ -126,6 +148,11 @@ pub trait EnergyTerm: Send + Sync {
     /// Hessian leaves a curvature out (self-contact leaves out the distance's own curvature).
     fn add_exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
         self.add_hessian(x, h, false);
+    }
+    /// Whether the Hessian is the same at every x, projected or not (a quadratic energy: bending
+    /// along grid lines, linear hinge bending): a [`Model`] then computes its blocks once.
+    fn hessian_is_constant(&self) -> bool {
+        false
     }
     /// Largest relative elongation of the term's springs, for divergence checks (0 if none).
     fn max_strain(&self, _x: &Vecs) -> f64 {
@@ -206,6 +233,9 @@ pub struct Model {
     pub damping_Ns_per_m: f64,
     /// Provot's elongation rate, applied by explicit Euler (None: no correction).
     pub elongation_rate: Option<f64>,
+    /// The Hessian blocks of the terms whose Hessian is constant, made at the first
+    /// [`Model::hessian`] (`Default::default()` when building; never set by hand).
+    pub constant_hessian: std::sync::OnceLock<Option<Arc<HessianBlocks>>>,
 }
 
 impl Model {
@@ -251,7 +281,17 @@ impl Model {
     /// Hessian blocks of the total energy into `h` (cleared first); `project` makes it positive semi-definite.
     pub fn hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
         h.clear();
-        for t in &self.terms {
+        h.constant = self
+            .constant_hessian
+            .get_or_init(|| {
+                let mut c = HessianBlocks::default();
+                for t in self.terms.iter().filter(|t| t.hessian_is_constant()) {
+                    t.add_hessian(x, &mut c, false);
+                }
+                (!c.pairs.is_empty()).then(|| Arc::new(c))
+            })
+            .clone();
+        for t in self.terms.iter().filter(|t| !t.hessian_is_constant()) {
             t.add_hessian(x, h, project);
         }
     }

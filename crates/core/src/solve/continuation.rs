@@ -158,6 +158,7 @@ mod tests {
             gravity_m_per_s2: 9.81,
             damping_Ns_per_m: 0.0,
             elongation_rate: None,
+            constant_hessian: Default::default(),
         };
         (model, vec![Vector3::zeros(), Vector3::new(0.0, 0.0, -0.1)])
     }

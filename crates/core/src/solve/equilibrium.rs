@@ -245,6 +245,7 @@ mod tests {
             gravity_m_per_s2: 9.81,
             damping_Ns_per_m: 0.0,
             elongation_rate: None,
+            constant_hessian: Default::default(),
         };
         (model, x)
     }
@@ -339,6 +340,7 @@ mod tests {
             gravity_m_per_s2: 0.0,
             damping_Ns_per_m: 0.0,
             elongation_rate: None,
+            constant_hessian: Default::default(),
         };
         let mut f = EquilibriumFactor::new(&model, &x).expect("semi-definite, shifted");
         let (y, r) = f.solve_checked(&[Vector3::zeros(), Vector3::new(1.0, 0.0, 0.0)]);

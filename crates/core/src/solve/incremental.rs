@@ -107,7 +107,7 @@ impl EnergyTerm for Inertia {
             }
         }
         if let Some((k, s)) = &self.stiffness {
-            for (&(p, q), b) in k.pairs.iter().zip(&k.blocks) {
+            for (&(p, q), b) in k.all() {
                 h.push(p as usize, q as usize, b * *s);
             }
         }

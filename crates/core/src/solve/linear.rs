@@ -94,9 +94,8 @@ fn structure_key(first: &[u32], blocks: &[(u32, u32)]) -> u64 {
 /// The unique blocks of `h` between free particles, sorted.
 fn free_blocks(dofs: &DofMap, h: &HessianBlocks) -> Vec<(u32, u32)> {
     let mut b: Vec<(u32, u32)> = h
-        .pairs
-        .iter()
-        .copied()
+        .all()
+        .map(|(&pair, _)| pair)
         .filter(|&(p, q)| dofs.dof(p as usize).is_some() && dofs.dof(q as usize).is_some())
         .collect();
     b.sort_unstable();
@@ -205,10 +204,15 @@ fn permute_once(
 /// Where the entries of one list of Hessian blocks land in a structure.
 struct Pattern {
     pairs: Vec<(u32, u32)>,
+    /// The pairs of the Hessian's constant part ([`HessianBlocks::constant`]).
+    constant_pairs: Vec<(u32, u32)>,
     structure: Arc<Structure>,
-    /// For each entry ([`SparseSpd::entries`] order, then the diagonal shifts), its position in
-    /// the compressed values: a factorization adds every entry straight into its slot, in that order.
+    /// For each entry ([`SparseSpd::entries`] order: the constant part's, then the others), then
+    /// each diagonal shift, its position in the compressed values: a factorization adds every
+    /// entry straight into its slot, in that order.
     slot: Vec<u32>,
+    /// How many of the entries are the constant part's.
+    constant_entries: usize,
 }
 
 impl Pattern {
@@ -221,13 +225,27 @@ impl Pattern {
             structure.to_permuted[start + k]
         };
         let mut slot = Vec::new();
+        let constant = h.constant.as_deref();
+        if let Some(c) = constant {
+            SparseSpd::entries(dofs, c, |r, c, _| slot.push(position(r, c)));
+        }
+        let constant_entries = slot.len();
         SparseSpd::entries(dofs, h, |r, c, _| slot.push(position(r, c)));
         slot.extend((0..dofs.n).map(|d| position(d, d)));
         Self {
             pairs: h.pairs.clone(),
+            constant_pairs: h.constant_pairs().to_vec(),
             slot,
+            constant_entries,
             structure,
         }
+    }
+
+    /// Whether this is the pattern of `h`'s blocks over `dofs`.
+    fn holds(&self, dofs: &DofMap, h: &HessianBlocks) -> bool {
+        self.pairs == h.pairs
+            && self.constant_pairs == h.constant_pairs()
+            && self.structure.first == dofs.first
     }
 
     /// The pattern of `h` on its own structure, from the process-wide cache or mapped now (with
@@ -235,9 +253,10 @@ impl Pattern {
     fn exact(dofs: &DofMap, h: &HessianBlocks) -> Option<(Arc<Self>, bool)> {
         let mut key = std::collections::hash_map::DefaultHasher::new();
         h.pairs.hash(&mut key);
+        h.constant_pairs().hash(&mut key);
         dofs.first.hash(&mut key);
         let key = key.finish();
-        let same = |p: &Pattern| p.pairs == h.pairs && p.structure.first == dofs.first;
+        let same = |p: &Pattern| p.holds(dofs, h);
         {
             let cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
             if let Some((_, p)) = cache.iter().find(|(k, p)| *k == key && same(p)) {
@@ -289,11 +308,21 @@ impl Pattern {
 /// grid, pin set and contact set): a solve's first factorization finds its mapping here.
 static PATTERNS: Mutex<Vec<(u64, Arc<Pattern>)>> = Mutex::new(Vec::new());
 
+/// The compressed values of a Hessian's constant part on one pattern (held with the part itself,
+/// so that the pointer identifies it while the values live).
+struct Base {
+    constant: Arc<HessianBlocks>,
+    pattern: Arc<Pattern>,
+    values: Vec<f64>,
+}
+
 /// A sparse SPD matrix H + diag(shift) over the free DOFs, assembled from Hessian blocks, factorized
 /// with a shared symbolic analysis and numeric buffers kept between calls.
 pub struct SparseSpd {
     pattern: Option<Arc<Pattern>>,
     values: Vec<f64>,
+    /// The assembled values of the Hessian's constant part on the current pattern.
+    base: Option<Base>,
     /// The factor's values, shared with the copies made of it until one factorizes on its own.
     l_values: Arc<Vec<f64>>,
     mem: MemBuffer,
@@ -323,6 +352,7 @@ impl SparseSpd {
         Self {
             pattern: None,
             values: Vec::new(),
+            base: None,
             l_values: Arc::new(Vec::new()),
             mem: MemBuffer::new(StackReq::empty()),
             factor_scratch: false,
@@ -366,6 +396,7 @@ impl SparseSpd {
         self.values = vec![0.0; nnz];
     }
 
+    /// The lower-triangle entries of `h`'s own list over the free DOFs (not its constant part).
     fn entries(dofs: &DofMap, h: &HessianBlocks, mut visit: impl FnMut(usize, usize, f64)) {
         for (&(p, q), b) in h.pairs.iter().zip(&h.blocks) {
             let (Some(dp), Some(dq)) = (dofs.dof(p as usize), dofs.dof(q as usize)) else {
@@ -385,10 +416,7 @@ impl SparseSpd {
     /// Factorizes H + diag(shift) over the free DOFs. Returns false when the matrix is not
     /// positive definite (the caller raises its damping or projects the Hessian and tries again).
     pub fn factorize(&mut self, dofs: &DofMap, h: &HessianBlocks, shift: &[f64]) -> bool {
-        let stale = self
-            .pattern
-            .as_ref()
-            .is_none_or(|p| p.pairs != h.pairs || p.structure.first != dofs.first);
+        let stale = self.pattern.as_ref().is_none_or(|p| !p.holds(dofs, h));
         if stale {
             let start = Instant::now();
             let Some((pattern, analysed)) = Pattern::next(dofs, h, self.pattern.as_ref()) else {
@@ -423,8 +451,31 @@ impl SparseSpd {
         if shift.len() != dofs.n || slot.len() < dofs.n {
             return false;
         }
-        values.fill(0.0);
-        let mut e = 0;
+        // The constant part's values once per model and pattern, copied in at every factorization.
+        let base_holds = |b: &Base| {
+            Arc::ptr_eq(&b.pattern, &pattern)
+                && h.constant
+                    .as_ref()
+                    .is_some_and(|c| Arc::ptr_eq(&b.constant, c))
+        };
+        match (&self.base, &h.constant) {
+            (Some(b), _) if base_holds(b) => values.copy_from_slice(&b.values),
+            (_, Some(c)) => {
+                values.fill(0.0);
+                let mut e = 0;
+                Self::entries(dofs, c, |_, _, v| {
+                    values[slot[e] as usize] += v;
+                    e += 1;
+                });
+                self.base = Some(Base {
+                    constant: c.clone(),
+                    pattern: pattern.clone(),
+                    values: values.clone(),
+                });
+            }
+            (_, None) => values.fill(0.0),
+        }
+        let mut e = pattern.constant_entries;
         Self::entries(dofs, h, |_, _, v| {
             values[slot[e] as usize] += v;
             e += 1;

@@ -23,7 +23,7 @@ use std::f64::consts::FRAC_PI_2;
 fn sag_shape(model: &Model, x0: &[Vector3<f64>]) -> Option<Vec<f64>> {
     let mut h = HessianBlocks::default();
     model.hessian(x0, &mut h, true);
-    let mut edges: Vec<(u32, u32)> = h.pairs.iter().copied().filter(|(p, q)| p != q).collect();
+    let mut edges: Vec<(u32, u32)> = h.all().map(|(&e, _)| e).filter(|(p, q)| p != q).collect();
     edges.sort_unstable();
     edges.dedup();
     let mut lap = HessianBlocks::default();
@@ -244,6 +244,7 @@ mod tests {
             gravity_m_per_s2: 9.81,
             damping_Ns_per_m: 0.0,
             elongation_rate: None,
+            constant_hessian: Default::default(),
         };
         (model, x)
     }

@@ -18,9 +18,7 @@ use nalgebra::Vector3;
 pub(super) fn mean_free_diagonal(h: &HessianBlocks, dofs: &DofMap, n: usize) -> f64 {
     // Summed block by block (no per-particle buffer: it was 4 % of a Cusick drape's solve).
     let sum: f64 = h
-        .pairs
-        .iter()
-        .zip(&h.blocks)
+        .all()
         .filter(|&(&(p, q), _)| p == q && dofs.dof(p as usize).is_some())
         .map(|(_, b)| b.trace())
         .sum();
