@@ -505,9 +505,11 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>>
     };
     // The limpest fabrics first (their drapes take the most Newton iterations), so that none is
     // left to run alone at the end: the order changes no fabric's result.
-    let cost = |k: usize| targets(&rows_of(data.fabrics[k].fabric)).specimen.dc_pct;
+    let cost: Vec<f64> = (data.fabrics.iter())
+        .map(|f| targets(&rows_of(f.fabric)).specimen.dc_pct)
+        .collect();
     let mut order: Vec<usize> = (0..data.fabrics.len()).collect();
-    order.sort_by(|&a, &b| cost(a).total_cmp(&cost(b)));
+    order.sort_by(|&a, &b| cost[a].total_cmp(&cost[b]));
     let fabrics = longest_first(&order, predict);
     let rows: Vec<PredictionRow> = fabrics.iter().map(|f| f.row.clone()).collect();
     write_table(ctx.output("predictions")?, &rows)?;

@@ -446,3 +446,58 @@ fn every_terms_derivatives_in_its_coefficients_match_central_differences() {
     }
     eprintln!("terms checked: {checked:?}");
 }
+
+/// The model's Hessian, whose constant terms' blocks are made at the first evaluation and kept
+/// ([`HessianBlocks::constant`]), is the sum of every term's own Hessian, at the first evaluation
+/// and at another position after it, in both modes.
+#[test]
+fn the_model_hessian_with_its_constant_part_kept_is_the_sum_of_its_terms() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(47);
+    let mut random = |n: usize, scale: f64| -> Vec<Vector3<f64>> {
+        (0..n)
+            .map(|_| {
+                (Vector3::new(rng.random(), rng.random(), rng.random()) * 2.0
+                    - Vector3::repeat(1.0))
+                    * scale
+            })
+            .collect()
+    };
+    let mut kept = 0;
+    for path in scenes() {
+        let Some(loaded) = load(&path, &[]) else {
+            continue;
+        };
+        let built = drapelab_core::build::build_scene(&loaded.scene);
+        let (model, n) = (&built.model, built.x0.len());
+        let v = random(n, 1.0);
+        for (k, project) in [(0, false), (1, true), (2, false)] {
+            let shift = random(n, if k == 0 { 0.0 } else { 1e-5 });
+            let x: Vec<Vector3<f64>> = built.x0.iter().zip(&shift).map(|(a, b)| a + b).collect();
+            let mut h = HessianBlocks::default();
+            model.hessian(&x, &mut h, project);
+            let mut got = vec![Vector3::zeros(); n];
+            h.mul_add(&v, &mut got);
+            let mut want = vec![Vector3::zeros(); n];
+            for t in &model.terms {
+                let mut ht = HessianBlocks::default();
+                t.add_hessian(&x, &mut ht, project);
+                ht.mul_add(&v, &mut want);
+            }
+            let size = dot(&want, &want).sqrt();
+            if !size.is_finite() {
+                continue;
+            }
+            let diff: Vec<Vector3<f64>> = got.iter().zip(&want).map(|(a, b)| a - b).collect();
+            assert!(
+                dot(&diff, &diff).sqrt() <= 1e-12 * size,
+                "{}: evaluation {k}",
+                loaded.scene.name
+            );
+            kept += usize::from(h.constant.is_some());
+        }
+    }
+    assert!(
+        kept > 0,
+        "no bundled scene has a term with a constant Hessian"
+    );
+}

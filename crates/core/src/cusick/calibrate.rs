@@ -145,16 +145,16 @@ pub fn secant_bending_length(
 
 /// The bending length whose simulated drape (seed `p.seed`, continued through c from its first
 /// solve at the bracket's geometric middle) on `mesh` has the drape coefficient `target_dc_pct`
-/// within `dc_tol_pct` ([`secant_bending_length`] over a [`Continuation`]).
+/// within `dc_tol_pct` ([`secant_bending_length`] over `continuation`, which keeps the drapes for
+/// a search that follows).
 pub fn calibrate_bending_length(
     mesh: DiscMesh<'_>,
     target_dc_pct: f64,
     p: &DrapeParams,
     tester: &Tester,
-    bracket_m: [f64; 2],
-    dc_tol_pct: f64,
+    (bracket_m, dc_tol_pct): ([f64; 2], f64),
+    continuation: &mut Continuation,
 ) -> Result<BendingCalibration, String> {
-    let mut continuation = Continuation::default();
     let dc = |c: f64| {
         let q = DrapeParams {
             bending_length_m: c,
@@ -255,7 +255,8 @@ mod tests {
             seed: 1,
             ..DrapeParams::default()
         };
-        let c = calibrate_bending_length(mesh, dc, &p, &t, [0.01, 0.06], 0.5)
+        let mut continuation = Continuation::default();
+        let c = calibrate_bending_length(mesh, dc, &p, &t, ([0.01, 0.06], 0.5), &mut continuation)
             .expect("calibrated")
             .bending_length_m;
         eprintln!("DC {dc:.2} %: c = {c:.5} m against 0.022");

@@ -10,8 +10,8 @@
 //! where it tells the laws apart, and the fit says when it does not (an identifiability flag).
 
 use super::{
-    Continuation, DC_SLOPE_PRIOR_PCT, DiscMesh, DrapeParams, SecantSearch, Tester, mesh_projection,
-    secant_bending_length, shadow_measures, solve_drape,
+    Continuation, DC_SLOPE_PRIOR_PCT, DiscMesh, DrapeParams, SecantSearch, Tester,
+    calibrate_bending_length, mesh_projection, secant_bending_length, shadow_measures, solve_drape,
 };
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -273,19 +273,16 @@ pub fn calibrate_fabric(
 ) -> Result<FabricFit, String> {
     let first = s.laws.first().ok_or("no bending law to try")?;
     let mut continuation = Continuation::default();
-    let mut search = SecantSearch {
-        target_dc_pct: target.dc_pct,
-        start_m: (s.bracket_m[0] * s.bracket_m[1]).sqrt(),
-        slope_pct: DC_SLOPE_PRIOR_PCT,
-        bracket_m: s.bracket_m,
-        dc_tol_pct: s
-            .dc_tol_pct
-            .min(DC_SLOPE_PRIOR_PCT * (1.0 + s.rel_tol).ln() / 2.0),
-        max_solves: 12,
-    };
-    let cal = secant_bending_length(
-        |c| continuation.dc(mesh, &first.apply(base, c), tester),
-        &search,
+    let first_tol = s
+        .dc_tol_pct
+        .min(DC_SLOPE_PRIOR_PCT * (1.0 + s.rel_tol).ln() / 2.0);
+    let cal = calibrate_bending_length(
+        mesh,
+        target.dc_pct,
+        &first.apply(base, s.bracket_m[0]),
+        tester,
+        (s.bracket_m, first_tol),
+        &mut continuation,
     )?;
     let slope = cal.sensitivity_pct(1.3).unwrap_or(DC_SLOPE_PRIOR_PCT);
     let (mut candidates, mut seeded) = (Vec::new(), 0);
@@ -294,10 +291,14 @@ pub fn calibrate_fabric(
         if k > 0 {
             // From the previous law's c and drape; a law that cannot reach the target is left out.
             continuation.keep_nearest(c);
-            search.start_m = c;
-            search.slope_pct = slope;
-            search.dc_tol_pct = s.dc_tol_pct;
-            search.max_solves = 7;
+            let search = SecantSearch {
+                target_dc_pct: target.dc_pct,
+                start_m: c,
+                slope_pct: slope,
+                bracket_m: s.bracket_m,
+                dc_tol_pct: s.dc_tol_pct,
+                max_solves: 7,
+            };
             let dc = |c| continuation.dc(mesh, &law.apply(base, c), tester);
             match secant_bending_length(dc, &search) {
                 Ok(found) => c = found.bending_length_m,

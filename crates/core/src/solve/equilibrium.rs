@@ -78,7 +78,7 @@ impl EquilibriumFactor {
         if dofs.n == 0 {
             return Err(NoFactor::NothingFree);
         }
-        let scale = super::step::mean_free_diagonal(&h, &dofs, model.len());
+        let scale = super::step::mean_free_diagonal(&h, &dofs);
         let mut shift = vec![NEUTRAL_SHIFT_REL * scale; dofs.n];
         let mut held = Vec::new();
         for p in 0..model.len() {
