@@ -398,7 +398,36 @@ fn every_terms_derivatives_in_its_coefficients_match_central_differences() {
             check(t.as_mut(), &x, &loaded.scene.name, &mut rng);
         }
     }
-    // The Cusick disc's orthotropic, saturating hinge bending on a small bent sheet.
+    let (bent, terms) = small_sheet_terms();
+    for (mut t, label) in terms {
+        check(t.as_mut(), &bent, label, &mut rng);
+    }
+    for family in [
+        "springs",
+        "gravity",
+        "bending/continuum",
+        "bending/hinge",
+        "bending/patch",
+        "bending/symmetry-plane",
+        "shear",
+        "twist",
+        "point-loads",
+    ] {
+        assert!(
+            checked.iter().any(|n| n.contains(family)),
+            "no {family} term among {checked:?}"
+        );
+    }
+    eprintln!("terms checked: {checked:?}");
+}
+
+/// A term and the name its check reports.
+type Labelled = (Box<dyn EnergyTerm>, &'static str);
+
+/// A small bent sheet and the terms no bundled grid scene has: the Cusick disc's orthotropic,
+/// saturating hinge bending, a triangulated grid's patch bending (orthotropic, with a twist
+/// rigidity, its warp turned) and a cell's twist.
+fn small_sheet_terms() -> (Vec<Vector3<f64>>, Vec<Labelled>) {
     let n = 6;
     let rest: Vec<[f64; 2]> = (0..n * n)
         .map(|k| [(k % n) as f64 * 0.01, (k / n) as f64 * 0.01])
@@ -413,38 +442,31 @@ fn every_terms_derivatives_in_its_coefficients_match_central_differences() {
             ]
         })
         .collect();
-    let mut hinge =
+    let hinge =
         drapelab_core::physics::saturating_hinge_bending(&rest, &tris, [2e-5, 1e-5], 0.3, 20.0);
     let bent: Vec<Vector3<f64>> = rest
         .iter()
         .map(|p| Vector3::new(p[0], p[1], 3.0 * p[0] * p[0] + 2.0 * p[0] * p[1]))
         .collect();
-    check(&mut hinge, &bent, "cusick hinge", &mut rng);
-    // A cell's twist (no bundled scene gives a twist rigidity).
+    let sheet = drapelab_core::physics::SewnSheet {
+        rest: &rest,
+        rest_triangles: &tris,
+        triangles: &tris,
+    };
+    let patch = drapelab_core::physics::patch_bending(&sheet, [2e-5, 1e-5, 0.7e-5], 0.3);
     let cells: Vec<[usize; 4]> = (0..n - 1)
         .flat_map(|j| {
             (0..n - 1).map(move |i| [id(i, j), id(i + 1, j), id(i, j + 1), id(i + 1, j + 1)])
         })
         .collect();
     let sides = vec![(0.01, 0.01); cells.len()];
-    let mut twist = drapelab_core::physics::CellTwist::cells(cells, &sides, 3e-6);
-    check(&mut twist, &bent, "twisted sheet", &mut rng);
-    for family in [
-        "springs",
-        "gravity",
-        "bending/continuum",
-        "bending/hinge",
-        "bending/symmetry-plane",
-        "shear",
-        "twist",
-        "point-loads",
-    ] {
-        assert!(
-            checked.iter().any(|n| n.contains(family)),
-            "no {family} term among {checked:?}"
-        );
-    }
-    eprintln!("terms checked: {checked:?}");
+    let twist = drapelab_core::physics::CellTwist::cells(cells, &sides, 3e-6);
+    let terms: Vec<Labelled> = vec![
+        (Box::new(hinge), "cusick hinge"),
+        (Box::new(patch), "patch bending"),
+        (Box::new(twist), "twisted sheet"),
+    ];
+    (bent, terms)
 }
 
 /// The model's Hessian, whose constant terms' blocks are made at the first evaluation and kept

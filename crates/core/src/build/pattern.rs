@@ -6,7 +6,10 @@
 
 use crate::material::Rigidities;
 use crate::pattern::Pattern;
-use crate::physics::{Membrane, MembraneError, ModelBuilder, SewnSheet, sewn_hinge_bending};
+use crate::physics::{
+    EnergyTerm, Membrane, MembraneError, ModelBuilder, SewnSheet, patch_bending, reads_creases,
+    sewn_hinge_bending,
+};
 
 /// A pattern and its fabric.
 pub struct PatternSheet<'a> {
@@ -60,15 +63,27 @@ pub fn pattern_builder(
     };
     b.term(Box::new(Membrane::sewn(&sewn, sheet.warp_angle_rad, y)?));
     if r.bending_warp_N_m > 0.0 || r.bending_weft_N_m > 0.0 {
-        b.term(Box::new(sewn_hinge_bending(
-            &sewn,
-            [r.bending_warp_N_m, r.bending_weft_N_m],
-            sheet.warp_angle_rad,
-            f64::INFINITY,
-        )));
+        b.term(bending(&sewn, r, sheet.warp_angle_rad));
     }
     b.gravity();
     Ok(b)
+}
+
+/// The sheet's bending: the orthotropic plate from each triangle's quadratic patch
+/// ([`patch_bending`], exact on quadratics, the grid's twist rigidity included) where the patches
+/// read every crease as curvature across it ([`reads_creases`]: a grid split along one diagonal),
+/// else orthotropic hinges ([`sewn_hinge_bending`], which charge every crease but read twist and
+/// bending across the diagonals two to three times the plate's).
+fn bending(sewn: &SewnSheet<'_>, r: &Rigidities, warp_angle_rad: f64) -> Box<dyn EnergyTerm> {
+    let b = [r.bending_warp_N_m, r.bending_weft_N_m];
+    match reads_creases(sewn) {
+        true => Box::new(patch_bending(
+            sewn,
+            [b[0], b[1], r.bending_twist_N_m],
+            warp_angle_rad,
+        )),
+        false => Box::new(sewn_hinge_bending(sewn, b, warp_angle_rad, f64::INFINITY)),
+    }
 }
 
 /// Builds the model of a validated scene whose sheet is a mesh (`cloth.mesh`): the pattern's

@@ -134,7 +134,7 @@ pub fn sewn_hinge_bending(
 /// The second triangle's opposite vertex laid in the first's rest plane across their shared edge:
 /// `a` and `b` are (edge start, edge end, opposite) of each in its own piece. For two triangles of
 /// one flat piece this is the second's own rest corner.
-fn unfolded(a: &[Vector3<f64>; 3], b: &[Vector3<f64>; 3]) -> Vector3<f64> {
+pub(super) fn unfolded(a: &[Vector3<f64>; 3], b: &[Vector3<f64>; 3]) -> Vector3<f64> {
     let (eb, qb) = (b[1] - b[0], b[2] - b[0]);
     let t = qb.dot(&eb) / eb.norm_squared();
     let h = eb.cross(&qb).norm() / eb.norm();

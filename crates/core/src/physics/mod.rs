@@ -10,6 +10,7 @@ mod kernel;
 mod loads;
 mod membrane;
 mod mesh_bending;
+mod patch_bending;
 mod self_contact;
 mod shear;
 mod springs;
@@ -27,6 +28,7 @@ pub use mesh_bending::{
     SewnSheet, hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending,
     sewn_hinge_bending,
 };
+pub use patch_bending::{patch_bending, reads_creases};
 pub use self_contact::{CandidateSet, SelfContact, SelfContactState};
 pub use shear::{CellShear, ShearKernel};
 pub use springs::{SpringFamily, SpringKernel, Springs};
