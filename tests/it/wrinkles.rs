@@ -257,7 +257,11 @@ fn a_synthetic_cosine_sheet_of_known_n_is_counted_exactly_on_the_grid() {
     // out of plane z = z_max cos(π n η) cos(π x / l) (η the fraction of the way down).
     use drapelab::wrinkles::full::{hung_sheet_scene, sheet_wrinkles};
     let inp = i_h140();
-    let grid = hung_sheet_scene(&inp, 29, 121, 1.0).unwrap().scene.grid();
+    let plate = drapelab::wrinkles::full::SheetReading::Plate { shear_ratio: 1.0 };
+    let grid = hung_sheet_scene(&inp, 29, 121, &plate)
+        .unwrap()
+        .scene
+        .grid();
     let l = drapelab::wrinkles::support_span_m(&inp);
     for n in 1..=12usize {
         let x: Vec<nalgebra::Vector3<f64>> = grid
@@ -297,7 +301,7 @@ fn a_simulated_hung_sheet_holds_its_weight_and_its_wrinkle_count_does_not_depend
             start: HungStart::Arc,
             ripple_amplitude_m: 0.005,
             seed,
-            shear_ratio: 1.0,
+            reading: drapelab::wrinkles::full::SheetReading::Plate { shear_ratio: 1.0 },
         };
         let sol = solve_hung(&inp, (29, 29), &setup).unwrap();
         assert_eq!(sol.report.status, Status::Converged, "{:?}", sol.report);
@@ -352,25 +356,33 @@ from rerun.experimental import RrdReader
 t = pq.read_table(sys.argv[1])
 want = {"case": pa.string(), "n_seed": pa.int32(), "n_tension_field": pa.int32(),
         "n_full_simulation": pa.int32(), "n_full_simulation_coarse": pa.int32(),
-        "z_max_full_simulation_m": pa.float64(), "wall_time_s": pa.float64(), "status": pa.string()}
+        "z_max_full_simulation_m": pa.float64(), "wall_time_s": pa.float64(), "status": pa.string(),
+        "reading": pa.string(), "bending_length_m": pa.float64(), "shear_rigidity_N_per_m": pa.float64()}
 for name, ty in want.items():
     assert t.schema.field(name).type == ty, (name, t.schema.field(name).type)
 rows = t.to_pylist()
-assert [r["case"] for r in rows] == ["I-h90", "II-w33"], rows
+assert [(r["case"], r["reading"]) for r in rows] == [
+    ("I-h90", "plate"), ("II-w33", "plate"), ("I-h90", "fabric"), ("II-w33", "fabric")], rows
 for r in rows:
     assert r["status"] in ("converged", "not converged in the mesh"), r
     assert r["n_seed"] in (5, 6) and r["n_tension_field"] == 0, r  # c = 1931: no tension-field wrinkle
     assert 0.0 < r["z_max_full_simulation_m"] < 1.0 and r["wall_time_s"] > 0.0, r
     assert len(r["line_depths_full_simulation_m"]) == r["n_full_simulation"] + 1, r
     assert r["self_crossing_edges"] == 0, r
+# The plate's bending lengths are centimetres and its shear kN/m; the fabric's the stage's defaults.
+for r in rows[:2]:
+    assert r["bending_length_m"] > 0.03 and r["shear_rigidity_N_per_m"] > 1e4, r
+for r in rows[2:]:
+    assert abs(r["bending_length_m"] - 0.0143) < 1e-12 and r["shear_rigidity_N_per_m"] == 53.3, r
 f = pq.read_table(sys.argv[2]).to_pylist()
-assert {(r["case"], r["mesh"]) for r in f} == {(c, m) for c in ("I-h90", "II-w33") for m in ("fine", "coarse")}
+assert {(r["case"], r["reading"], r["mesh"]) for r in f} == {
+    (c, g, m) for c in ("I-h90", "II-w33") for g in ("plate", "fabric") for m in ("fine", "coarse")}
 s = pq.read_table(sys.argv[3]).to_pylist()
 assert sorted((r["case"], r["start"], r["shear_ratio"]) for r in s) == [
     (c, st, g) for c in ("I-h90", "II-w33") for st, g in (("arc", 1e-4), ("arc", 1.0), ("compressed", 1.0))], s
 assert all(r["self_crossing_edges"] == 0 and r["status"] == "converged" for r in s), s
 meshes = {c.entity_path for c in RrdReader(sys.argv[4]).stream().to_chunks() if c.entity_path.endswith("/mesh")}
-assert len(meshes) == 4, meshes
+assert len(meshes) == 8, meshes
 "#;
     crate::support::run_python(
         code,
@@ -386,6 +398,7 @@ assert len(meshes) == 4, meshes
         "## Three columns side by side",
         "## Does the count depend on the start?",
         "## Which reading of Eq. 7 the simulations support",
+        "## The sheets read as fabric",
         "![the simulated sheets, finer mesh](sheets.png)",
     ] {
         assert!(md.contains(part), "{part} missing from the report");
@@ -408,6 +421,11 @@ fn a_bad_wrinkles_simulate_parameter_exits_2_naming_the_pipeline_and_key() {
             "shear_ratios = [1e-4]",
             "shear_ratios = [0.0]",
             "shear_ratios",
+        ),
+        (
+            "shear_ratios = [1e-4]",
+            "shear_ratios = [1e-4], fabric_bending_length_m = -0.01",
+            "fabric_bending_length_m",
         ),
     ] {
         let (_tmp, file) = crate::support::temp_project(
@@ -435,5 +453,40 @@ fn a_bad_wrinkles_simulate_parameter_exits_2_naming_the_pipeline_and_key() {
         !tmp.path()
             .join("runs/wrinkles_small/full/wrinkles_full.parquet")
             .exists()
+    );
+}
+
+/// Issue 50: I-h140 read as a fabric (bending length 14.3 mm, shear 17 N/m — the soft end of KES
+/// apparel shear) on the 29 × 29 grid folds into more wrinkles than the same sheet read as seed
+/// 002's plate, with one count for three seeds of the start's ripple (measured n = 3 against 1).
+#[test]
+fn a_hung_sheet_read_as_fabric_folds_into_more_wrinkles_than_as_a_plate_whatever_the_seed() {
+    use drapelab::wrinkles::full::{
+        HungSetup, HungStart, SheetReading, sheet_wrinkles, solve_hung,
+    };
+    let inp = i_h140();
+    let count = |reading: SheetReading, seed: u64| {
+        let setup = HungSetup {
+            start: HungStart::Arc,
+            ripple_amplitude_m: 0.005,
+            seed,
+            reading,
+        };
+        let sol = solve_hung(&inp, (29, 29), &setup).unwrap();
+        assert_eq!(sol.report.status, Status::Converged, "{:?}", sol.report);
+        sheet_wrinkles(&sol.grid, &sol.x, 0.005).n
+    };
+    let fabric = SheetReading::Fabric {
+        bending_length_m: 0.0143,
+        shear_N_per_m: 17.0,
+    };
+    let plate = SheetReading::Plate { shear_ratio: 1.0 };
+    assert!(fabric.bending_length_m(&inp) < 0.3 * plate.bending_length_m(&inp));
+    let fabrics: Vec<usize> = [1, 2, 3].map(|seed| count(fabric, seed)).to_vec();
+    let plates: Vec<usize> = [1, 2, 3].map(|seed| count(plate, seed)).to_vec();
+    assert!(
+        fabrics.iter().all(|&n| n == fabrics[0])
+            && fabrics[0] > plates.iter().copied().max().unwrap(),
+        "n by seed: fabric {fabrics:?}, plate {plates:?}"
     );
 }

@@ -12,7 +12,7 @@ use drapelab_core::cloth::Grid;
 use drapelab_core::solve::{SolveReport, Status};
 use drapelab_core::table::Table;
 use drapelab_core::wrinkles::full::{
-    self, FibreWrinkles, HungSetup, HungStart, LeaveOneOut, leave_one_out,
+    self, FibreWrinkles, HungSetup, HungStart, LeaveOneOut, SheetReading, leave_one_out,
 };
 use drapelab_core::wrinkles::{WrinkleConfig, WrinkleInputs, WrinkleMesh, WrinkleResult};
 use nalgebra::Vector3;
@@ -64,8 +64,29 @@ pub struct WrinklesSimulateParams {
     /// Only the cases of these names (empty: every case). Default empty.
     #[serde(default)]
     pub cases: Vec<String>,
+    /// Solve every case read as a fabric too, on both meshes (issue 50). Default true.
+    #[serde(default = "default_true")]
+    pub fabric: bool,
+    /// The fabric reading's bending length c, m: bending rigidity w c³ both ways (Peirce), no
+    /// twist rigidity. Default 0.0143, the geometric middle of the 7–29 mm at which the bundled
+    /// Cusick fabrics calibrate — chosen from fabrics, not from the seed's counts.
+    #[serde(default = "default_fabric_bending_length")]
+    pub fabric_bending_length_m: f64,
+    /// The fabric reading's in-plane shear rigidity G, N/m. Default 53.3: 0.95 gf/cm/deg, the
+    /// geometric middle of KES shear of apparel fabrics (0.3–3 gf/cm/deg).
+    #[serde(default = "default_fabric_shear")]
+    pub fabric_shear_N_per_m: f64,
 }
 
+fn default_true() -> bool {
+    true
+}
+fn default_fabric_bending_length() -> f64 {
+    0.0143
+}
+fn default_fabric_shear() -> f64 {
+    53.3
+}
 fn default_coarse_nx() -> usize {
     57
 }
@@ -112,6 +133,9 @@ impl Default for WrinklesSimulateParams {
             thresholds_rel: default_thresholds(),
             buckling_constants: default_constants(),
             cases: Vec::new(),
+            fabric: true,
+            fabric_bending_length_m: default_fabric_bending_length(),
+            fabric_shear_N_per_m: default_fabric_shear(),
         }
     }
 }
@@ -202,7 +226,16 @@ impl WrinklesSimulateParams {
             start: v.start,
             ripple_amplitude_m: self.ripple_amplitude_m,
             seed: self.seed,
-            shear_ratio: v.shear_ratio,
+            reading: SheetReading::Plate {
+                shear_ratio: v.shear_ratio,
+            },
+        }
+    }
+    /// The fabric reading of these parameters.
+    pub fn fabric_reading(&self) -> SheetReading {
+        SheetReading::Fabric {
+            bending_length_m: self.fabric_bending_length_m,
+            shear_N_per_m: self.fabric_shear_N_per_m,
         }
     }
 }
@@ -217,16 +250,24 @@ pub struct SimulatedCase {
     pub seed: Option<drapelab_core::wrinkles::SeedResult>,
     /// drapelab's tension-field model with the config's ν and c.
     pub tension_field: WrinkleResult,
-    /// The coarser mesh's solve.
-    pub coarse: SheetSolve,
-    /// The finer mesh's solve.
-    pub fine: SheetSolve,
+    /// The case read as seed 002's plate, from the result's start on both meshes.
+    pub plate: MeshPair,
     /// The other variants' solves on the coarser mesh: the other starts (shear ratio 1), then the
     /// result's start with each of the other shear stiffnesses.
     pub others: Vec<(Variant, SheetSolve)>,
+    /// The case read as a fabric, from the result's start on both meshes (issue 50), if asked.
+    pub fabric: Option<MeshPair>,
 }
 
-impl SimulatedCase {
+/// One reading of a case solved on both meshes.
+pub struct MeshPair {
+    /// The coarser mesh's solve.
+    pub coarse: SheetSolve,
+    /// The finer mesh's solve, the result.
+    pub fine: SheetSolve,
+}
+
+impl MeshPair {
     /// Both solves reached an equilibrium.
     pub fn solved(&self) -> bool {
         [&self.coarse, &self.fine]
@@ -275,6 +316,8 @@ pub struct WrinklesFull {
     pub tension_field_n: Vec<Vec<usize>>,
     /// The constant chosen by leave-one-out on agreement (±1) with the full simulation.
     pub constant: LeaveOneOut,
+    /// The same against the sheets read as fabric (issue 50), where every case has them.
+    pub constant_fabric: Option<LeaveOneOut>,
 }
 
 impl WrinklesFull {
@@ -289,8 +332,20 @@ impl WrinklesFull {
     }
     fn agreement_rows(&self) -> Vec<Vec<bool>> {
         let t = self.threshold_rel();
-        let n: Vec<usize> = self.cases.iter().map(|c| c.fine.wrinkles(t).n).collect();
+        let n: Vec<usize> = self
+            .cases
+            .iter()
+            .map(|c| c.plate.fine.wrinkles(t).n)
+            .collect();
         self.agreement_with(&n)
+    }
+    /// The fabric reading's counts (finer mesh), one per case, if every case has them.
+    pub fn fabric_counts(&self) -> Option<Vec<usize>> {
+        let t = self.threshold_rel();
+        self.cases
+            .iter()
+            .map(|c| c.fabric.as_ref().map(|f| f.fine.wrinkles(t).n))
+            .collect()
     }
     /// For each case and constant: is the tension field within ±1 of `n[case]`?
     pub fn agreement_with(&self, n: &[usize]) -> Vec<Vec<bool>> {
@@ -361,6 +416,12 @@ impl WrinklesSimulateParams {
         {
             return bad("shear_ratios", "must be positive fractions");
         }
+        if !(self.fabric_bending_length_m.is_finite() && self.fabric_bending_length_m > 0.0) {
+            return bad("fabric_bending_length_m", "must be a positive length in m");
+        }
+        if !(self.fabric_shear_N_per_m.is_finite() && self.fabric_shear_N_per_m > 0.0) {
+            return bad("fabric_shear_N_per_m", "must be a positive rigidity in N/m");
+        }
         Ok(())
     }
 }
@@ -393,20 +454,30 @@ pub fn simulate(
         .iter()
         .filter(|c| p.cases.is_empty() || p.cases.contains(&c.case))
         .collect();
-    // Finer meshes first: the longest solves start first. Job (case, nx, variant).
+    // Finer meshes first: the longest solves start first. Job (case, nx, setup): the plate's
+    // finer mesh, every variant's coarser one, then the fabric's finer and coarser meshes.
     let variants = p.variants();
-    let mut jobs: Vec<(usize, usize, Variant)> = (0..chosen.len())
-        .map(|k| (k, p.fine_nx, variants[0]))
+    let n = chosen.len();
+    let fabric = HungSetup {
+        reading: p.fabric_reading(),
+        ..p.setup(variants[0])
+    };
+    let mut jobs: Vec<(usize, usize, HungSetup)> = (0..n)
+        .map(|k| (k, p.fine_nx, p.setup(variants[0])))
         .collect();
     for v in &variants {
-        jobs.extend((0..chosen.len()).map(|k| (k, p.coarse_nx, *v)));
+        jobs.extend((0..n).map(|k| (k, p.coarse_nx, p.setup(*v))));
+    }
+    if p.fabric {
+        jobs.extend((0..n).map(|k| (k, p.fine_nx, fabric)));
+        jobs.extend((0..n).map(|k| (k, p.coarse_nx, fabric)));
     }
     ctx.started(jobs.len());
     let mut solves: Vec<Option<SheetSolve>> = jobs
         .par_iter()
-        .map(|&(k, nx, v)| {
+        .map(|&(k, nx, setup)| {
             let inp = chosen[k].inputs(&cfg.defaults);
-            let s = full::solve_hung(&inp, case_grid(&inp, nx), &p.setup(v));
+            let s = full::solve_hung(&inp, case_grid(&inp, nx), &setup);
             ctx.item_done();
             s.map(|s| SheetSolve {
                 grid: s.grid,
@@ -416,7 +487,7 @@ pub fn simulate(
             .map(Some)
         })
         .collect::<std::result::Result<_, _>>()?;
-    let n = chosen.len();
+    let fabric_at = (variants.len() + 1) * n;
     let cases: Vec<SimulatedCase> = chosen
         .iter()
         .enumerate()
@@ -428,13 +499,19 @@ pub fn simulate(
                 tension_field: drapelab_core::wrinkles::solve(&inputs),
                 inputs,
                 seed: c.seed.clone(),
-                fine: take(k),
-                coarse: take(n + k),
+                plate: MeshPair {
+                    fine: take(k),
+                    coarse: take(n + k),
+                },
                 others: variants[1..]
                     .iter()
                     .enumerate()
                     .map(|(o, v)| (*v, take((o + 2) * n + k)))
                     .collect(),
+                fabric: p.fabric.then(|| MeshPair {
+                    fine: take(fabric_at + k),
+                    coarse: take(fabric_at + n + k),
+                }),
             }
         })
         .collect();
@@ -448,7 +525,7 @@ fn choose(cases: Vec<SimulatedCase>, p: &WrinklesSimulateParams) -> WrinklesFull
         .map(|c| {
             p.thresholds_rel
                 .iter()
-                .map(|&t| c.mesh_converged(t))
+                .map(|&t| c.plate.mesh_converged(t))
                 .collect()
         })
         .collect();
@@ -478,8 +555,12 @@ fn choose(cases: Vec<SimulatedCase>, p: &WrinklesSimulateParams) -> WrinklesFull
             chosen: 0,
             held_out: Vec::new(),
         },
+        constant_fabric: None,
     };
     out.constant = leave_one_out(&out.agreement_rows());
+    out.constant_fabric = out
+        .fabric_counts()
+        .map(|n| leave_one_out(&out.agreement_with(&n)));
     out
 }
 
@@ -504,6 +585,13 @@ pub struct WrinkleFullRow {
     /// "converged", "not converged in the mesh" (the meshes disagree on n or on z_max by more than
     /// 10 %), or "not converged: STATUS (GRID)" for a solve that stopped early.
     pub status: String,
+    /// How the sheet's bending and shear were read from the case: "plate" (seed 002's E t³/12 and
+    /// E t/2(1 + ν)) or "fabric" (a bending length and a shear rigidity of real fabrics).
+    pub reading: String,
+    /// The sheet's bending length (B/w)^(1/3), m.
+    pub bending_length_m: f64,
+    /// The sheet's in-plane shear rigidity, N/m.
+    pub shear_rigidity_N_per_m: f64,
     /// The same on the coarser mesh, m.
     pub z_max_full_simulation_coarse_m: f64,
     /// The seed's z_max, m.
@@ -547,6 +635,8 @@ impl Table for WrinkleFullRow {
 pub struct FibreRow {
     /// Case name.
     pub case: String,
+    /// "plate" or "fabric".
+    pub reading: String,
     /// "fine" or "coarse".
     pub mesh: String,
     /// Grid row from the top (0: the supports' row).
@@ -610,7 +700,7 @@ pub fn start_rows(found: &WrinklesFull, result_start: HungStart) -> Vec<StartRow
         let iso = c.inputs.youngs_modulus_Pa * c.inputs.thickness_m
             / (2.0 * (1.0 + c.inputs.poisson_ratio));
         for (v, s) in
-            std::iter::once((result, &c.coarse)).chain(c.others.iter().map(|(v, s)| (*v, s)))
+            std::iter::once((result, &c.plate.coarse)).chain(c.others.iter().map(|(v, s)| (*v, s)))
         {
             let w = s.wrinkles(t);
             out.push(StartRow {
@@ -632,61 +722,83 @@ pub fn start_rows(found: &WrinklesFull, result_start: HungStart) -> Vec<StartRow
     out
 }
 
-/// The result table.
-pub fn rows(found: &WrinklesFull) -> Vec<WrinkleFullRow> {
-    let t = found.threshold_rel();
-    found
+/// The result table: every case read as a plate, then every case read as a fabric.
+pub fn rows(found: &WrinklesFull, p: &WrinklesSimulateParams) -> Vec<WrinkleFullRow> {
+    let plate = SheetReading::Plate { shear_ratio: 1.0 };
+    let fabric = p.fabric_reading();
+    let plates = found.cases.iter().map(|c| row(found, c, &plate, &c.plate));
+    let fabrics = found
         .cases
         .iter()
-        .map(|c| {
-            let (wf, wc) = (c.fine.wrinkles(t), c.coarse.wrinkles(t));
-            let grid = |s: &SheetSolve| format!("{}x{}", s.grid.nx, s.grid.ny);
-            WrinkleFullRow {
-                case: c.case.clone(),
-                n_seed: c.seed.as_ref().map(|r| r.n as i32),
-                n_tension_field: c.tension_field.n as i32,
-                n_full_simulation: wf.n as i32,
-                n_full_simulation_coarse: wc.n as i32,
-                z_max_full_simulation_m: wf.zmax_m,
-                wall_time_s: c.fine.report.wall_time_s + c.coarse.report.wall_time_s,
-                status: c.status(t),
-                z_max_full_simulation_coarse_m: wc.zmax_m,
-                z_max_seed_m: c.seed.as_ref().map(|r| r.zmax_cm / 100.0),
-                z_max_tension_field_m: c.tension_field.zmax_m,
-                q_seed: c.seed.as_ref().map(|r| r.q),
-                q_tension_field: c.tension_field.q,
-                q_full_simulation: wf.q,
-                line_depths_full_simulation_m: wf.line_depths_m,
-                threshold_rel: t,
-                grid: grid(&c.fine),
-                grid_coarse: grid(&c.coarse),
-                iterations: c.fine.report.iterations as u32,
-                iterations_coarse: c.coarse.report.iterations as u32,
-                wall_time_fine_s: c.fine.report.wall_time_s,
-                energy_J: c.fine.report.energy_J,
-                self_crossing_edges: c.fine.self_crossings() as u32,
-            }
-        })
-        .collect()
+        .filter_map(|c| Some(row(found, c, &fabric, c.fabric.as_ref()?)));
+    plates.chain(fabrics).collect()
+}
+
+/// One case under one reading.
+fn row(
+    found: &WrinklesFull,
+    c: &SimulatedCase,
+    reading: &SheetReading,
+    pair: &MeshPair,
+) -> WrinkleFullRow {
+    let t = found.threshold_rel();
+    let (wf, wc) = (pair.fine.wrinkles(t), pair.coarse.wrinkles(t));
+    let grid = |s: &SheetSolve| format!("{}x{}", s.grid.nx, s.grid.ny);
+    WrinkleFullRow {
+        case: c.case.clone(),
+        n_seed: c.seed.as_ref().map(|r| r.n as i32),
+        n_tension_field: c.tension_field.n as i32,
+        n_full_simulation: wf.n as i32,
+        n_full_simulation_coarse: wc.n as i32,
+        z_max_full_simulation_m: wf.zmax_m,
+        wall_time_s: pair.fine.report.wall_time_s + pair.coarse.report.wall_time_s,
+        status: pair.status(t),
+        reading: reading.name().into(),
+        bending_length_m: reading.bending_length_m(&c.inputs),
+        shear_rigidity_N_per_m: reading.rigidities(&c.inputs).2,
+        z_max_full_simulation_coarse_m: wc.zmax_m,
+        z_max_seed_m: c.seed.as_ref().map(|r| r.zmax_cm / 100.0),
+        z_max_tension_field_m: c.tension_field.zmax_m,
+        q_seed: c.seed.as_ref().map(|r| r.q),
+        q_tension_field: c.tension_field.q,
+        q_full_simulation: wf.q,
+        line_depths_full_simulation_m: wf.line_depths_m,
+        threshold_rel: t,
+        grid: grid(&pair.fine),
+        grid_coarse: grid(&pair.coarse),
+        iterations: pair.fine.report.iterations as u32,
+        iterations_coarse: pair.coarse.report.iterations as u32,
+        wall_time_fine_s: pair.fine.report.wall_time_s,
+        energy_J: pair.fine.report.energy_J,
+        self_crossing_edges: pair.fine.self_crossings() as u32,
+    }
+}
+
+/// Each case's readings: ("plate", its solves), then ("fabric", its solves) where solved.
+fn readings(c: &SimulatedCase) -> impl Iterator<Item = (&'static str, &MeshPair)> {
+    std::iter::once(("plate", &c.plate)).chain(c.fabric.as_ref().map(|f| ("fabric", f)))
 }
 
 /// The centre fibres of both meshes.
 pub fn fibre_rows(found: &WrinklesFull) -> Vec<FibreRow> {
     let mut out = Vec::new();
     for c in &found.cases {
-        for (mesh, s) in [("fine", &c.fine), ("coarse", &c.coarse)] {
-            out.extend(
-                s.fibre()
-                    .into_iter()
-                    .enumerate()
-                    .map(|(k, (d, y))| FibreRow {
-                        case: c.case.clone(),
-                        mesh: mesh.into(),
-                        row: k as i32,
-                        depth_m: d,
-                        out_of_plane_m: y,
-                    }),
-            );
+        for (reading, pair) in readings(c) {
+            for (mesh, s) in [("fine", &pair.fine), ("coarse", &pair.coarse)] {
+                out.extend(
+                    s.fibre()
+                        .into_iter()
+                        .enumerate()
+                        .map(|(k, (d, y))| FibreRow {
+                            case: c.case.clone(),
+                            reading: reading.into(),
+                            mesh: mesh.into(),
+                            row: k as i32,
+                            depth_m: d,
+                            out_of_plane_m: y,
+                        }),
+                );
+            }
         }
     }
     out
@@ -703,7 +815,7 @@ pub fn write_outputs(
         drapelab_record::write_table(out, &start_rows(found, p.start))?;
     }
     if let Some(out) = ctx.optional_output("table") {
-        drapelab_record::write_table(out, &rows(found))?;
+        drapelab_record::write_table(out, &rows(found, p))?;
     }
     if let Some(out) = ctx.optional_output("fibres") {
         drapelab_record::write_table(out, &fibre_rows(found))?;
@@ -713,10 +825,12 @@ pub fn write_outputs(
             .cases
             .iter()
             .flat_map(|c| {
-                [
-                    (format!("{}/fine", c.case), c.fine.mesh()),
-                    (format!("{}/coarse", c.case), c.coarse.mesh()),
-                ]
+                readings(c).flat_map(move |(reading, pair)| {
+                    [
+                        (format!("{}/{reading}/fine", c.case), pair.fine.mesh()),
+                        (format!("{}/{reading}/coarse", c.case), pair.coarse.mesh()),
+                    ]
+                })
             })
             .collect();
         drapelab_record::write_wrinkle_meshes(out, &meshes)?;

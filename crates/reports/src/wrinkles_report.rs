@@ -74,7 +74,11 @@ pub fn threshold_section(found: &WrinklesFull) -> String {
         "| lobe threshold (fraction of z_max) | cases converged in the mesh |\n|---|---|\n",
     );
     for (k, t) in found.thresholds_rel.iter().enumerate() {
-        let hits = found.cases.iter().filter(|c| c.mesh_converged(*t)).count();
+        let hits = found
+            .cases
+            .iter()
+            .filter(|c| c.plate.mesh_converged(*t))
+            .count();
         let mark = if k == found.threshold.chosen {
             " (chosen)"
         } else {
@@ -254,7 +258,7 @@ pub fn fibres_svg(found: &WrinklesFull) -> Result<String> {
         let areas = root.split_evenly((rows_n, cols));
         let t = found.threshold_rel();
         for (c, area) in found.cases.iter().zip(&areas) {
-            let (ff, fc) = (c.fine.fibre(), c.coarse.fibre());
+            let (ff, fc) = (c.plate.fine.fibre(), c.plate.coarse.fibre());
             let depth = ff.iter().chain(&fc).fold(0.0f64, |m, p| m.max(p.0)) * 100.0;
             let ymax = ff
                 .iter()
@@ -262,7 +266,7 @@ pub fn fibres_svg(found: &WrinklesFull) -> Result<String> {
                 .fold(1.0f64, |m, p| m.max(100.0 * p.1.abs()));
             let mut chart = crate::cusick_plots::panel(
                 area,
-                &format!("{}: n = {}", c.case, c.fine.wrinkles(t).n),
+                &format!("{}: n = {}", c.case, c.plate.fine.wrinkles(t).n),
                 (-ymax * 1.1..ymax * 1.1, "out of plane (cm)"),
                 (-depth - 2.0..2.0, "height below supports (cm)", 6),
             )?;
@@ -272,7 +276,7 @@ pub fn fibres_svg(found: &WrinklesFull) -> Result<String> {
                     colour.stroke_width(2),
                 ))?;
             }
-            let lines = c.fine.wrinkles(t).line_depths_m;
+            let lines = c.plate.fine.wrinkles(t).line_depths_m;
             chart.draw_series(
                 lines
                     .iter()
@@ -284,26 +288,138 @@ pub fn fibres_svg(found: &WrinklesFull) -> Result<String> {
     Ok(out)
 }
 
-/// The simulated sheets (finer mesh), four to a row.
+/// The simulated sheets (finer mesh), four to a row: each case read as a plate, then beside it
+/// read as a fabric where it was.
 pub fn sheets_png(found: &WrinklesFull) -> image::RgbImage {
-    let present: Vec<Vec<bool>> = found
+    let sheets: Vec<(String, &drapelab_app::wrinkles_full::SheetSolve)> = found
         .cases
         .iter()
-        .map(|c| vec![true; c.fine.grid.len()])
+        .flat_map(|c| {
+            std::iter::once((format!("{} plate", c.case), &c.plate.fine)).chain(
+                c.fabric
+                    .as_ref()
+                    .map(|f| (format!("{} fabric", c.case), &f.fine)),
+            )
+        })
         .collect();
-    let tiles: Vec<crate::montage::Tile<'_>> = found
-        .cases
+    let tiles: Vec<crate::montage::Tile<'_>> = sheets
         .iter()
-        .zip(present)
-        .map(|(c, present)| crate::montage::Tile {
-            name: &c.case,
-            grid: &c.fine.grid,
-            x: &c.fine.x[..c.fine.grid.len()],
-            present,
+        .map(|(name, s)| crate::montage::Tile {
+            name,
+            grid: &s.grid,
+            x: &s.x[..s.grid.len()],
+            present: vec![true; s.grid.len()],
             from_above: false,
         })
         .collect();
     crate::montage::montage(&tiles)
+}
+
+/// The twelve sheets read as fabric (issue 50) beside the plates: n on both meshes, the tension
+/// field's agreement with them and Eq. 7's constant chosen against them by leave-one-out, and
+/// each table's trend in sign against the seed's.
+pub fn fabric_section(
+    found: &WrinklesFull,
+    plates: &[WrinkleFullRow],
+    fabrics: &[WrinkleFullRow],
+) -> String {
+    let mut s = String::from(
+        "| case | n: seed | n: tension field | n: plate | **n: fabric** (coarse) | z_max cm: plate | fabric | bending length mm: plate | fabric | shear N/m: plate | fabric | status (fabric) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for (p, f) in plates.iter().zip(fabrics) {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | **{}** ({}) | {:.1} | {:.1} | {:.0} | {:.1} | {:.0} | {:.0} | {} |",
+            p.case,
+            opt(p.n_seed.map(f64::from), 0),
+            p.n_tension_field,
+            p.n_full_simulation,
+            f.n_full_simulation,
+            f.n_full_simulation_coarse,
+            100.0 * p.z_max_full_simulation_m,
+            100.0 * f.z_max_full_simulation_m,
+            1000.0 * p.bending_length_m,
+            1000.0 * f.bending_length_m,
+            p.shear_rigidity_N_per_m,
+            f.shear_rigidity_N_per_m,
+            f.status,
+        );
+    }
+    let n = fabrics.len();
+    let (converged, tf, seed) = agreement_counts(fabrics);
+    let _ = write!(
+        s,
+        "\n**{converged} of {n}** fabric sheets converged in the mesh; the tension field (the config's c) is \
+within ±1 of them in **{tf} of {n}**, the seed's table in **{seed} of {n}**. {}\n\n{}",
+        fabric_constant(found),
+        trends(plates, fabrics)
+    );
+    s
+}
+
+/// Eq. 7's constant chosen by leave-one-out against the fabric sheets, with its held-out score.
+fn fabric_constant(found: &WrinklesFull) -> String {
+    let Some(loo) = &found.constant_fabric else {
+        return String::new();
+    };
+    format!(
+        "Eq. 7's constant chosen by leave-one-out on agreement (±1) with the fabric sheets: c = {:.0}, the \
+case left out within ±1 in **{} of {}** (per fold: {}).",
+        found.buckling_constants[loo.chosen],
+        loo.held_out_hits(),
+        loo.held_out.len(),
+        loo.held_out
+            .iter()
+            .map(|h| format!("{:.0}", found.buckling_constants[h.0]))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
+/// Each table's trend (its cases in the config's order, the varied quantity rising): the sign of
+/// n's change from the first case to the last, the seed's against the plate's and the fabric's.
+fn trends(plates: &[WrinkleFullRow], fabrics: &[WrinkleFullRow]) -> String {
+    let table = |r: &WrinkleFullRow| r.case.split('-').next().unwrap_or("").to_string();
+    let sign = |a: i32, b: i32| match b.cmp(&a) {
+        std::cmp::Ordering::Greater => "rises",
+        std::cmp::Ordering::Less => "falls",
+        std::cmp::Ordering::Equal => "stays",
+    };
+    let mut s = String::from(
+        "| table | cases | seed's n | plate's n | fabric's n |\n|---|---|---|---|---|\n",
+    );
+    let mut names: Vec<String> = plates.iter().map(table).collect();
+    names.dedup();
+    for name in names {
+        let mine = |rows: &[WrinkleFullRow]| -> Vec<WrinkleFullRow> {
+            rows.iter().filter(|r| table(r) == name).cloned().collect()
+        };
+        let (p, f) = (mine(plates), mine(fabrics));
+        let seq = |rows: &[WrinkleFullRow], n: fn(&WrinkleFullRow) -> Option<i32>| {
+            let v: Vec<i32> = rows.iter().filter_map(n).collect();
+            match (v.first(), v.last()) {
+                (Some(&a), Some(&b)) => format!(
+                    "{} ({})",
+                    sign(a, b),
+                    v.iter().map(i32::to_string).collect::<Vec<_>>().join(", ")
+                ),
+                _ => "–".into(),
+            }
+        };
+        let _ = writeln!(
+            s,
+            "| {name} | {} | {} | {} | {} |",
+            p.iter()
+                .map(|r| r.case.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            seq(&p, |r| r.n_seed),
+            seq(&p, |r| Some(r.n_full_simulation)),
+            seq(&f, |r| Some(r.n_full_simulation)),
+        );
+    }
+    s
 }
 
 /// The tension-field model's own table (the `wrinkles` stage's report body).
@@ -354,7 +470,11 @@ pub fn markdown(
     p: &WrinklesSimulateParams,
 ) -> String {
     // Both tables once: each row counts its sheet's self-crossings.
-    let r = rows(found);
+    let all = rows(found, p);
+    let reading = |name: &str| -> Vec<WrinkleFullRow> {
+        all.iter().filter(|x| x.reading == name).cloned().collect()
+    };
+    let (r, fabrics) = (reading("plate"), reading("fabric"));
     let starts = start_rows(found, p.start);
     let n = r.len();
     let (converged, tf, seed) = agreement_counts(&r);
@@ -384,7 +504,7 @@ mesh, the result; in brackets the coarser one. Self-crossing edges (the sheet pa
         let _ = write!(
             s,
             "\n![the simulated sheets, finer mesh]({png})\n\nThe simulated sheets on the finer mesh, 30° \
-above the horizon and turned 30°, in the order of the table.\n"
+above the horizon and turned 30°, in the order of the table: each case read as a plate, then as a fabric.\n"
         );
     }
     if let Some(svg) = name("fibres_plot") {
@@ -392,6 +512,14 @@ above the horizon and turned 30°, in the order of the table.\n"
             s,
             "\n![centre fibres]({svg})\n\nThe centre fibre of each sheet: out-of-plane displacement against \
 height below the supports, finer mesh dark, coarser light; red dots: the wrinkle lines counted.\n"
+        );
+    }
+    if !fabrics.is_empty() {
+        let _ = write!(
+            s,
+            "\n## The sheets read as fabric\n\n{}\n{}",
+            crate::wrinkles_text::FABRIC,
+            fabric_section(found, &r, &fabrics)
         );
     }
     let _ = write!(

@@ -89,6 +89,17 @@ speak of.",
     s
 }
 
+/// What the fabric reading is and where its rigidities come from (issue 50).
+pub const FABRIC: &str = "Seed 002 gives each sheet E, t and ν, and reading them as a plate gives bending \
+D = E t³/12(1 − ν²) and shear E t/2(1 + ν): bending lengths (D/w)^(1/3) of 3–8 cm and shear of kN/m. A woven \
+or knitted fabric's yarns slide, so its bending and shear are far below the plate's of the same E·t: the \
+Cusick fabrics drapelab calibrates have bending lengths of 7–29 mm, KES shear rigidities of apparel fabrics \
+are 0.3–3 gf/cm/deg (17–170 N/m). The fabric reading keeps each case's size, weight, supports and tensile \
+rigidity E·t and gives every sheet one bending length and one shear rigidity, the geometric middles of those \
+ranges (the stage's `fabric_bending_length_m`, `fabric_shear_N_per_m`; bending w c³ both ways, no twist \
+rigidity, as seed 003's KES fabrics): chosen from fabrics, not from the seed's counts. Thickness and modulus \
+then enter only through E·t, which an almost inextensible sheet hardly feels.\n";
+
 /// The findings written from the numbers.
 pub fn findings(
     found: &WrinklesFull,

@@ -12,20 +12,74 @@ use rand::{Rng, SeedableRng};
 use serde::Serialize;
 use std::path::Path;
 
+/// How a hung sheet's bending and shear are read from its case (issue 50): seed 002 gives only
+/// E, t and ν, which make a plate; a woven or knitted fabric's yarns slide, so its bending and
+/// shear are far below the plate's of the same E·t.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "reading", rename_all = "lowercase")]
+pub enum SheetReading {
+    /// Seed 002's isotropic plate: bending and twist D = E t³/(12(1 − ν²)), shear `shear_ratio`
+    /// times E·t/(2(1 + ν)) (1: the seed's sheet).
+    Plate {
+        /// In-plane shear stiffness as a fraction of the isotropic E·t/(2(1 + ν)).
+        shear_ratio: f64,
+    },
+    /// A fabric: bending rigidity w c³ both ways from its bending length c (Peirce's
+    /// cantilever, c = (B/w)^(1/3), w the case's weight per area), no twist rigidity (as seed 003's
+    /// KES fabrics), in-plane shear G; the tensile rigidity stays the case's E·t.
+    Fabric {
+        /// Bending length c, m (the Cusick fabrics drapelab calibrates span 7–29 mm).
+        bending_length_m: f64,
+        /// In-plane shear rigidity G, N/m (KES shear of apparel fabrics, 0.3–3 gf/cm/deg, is
+        /// 17–170 N/m).
+        shear_N_per_m: f64,
+    },
+}
+
+impl SheetReading {
+    /// "plate" or "fabric".
+    pub fn name(&self) -> &'static str {
+        match self {
+            SheetReading::Plate { .. } => "plate",
+            SheetReading::Fabric { .. } => "fabric",
+        }
+    }
+    /// (bending warp = weft, twist, shear) of a case under this reading: N·m, N·m, N/m.
+    pub fn rigidities(&self, inp: &WrinkleInputs) -> (f64, f64, f64) {
+        let nu = inp.poisson_ratio;
+        let e_t = inp.youngs_modulus_Pa * inp.thickness_m;
+        match *self {
+            SheetReading::Plate { shear_ratio } => {
+                let d = e_t * inp.thickness_m.powi(2) / (12.0 * (1.0 - nu * nu));
+                (d, d, shear_ratio * e_t / (2.0 * (1.0 + nu)))
+            }
+            SheetReading::Fabric {
+                bending_length_m,
+                shear_N_per_m,
+            } => (
+                inp.weight_N_per_m2 * bending_length_m.powi(3),
+                0.0,
+                shear_N_per_m,
+            ),
+        }
+    }
+    /// The bending length (B/w)^(1/3) of a case under this reading, m.
+    pub fn bending_length_m(&self, inp: &WrinkleInputs) -> f64 {
+        (self.rigidities(inp).0 / inp.weight_N_per_m2).cbrt()
+    }
+}
+
 /// The continuum scene of a case on an `nx × ny` grid: the rest state is the flat L × h sheet (grid
-/// x along the supports, grid y up the sheet, the top row at y = h), its two top corners pinned.
-/// The in-plane shear stiffness is `shear_ratio` times the isotropic E·t/(2(1 + ν)) (1: the seed's
-/// isotropic sheet; a woven fabric's is two to four orders of magnitude lower).
+/// x along the supports, grid y up the sheet, the top row at y = h), its two top corners pinned;
+/// membrane E·t both ways, bending, twist and shear as `reading` says.
 pub fn hung_sheet_scene(
     inp: &WrinkleInputs,
     nx: usize,
     ny: usize,
-    shear_ratio: f64,
+    reading: &SheetReading,
 ) -> Result<LoadedScene, InputError> {
-    let nu = inp.poisson_ratio;
     let e_t = inp.youngs_modulus_Pa * inp.thickness_m;
-    let g_t = shear_ratio * e_t / (2.0 * (1.0 + nu));
-    let d = inp.youngs_modulus_Pa * inp.thickness_m.powi(3) / (12.0 * (1.0 - nu * nu));
+    let (d, twist, g_t) = reading.rigidities(inp);
     let rho = inp.weight_N_per_m2 / crate::STANDARD_GRAVITY_M_PER_S2;
     let text = format!(
         "name = \"wrinkles-full\"\n\
@@ -33,7 +87,7 @@ pub fn hung_sheet_scene(
          areal_density_kg_per_m2 = {rho}\n\
          [material.continuum]\ntensile_warp_N_per_m = {e_t}\ntensile_weft_N_per_m = {e_t}\n\
          shear_N_per_m = {g_t}\nbending_warp_N_m = {d}\nbending_weft_N_m = {d}\n\
-         bending_twist_N_m = {d}\nthickness_m = {t}\n\
+         bending_twist_N_m = {twist}\nthickness_m = {t}\n\
          [boundary]\npin_corners = [\"xmin_ymax\", \"xmax_ymax\"]\n\
          [solver]\nkind = \"static\"\n[solver.static]\nmax_iterations = 3000\n",
         L = inp.length_m,
@@ -180,8 +234,8 @@ pub struct HungSetup {
     pub ripple_amplitude_m: f64,
     /// Seed of the ripple.
     pub seed: u64,
-    /// In-plane shear stiffness as a fraction of the isotropic E·t/(2(1 + ν)).
-    pub shear_ratio: f64,
+    /// How the sheet's bending and shear are read from the case.
+    pub reading: SheetReading,
 }
 
 /// A case solved on an `nx × ny` grid as `setup` says: the static equilibrium (or why there is
@@ -191,7 +245,7 @@ pub fn solve_hung(
     (nx, ny): (usize, usize),
     setup: &HungSetup,
 ) -> Result<crate::simulate::Solution, InputError> {
-    let loaded = hung_sheet_scene(inp, nx, ny, setup.shear_ratio)?;
+    let loaded = hung_sheet_scene(inp, nx, ny, &setup.reading)?;
     let start = hung_start(
         inp,
         &loaded.scene.grid(),
@@ -372,7 +426,8 @@ mod tests {
             initial_zmax_m: 0.014,
             simpson_intervals: 200,
         };
-        let loaded = hung_sheet_scene(&inp, 15, 15, 1.0).expect("a valid scene");
+        let plate = SheetReading::Plate { shear_ratio: 1.0 };
+        let loaded = hung_sheet_scene(&inp, 15, 15, &plate).expect("a valid scene");
         let grid = loaded.scene.grid();
         let x = hung_start(&inp, &grid, HungStart::Compressed, 1e-3, 7);
         let (tl, tr) = (grid.index(0, 14), grid.index(14, 14));
