@@ -323,10 +323,15 @@ pub fn fabric_section(
     plates: &[WrinkleFullRow],
     fabrics: &[WrinkleFullRow],
 ) -> String {
-    let mut s = String::from(
-        "| case | n: seed | n: tension field | n: plate | **n: fabric** (coarse) | z_max cm: plate | fabric | bending length mm: plate | fabric | shear N/m: plate | fabric | status (fabric) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    if fabrics.is_empty() {
+        return String::new();
+    }
+    let mut s = format!(
+        "\n## The sheets read as fabric\n\n{}\n",
+        crate::wrinkles_text::FABRIC
     );
+    s += "| case | n: seed | n: tension field | n: plate | **n: fabric** (coarse) | z_max cm: plate | fabric | bending length mm: plate | fabric | shear N/m: plate | fabric | status (fabric) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (p, f) in plates.iter().zip(fabrics) {
         let _ = writeln!(
             s,
@@ -514,14 +519,7 @@ above the horizon and turned 30°, in the order of the table: each case read as 
 height below the supports, finer mesh dark, coarser light; red dots: the wrinkle lines counted.\n"
         );
     }
-    if !fabrics.is_empty() {
-        let _ = write!(
-            s,
-            "\n## The sheets read as fabric\n\n{}\n{}",
-            crate::wrinkles_text::FABRIC,
-            fabric_section(found, &r, &fabrics)
-        );
-    }
+    s += &fabric_section(found, &r, &fabrics);
     let _ = write!(
         s,
         "\n## Does the count depend on the start?\n\nThe result's start is \"{}\"; the coarser mesh is also \

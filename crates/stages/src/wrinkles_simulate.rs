@@ -14,7 +14,10 @@ impl StageKind for WrinklesSimulate {
     const SUMMARY: &'static str = "Seed 002's hung sheets as full continuum simulations on two meshes, beside the seed's tables and the tension-field model";
     const INPUTS: &'static [Slot] = &[Slot::one("config", "the wrinkle config TOML")];
     const OUTPUTS: &'static [Slot] = &[
-        Slot::optional("table", "wrinkles_full.parquet: one row per case and reading"),
+        Slot::optional(
+            "table",
+            "wrinkles_full.parquet: one row per case and reading",
+        ),
         Slot::optional("fibres", "fibres.parquet: the sheets' centre fibres"),
         Slot::optional(
             "starts",

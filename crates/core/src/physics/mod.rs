@@ -170,6 +170,14 @@ pub trait EnergyTerm: Send + Sync {
     fn is_external_load(&self) -> bool {
         false
     }
+    /// Raises the term's barrier stiffness κ where a pair has been pressed to within a small
+    /// fraction of its band (incremental potential contact's adaptive κ, Li et al. 2020): at a gap
+    /// where κ b′ balances a force F the barrier's curvature is about F²/(κ d̂²), so stacked layers
+    /// that press a pair nanometres from its limit leave Newton a nearly singular system until κ
+    /// grows. Called between the steps of a dynamic solve; true when it changed the energy.
+    fn stiffen_barrier(&mut self, _x: &Vecs) -> bool {
+        false
+    }
     /// The largest fraction of the step `dx` from `x` that the term allows (contact: a step that
     /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
     fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
@@ -306,6 +314,15 @@ impl Model {
         }
     }
     /// The largest fraction of the step `dx` that every term allows (see [`EnergyTerm::max_step`]).
+    /// [`EnergyTerm::stiffen_barrier`] of every term: true when one changed its energy.
+    pub fn stiffen_barriers(&mut self, x: &Vecs) -> bool {
+        let mut changed = false;
+        for t in &mut self.terms {
+            changed |= t.stiffen_barrier(x);
+        }
+        changed
+    }
+
     pub fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
         self.terms
             .iter()

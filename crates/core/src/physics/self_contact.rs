@@ -96,6 +96,8 @@ pub struct SelfContact {
     pub band_m: f64,
     /// Barrier stiffness κ, J.
     pub kappa_J: f64,
+    /// The largest κ [`EnergyTerm::stiffen_barrier`] raises it to, J.
+    kappa_limit_J: f64,
     margin_m: f64,
     /// The longest vertex move checked with one broad phase, m: four of the longest rest edge.
     piece_m: f64,
@@ -129,11 +131,13 @@ impl SelfContact {
         } else {
             thickness_m + band_m
         };
+        let kappa_J = super::BarrierContact::kappa_for_weight(weight_N, band_m);
         Self {
             topo,
             thickness_m,
             band_m,
-            kappa_J: super::BarrierContact::kappa_for_weight(weight_N, band_m),
+            kappa_J,
+            kappa_limit_J: KAPPA_GROWTH_LIMIT * kappa_J,
             margin_m,
             piece_m: (4.0 * longest).max(margin_m),
             cache: Mutex::new(Cache::default()),
@@ -364,9 +368,30 @@ impl SelfContact {
     }
 }
 
+/// A pair pressed to within this fraction of the band beyond the thickness doubles κ (a pair
+/// carrying ten particles' weight sits about there; κ balances one particle's at a tenth).
+const STIFFEN_GAP: f64 = 0.01;
+
+/// κ grows at most this factor above its start.
+const KAPPA_GROWTH_LIMIT: f64 = 1024.0;
+
 impl EnergyTerm for SelfContact {
     fn name(&self) -> String {
         "contact/self".into()
+    }
+    /// Doubles κ when the closest active pair's gap beyond the thickness is under [`STIFFEN_GAP`]
+    /// of the band, up to [`KAPPA_GROWTH_LIMIT`] times its start.
+    fn stiffen_barrier(&mut self, x: &Vecs) -> bool {
+        if self.kappa_J * 2.0 > self.kappa_limit_J {
+            return false;
+        }
+        let mut closest = f64::INFINITY;
+        self.each_active(x, |_, d, _| closest = closest.min(d - self.thickness_m));
+        let pressed = closest < STIFFEN_GAP * self.band_m;
+        if pressed {
+            self.kappa_J *= 2.0;
+        }
+        pressed
     }
     fn energy(&self, x: &Vecs) -> f64 {
         let mut e = 0.0;
@@ -563,6 +588,32 @@ mod tests {
             }
         }
         (x, tris)
+    }
+
+    /// A pair pressed within 1 % of the band beyond the thickness doubles κ (incremental potential
+    /// contact's adaptive κ), one held at 5 % does not, and κ stops growing at its limit.
+    #[test]
+    fn a_pressed_pair_stiffens_the_barrier_up_to_its_limit() {
+        // Two flat layers `gap` apart (the lower at z = 0).
+        let flat = |gap: f64| {
+            let (mut x, tris) = stacked(gap);
+            x.iter_mut()
+                .enumerate()
+                .for_each(|(k, p)| p.z = if k < 9 { 0.0 } else { gap });
+            (x, tris)
+        };
+        let (xi, band) = (5e-4, 1e-3);
+        let (pressed, tris) = flat(xi + 0.005 * band);
+        let (held, _) = flat(xi + 0.05 * band);
+        let mut term = SelfContact::new(tris, &held, xi, band, 1e-3);
+        let k0 = term.kappa_J;
+        assert!(!term.stiffen_barrier(&held));
+        assert_eq!(term.kappa_J, k0);
+        assert!(term.stiffen_barrier(&pressed));
+        assert_eq!(term.kappa_J, 2.0 * k0);
+        while term.stiffen_barrier(&pressed) {}
+        assert!(term.kappa_J <= KAPPA_GROWTH_LIMIT * k0);
+        assert!(2.0 * term.kappa_J > KAPPA_GROWTH_LIMIT * k0);
     }
 
     #[test]

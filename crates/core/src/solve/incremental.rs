@@ -207,6 +207,10 @@ fn step(
                 (x[p] - x_n[p]) / h
             };
         }
+        // Barriers stiffened where layers press (the factor then no longer serves the next step).
+        if model.stiffen_barriers(x) {
+            *carried = None;
+        }
         // The step grows with Newton's factorizing iterations (its cost); chord and Krylov steps
         // are cheap.
         let g = &r.globalization;
