@@ -370,7 +370,7 @@ impl SelfContact {
 
 /// A pair pressed to within this fraction of the band beyond the thickness doubles κ (a pair
 /// carrying ten particles' weight sits about there; κ balances one particle's at a tenth).
-const STIFFEN_GAP: f64 = 0.01;
+const STIFFEN_GAP: f64 = 0.1;
 
 /// κ grows at most this factor above its start.
 const KAPPA_GROWTH_LIMIT: f64 = 1024.0;
@@ -590,8 +590,8 @@ mod tests {
         (x, tris)
     }
 
-    /// A pair pressed within 1 % of the band beyond the thickness doubles κ (incremental potential
-    /// contact's adaptive κ), one held at 5 % does not, and κ stops growing at its limit.
+    /// A pair pressed within 10 % of the band beyond the thickness doubles κ (incremental potential
+    /// contact's adaptive κ), one held at 20 % does not, and κ stops growing at its limit.
     #[test]
     fn a_pressed_pair_stiffens_the_barrier_up_to_its_limit() {
         // Two flat layers `gap` apart (the lower at z = 0).
@@ -603,8 +603,8 @@ mod tests {
             (x, tris)
         };
         let (xi, band) = (5e-4, 1e-3);
-        let (pressed, tris) = flat(xi + 0.005 * band);
-        let (held, _) = flat(xi + 0.05 * band);
+        let (pressed, tris) = flat(xi + 0.05 * band);
+        let (held, _) = flat(xi + 0.2 * band);
         let mut term = SelfContact::new(tris, &held, xi, band, 1e-3);
         let k0 = term.kappa_J;
         assert!(!term.stiffen_barrier(&held));
