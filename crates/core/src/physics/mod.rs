@@ -313,7 +313,6 @@ impl Model {
             t.add_exact_hessian(x, h);
         }
     }
-    /// The largest fraction of the step `dx` that every term allows (see [`EnergyTerm::max_step`]).
     /// [`EnergyTerm::stiffen_barrier`] of every term: true when one changed its energy.
     pub fn stiffen_barriers(&mut self, x: &Vecs) -> bool {
         let mut changed = false;
@@ -322,7 +321,7 @@ impl Model {
         }
         changed
     }
-
+    /// The largest fraction of the step `dx` that every term allows (see [`EnergyTerm::max_step`]).
     pub fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
         self.terms
             .iter()
