@@ -48,6 +48,11 @@ struct Cache {
     valid: bool,
     broad_phases: usize,
     time_s: f64,
+    /// The active pairs (vertices, distance, coefficients) at `active_at` for the activation
+    /// distance `active_m`: energy, gradient and Hessian at one state measure them once.
+    active: Vec<([usize; 4], f64, [f64; 4])>,
+    active_at: Vec<Vector3<f64>>,
+    active_m: f64,
 }
 
 impl Cache {
@@ -276,22 +281,38 @@ impl SelfContact {
     fn each_active(&self, x: &Vecs, mut f: impl FnMut([usize; 4], f64, [f64; 4])) {
         let start = Instant::now();
         let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        self.ensure(&mut c, x, None);
+        let act = self.activation_m();
+        if c.active_m != act || c.active_at.as_slice() != x {
+            self.measure_active(&mut c, x);
+        }
+        for &(idx, d, coef) in &c.active {
+            f(idx, d, coef);
+        }
+        c.time_s += start.elapsed().as_secs_f64();
+    }
+
+    /// The candidate pairs within the activation distance at `x`, into the cache's active list.
+    fn measure_active(&self, c: &mut Cache, x: &Vecs) {
+        self.ensure(c, x, None);
         let act = self.activation_m();
         c.measure_moves(x);
-        let list = &*c;
-        for (&pair, &gap) in list.pairs.iter().zip(list.gaps.iter()) {
+        let mut active = std::mem::take(&mut c.active);
+        active.clear();
+        for (&pair, &gap) in c.pairs.iter().zip(c.gaps.iter()) {
             // A pair whose gap still exceeds its vertices' moves is out of range, unmeasured.
-            if list.gap_left(&self.topo, pair, gap) >= 0.0 {
+            if c.gap_left(&self.topo, pair, gap) >= 0.0 {
                 continue;
             }
             let idx = pair.vertices(&self.topo);
             let (d, coef) = pair_distance(pair.is_point_triangle(), &idx.map(|k| x[k]));
             if d < act {
-                f(idx, d, coef);
+                active.push((idx, d, coef));
             }
         }
-        c.time_s += start.elapsed().as_secs_f64();
+        c.active = active;
+        c.active_at.clear();
+        c.active_at.extend_from_slice(x);
+        c.active_m = act;
     }
 
     /// The first impact time in (0, 1] of the candidate pairs moving from `x` by `seg`
@@ -614,6 +635,34 @@ mod tests {
         while term.stiffen_barrier(&pressed) {}
         assert!(term.kappa_J <= KAPPA_GROWTH_LIMIT * k0);
         assert!(2.0 * term.kappa_J > KAPPA_GROWTH_LIMIT * k0);
+    }
+
+    /// The active pairs are measured once per state and serve energy, gradient and Hessian there:
+    /// a term that measured other states in between, or whose activation distance moved, gives
+    /// what a fresh term gives.
+    #[test]
+    fn active_pairs_measured_at_a_state_are_those_a_fresh_term_measures() {
+        let (x, tris) = stacked(1.2e-3);
+        let (y, _) = stacked(8e-4);
+        let fresh = |c: [f64; 3], z: &[Vector3<f64>]| {
+            let mut t = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+            t.set_coefficients(&c);
+            let mut g = vec![Vector3::zeros(); z.len()];
+            t.add_gradient(z, &mut g);
+            (t.energy(z), g)
+        };
+        let mut term = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        let c0 = [term.thickness_m, term.band_m, term.kappa_J];
+        for z in [&x, &y, &x, &x, &y] {
+            let mut g = vec![Vector3::zeros(); z.len()];
+            term.add_gradient(z, &mut g);
+            assert_eq!((term.energy(z), g), fresh(c0, z));
+        }
+        // A band a fifth as wide: fewer pairs active at x, the list measured again.
+        let c1 = [c0[0], 0.2 * c0[1], c0[2]];
+        term.set_coefficients(&c1);
+        assert_eq!(term.energy(&x), fresh(c1, &x).0);
+        assert!(term.energy(&x) < fresh(c0, &x).0);
     }
 
     #[test]
