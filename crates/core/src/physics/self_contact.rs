@@ -389,8 +389,8 @@ impl SelfContact {
     }
 }
 
-/// A pair pressed to within this fraction of the band beyond the thickness doubles κ (a pair
-/// carrying ten particles' weight sits about there; κ balances one particle's at a tenth).
+/// A pair pressed to within this fraction of the band beyond the thickness doubles κ: κ is built
+/// to balance one particle's weight there, so a pair pressed closer carries more than one's.
 const STIFFEN_GAP: f64 = 0.1;
 
 /// κ grows at most this factor above its start.
