@@ -518,3 +518,61 @@ fn the_orthotropic_bending_on_the_template_disc_has_its_two_rigidities() {
         }
     }
 }
+
+#[test]
+fn a_curled_disc_turned_over_moves_its_dc_as_its_tangent_in_the_curl_says() {
+    // Issue 51: a fabric that curls toward one face (a free strip rolls to κ_r = 15 /m, radius
+    // 6.7 cm) draped face up lifts its rim (κ_r > 0 as laid: higher DC), face down lowers it. The
+    // amount: the flat-curl drape moved along its sensitivity to the curl, x₀ ± κ_r dx/dκ_r, gives
+    // the faces' DC within a tenth of their solved difference — the same perturbation seeds.
+    use drapelab::cusick::{DiscMesh, DrapeParams, SpecimenParameters, drape_model, solve_drape};
+    use drapelab::sensitivity::Equilibrium;
+    let (rest, tris) = template();
+    let tester = Tester::default();
+    let mesh = DiscMesh {
+        rest_xy: &rest,
+        triangles: &tris,
+    };
+    let dc = |x: &[Vector3<f64>]| shadow_measures(&mesh_projection(x, &tris), &tester).dc_pct;
+    let kappa = 15.0;
+    for seed in 0..2 {
+        let p = |k: f64| DrapeParams {
+            bending_length_m: 0.02,
+            curl_per_m: Some(k),
+            self_thickness_m: None,
+            seed,
+            ..DrapeParams::default()
+        };
+        let solved = |k: f64| {
+            let (r, x) = solve_drape(mesh, &p(k), &tester);
+            assert!(r.is_converged(), "seed {seed}, curl {k}: {}", r.message);
+            (r, x)
+        };
+        let ((r0, x0), (_, up), (_, down)) = (solved(0.0), solved(kappa), solved(-kappa));
+        let (dc0, dc_up, dc_down) = (dc(&x0), dc(&up), dc(&down));
+        assert!(
+            dc_down < dc0 && dc0 < dc_up,
+            "seed {seed}: face down {dc_down:.2} %, no curl {dc0:.2} %, face up {dc_up:.2} %"
+        );
+        let params = SpecimenParameters {
+            mesh,
+            params: p(0.0),
+            tester: &tester,
+        };
+        let model = drape_model(mesh, &p(0.0), &tester);
+        let mut eq = Equilibrium::of(Box::new(params), &model, &x0, &r0).unwrap();
+        let t = eq.sensitivity("curl_per_m").unwrap().dx;
+        let along = |s: f64| -> Vec<Vector3<f64>> {
+            x0.iter().zip(&t).map(|(x, t)| x + t * (s * kappa)).collect()
+        };
+        let (solved_gap, predicted_gap) = (dc_up - dc_down, dc(&along(1.0)) - dc(&along(-1.0)));
+        eprintln!(
+            "seed {seed}: DC face up {dc_up:.2} %, none {dc0:.2} %, face down {dc_down:.2} %; \
+             up − down solved {solved_gap:.2}, from the tangent {predicted_gap:.2} points"
+        );
+        assert!(
+            (predicted_gap - solved_gap).abs() <= 0.1 * solved_gap,
+            "seed {seed}: solved {solved_gap:.2} against the tangent's {predicted_gap:.2}"
+        );
+    }
+}

@@ -375,7 +375,7 @@ fn dot_all(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
 #[test]
 fn cusick_specimen_sensitivities_match_central_differences_for_every_key() {
     // The Cusick disc over its own parameters (bending length, anisotropy, saturation, warp angle,
-    // areal density, tensile rigidity, gravity): an orthotropic, saturating drape on the pedestal's
+    // natural curl, areal density, tensile rigidity, gravity): an orthotropic, saturating drape on the pedestal's
     // barrier, solved to 1e-12 of a vertex's weight, each key's sensitivity against the central
     // difference of drapes solved from x* at θ(1 ± δ).
     use drapelab_core::cusick::{
@@ -394,6 +394,7 @@ fn cusick_specimen_sensitivities_match_central_differences_for_every_key() {
         bending_ratio: 2.0,
         warp_angle_deg: 20.0,
         bending_saturation: Some(3.0),
+        curl_per_m: Some(6.0),
         self_thickness_m: None,
         ..DrapeParams::default()
     };
@@ -435,6 +436,7 @@ fn cusick_specimen_sensitivities_match_central_differences_for_every_key() {
                 "bending_ratio" => p.bending_ratio = t,
                 "bending_saturation" => p.bending_saturation = Some(t),
                 "warp_angle_deg" => p.warp_angle_deg = t,
+                "curl_per_m" => p.curl_per_m = Some(t),
                 other => panic!("{other} is not set by this test"),
             }
             // From x*, to 1e-9 of a vertex's weight: the disc's residual can stall at 5e-10 (bending_ratio

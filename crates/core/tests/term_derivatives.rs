@@ -408,6 +408,7 @@ fn every_terms_derivatives_in_its_coefficients_match_central_differences() {
         "bending/continuum",
         "bending/hinge",
         "bending/patch",
+        "bending/curl",
         "bending/symmetry-plane",
         "shear",
         "twist",
@@ -425,8 +426,8 @@ fn every_terms_derivatives_in_its_coefficients_match_central_differences() {
 type Labelled = (Box<dyn EnergyTerm>, &'static str);
 
 /// A small bent sheet and the terms no bundled grid scene has: the Cusick disc's orthotropic,
-/// saturating hinge bending, a triangulated grid's patch bending (orthotropic, with a twist
-/// rigidity, its warp turned) and a cell's twist.
+/// saturating hinge bending and its natural curl, a triangulated grid's patch bending
+/// (orthotropic, with a twist rigidity, its warp turned) and a cell's twist.
 fn small_sheet_terms() -> (Vec<Vector3<f64>>, Vec<Labelled>) {
     let n = 6;
     let rest: Vec<[f64; 2]> = (0..n * n)
@@ -454,6 +455,7 @@ fn small_sheet_terms() -> (Vec<Vector3<f64>>, Vec<Labelled>) {
         triangles: &tris,
     };
     let patch = drapelab_core::physics::patch_bending(&sheet, [2e-5, 1e-5, 0.7e-5], 0.3);
+    let curl = drapelab_core::physics::hinge_curl(&sheet, 1.4e-5, -8.0);
     let cells: Vec<[usize; 4]> = (0..n - 1)
         .flat_map(|j| {
             (0..n - 1).map(move |i| [id(i, j), id(i + 1, j), id(i, j + 1), id(i + 1, j + 1)])
@@ -464,6 +466,7 @@ fn small_sheet_terms() -> (Vec<Vector3<f64>>, Vec<Labelled>) {
     let terms: Vec<Labelled> = vec![
         (Box::new(hinge), "cusick hinge"),
         (Box::new(patch), "patch bending"),
+        (Box::new(curl), "curled sheet"),
         (Box::new(twist), "twisted sheet"),
     ];
     (bent, terms)

@@ -8,7 +8,9 @@
 
 use super::Tester;
 use crate::contact::Obstacle;
-use crate::physics::{Model, ModelBuilder, SpringFamily, Springs, saturating_hinge_bending};
+use crate::physics::{
+    Model, ModelBuilder, SewnSheet, SpringFamily, Springs, hinge_curl, saturating_hinge_bending,
+};
 use crate::solve::{
     Direction, FactorReuse, ImplicitSettings, NoObserver, Observer, Regularization, Settle,
     SolveReport, StaticOptions, StopReason, integrate_implicit, solve_static,
@@ -50,6 +52,11 @@ pub struct DrapeParams {
     pub bending_saturation: Option<f64>,
     /// Direction of the warp from the template's +x, degrees. Default 0.
     pub warp_angle_deg: f64,
+    /// The fabric's natural curl as laid on the tester: the curvature a free strip of it rolls
+    /// up to, 1/m, positive toward the upper side (the rim lifts), so that turning the specimen over
+    /// flips its sign ([`hinge_curl`]). Default none (no curl term; `Some(0.0)` keeps the term at
+    /// zero, for sensitivities in it).
+    pub curl_per_m: Option<f64>,
     /// How the drape reaches equilibrium. Default `cone`.
     pub start: DrapeStart,
     /// `fall` start: simulated time of the fall before Newton finishes the drape, s. Default 0.4.
@@ -87,6 +94,7 @@ impl Default for DrapeParams {
             bending_ratio: 1.0,
             bending_saturation: None,
             warp_angle_deg: 0.0,
+            curl_per_m: None,
             start: DrapeStart::Cone,
             fall_time_s: 0.4,
             fall_max_dt_s: 0.002,
@@ -153,6 +161,14 @@ pub fn drape_model(mesh: DiscMesh<'_>, p: &DrapeParams, tester: &Tester) -> Mode
         p.bending_saturation
             .map_or(f64::INFINITY, |s| s / p.bending_length_m),
     )));
+    if let Some(curl) = p.curl_per_m {
+        let sheet = SewnSheet {
+            rest: mesh.rest_xy,
+            rest_triangles: mesh.triangles,
+            triangles: mesh.triangles,
+        };
+        b.term(Box::new(hinge_curl(&sheet, rigidity, curl)));
+    }
     b.gravity();
     // The pedestal (its top at z = 0, 1 m deep): a barrier keeps every free vertex out of it on any
     // path (the fall, Newton's iterations), exact step bound (it is convex).

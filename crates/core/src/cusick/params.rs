@@ -13,7 +13,7 @@ use crate::physics::Model;
 use nalgebra::Vector3;
 
 /// The continuous keys of a specimen, as [`DrapeParams`] writes them.
-pub const SPECIMEN_KEYS: [&str; 8] = [
+pub const SPECIMEN_KEYS: [&str; 9] = [
     "bending_length_m",
     "areal_density_kg_per_m2",
     "tensile_N_per_m",
@@ -21,6 +21,7 @@ pub const SPECIMEN_KEYS: [&str; 8] = [
     "bending_ratio",
     "bending_saturation",
     "warp_angle_deg",
+    "curl_per_m",
     "self_thickness_m",
 ];
 
@@ -47,6 +48,7 @@ impl SpecimenParameters<'_> {
             "bending_ratio" => Some(&mut p.bending_ratio),
             "bending_saturation" => p.bending_saturation.as_mut(),
             "warp_angle_deg" => Some(&mut p.warp_angle_deg),
+            "curl_per_m" => p.curl_per_m.as_mut(),
             "self_thickness_m" => p.self_thickness_m.as_mut(),
             _ => None,
         }
@@ -81,8 +83,9 @@ impl Parameterized for SpecimenParameters<'_> {
     fn model_with(&self, key: &str, v: f64) -> Result<(Model, Vec<Vector3<f64>>), InputError> {
         let mut p = self.params.clone();
         let slot = Self::slot(&mut p, key).ok_or_else(|| self.unknown(key))?;
-        // Every key but the warp's direction is a positive quantity.
-        if !v.is_finite() || (key != "warp_angle_deg" && v <= 0.0) {
+        // Every key but the warp's direction and the curl (signed: its side) is a positive quantity.
+        let signed = matches!(key, "warp_angle_deg" | "curl_per_m");
+        if !v.is_finite() || (!signed && v <= 0.0) {
             return Err(InputError::new(
                 "drape",
                 key,

@@ -81,6 +81,45 @@ pub fn sewn_hinge_bending(
 ) -> super::QuadraticStencil<4> {
     let (ws, wc) = warp_angle_rad.sin_cos();
     let mean = 0.5 * (rigidity_N_m[0] + rigidity_N_m[1]);
+    let (mut stencils, mut coef, mut stiff, mut u0) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for h in hinges(sheet) {
+        stencils.push(h.stencil);
+        coef.push(h.coef);
+        // Unit in-plane normal of the edge, then its share along the warp.
+        let e0 = h.rest[1] - h.rest[0];
+        let along_warp = (e0.y * wc - e0.x * ws) / e0.norm();
+        let cos2 = 2.0 * along_warp.powi(2) - 1.0;
+        let b = (mean + 0.75 * (rigidity_N_m[0] - rigidity_N_m[1]) * cos2).max(0.02 * mean);
+        stiff.push(b / h.area);
+        u0.push(kappa0_per_m * h.area / 3f64.sqrt());
+    }
+    let term = super::QuadraticStencil::from_stencils("bending/hinge", stencils, coef, stiff);
+    if kappa0_per_m.is_finite() {
+        term.with_saturation(u0)
+    } else {
+        term
+    }
+}
+
+/// One hinge of a sheet: an edge two triangles share, in its rest geometry.
+pub(super) struct Hinge {
+    /// Particles: the edge's two ends (smaller first), then the first and the second triangle's
+    /// opposite particle.
+    pub stencil: [usize; 4],
+    /// Bergou's K = (c₀₃ + c₀₄, c₀₁ + c₀₂, −c₀₁ − c₀₃, −c₀₂ − c₀₄): u = Σ Kᵢ xᵢ.
+    pub coef: [f64; 4],
+    /// The two triangles' rest area A₀ + A₁, m².
+    pub area: f64,
+    /// The four corners at rest, in the pattern's plane (z = 0), the second triangle's laid
+    /// beside the first across a seam.
+    pub rest: [Vector3<f64>; 4],
+}
+
+/// The hinges of `sheet`: one on every edge two triangles share in the particles (a seam's edge
+/// included), its rest geometry the two triangles unfolded about that edge, each with its own
+/// piece's rest shape.
+pub(super) fn hinges(sheet: &SewnSheet<'_>) -> Vec<Hinge> {
     let p3 = |r: usize| Vector3::new(sheet.rest[r][0], sheet.rest[r][1], 0.0);
     let cot = |a: Vector3<f64>, b: Vector3<f64>| a.dot(&b) / a.cross(&b).norm().max(1e-300);
     // Each undirected particle edge → (opposite particle, triangle area, rest vertices of the edge's
@@ -100,8 +139,7 @@ pub fn sewn_hinge_bending(
                 .push((o, a, c));
         }
     }
-    let (mut stencils, mut coef, mut stiff, mut u0) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut out = Vec::new();
     for (&(i0, i1), opp) in &sides {
         let [(i2, a0, c0), (i3, a1, c1)] = opp.as_slice() else {
             continue;
@@ -114,21 +152,14 @@ pub fn sewn_hinge_bending(
         };
         let (e0, e1, e2, e3, e4) = (x1 - x0, x2 - x0, x3 - x0, x2 - x1, x3 - x1);
         let (c01, c02, c03, c04) = (cot(e0, e1), cot(e0, e2), cot(-e0, e3), cot(-e0, e4));
-        stencils.push([i0, i1, *i2, *i3]);
-        coef.push([c03 + c04, c01 + c02, -c01 - c03, -c02 - c04]);
-        // Unit in-plane normal of the edge, then its share along the warp.
-        let along_warp = (e0.y * wc - e0.x * ws) / e0.norm();
-        let cos2 = 2.0 * along_warp.powi(2) - 1.0;
-        let b = (mean + 0.75 * (rigidity_N_m[0] - rigidity_N_m[1]) * cos2).max(0.02 * mean);
-        stiff.push(b / (a0 + a1));
-        u0.push(kappa0_per_m * (a0 + a1) / 3f64.sqrt());
+        out.push(Hinge {
+            stencil: [i0, i1, *i2, *i3],
+            coef: [c03 + c04, c01 + c02, -c01 - c03, -c02 - c04],
+            area: a0 + a1,
+            rest: [x0, x1, x2, x3],
+        });
     }
-    let term = super::QuadraticStencil::from_stencils("bending/hinge", stencils, coef, stiff);
-    if kappa0_per_m.is_finite() {
-        term.with_saturation(u0)
-    } else {
-        term
-    }
+    out
 }
 
 /// The second triangle's opposite vertex laid in the first's rest plane across their shared edge:

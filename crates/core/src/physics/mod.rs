@@ -5,6 +5,7 @@
 mod assembly;
 mod bending;
 mod contact;
+mod curl;
 mod friction;
 mod kernel;
 mod loads;
@@ -20,6 +21,7 @@ pub use bending::{
     CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,
 };
 pub use contact::{BarrierContact, max_penetration_m};
+pub use curl::{Curl, CurlKernel, hinge_curl};
 pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
 pub use kernel::{Kernel, Local, Potential};
 pub use loads::{Gravity, LoadKernel, PointLoads};
