@@ -272,16 +272,45 @@ for chunk in RrdReader(sys.argv[2]).stream().to_chunks():
     paths.add(chunk.entity_path)
 need = {"/fabric_05/measured/s2_c1", "/fabric_05/simulated/seed_2", "/fabric_07/simulated/seed_3", "/fabric_07/pedestal"}
 assert need <= paths, sorted(paths)
+# Issue 51's contract: one row per capture of every specimen but the calibration one.
+t = pq.read_table(sys.argv[3])
+for c in ["fabric", "sample", "capture", "nodes_predicted_mode"]:
+    assert str(t.schema.field(c).type) == "int32", c
+assert str(t.schema.field("face").type) == "string"
+for c in ["dc_predicted_pct", "dc_low_pct", "dc_high_pct", "nodes_predicted"]:
+    assert str(t.schema.field(c).type) == "double", c
+rows = t.to_pylist()
+assert {(r["fabric"], r["sample"]) for r in rows} == {(f, s) for f in (5, 7) for s in (2, 3, 4)}, rows
+assert all(r["face"] in ("up", "down") and r["dc_low_pct"] < r["dc_high_pct"] for r in rows)
+# Face up and face down of one fabric are predicted apart (the curl), each its own seeds.
+for f in (5, 7):
+    up = {r["dc_predicted_pct"] for r in rows if r["fabric"] == f and r["face"] == "up"}
+    down = {r["dc_predicted_pct"] for r in rows if r["fabric"] == f and r["face"] == "down"}
+    assert len(up) == 1 and len(down) == 1 and up != down, (f, up, down)
 print("ok")
 "#,
         &[
             &run.join("predict/predictions.parquet"),
             &run.join("predict/drapes.rrd"),
+            &run.join("predict/predictions_by_capture.parquet"),
         ],
     );
     assert_eq!(out.trim(), "ok");
     let md = std::fs::read_to_string(tmp.path().join("reports/cusick.md")).unwrap();
     assert!(md.contains("![shadows](cusick_shadows.svg)"), "{md}");
+    assert!(
+        md.contains("## Both faces of every capture") && md.contains("face down from face up only")
+    );
+    for r in &rows {
+        // Both faces photographed: a curl fitted; a curl toward the upper side lifts the rim face
+        // up, so the gap (down − up) falls with it and the curl's sign is the gap's opposite.
+        let (gap, slope) = (
+            r.calibration_face_gap_pct.unwrap(),
+            r.face_gap_slope_pct_m.unwrap(),
+        );
+        assert!(slope < 0.0 && r.curl_per_m.unwrap() * gap < 0.0, "{r:?}");
+        assert!(r.dc_predicted_face_up_pct.is_some() && r.dc_predicted_face_down_pct.is_some());
+    }
     for svg in ["cusick_shadows.svg", "cusick_profiles.svg"] {
         let text = std::fs::read_to_string(tmp.path().join("reports").join(svg)).unwrap();
         assert!(text.contains("<svg") && text.contains("fabric 7"), "{svg}");
@@ -367,6 +396,7 @@ fn a_synthetic_orthotropic_fabric_photographed_gives_its_parameters_back() {
         dc_pct: mean,
         dc_se_pct: sd / 2.0,
         nodes: 0.5 * (nodes[1] + nodes[2]),
+        face_gap: None,
     };
     let settings = FabricSettings {
         laws: vec![
@@ -563,7 +593,10 @@ fn a_curled_disc_turned_over_moves_its_dc_as_its_tangent_in_the_curl_says() {
         let mut eq = Equilibrium::of(Box::new(params), &model, &x0, &r0).unwrap();
         let t = eq.sensitivity("curl_per_m").unwrap().dx;
         let along = |s: f64| -> Vec<Vector3<f64>> {
-            x0.iter().zip(&t).map(|(x, t)| x + t * (s * kappa)).collect()
+            x0.iter()
+                .zip(&t)
+                .map(|(x, t)| x + t * (s * kappa))
+                .collect()
         };
         let (solved_gap, predicted_gap) = (dc_up - dc_down, dc(&along(1.0)) - dc(&along(-1.0)));
         eprintln!(
@@ -575,4 +608,49 @@ fn a_curled_disc_turned_over_moves_its_dc_as_its_tangent_in_the_curl_says() {
             "seed {seed}: solved {solved_gap:.2} against the tangent's {predicted_gap:.2}"
         );
     }
+}
+
+#[test]
+fn a_known_curl_is_recovered_from_the_face_gap_it_makes() {
+    // Issue 51: a fabric (c = 20 mm) curling toward its back by 12 /m draped face up and face down
+    // at seed 0 gives a face gap; the fit, knowing c, gets the curl back from that gap alone.
+    use drapelab::cusick::{DiscMesh, DrapeParams, FaceGap, GAP_TOL_PCT, fit_curl, solve_drape};
+    let (rest, tris) = template();
+    let tester = Tester::default();
+    let mesh = DiscMesh {
+        rest_xy: &rest,
+        triangles: &tris,
+    };
+    let fabric = DrapeParams {
+        bending_length_m: 0.02,
+        self_thickness_m: None,
+        ..DrapeParams::default()
+    };
+    let dc_at = |k: f64| {
+        let p = DrapeParams {
+            curl_per_m: Some(k),
+            ..fabric.clone()
+        };
+        let (r, x) = solve_drape(mesh, &p, &tester);
+        assert!(r.is_converged(), "{}", r.message);
+        shadow_measures(&mesh_projection(&x, &tris), &tester).dc_pct
+    };
+    let truth = -12.0;
+    let gap = dc_at(-truth) - dc_at(truth);
+    let target = FaceGap {
+        gap_pct: gap,
+        gap_se_pct: 0.5,
+    };
+    let fit = fit_curl(mesh, &fabric, &tester, &target).expect("fitted");
+    eprintln!(
+        "gap {gap:.2} points: curl {:.2} /m ({fit:?})",
+        fit.curl_per_m
+    );
+    assert!((fit.gap_solved_pct - gap).abs() <= GAP_TOL_PCT, "{fit:?}");
+    assert!(
+        (fit.curl_per_m - truth).abs() < 0.1 * truth.abs(),
+        "{fit:?}"
+    );
+    assert!(fit.identifiable && fit.interval_per_m[0] < truth && truth < fit.interval_per_m[1]);
+    assert!(fit.gap_slope_pct_m < 0.0 && fit.solves <= 9, "{fit:?}");
 }

@@ -6,14 +6,17 @@
 //! simulated shadow outlines and height profiles (for the report's pictures) and a rerun recording
 //! overlaying each fabric's registered meshes and simulated drapes.
 
+use crate::cusick_captures::{
+    CaptureRow, FaceDrapes, FacePredictions, capture_rows, fill_intervals,
+};
 use crate::cusick_measure::ShadowRow;
 use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{
-    BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricSettings, NodeDistribution,
-    SpecimenTargets, Tester, calibrate_and_predict, height_profile, histogram, histogram_label,
-    polar_disc, sector_angle_rad, subdivide_disc, two_fold,
+    BendingLaw, DiscMesh, DrapeParams, FabricFit, FabricOutcome, FabricSettings, FaceGap,
+    NodeDistribution, SpecimenTargets, Tester, calibrate_and_predict, height_profile, histogram,
+    histogram_label, polar_disc, sector_angle_rad, subdivide_disc, two_fold,
 };
 use drapelab_core::measure::median;
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -97,6 +100,11 @@ pub struct FabricPrediction {
     drapes: Vec<(u64, Vec<Vector3<f64>>)>,
     /// The registered meshes of the fabric (key, vertices).
     measured: Vec<KeyedMesh>,
+    /// Its predicted captures (intervals set once every fabric is predicted).
+    captures: Vec<CaptureRow>,
+    /// The model's own DC spread, % (the fallback interval's): its seeds' SD and the calibration
+    /// specimen's standard error.
+    spread_pct: f64,
 }
 
 impl FabricPrediction {
@@ -183,6 +191,37 @@ pub struct Targets {
     nodes_histogram: String,
 }
 
+/// The face gap of one specimen's captures `own`: mean DC face down less face up, with its
+/// standard error from the SD pooled within the faces (repeated captures of one face); none
+/// without a capture on each face. With one capture per face (no repeat) the error is the gap
+/// itself: the curl is then fitted but not identifiable.
+pub fn face_gap(own: &[&&ShadowRow]) -> Option<FaceGap> {
+    let of = |face: &str| -> Vec<f64> {
+        own.iter()
+            .filter(|r| r.face == face)
+            .map(|r| r.dc_photo_pct)
+            .collect()
+    };
+    let (up, down) = (of("up"), of("down"));
+    if up.is_empty() || down.is_empty() {
+        return None;
+    }
+    let ((mu, _), (md, _)) = (mean_sd(&up), mean_sd(&down));
+    let gap_pct = md - mu;
+    let squares: f64 = up.iter().map(|v| (v - mu).powi(2)).sum::<f64>()
+        + down.iter().map(|v| (v - md).powi(2)).sum::<f64>();
+    let dof = up.len() + down.len() - 2;
+    let gap_se_pct = if dof == 0 {
+        gap_pct.abs()
+    } else {
+        (squares / dof as f64 * (1.0 / up.len() as f64 + 1.0 / down.len() as f64)).sqrt()
+    };
+    Some(FaceGap {
+        gap_pct,
+        gap_se_pct,
+    })
+}
+
 pub fn targets(rows: &[&ShadowRow]) -> Targets {
     let calib = rows.iter().map(|r| r.sample).min().unwrap_or(0);
     let own: Vec<&&ShadowRow> = rows.iter().filter(|r| r.sample == calib).collect();
@@ -196,6 +235,7 @@ pub fn targets(rows: &[&ShadowRow]) -> Targets {
             dc_pct,
             dc_se_pct: sd / (own.len().max(1) as f64).sqrt(),
             nodes: median(&own.iter().map(|r| r.nodes_photo as f64).collect::<Vec<_>>()),
+            face_gap: face_gap(&own),
         },
         others: others
             .iter()
@@ -253,6 +293,14 @@ pub fn empty_row(fabric: i32, tg: &Targets) -> PredictionRow {
         outline_two_fold_measured_m: None,
         outline_two_fold_predicted_m: None,
         profile_rms_mm: None,
+        curl_per_m: None,
+        curl_lo_per_m: None,
+        curl_hi_per_m: None,
+        curl_identifiable: None,
+        face_gap_slope_pct_m: None,
+        calibration_face_gap_pct: tg.specimen.face_gap.map(|g| g.gap_pct),
+        dc_predicted_face_up_pct: None,
+        dc_predicted_face_down_pct: None,
         status: String::new(),
         solves: 0,
         solve_time_mean_s: 0.0,
@@ -311,6 +359,42 @@ pub fn fill_distribution(row: &mut PredictionRow, d: &NodeDistribution) {
     };
 }
 
+/// The fitted curl and each face's prediction into `row`; the faces' predictions (none when no
+/// drape converged).
+fn fill_faces(row: &mut PredictionRow, outcome: &FabricOutcome) -> Option<FacePredictions> {
+    let drapes_of = |d: &[drapelab_core::cusick::SeededDrape]| {
+        NodeDistribution::of(d, d.len()).map(|n| FaceDrapes {
+            dc_pct: n.dc_mean_pct,
+            dc_sd_pct: n.dc_sd_pct,
+            nodes: n.nodes_mean,
+            nodes_mode: n.nodes_mode as i32,
+        })
+    };
+    let average = drapes_of(&outcome.drapes)?;
+    let (mut up, mut down) = (None, None);
+    match &outcome.curl {
+        Ok(c) => {
+            row.curl_per_m = Some(c.curl_per_m);
+            row.curl_lo_per_m = Some(c.interval_per_m[0]);
+            row.curl_hi_per_m = Some(c.interval_per_m[1]);
+            row.curl_identifiable = Some(c.identifiable);
+            row.face_gap_slope_pct_m = Some(c.gap_slope_pct_m);
+            if c.at_bound {
+                row.status = format!(
+                    "{}; the curl stopped at its bound ({} /m): the drape's DC moves {:.3} points per 1/m, too little to reach the face gap",
+                    row.status, c.curl_per_m, c.gap_slope_pct_m
+                );
+            }
+            up = drapes_of(&outcome.face(false));
+            down = drapes_of(&outcome.face(true));
+            row.dc_predicted_face_up_pct = up.map(|f| f.dc_pct);
+            row.dc_predicted_face_down_pct = down.map(|f| f.dc_pct);
+        }
+        Err(why) => row.status = format!("{}; face-blind: {why}", row.status),
+    }
+    Some(FacePredictions { up, down, average })
+}
+
 pub fn predict_fabric(
     fabric: i32,
     density_known: bool,
@@ -328,6 +412,8 @@ pub fn predict_fabric(
         profiles: Vec::new(),
         drapes: Vec::new(),
         measured: measured.of_fabric(fabric),
+        captures: Vec::new(),
+        spread_pct: f64::NAN,
     };
     let outcome = match calibrate_and_predict(
         mesh,
@@ -351,8 +437,14 @@ pub fn predict_fabric(
     out.row.prediction_seeds = p.seeds as i32;
     out.row.solve_time_mean_s = start.elapsed().as_secs_f64() / outcome.solves as f64;
     match &outcome.distribution {
-        Some(d) => fill_distribution(&mut out.row, d),
+        Some(d) => {
+            fill_distribution(&mut out.row, d);
+            out.spread_pct = d.dc_sd_pct.hypot(tg.specimen.dc_se_pct);
+        }
         None => out.row.status = "no perturbed drape converged".into(),
+    }
+    if let Some(faces) = fill_faces(&mut out.row, &outcome) {
+        out.captures = capture_rows(rows, tg.calib, &faces);
     }
     let drapes = outcome.drapes;
     // The warp: the two-fold maximum of the calibration specimen's face-up photos (turned over, the
@@ -513,6 +605,15 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>>
     let fabrics = longest_first(&order, predict);
     let rows: Vec<PredictionRow> = fabrics.iter().map(|f| f.row.clone()).collect();
     write_table(ctx.output("predictions")?, &rows)?;
+    let mut captures: Vec<CaptureRow> = fabrics.iter().flat_map(|f| f.captures.clone()).collect();
+    let spread: BTreeMap<i32, f64> = fabrics
+        .iter()
+        .map(|f| (f.row.fabric, f.spread_pct))
+        .collect();
+    fill_intervals(&mut captures, |fabric| {
+        spread.get(&fabric).copied().unwrap_or(f64::NAN)
+    });
+    write_table(ctx.output("by_capture")?, &captures)?;
     let outlines: Vec<OutlineRow> = fabrics.iter().flat_map(|f| f.outlines.clone()).collect();
     write_table(ctx.output("outlines")?, &outlines)?;
     let profiles: Vec<ProfileRow> = fabrics.iter().flat_map(|f| f.profiles.clone()).collect();

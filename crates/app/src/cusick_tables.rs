@@ -75,6 +75,24 @@ pub struct PredictionRow {
     pub nodes_measured_histogram: String,
     /// RMS over the rings of simulated minus measured mean height z(r), mm (None without registered meshes).
     pub profile_rms_mm: Option<f64>,
+    /// The fabric's natural curl as fitted to the calibration specimen's face gap: the curvature
+    /// a free strip rolls up to toward the fabric's face, 1/m (negative: toward its back; None: the
+    /// fit is face-blind, see `status`).
+    pub curl_per_m: Option<f64>,
+    /// Lower end of the curl's 2σ interval (the face gap's standard error over its slope), 1/m.
+    pub curl_lo_per_m: Option<f64>,
+    /// Upper end of that interval, 1/m.
+    pub curl_hi_per_m: Option<f64>,
+    /// Whether the face gap pins the curl's side (its interval excludes zero).
+    pub curl_identifiable: Option<bool>,
+    /// Slope of the simulated face gap in the curl, d(DC_down − DC_up)/dκ, points per (1/m).
+    pub face_gap_slope_pct_m: Option<f64>,
+    /// The calibration specimen's face gap: mean DC face down less face up, points.
+    pub calibration_face_gap_pct: Option<f64>,
+    /// Mean simulated DC face up (curl as fitted), %.
+    pub dc_predicted_face_up_pct: Option<f64>,
+    /// Mean simulated DC face down (curl negated), %.
+    pub dc_predicted_face_down_pct: Option<f64>,
     /// "ok", or why there is no prediction.
     pub status: String,
     /// Drape solves made (the calibration's and the predictions').

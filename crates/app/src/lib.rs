@@ -13,6 +13,7 @@ pub mod job;
 pub mod benchmark;
 pub mod calibrate;
 pub mod calibration_tables;
+pub mod cusick_captures;
 pub mod cusick_measure;
 pub mod cusick_predict;
 pub mod cusick_tables;
@@ -63,6 +64,7 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<crate::peers::PeerRow>()?,
         md::<crate::cusick_measure::ShadowRow>()?,
         md::<crate::cusick_tables::PredictionRow>()?,
+        md::<crate::cusick_captures::CaptureRow>()?,
         md::<crate::cusick_tables::OutlineRow>()?,
         md::<crate::cusick_tables::ProfileRow>()?,
     ];

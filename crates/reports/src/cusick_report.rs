@@ -3,9 +3,12 @@
 //! 1 of the measured median), the misses explained, the shadows and height profiles as pictures, and
 //! the run time per drape solve.
 
+use crate::cusick_faces::faces_section;
 use crate::cusick_plots::{profiles_svg, shadows_svg};
+pub use crate::format::opt;
 use anyhow::Result;
 use drapelab_app::Job;
+use drapelab_app::cusick_captures::CaptureRow;
 use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use drapelab_core::cusick::Tester;
 use drapelab_record::{read_table, write_text};
@@ -16,10 +19,6 @@ use std::path::Path;
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CusickReportParams {}
-
-pub fn opt(v: Option<f64>, digits: usize) -> String {
-    v.map_or("–".into(), |x| format!("{x:.digits$}"))
-}
 
 /// Whether the predicted DC lies within the measured mean ± max(2 SD, 4 points).
 pub fn dc_within(r: &PredictionRow) -> Option<bool> {
@@ -320,7 +319,12 @@ pub fn timing_table(rows: &[PredictionRow]) -> String {
 }
 
 /// The report's Markdown; `shadows_svg` and `profiles_svg` are the pictures' paths relative to it.
-pub fn report_markdown(rows: &[PredictionRow], shadows_svg: &str, profiles_svg: &str) -> String {
+pub fn report_markdown(
+    rows: &[PredictionRow],
+    captures: &[CaptureRow],
+    shadows_svg: &str,
+    profiles_svg: &str,
+) -> String {
     let count = |f: &dyn Fn(&PredictionRow) -> Option<bool>| {
         rows.iter().filter(|r| f(r) == Some(true)).count()
     };
@@ -344,6 +348,7 @@ pub fn report_markdown(rows: &[PredictionRow], shadows_svg: &str, profiles_svg: 
     s += &baselines_table(rows);
     s += "\n## Where the model misses\n\n";
     s += &misses(rows);
+    s += &faces_section(rows, captures);
     s += &format!(
         "\n## What the data pin down\n\nTwo numbers per fabric are fitted: the calibration specimen's mean DC and its median node count. The DC pins the bending length c: its 2σ interval comes from the uncertainty of that DC (the SD of the specimen's photos over √n, and the model's seed-to-seed SD) divided by the sensitivity dDC/d ln c of the simulated drapes near c: ± {wmin:.0}–{wmax:.0} % of c here. The node count chooses the bending law; \"laws within 1 node\" lists every law whose drapes' mean node count lies within one node of the target, and the law is marked not identifiable where the laws' mean node counts span no more than one node. Anisotropy moves the fold count only on stiff fabrics (at DC ≈ 80 %, ρ = 4 gives ~4.5 nodes against ~6 isotropic; at DC ≈ 55 % it moves it by < 0.5); saturation moves it at every DC (at DC ≈ 58 %: 8.0 nodes linear, 7.1 with κ₀c = 2, 6.6 with κ₀c = 1, eight seeds each). The direction of the warp does not enter the predicted DC or node count (the specimens lie on the tester at unknown orientations), so it is not fitted. The other specimens' DC, node counts and height profiles are not fitted; they test the model.\n\n## The specimens' own spread\n\nThe specimens of one fabric differ by more than the model's perturbations move its DC: the model, given one (c, law), explains the specimens' mean DC, not their spread. Their node counts are another matter: the node histograms of the other specimens' captures and of the model's prediction seeds stand side by side here, with their SDs. The outline's two-fold component (r(θ) ≈ r̄ + a₂ cos 2(θ − θ₂)) is what an anisotropy shows: its amplitude in the calibration specimen's face-up photos against the model's, and its direction θ₂ in the photos, the estimated warp. The rest is the fabric (specimen-to-specimen variation of bending, anisotropy, how each was laid on the pedestal).\n\n"
     );
@@ -359,6 +364,7 @@ pub fn report_markdown(rows: &[PredictionRow], shadows_svg: &str, profiles_svg: 
 /// The `run` of the stage kind over this workflow.
 pub fn run(ctx: &Job<'_>, _: &CusickReportParams) -> Result<()> {
     let rows = read_table::<PredictionRow>(ctx.input("predictions")?)?;
+    let captures = read_table::<CaptureRow>(ctx.input("by_capture")?)?;
     let photos = read_table::<OutlineRow>(ctx.input("photo_outlines")?)?;
     let model = read_table::<OutlineRow>(ctx.input("model_outlines")?)?;
     let profiles = read_table::<ProfileRow>(ctx.input("profiles")?)?;
@@ -382,7 +388,7 @@ pub fn run(ctx: &Job<'_>, _: &CusickReportParams) -> Result<()> {
     };
     write_text(
         md,
-        &report_markdown(&rows, &rel(shadows), &rel(profile_plot)),
+        &report_markdown(&rows, &captures, &rel(shadows), &rel(profile_plot)),
     )?;
     Ok(())
 }

@@ -5,8 +5,10 @@
 
 pub mod benchmark_report;
 pub mod calibration_report;
+pub mod cusick_faces;
 pub mod cusick_plots;
 pub mod cusick_report;
+pub mod format;
 pub mod montage;
 pub mod report;
 pub mod seed003_report;

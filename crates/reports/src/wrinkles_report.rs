@@ -3,6 +3,7 @@
 //! leave-one-out choices (the lobe threshold, Eq. 7's constant), the sheets as a picture strip
 //! and the centre fibres as a plot; the tension-field model's own table after them.
 
+use crate::format::opt;
 use anyhow::Result;
 use drapelab_app::Job;
 use drapelab_app::wrinkles::{SolvedCase, report_markdown};
@@ -13,11 +14,6 @@ use drapelab_core::wrinkles::WrinkleConfig;
 use drapelab_record::write_text;
 use plotters::prelude::*;
 use std::fmt::Write;
-
-/// A number with `digits` decimals, or a dash.
-fn opt(v: Option<f64>, digits: usize) -> String {
-    v.map_or("–".into(), |v| format!("{v:.digits$}"))
-}
 
 /// The three columns: one row per case.
 pub fn comparison_table(rows: &[WrinkleFullRow]) -> String {

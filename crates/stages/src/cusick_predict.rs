@@ -27,6 +27,10 @@ impl StageKind for CusickPredict {
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("predictions", "predictions.parquet: one row per fabric"),
         Slot::one(
+            "by_capture",
+            "predictions_by_capture.parquet: one row per predicted capture, its face's DC with a 90 % interval",
+        ),
+        Slot::one(
             "outlines",
             "outlines.parquet: the simulated drapes' shadow outlines r(θ)",
         ),

@@ -27,6 +27,10 @@ impl StageKind for CusickReport {
             "a cusick-predict stage's outlines.parquet (the simulated drapes)",
         ),
         Slot::one("profiles", "a cusick-predict stage's profiles.parquet"),
+        Slot::one(
+            "by_capture",
+            "a cusick-predict stage's predictions_by_capture.parquet",
+        ),
     ];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("markdown", "the report, .md"),

@@ -9,6 +9,7 @@
 //! curvature (cheap sharp folds) gives fewer folds at any DC. So the node count chooses the law
 //! where it tells the laws apart, and the fit says when it does not (an identifiability flag).
 
+use super::face::{CurlFit, FaceGap, fit_curl};
 use super::{
     Continuation, DC_SLOPE_PRIOR_PCT, DiscMesh, DrapeParams, SecantSearch, Tester,
     calibrate_bending_length, mesh_projection, secant_bending_length, shadow_measures, solve_drape,
@@ -26,6 +27,8 @@ pub struct SpecimenTargets {
     pub dc_se_pct: f64,
     /// Median node count of its captures.
     pub nodes: f64,
+    /// Its face gap, where it was photographed on both faces (none: the fit is face-blind).
+    pub face_gap: Option<FaceGap>,
 }
 
 /// One bending law a calibration tries: an anisotropy and a saturation.
@@ -239,8 +242,11 @@ pub struct LawCandidate {
 /// A fabric's calibration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FabricFit {
-    /// The chosen bending length c (geometric mean of warp and weft), m.
+    /// The chosen bending length c (geometric mean of warp and weft), m: where the calibration
+    /// seeds' mean DC meets the target (the seed-0 root moved by one secant step).
     pub bending_length_m: f64,
+    /// The bending length whose seed-0 drape meets the target, m.
+    pub seed0_bending_length_m: f64,
     /// 2σ interval of c from the DC's uncertainty (delta method over dDC/d ln c), m.
     pub bending_length_interval_m: Option<[f64; 2]>,
     /// dDC/d ln c near the isotropic c, %.
@@ -259,11 +265,16 @@ pub struct FabricFit {
     pub solves: usize,
 }
 
+/// The largest move in ln c from the seed-0 root to the seeds' mean (10 %: the continuation's
+/// reach, [`super::MAX_CONTINUATION_LN`]).
+pub const MAX_SEED_MEAN_LN: f64 = 0.1;
+
 /// Calibrates a fabric on its calibration specimen: per law, c by a secant on ln c over the seed-0
 /// drape continued through c ([`Continuation`]; the first law from the bracket's geometric middle,
 /// each later one from the previous law's c, slope and drape); per law the mean node count over
 /// `calibration_seeds` (each from the cone); the law whose mean is nearest the target node count
-/// wins (ties to the earlier law). Err names what failed.
+/// wins (ties to the earlier law), and its c is moved to where the seeds' mean DC meets the target.
+/// Err names what failed.
 pub fn calibrate_fabric(
     mesh: DiscMesh<'_>,
     target: &SpecimenTargets,
@@ -335,9 +346,15 @@ pub fn calibrate_fabric(
             (a.0.min(m), a.1.max(m))
         });
     let sigma = target.dc_se_pct.hypot(best.drapes.dc_sd_pct);
-    let scale = best.bending_length_m / cal.bending_length_m;
+    // c puts the seed-0 drape on the target; the prediction is a mean over other seeds. One secant
+    // step along dDC/d ln c moves c to where the calibration seeds' mean would meet the target
+    // (no further solve), by at most MAX_SEED_MEAN_LN in ln c.
+    let step = (target.dc_pct - best.drapes.dc_mean_pct) / slope;
+    let c = best.bending_length_m * step.clamp(-MAX_SEED_MEAN_LN, MAX_SEED_MEAN_LN).exp();
+    let scale = c / cal.bending_length_m;
     Ok(FabricFit {
-        bending_length_m: best.bending_length_m,
+        bending_length_m: c,
+        seed0_bending_length_m: best.bending_length_m,
         bending_length_interval_m: cal
             .interval_m(sigma, 2.0)
             .map(|[a, b]| [a * scale, b * scale]),
@@ -355,19 +372,37 @@ pub fn calibrate_fabric(
 pub struct FabricOutcome {
     /// The calibration on the calibration specimen.
     pub fit: FabricFit,
-    /// The converged drapes of the fitted parameters at the prediction seeds.
+    /// The curl fitted to its face gap, or why there is none (the prediction is then face-blind).
+    pub curl: Result<CurlFit, String>,
+    /// The converged drapes of the fitted parameters at the prediction seeds: face up, then (with
+    /// a curl) face down at the seeds of `face_down_seeds`.
     pub drapes: Vec<SeededDrape>,
-    /// Their node and DC distribution (None when none converged).
+    /// The seeds of the face-down drapes (empty without a curl).
+    pub face_down_seeds: std::ops::Range<u64>,
+    /// The node and DC distribution of all of them, the face average (None when none converged).
     pub distribution: Option<NodeDistribution>,
-    /// Prediction seeds tried.
+    /// Prediction seeds tried per face.
     pub seeds: u64,
     /// Drape solves made, calibration included.
     pub solves: usize,
 }
 
-/// The whole workflow of one fabric: [`calibrate_fabric`] on its calibration specimen, then the
-/// drapes of the fitted (c, law) at `seeds` further seeds (after the calibration's, so that no
-/// drape is both fitted and predicted) as the prediction for the other specimens.
+impl FabricOutcome {
+    /// The drapes of one face (`down`), or every drape of a face-blind prediction.
+    pub fn face(&self, down: bool) -> Vec<SeededDrape> {
+        let blind = self.face_down_seeds.is_empty();
+        self.drapes
+            .iter()
+            .filter(|d| blind || self.face_down_seeds.contains(&d.seed) == down)
+            .cloned()
+            .collect()
+    }
+}
+
+/// The whole workflow of one fabric: [`calibrate_fabric`] on its calibration specimen, the curl
+/// on its face gap ([`fit_curl`], where it has both faces), then the drapes of the fitted
+/// (c, law) at `seeds` further seeds per face (after the calibration's, so that no drape is both
+/// fitted and predicted) as the prediction for the other specimens.
 pub fn calibrate_and_predict(
     mesh: DiscMesh<'_>,
     target: &SpecimenTargets,
@@ -378,13 +413,40 @@ pub fn calibrate_and_predict(
 ) -> Result<FabricOutcome, String> {
     let fit = calibrate_fabric(mesh, target, base, tester, s)?;
     let q = fit.law.apply(base, fit.bending_length_m);
+    let curl = match &target.face_gap {
+        Some(gap) => fit_curl(mesh, &q, tester, gap),
+        None => Err("the calibration specimen was photographed on one face only".into()),
+    };
     let first = s.calibration_seeds;
-    let drapes = seeded_drapes(mesh, &q, tester, first..first + seeds);
+    let (drapes, face_down_seeds, solves) = match &curl {
+        Ok(c) => {
+            let at = |k: f64| DrapeParams {
+                curl_per_m: Some(k),
+                ..q.clone()
+            };
+            let down = first + seeds..first + 2 * seeds;
+            let mut drapes = seeded_drapes(mesh, &at(c.curl_per_m), tester, first..first + seeds);
+            drapes.extend(seeded_drapes(
+                mesh,
+                &at(-c.curl_per_m),
+                tester,
+                down.clone(),
+            ));
+            (drapes, down, fit.solves + c.solves + 2 * seeds as usize)
+        }
+        Err(_) => {
+            let drapes = seeded_drapes(mesh, &q, tester, first..first + seeds);
+            (drapes, 0..0, fit.solves + seeds as usize)
+        }
+    };
+    let tried = seeds as usize * if face_down_seeds.is_empty() { 1 } else { 2 };
     Ok(FabricOutcome {
-        distribution: NodeDistribution::of(&drapes, seeds as usize),
-        solves: fit.solves + seeds as usize,
+        distribution: NodeDistribution::of(&drapes, tried),
+        solves,
         fit,
+        curl,
         drapes,
+        face_down_seeds,
         seeds,
     })
 }

@@ -8,6 +8,7 @@ mod branch;
 mod calibrate;
 mod drape;
 mod fabric;
+mod face;
 mod params;
 
 pub use branch::{
@@ -26,6 +27,7 @@ pub use fabric::{
     SeededDrape, SpecimenTargets, calibrate_and_predict, calibrate_fabric, histogram,
     histogram_label, seeded_drapes,
 };
+pub use face::{CurlFit, FaceGap, GAP_TOL_PCT, MAX_CURL_PER_M, fit_curl};
 pub use params::{SPECIMEN_KEYS, SpecimenParameters};
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};

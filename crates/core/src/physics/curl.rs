@@ -172,7 +172,12 @@ mod tests {
         let mut tris = Vec::new();
         for j in 0..n - 1 {
             for i in 0..n - 1 {
-                let (a, b, c, d) = (j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i);
+                let (a, b, c, d) = (
+                    j * n + i,
+                    j * n + i + 1,
+                    (j + 1) * n + i + 1,
+                    (j + 1) * n + i,
+                );
                 if (i + j) % 2 == 0 {
                     tris.extend([[a, b, c], [a, c, d]]);
                 } else {
@@ -263,12 +268,17 @@ mod tests {
         term.add_hessian(&x, &mut h, false);
         let mut hv = vec![Vector3::zeros(); x.len()];
         h.mul_add(&v, &mut hv);
-        let shifted = |t: f64| -> Vec<Vector3<f64>> { x.iter().zip(&v).map(|(a, b)| a + b * t).collect() };
+        let shifted =
+            |t: f64| -> Vec<Vector3<f64>> { x.iter().zip(&v).map(|(a, b)| a + b * t).collect() };
         let (gp, gm) = (grad(&shifted(step)), grad(&shifted(-step)));
         let hscale = hv.iter().map(|v| v.amax()).fold(0.0, f64::max);
         for k in 0..x.len() {
             let fd = (gp[k] - gm[k]) / (2.0 * step);
-            assert!((fd - hv[k]).amax() < 1e-6 * hscale, "H v at {k}: {fd} vs {}", hv[k]);
+            assert!(
+                (fd - hv[k]).amax() < 1e-6 * hscale,
+                "H v at {k}: {fd} vs {}",
+                hv[k]
+            );
         }
         // The projected Hessian leaves the term out.
         let mut hp = crate::physics::HessianBlocks::default();
@@ -284,7 +294,10 @@ mod tests {
         let term = curl(&rest, &tris, 5.0);
         let x = rolled(&rest, 8.0);
         let turn = nalgebra::Rotation3::from_euler_angles(0.3, -1.1, 2.0);
-        let moved: Vec<Vector3<f64>> = x.iter().map(|p| turn * p + Vector3::new(1.0, 2.0, -3.0)).collect();
+        let moved: Vec<Vector3<f64>> = x
+            .iter()
+            .map(|p| turn * p + Vector3::new(1.0, 2.0, -3.0))
+            .collect();
         let (a, b) = (term.energy(&x), term.energy(&moved));
         assert!((a - b).abs() < 1e-12 * a.abs(), "{a} vs {b}");
     }

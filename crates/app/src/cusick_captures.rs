@@ -1,0 +1,256 @@
+//! `predictions_by_capture.parquet` (issue 51): one row per capture of every specimen but the
+//! calibration one — the model's DC and node count for the capture's face (face up at the fitted
+//! curl, face down at its negative; the face average where the face is unknown or the fit is
+//! face-blind), a 90 % prediction interval, and the baselines a textile lab would use beside it.
+//!
+//! The interval holds the specimen-to-specimen variation the model cannot know: it is the
+//! prediction plus the 5 % and 95 % quantiles of the residuals (measured − predicted) of every
+//! *other* fabric's captures of the same kind (known face, or face average) — leave one fabric
+//! out, never this fabric's own data. With fewer than [`MIN_POOL`] such residuals (a dataset of
+//! one or two fabrics) it falls back to ±1.645 of the model's own spread (its seeds' DC SD and the
+//! calibration specimen's), and says so.
+
+use crate::cusick_measure::ShadowRow;
+use drapelab_core::table::Table;
+use serde::{Deserialize, Serialize};
+
+/// One capture of a predicted specimen.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaptureRow {
+    /// Fabric number.
+    pub fabric: i32,
+    /// Specimen number.
+    pub sample: i32,
+    /// Capture number (1–2 face up, 3–4 face down in the bundled dataset).
+    pub capture: i32,
+    /// "up", "down" or "unknown".
+    pub face: String,
+    /// Predicted DC for this face, %: the mean over the face's perturbation seeds.
+    pub dc_predicted_pct: f64,
+    /// Lower end of the 90 % prediction interval, %.
+    pub dc_low_pct: f64,
+    /// Upper end of the 90 % prediction interval, %.
+    pub dc_high_pct: f64,
+    /// Predicted node count for this face: mean over its seeds.
+    pub nodes_predicted: f64,
+    /// Most frequent predicted node count for this face (the smaller on a tie).
+    pub nodes_predicted_mode: i32,
+    /// How the interval was made: "leave-one-fabric-out" or "model spread".
+    pub interval: String,
+    /// The capture's measured DC (its photo), %.
+    pub dc_measured_pct: f64,
+    /// The capture's measured node count (its photo).
+    pub nodes_measured: i32,
+    /// The face-average prediction (both faces' seeds), %.
+    pub dc_face_average_pct: f64,
+    /// Baseline: the calibration specimen's mean DC over both faces, carried over, %.
+    pub dc_carry_over_pct: f64,
+    /// Baseline: the calibration specimen's mean DC on this face, carried over, % (None: it has no
+    /// capture on this face, or the face is unknown).
+    pub dc_carry_over_face_pct: Option<f64>,
+    /// Baseline: the mean DC of the fabric's other predicted specimens (not this one), %.
+    pub dc_other_specimens_pct: Option<f64>,
+    /// Baseline: the same on this face only, %.
+    pub dc_other_specimens_face_pct: Option<f64>,
+}
+
+impl Table for CaptureRow {
+    const FILE: &'static str = "predictions_by_capture.parquet";
+    const ROW: &'static str = "One capture of a predicted Cusick specimen: its face's predicted DC with a 90 % interval (leave one fabric out), nodes, and baselines.";
+}
+
+/// Residuals of other fabrics' captures below this many: the interval falls back to the model's
+/// own spread.
+pub const MIN_POOL: usize = 10;
+
+/// One face's (or the face average's) prediction: DC mean and SD over its seeds, node mean and mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FaceDrapes {
+    /// Mean DC, %.
+    pub dc_pct: f64,
+    /// SD of the DC over the seeds, %.
+    pub dc_sd_pct: f64,
+    /// Mean node count.
+    pub nodes: f64,
+    /// Most frequent node count.
+    pub nodes_mode: i32,
+}
+
+/// A fabric's predictions per face: up, down (both none for a face-blind fit) and the average.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FacePredictions {
+    /// Face up (curl as fitted).
+    pub up: Option<FaceDrapes>,
+    /// Face down (curl negated).
+    pub down: Option<FaceDrapes>,
+    /// Every seed of both faces (or of the face-blind prediction).
+    pub average: FaceDrapes,
+}
+
+impl FacePredictions {
+    fn of(&self, face: &str) -> FaceDrapes {
+        match face {
+            "up" => self.up.unwrap_or(self.average),
+            "down" => self.down.unwrap_or(self.average),
+            _ => self.average,
+        }
+    }
+}
+
+fn mean(v: &[f64]) -> Option<f64> {
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+/// A capture's face as the table writes it.
+fn face_of(r: &ShadowRow) -> &str {
+    match r.face.as_str() {
+        "up" | "down" => &r.face,
+        _ => "unknown",
+    }
+}
+
+/// The rows of one fabric's predicted captures (`rows`: all its captures; `calib`: the calibration
+/// specimen), intervals not yet set (NaN; [`fill_intervals`] sets them).
+pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> Vec<CaptureRow> {
+    let dc_where = |keep: &dyn Fn(&ShadowRow) -> bool| {
+        mean(
+            &rows
+                .iter()
+                .filter(|r| keep(r))
+                .map(|r| r.dc_photo_pct)
+                .collect::<Vec<_>>(),
+        )
+    };
+    let carry = dc_where(&|r| r.sample == calib).unwrap_or(f64::NAN);
+    rows.iter()
+        .filter(|r| r.sample != calib)
+        .map(|r| {
+            let face = face_of(r);
+            let p = pred.of(face);
+            let known = face != "unknown";
+            let same_face = |o: &ShadowRow| known && face_of(o) == face;
+            CaptureRow {
+                fabric: r.fabric,
+                sample: r.sample,
+                capture: r.capture,
+                face: face.to_string(),
+                dc_predicted_pct: p.dc_pct,
+                dc_low_pct: f64::NAN,
+                dc_high_pct: f64::NAN,
+                nodes_predicted: p.nodes,
+                nodes_predicted_mode: p.nodes_mode,
+                interval: String::new(),
+                dc_measured_pct: r.dc_photo_pct,
+                nodes_measured: r.nodes_photo as i32,
+                dc_face_average_pct: pred.average.dc_pct,
+                dc_carry_over_pct: carry,
+                dc_carry_over_face_pct: dc_where(&|o| o.sample == calib && same_face(o)),
+                dc_other_specimens_pct: dc_where(&|o| o.sample != calib && o.sample != r.sample),
+                dc_other_specimens_face_pct: dc_where(&|o| {
+                    o.sample != calib && o.sample != r.sample && same_face(o)
+                }),
+            }
+        })
+        .collect()
+}
+
+/// The `q`-quantile of sorted `v` (linear between order statistics).
+fn quantile(v: &[f64], q: f64) -> f64 {
+    let at = q * (v.len() - 1) as f64;
+    let (lo, hi) = (at.floor() as usize, at.ceil() as usize);
+    v[lo] + (v[hi] - v[lo]) * (at - lo as f64)
+}
+
+/// Sets every row's 90 % interval from the other fabrics' residuals (see the module), or from
+/// `spread(fabric)` (the model's own DC spread, %) where they are too few.
+pub fn fill_intervals(rows: &mut [CaptureRow], spread: impl Fn(i32) -> f64) {
+    let residual = |r: &CaptureRow, average: bool| {
+        r.dc_measured_pct
+            - if average {
+                r.dc_face_average_pct
+            } else {
+                r.dc_predicted_pct
+            }
+    };
+    let snapshot = rows.to_vec();
+    for r in rows.iter_mut() {
+        let average = r.face == "unknown";
+        let mut pool: Vec<f64> = snapshot
+            .iter()
+            .filter(|o| o.fabric != r.fabric && (average || o.face != "unknown"))
+            .map(|o| residual(o, average))
+            .filter(|v| v.is_finite())
+            .collect();
+        pool.sort_by(f64::total_cmp);
+        let (lo, hi, how) = if pool.len() >= MIN_POOL {
+            (
+                quantile(&pool, 0.05),
+                quantile(&pool, 0.95),
+                "leave-one-fabric-out",
+            )
+        } else {
+            let h = 1.645 * spread(r.fabric);
+            (-h, h, "model spread")
+        };
+        r.dc_low_pct = r.dc_predicted_pct + lo;
+        r.dc_high_pct = r.dc_predicted_pct + hi;
+        r.interval = how.into();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(fabric: i32, face: &str, measured: f64, predicted: f64) -> CaptureRow {
+        CaptureRow {
+            fabric,
+            sample: 2,
+            capture: 1,
+            face: face.into(),
+            dc_predicted_pct: predicted,
+            dc_low_pct: f64::NAN,
+            dc_high_pct: f64::NAN,
+            nodes_predicted: 7.0,
+            nodes_predicted_mode: 7,
+            interval: String::new(),
+            dc_measured_pct: measured,
+            nodes_measured: 7,
+            dc_face_average_pct: predicted,
+            dc_carry_over_pct: predicted,
+            dc_carry_over_face_pct: None,
+            dc_other_specimens_pct: None,
+            dc_other_specimens_face_pct: None,
+        }
+    }
+
+    #[test]
+    fn an_interval_is_made_of_the_other_fabrics_residuals_only() {
+        // Fabric 1's residuals are all +50; the others' spread uniformly over −10…+10: fabric 1's
+        // interval ignores its own and spans the others' 5–95 %, the others' include fabric 1's.
+        let mut rows: Vec<CaptureRow> = (0..21)
+            .map(|k| row(2 + k % 3, "up", 50.0 + (k as f64 - 10.0), 50.0))
+            .collect();
+        rows.extend((0..4).map(|_| row(1, "down", 100.0, 50.0)));
+        fill_intervals(&mut rows, |_| 1.0);
+        let own = rows.iter().find(|r| r.fabric == 1).unwrap();
+        assert_eq!(own.interval, "leave-one-fabric-out");
+        assert!((own.dc_low_pct - 41.0).abs() < 1e-9 && (own.dc_high_pct - 59.0).abs() < 1e-9);
+        let other = rows.iter().find(|r| r.fabric == 2).unwrap();
+        assert!(other.dc_high_pct > 60.0, "{}", other.dc_high_pct);
+        // A capture of unknown face: the face-average prediction's residuals of the others (here
+        // fabric 1's, +50 against its face average) and its interval built on them.
+        let mut unknown = row(3, "unknown", 50.0, 50.0);
+        unknown.dc_face_average_pct = 48.0;
+        let mut mixed = rows.clone();
+        mixed.push(unknown);
+        fill_intervals(&mut mixed, |_| 1.0);
+        let u = mixed.last().unwrap();
+        assert!(u.dc_high_pct >= 50.0 + 49.0, "{u:?}");
+        // One fabric alone: the model's own spread.
+        let mut lone = vec![row(5, "up", 52.0, 50.0), row(5, "down", 49.0, 50.0)];
+        fill_intervals(&mut lone, |_| 2.0);
+        assert_eq!(lone[0].interval, "model spread");
+        assert!((lone[0].dc_high_pct - 53.29).abs() < 1e-9);
+    }
+}
