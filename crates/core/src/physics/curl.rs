@@ -165,27 +165,7 @@ mod tests {
 
     /// A 6 × 6 grid of 1 cm squares, each cut along alternating diagonals.
     fn sheet() -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
-        let n = 6;
-        let rest: Vec<[f64; 2]> = (0..n * n)
-            .map(|k| [(k % n) as f64 * 0.01, (k / n) as f64 * 0.01])
-            .collect();
-        let mut tris = Vec::new();
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let (a, b, c, d) = (
-                    j * n + i,
-                    j * n + i + 1,
-                    (j + 1) * n + i + 1,
-                    (j + 1) * n + i,
-                );
-                if (i + j) % 2 == 0 {
-                    tris.extend([[a, b, c], [a, c, d]]);
-                } else {
-                    tris.extend([[a, b, d], [b, c, d]]);
-                }
-            }
-        }
-        (rest, tris)
+        crate::physics::testing::grid(6, 0.01, true)
     }
 
     fn curl(rest: &[[f64; 2]], tris: &[[usize; 3]], kappa: f64) -> Curl {

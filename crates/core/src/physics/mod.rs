@@ -15,6 +15,8 @@ mod patch_bending;
 mod self_contact;
 mod shear;
 mod springs;
+#[cfg(test)]
+pub(crate) mod testing;
 
 pub use assembly::ModelBuilder;
 pub use bending::{
