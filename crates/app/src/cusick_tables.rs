@@ -54,7 +54,8 @@ pub struct PredictionRow {
     pub nodes_predicted_histogram: String,
     /// Sample SD of the simulated node count over the seeds.
     pub nodes_predicted_sd: Option<f64>,
-    /// Perturbation seeds of the prediction (disjoint from the calibration's).
+    /// Perturbation seeds of the prediction per face (disjoint from the calibration's; as many again
+    /// face down where a curl is fitted, on seeds of their own).
     pub prediction_seeds: i32,
     /// Median node count of the calibration specimen's photos (the calibration's target).
     pub nodes_calibration_median: f64,
