@@ -225,6 +225,15 @@ fn the_pipeline_calibrates_predicts_draws_and_records_two_fabrics() {
         &pipeline,
     );
     keep_fabrics(&tmp.path().join("datasets/cusick"), &["5", "7"]);
+    // One capture whose face the index does not give: predicted as the face average.
+    let index = tmp.path().join("datasets/cusick/captures_index.csv");
+    let text = std::fs::read_to_string(&index).unwrap();
+    let text = text.replacen("\n7,3,2,up,", "\n7,3,2,,", 1);
+    assert!(
+        text.contains("\n7,3,2,,"),
+        "fabric 7, specimen 3, capture 2 is in the index"
+    );
+    std::fs::write(&index, text).unwrap();
     run_plan(&file);
     let run = tmp.path().join("runs/cusick");
     let rows: Vec<drapelab::stages::PredictionRow> =
@@ -281,7 +290,10 @@ for c in ["dc_predicted_pct", "dc_low_pct", "dc_high_pct", "nodes_predicted"]:
     assert str(t.schema.field(c).type) == "double", c
 rows = t.to_pylist()
 assert {(r["fabric"], r["sample"]) for r in rows} == {(f, s) for f in (5, 7) for s in (2, 3, 4)}, rows
-assert all(r["face"] in ("up", "down") and r["dc_low_pct"] < r["dc_high_pct"] for r in rows)
+assert all(r["face"] in ("up", "down", "unknown") and r["dc_low_pct"] < r["dc_high_pct"] for r in rows)
+unknown = [r for r in rows if r["face"] == "unknown"]
+assert [(r["fabric"], r["sample"], r["capture"]) for r in unknown] == [(7, 3, 2)], unknown
+assert unknown[0]["dc_predicted_pct"] == unknown[0]["dc_face_average_pct"]
 # Face up and face down of one fabric are predicted apart (the curl), each its own seeds.
 for f in (5, 7):
     up = {r["dc_predicted_pct"] for r in rows if r["fabric"] == f and r["face"] == "up"}
