@@ -11,11 +11,29 @@ fn mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-/// The curl table: per fabric, the calibration specimen's face gap, the fitted curl with its 2σ
-/// interval, the gap's slope and the predicted DC of each face.
-fn curl_table(rows: &[PredictionRow]) -> String {
+/// The other specimens' mean face gap of each fabric (mean DC face down less face up over its
+/// predicted captures), points.
+fn measured_gaps(caps: &[CaptureRow]) -> BTreeMap<i32, f64> {
+    let mut by: BTreeMap<i32, (Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    for c in caps {
+        let e = by.entry(c.fabric).or_default();
+        match c.face.as_str() {
+            "up" => e.0.push(c.dc_measured_pct),
+            "down" => e.1.push(c.dc_measured_pct),
+            _ => {}
+        }
+    }
+    by.into_iter()
+        .filter_map(|(f, (u, d))| Some((f, mean(&d)? - mean(&u)?)))
+        .collect()
+}
+
+/// The curl table: per fabric, the calibration specimen's face gap beside its other specimens',
+/// the fitted curl with its 2σ interval, the gap's slope and the predicted DC of each face.
+fn curl_table(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
+    let others = measured_gaps(caps);
     let mut s = String::from(
-        "| fabric | calibration face gap, down − up (points) | curl κ (1/m) | κ, 2σ interval (1/m) | side identifiable | gap slope dΔ/dκ (points·m) | DC predicted face up (%) | DC predicted face down (%) |\n|---|---|---|---|---|---|---|---|\n",
+        "| fabric | calibration face gap, down − up (points) | the other specimens' face gap (points) | curl κ (1/m) | κ, 2σ interval (1/m) | side identifiable | gap slope dΔ/dκ (points·m) | DC predicted face up (%) | DC predicted face down (%) |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let interval = match (r.curl_lo_per_m, r.curl_hi_per_m) {
@@ -23,9 +41,10 @@ fn curl_table(rows: &[PredictionRow]) -> String {
             _ => "–".into(),
         };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.fabric,
             opt(r.calibration_face_gap_pct, 1),
+            opt(others.get(&r.fabric).copied(), 1),
             opt(r.curl_per_m, 1),
             interval,
             r.curl_identifiable
@@ -204,7 +223,7 @@ pub fn faces_section(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
     let mut s = String::from(
         "\n## Both faces of every capture\n\nISO 9073-9 and BS 5058 drape every specimen face up and face down (captures 1–2 up, 3–4 down), and the faces differ with a sign that is the fabric's own. The model gives the fabric a natural curl κ (the curvature a free strip rolls up to toward the fabric's face; `physics::hinge_curl`, the linear term −Bκ∫2H dA of a spontaneous curvature), positive lifting the rim face up and lowering it face down. κ is fitted to the calibration specimen's face gap Δ = DC_down − DC_up after c (the faces' mean DC is the curl-free DC to second order in κ): the gap's slope comes from the seed-0 drape's sensitivity dx/dκ, then the faces at ±κ are solved and κ corrected by a secant until the solved gap is within 0.3 points. Its 2σ interval is the gap's standard error (pooled over repeated captures of a face) over the slope; the side is identifiable where the interval excludes zero. Each other specimen's capture is then predicted for its face (six seeds per face), with a 90 % interval made of the other fabrics' residuals only (leave one fabric out).\n\n",
     );
-    s += &curl_table(rows);
+    s += &curl_table(rows, caps);
     s += "\n### Every predicted capture, per face\n\nThe baselines beside the model: the calibration specimen's mean (both faces) and its face-matched mean carried over, and — using data of the predicted fabric's other specimens, which the model never sees — their mean and face-matched mean.\n\n";
     s += &score_table(caps, rows);
     s += "\n### The harder test: face down from face up only\n\nEach predicted specimen's face-down captures from its own face-up captures only, against carrying the face-up mean over and against the population's mean face effect (the other fabrics' specimens). The model's version shifts the face-up mean by the gap its drapes give at the other fabrics' mean curl, slope × κ̄ — linearised, with the slope taken at c as fitted on both faces of the calibration specimen (a fit on face-up captures alone would move c by the O(κ²) that the faces' mean differs from the curl-free DC).\n\n";
