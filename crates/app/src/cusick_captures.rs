@@ -11,6 +11,8 @@
 //! calibration specimen's), and says so.
 
 use crate::cusick_measure::ShadowRow;
+use drapelab_core::cusick::NodeDistribution;
+use drapelab_core::measure::mean;
 use drapelab_core::table::Table;
 use serde::{Deserialize, Serialize};
 
@@ -63,42 +65,27 @@ impl Table for CaptureRow {
 /// own spread.
 pub const MIN_POOL: usize = 10;
 
-/// One face's (or the face average's) prediction: DC mean and SD over its seeds, node mean and mode.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FaceDrapes {
-    /// Mean DC, %.
-    pub dc_pct: f64,
-    /// SD of the DC over the seeds, %.
-    pub dc_sd_pct: f64,
-    /// Mean node count.
-    pub nodes: f64,
-    /// Most frequent node count.
-    pub nodes_mode: i32,
-}
-
-/// A fabric's predictions per face: up, down (both none for a face-blind fit) and the average.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A fabric's predictions per face: the node and DC distributions of its face-up and face-down
+/// seeds (both none for a face-blind fit) and of all of them, the face average.
+#[derive(Debug, Clone, PartialEq)]
 pub struct FacePredictions {
     /// Face up (curl as fitted).
-    pub up: Option<FaceDrapes>,
+    pub up: Option<NodeDistribution>,
     /// Face down (curl negated).
-    pub down: Option<FaceDrapes>,
+    pub down: Option<NodeDistribution>,
     /// Every seed of both faces (or of the face-blind prediction).
-    pub average: FaceDrapes,
+    pub average: NodeDistribution,
 }
 
 impl FacePredictions {
-    fn of(&self, face: &str) -> FaceDrapes {
-        match face {
-            "up" => self.up.unwrap_or(self.average),
-            "down" => self.down.unwrap_or(self.average),
-            _ => self.average,
-        }
+    fn of(&self, face: &str) -> &NodeDistribution {
+        let own = match face {
+            "up" => self.up.as_ref(),
+            "down" => self.down.as_ref(),
+            _ => None,
+        };
+        own.unwrap_or(&self.average)
     }
-}
-
-fn mean(v: &[f64]) -> Option<f64> {
-    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
 /// A capture's face as the table writes it.
@@ -134,15 +121,15 @@ pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> 
                 sample: r.sample,
                 capture: r.capture,
                 face: face.to_string(),
-                dc_predicted_pct: p.dc_pct,
+                dc_predicted_pct: p.dc_mean_pct,
                 dc_low_pct: f64::NAN,
                 dc_high_pct: f64::NAN,
-                nodes_predicted: p.nodes,
-                nodes_predicted_mode: p.nodes_mode,
+                nodes_predicted: p.nodes_mean,
+                nodes_predicted_mode: p.nodes_mode as i32,
                 interval: String::new(),
                 dc_measured_pct: r.dc_photo_pct,
                 nodes_measured: r.nodes_photo as i32,
-                dc_face_average_pct: pred.average.dc_pct,
+                dc_face_average_pct: pred.average.dc_mean_pct,
                 dc_carry_over_pct: carry,
                 dc_carry_over_face_pct: dc_where(&|o| o.sample == calib && same_face(o)),
                 dc_other_specimens_pct: dc_where(&|o| o.sample != calib && o.sample != r.sample),

@@ -6,9 +6,7 @@
 //! simulated shadow outlines and height profiles (for the report's pictures) and a rerun recording
 //! overlaying each fabric's registered meshes and simulated drapes.
 
-use crate::cusick_captures::{
-    CaptureRow, FaceDrapes, FacePredictions, capture_rows, fill_intervals,
-};
+use crate::cusick_captures::{CaptureRow, FacePredictions, capture_rows, fill_intervals};
 use crate::cusick_measure::ShadowRow;
 use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use crate::job::Job;
@@ -362,15 +360,7 @@ pub fn fill_distribution(row: &mut PredictionRow, d: &NodeDistribution) {
 /// The fitted curl and each face's prediction into `row`; the faces' predictions (none when no
 /// drape converged).
 fn fill_faces(row: &mut PredictionRow, outcome: &FabricOutcome) -> Option<FacePredictions> {
-    let drapes_of = |d: &[drapelab_core::cusick::SeededDrape]| {
-        NodeDistribution::of(d, d.len()).map(|n| FaceDrapes {
-            dc_pct: n.dc_mean_pct,
-            dc_sd_pct: n.dc_sd_pct,
-            nodes: n.nodes_mean,
-            nodes_mode: n.nodes_mode as i32,
-        })
-    };
-    let average = drapes_of(&outcome.drapes)?;
+    let average = outcome.distribution.clone()?;
     let (mut up, mut down) = (None, None);
     match &outcome.curl {
         Ok(c) => {
@@ -385,10 +375,11 @@ fn fill_faces(row: &mut PredictionRow, outcome: &FabricOutcome) -> Option<FacePr
                     row.status, c.curl_per_m, c.gap_slope_pct_m
                 );
             }
-            up = drapes_of(&outcome.face(false));
-            down = drapes_of(&outcome.face(true));
-            row.dc_predicted_face_up_pct = up.map(|f| f.dc_pct);
-            row.dc_predicted_face_down_pct = down.map(|f| f.dc_pct);
+            let of = |d: Vec<_>| NodeDistribution::of(&d, d.len());
+            up = of(outcome.face(false));
+            down = of(outcome.face(true));
+            row.dc_predicted_face_up_pct = up.as_ref().map(|f| f.dc_mean_pct);
+            row.dc_predicted_face_down_pct = down.as_ref().map(|f| f.dc_mean_pct);
         }
         Err(why) => row.status = format!("{}; face-blind: {why}", row.status),
     }

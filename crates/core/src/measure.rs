@@ -210,6 +210,11 @@ pub fn count_rises(s: &[f64], threshold: f64) -> usize {
     count
 }
 
+/// The mean of `v`; none when it is empty.
+pub fn mean(v: &[f64]) -> Option<f64> {
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
 /// The median of the finite values of `v` (the mean of the middle two for an even count); NaN when
 /// none is finite.
 pub fn median(v: &[f64]) -> f64 {

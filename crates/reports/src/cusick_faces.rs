@@ -5,11 +5,8 @@
 use crate::format::opt;
 use drapelab_app::cusick_captures::CaptureRow;
 use drapelab_app::cusick_tables::PredictionRow;
+use drapelab_core::measure::mean;
 use std::collections::BTreeMap;
-
-fn mean(v: &[f64]) -> Option<f64> {
-    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-}
 
 /// The other specimens' mean face gap of each fabric (mean DC face down less face up over its
 /// predicted captures), points.

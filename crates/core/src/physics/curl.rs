@@ -123,14 +123,6 @@ impl Kernel<4> for CurlKernel {
             }
         }
     }
-    fn exact_hessian(
-        &self,
-        s: usize,
-        x: &Local<4>,
-        push: &mut impl FnMut(usize, usize, Matrix3<f64>),
-    ) {
-        self.hessian(s, x, false, push);
-    }
     fn coefficients(&self, s: usize, out: &mut Vec<f64>) {
         out.extend(self.coef[s]);
         out.push(self.weight[s]);
