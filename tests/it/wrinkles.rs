@@ -5,8 +5,8 @@
 use crate::support::{drapelab, root};
 use drapelab::solve::Status;
 use drapelab::wrinkles::{
-    WrinkleConfig, WrinkleResult, boundary_length_m, count_folds, load_config, simpson, solve,
-    wrinkle_mesh,
+    WrinkleConfig, WrinkleInputs, WrinkleResult, boundary_length_m, count_folds, load_config,
+    simpson, solve, wrinkle_mesh,
 };
 use std::path::Path;
 
@@ -16,10 +16,11 @@ fn seed_tables() -> WrinkleConfig {
 
 /// The seed's tables with the reading of Eq. 7 fitted to the seed (c = 135, Table I's middle row):
 /// the tension field then wrinkles every case but one, and its trends can be tested. The bundled
-/// config's c = 1931 (supported by full simulations, issue 36) predicts almost no wrinkles.
+/// config reads Eq. 7 for a fabric (issue 50), whose count depends on h and l alone.
 fn seed_tables_seed_reading() -> WrinkleConfig {
     let mut cfg = seed_tables();
     cfg.defaults.buckling_constant = 135.0;
+    cfg.defaults.bending_length_m = None;
     cfg
 }
 
@@ -58,6 +59,51 @@ fn wrinkles_follow_the_trends_the_seed_states() {
     assert!(q2.windows(2).all(|w| w[1] < w[0]), "Q against w: {q2:?}");
     assert!(q3.windows(2).all(|w| w[1] > w[0]), "Q against t: {q3:?}");
     assert!(q4[2] > q4[0], "Q against E: {q4:?}");
+}
+
+/// Eq. 7 read for a fabric (issue 50): a fabric whose bending term 12 w c_b³ equals the plate's
+/// E t³/(1 − ν²) gives the plate's count exactly; and the fabric's count depends on h and l alone
+/// (s = 12 c c_b³/(h l²)), not on the weight, thickness or modulus the plate's reading feels.
+#[test]
+fn eq7_read_for_a_fabric_is_the_plates_at_the_same_bending_term_and_blind_to_weight() {
+    let plate = WrinkleInputs {
+        bending_length_m: None,
+        buckling_constant: 135.0,
+        ..i_h140()
+    };
+    let term =
+        plate.youngs_modulus_Pa * plate.thickness_m.powi(3) / (1.0 - plate.poisson_ratio.powi(2));
+    let same = WrinkleInputs {
+        bending_length_m: Some((term / (12.0 * plate.weight_N_per_m2)).cbrt()),
+        ..plate.clone()
+    };
+    let (a, b) = (solve(&plate), solve(&same));
+    assert!(a.n >= 2, "{a:?}");
+    assert_eq!(a.n, b.n);
+    assert!((a.q_critical - b.q_critical).abs() < 1e-12, "{a:?} {b:?}");
+    assert!((a.zmax_m - b.zmax_m).abs() < 1e-9, "{a:?} {b:?}");
+    // The fabric's count: the same whatever w, t and E; the plate's moves with each.
+    let fabric = WrinkleInputs {
+        bending_length_m: Some(0.0143),
+        buckling_constant: 7197.0,
+        ..plate.clone()
+    };
+    let heavier = |inp: &WrinkleInputs| WrinkleInputs {
+        weight_N_per_m2: 3.0 * inp.weight_N_per_m2,
+        thickness_m: 2.0 * inp.thickness_m,
+        youngs_modulus_Pa: 0.5 * inp.youngs_modulus_Pa,
+        ..inp.clone()
+    };
+    let f = solve(&fabric);
+    assert!(f.n >= 1, "{f:?}");
+    assert!((solve(&heavier(&fabric)).q_critical - f.q_critical).abs() < 1e-12);
+    assert!((solve(&heavier(&plate)).q_critical - a.q_critical).abs() > 1e-3);
+    // A taller fabric sheet wrinkles more: s falls as 1/h.
+    let taller = WrinkleInputs {
+        height_m: 2.0 * fabric.height_m,
+        ..fabric.clone()
+    };
+    assert!(solve(&taller).q_critical < f.q_critical);
 }
 
 #[test]
@@ -220,7 +266,8 @@ fn a_sweep_adds_one_case_per_value_and_n_grows_with_height() {
     let file = tmp.path().join("s.toml");
     let base = std::fs::read_to_string(root().join("datasets/wrinkles/seed_tables.toml"))
         .unwrap()
-        .replacen("buckling_constant = 1931.0", "buckling_constant = 135.0", 1);
+        .replacen("buckling_constant = 7197.0", "buckling_constant = 135.0", 1)
+        .replacen("bending_length_m = 0.0143\n", "", 1);
     assert!(base.contains("buckling_constant = 135.0"));
     std::fs::write(
         &file,
@@ -338,7 +385,7 @@ outputs.recording = "{run}/full/sheets.rrd"
 outputs.sheets = "{run}/full/sheets.png"
 outputs.fibres_plot = "{run}/full/fibres.svg"
 outputs.markdown = "{run}/full/wrinkles.md"
-params = { coarse_nx = 15, fine_nx = 29, cases = ["I-h90", "II-w33"], other_starts = ["compressed"], shear_ratios = [1e-4] }
+params = { coarse_nx = 15, fine_nx = 29, cases = ["I-h90", "II-w33"], other_starts = ["compressed"], shear_ratios = [1e-4], fabric_coarse_nx = 15, fabric_fine_nx = 29, map_cases = ["I-h90"], map_bending_lengths_m = [0.029], map_shear_N_per_m = [170.0], points_coarse_nx = 9, points_fine_nx = 15 }
 "#;
 
 #[test]
@@ -360,19 +407,28 @@ want = {"case": pa.string(), "n_seed": pa.int32(), "n_tension_field": pa.int32()
         "reading": pa.string(), "bending_length_m": pa.float64(), "shear_rigidity_N_per_m": pa.float64()}
 for name, ty in want.items():
     assert t.schema.field(name).type == ty, (name, t.schema.field(name).type)
+assert t.schema.field("role").type == pa.string()
 rows = t.to_pylist()
-assert [(r["case"], r["reading"]) for r in rows] == [
-    ("I-h90", "plate"), ("II-w33", "plate"), ("I-h90", "fabric"), ("II-w33", "fabric")], rows
+assert [(r["case"], r["reading"], r["role"]) for r in rows] == [
+    ("I-h90", "plate", "table"), ("II-w33", "plate", "table"), ("I-h90", "fabric", "table"),
+    ("II-w33", "fabric", "table"), ("I-h90", "fabric", "map"), ("Fig4-d5", "fabric", "photograph"),
+    ("Fig4-d10", "fabric", "photograph"), ("Fig4-d15", "fabric", "photograph")], rows
+# The map's point and the photographs are solved on the points' meshes.
+assert all(r["grid"].startswith("15x") and r["grid_coarse"].startswith("9x") for r in rows[4:]), rows
+m = rows[4]
+assert abs(m["bending_length_m"] - 0.029) < 1e-12 and m["shear_rigidity_N_per_m"] == 170.0, m
 for r in rows:
-    assert r["status"] in ("converged", "not converged in the mesh"), r
-    assert r["n_seed"] in (5, 6) and r["n_tension_field"] == 0, r  # c = 1931: no tension-field wrinkle
+    assert r["status"] in ("converged", "converged in n only", "not converged in the mesh"), r
+    # Eq. 7 read for a fabric of 14.3 mm (c = 7197) wrinkles every one of these sheets.
+    assert r["n_tension_field"] >= 1, r
+    assert r["n_seed"] in ((5, 6) if r["role"] != "photograph" else (4,)), r
     assert 0.0 < r["z_max_full_simulation_m"] < 1.0 and r["wall_time_s"] > 0.0, r
     assert len(r["line_depths_full_simulation_m"]) == r["n_full_simulation"] + 1, r
     assert r["self_crossing_edges"] == 0, r
 # The plate's bending lengths are centimetres and its shear kN/m; the fabric's the stage's defaults.
 for r in rows[:2]:
     assert r["bending_length_m"] > 0.03 and r["shear_rigidity_N_per_m"] > 1e4, r
-for r in rows[2:]:
+for r in rows[2:4] + rows[5:]:
     assert abs(r["bending_length_m"] - 0.0143) < 1e-12 and r["shear_rigidity_N_per_m"] == 53.3, r
 f = pq.read_table(sys.argv[2]).to_pylist()
 assert {(r["case"], r["reading"], r["mesh"]) for r in f} == {
@@ -382,7 +438,8 @@ assert sorted((r["case"], r["start"], r["shear_ratio"]) for r in s) == [
     (c, st, g) for c in ("I-h90", "II-w33") for st, g in (("arc", 1e-4), ("arc", 1.0), ("compressed", 1.0))], s
 assert all(r["self_crossing_edges"] == 0 and r["status"] == "converged" for r in s), s
 meshes = {c.entity_path for c in RrdReader(sys.argv[4]).stream().to_chunks() if c.entity_path.endswith("/mesh")}
-assert len(meshes) == 8, meshes
+assert len(meshes) == 16, meshes
+assert "/cases/I-h90_fabric-c29_0mm-G170Npm_fine/mesh" in meshes, meshes
 "#;
     crate::support::run_python(
         code,
@@ -399,6 +456,9 @@ assert len(meshes) == 8, meshes
         "## Does the count depend on the start?",
         "## Which reading of Eq. 7 the simulations support",
         "## The sheets read as fabric",
+        "**Eq. 7 refitted to fabric.**",
+        "### The map: bending length × shear rigidity",
+        "### The photographed cloth (Fig. 4)",
         "![the simulated sheets, finer mesh](sheets.png)",
     ] {
         assert!(md.contains(part), "{part} missing from the report");
@@ -427,6 +487,16 @@ fn a_bad_wrinkles_simulate_parameter_exits_2_naming_the_pipeline_and_key() {
             "shear_ratios = [1e-4], fabric_bending_length_m = -0.01",
             "fabric_bending_length_m",
         ),
+        (
+            "points_fine_nx = 15",
+            "points_fine_nx = 9",
+            "points_fine_nx",
+        ),
+        (
+            "map_shear_N_per_m = [170.0]",
+            "map_shear_N_per_m = [-1.0]",
+            "map_shear_N_per_m",
+        ),
     ] {
         let (_tmp, file) = crate::support::temp_project(
             &["datasets/wrinkles/seed_tables.toml"],
@@ -436,24 +506,32 @@ fn a_bad_wrinkles_simulate_parameter_exits_2_naming_the_pipeline_and_key() {
         crate::support::assert_bad_input([Path::new("run"), &file], &["wrinkles_small.toml", key]);
     }
     // A case the config does not have: found when the stage reads the config, before any solve.
-    let (tmp, file) = crate::support::temp_project(
-        &["datasets/wrinkles/seed_tables.toml"],
-        "wrinkles_small.toml",
-        &FULL_PIPELINE.replacen("\"II-w33\"", "\"II-w99\"", 1),
-    );
-    let o = drapelab().arg("run").arg(&file).output().unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.lines()
-            .any(|l| l.contains("stages.full.params.cases") && l.contains("II-w99")),
-        "{err}"
-    );
-    assert!(
-        !tmp.path()
-            .join("runs/wrinkles_small/full/wrinkles_full.parquet")
-            .exists()
-    );
+    for (from, to, key) in [
+        ("\"II-w33\"", "\"II-w99\"", "stages.full.params.cases"),
+        (
+            "map_cases = [\"I-h90\"]",
+            "map_cases = [\"II-w99\"]",
+            "stages.full.params.map_cases",
+        ),
+    ] {
+        let (tmp, file) = crate::support::temp_project(
+            &["datasets/wrinkles/seed_tables.toml"],
+            "wrinkles_small.toml",
+            &FULL_PIPELINE.replacen(from, to, 1),
+        );
+        let o = drapelab().arg("run").arg(&file).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.lines().any(|l| l.contains(key) && l.contains("II-w99")),
+            "{err}"
+        );
+        assert!(
+            !tmp.path()
+                .join("runs/wrinkles_small/full/wrinkles_full.parquet")
+                .exists()
+        );
+    }
 }
 
 /// Issue 50: I-h140 read as a fabric (bending length 14.3 mm, shear 17 N/m — the soft end of KES

@@ -31,6 +31,7 @@ pub mod tune;
 pub mod validate;
 pub mod wrinkles;
 pub mod wrinkles_full;
+pub mod wrinkles_points;
 
 pub use job::{Job, Progress, Quiet};
 

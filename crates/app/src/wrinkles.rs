@@ -114,6 +114,8 @@ pub struct WrinkleRow {
     pub support_displacement_m: f64,
     /// Load constant c of Eq. 7.
     pub buckling_constant: f64,
+    /// The fabric's bending length of Eq. 7, m (none: the seed's plate reading, E t³).
+    pub bending_length_m: Option<f64>,
     /// Number of wrinkles.
     pub n: u32,
     /// Ratio of consecutive amplitudes (Eq. 5).
@@ -179,6 +181,7 @@ pub fn write_table(out: &Path, cfg: &WrinkleConfig, solved: &[SolvedCase]) -> Re
                 weight_N_per_m2: i.weight_N_per_m2,
                 support_displacement_m: i.support_displacement_m,
                 buckling_constant: i.buckling_constant,
+                bending_length_m: i.bending_length_m,
                 n: r.n as u32,
                 q: r.q,
                 q_critical: r.q_critical,
@@ -242,12 +245,15 @@ the seed's in brackets; Q_c is the critical ratio of Eq. 7, Q = (a₀/a_n)^(1/n)
 rounding n; L error is |L' − L|/L at convergence (tolerance 5 %, the seed's).\n\n";
 
 pub const REPORT_TAIL: &str = "\n## Where drapelab and the seed differ, and why\n\n\
-- The trends agree (n grows with h and w and falls with t and E; Q falls with w and rises with t), the \
-numbers only roughly (z_max within a factor of 1.5 where both have wrinkles; n off by up to a factor of 2).\n\
+- Read as the seed's plate with c = 135, the trends agree (n grows with h and w and falls with t and E; Q \
+falls with w and rises with t), the numbers only roughly (z_max within a factor of 1.5 where both have wrinkles; n off by up to a factor of 2).\n\
 - The seed's equations are garbled in its text and it gives neither Poisson's ratio nor the load constant c \
 of Eq. 7: drapelab reads Eq. 7 as plate buckling, σ_c = c E t²/(l²(1 − ν²)), with ν = 0.3 and c = 135 \
-chosen so that Table I's middle row has the seed's Q = 1.29 (datasets/wrinkles/seed_tables.toml).\n\
-- With that reading Q_c depends on t³ E/(w h): Table III's thickness range (0.09–0.40 mm, a factor of 88 \
+chosen so that Table I's middle row has the seed's Q = 1.29. The bundled config reads it for a fabric \
+instead (`bending_length_m`: E t³/(1 − ν²) becomes 12 w c_b³, c = 7197, the reading that full simulations of \
+the sheets as fabric support: reports/wrinkles.md); then s = 12 c c_b³/(h l²) no longer depends on w, t or \
+E, and n rises with h alone.\n\
+- With the plate's reading Q_c depends on t³ E/(w h): Table III's thickness range (0.09–0.40 mm, a factor of 88 \
 in t³) spans Q_c from 1.08 to no wrinkling at all (s ≥ 1 at 0.40 mm), where the seed, whose Q moves only \
 from 1.33 to 2.60, still finds 2 wrinkles. The seed's own Q values do not follow any single power of t, E, \
 w or h (Table I's Q is not even monotone in h), so no choice of c reproduces all twelve cases: its Q \
@@ -272,9 +278,9 @@ pub fn report_markdown(cfg: &WrinkleConfig, solved: &[SolvedCase]) -> String {
             r.result.n,
             seed(&|x| x.n.to_string()),
             100.0 * r.result.zmax_m,
-            seed(&|x| format!("{:.2}", x.zmax_cm)),
+            seed(&|x| x.zmax_cm.map_or("–".into(), |z| format!("{z:.2}"))),
             r.result.q,
-            seed(&|x| format!("{:.2}", x.q)),
+            seed(&|x| x.q.map_or("–".into(), |q| format!("{q:.2}"))),
             r.result.q_critical,
             r.result.iterations,
             if r.result.converged { "yes" } else { "no" },

@@ -7,6 +7,9 @@
 //! `.rrd` of the simulated sheets; the report and pictures are the reports crate's.
 
 use crate::job::Job;
+use crate::wrinkles_points::{
+    FitSheet, MapAxes, PointRole, PointSpec, TensionFieldFit, fit_tension_field, point_specs,
+};
 use anyhow::Result;
 use drapelab_core::cloth::Grid;
 use drapelab_core::solve::{SolveReport, Status};
@@ -76,6 +79,42 @@ pub struct WrinklesSimulateParams {
     /// geometric middle of KES shear of apparel fabrics (0.3–3 gf/cm/deg).
     #[serde(default = "default_fabric_shear")]
     pub fabric_shear_N_per_m: f64,
+    /// Grid points along the supports of the fabric reading's coarser mesh. Default 85: at 57
+    /// (2.5 cm, longer than a fabric's bending length) six of the twelve sheets fold once where the
+    /// finer meshes fold three times (issue 50's mesh study: n = 1, 3, 3, 3 on 29, 57, 85, 113
+    /// points for I-h140). Must be below `fabric_fine_nx`.
+    #[serde(default = "default_fabric_coarse_nx")]
+    pub fabric_coarse_nx: usize,
+    /// Grid points along the supports of the fabric reading's finer mesh, whose wrinkles are the
+    /// result. Default 113.
+    #[serde(default = "default_fine_nx")]
+    pub fabric_fine_nx: usize,
+    /// The cases of the map (issue 50): each solved read as fabric at every bending length ×
+    /// shear rigidity below. Default empty (no map); the bundled pipeline names Table I's.
+    #[serde(default)]
+    pub map_cases: Vec<String>,
+    /// The map's bending lengths, m. Default [0.007, 0.029]: the ends of the Cusick fabrics' range.
+    #[serde(default = "default_map_lengths")]
+    pub map_bending_lengths_m: Vec<f64>,
+    /// The map's shear rigidities, N/m. Default [17, 170]: KES 0.3 and 3 gf/cm/deg.
+    #[serde(default = "default_map_shears")]
+    pub map_shear_N_per_m: Vec<f64>,
+    /// Grid points along the supports of the map's and the photographs' coarser mesh. Default 57.
+    #[serde(default = "default_coarse_nx")]
+    pub points_coarse_nx: usize,
+    /// ... and of their finer mesh, whose wrinkles are reported. Default 85.
+    #[serde(default = "default_fabric_coarse_nx")]
+    pub points_fine_nx: usize,
+}
+
+fn default_fabric_coarse_nx() -> usize {
+    85
+}
+fn default_map_lengths() -> Vec<f64> {
+    vec![0.007, 0.029]
+}
+fn default_map_shears() -> Vec<f64> {
+    vec![17.0, 170.0]
 }
 
 fn default_true() -> bool {
@@ -136,6 +175,13 @@ impl Default for WrinklesSimulateParams {
             fabric: true,
             fabric_bending_length_m: default_fabric_bending_length(),
             fabric_shear_N_per_m: default_fabric_shear(),
+            fabric_coarse_nx: default_fabric_coarse_nx(),
+            fabric_fine_nx: default_fine_nx(),
+            map_cases: Vec::new(),
+            map_bending_lengths_m: default_map_lengths(),
+            map_shear_N_per_m: default_map_shears(),
+            points_coarse_nx: default_coarse_nx(),
+            points_fine_nx: default_fabric_coarse_nx(),
         }
     }
 }
@@ -284,7 +330,8 @@ impl MeshPair {
             && c.n == f.n
             && (c.zmax_m - f.zmax_m).abs() <= ZMAX_AGREEMENT_REL * f.zmax_m.max(1e-12)
     }
-    /// "converged", "not converged in the mesh", or why a solve stopped.
+    /// "converged", "converged in n only" (z_max apart by more than [`ZMAX_AGREEMENT_REL`]), "not
+    /// converged in the mesh", or why a solve stopped.
     pub fn status(&self, threshold_rel: f64) -> String {
         if let Some(s) = [&self.coarse, &self.fine]
             .into_iter()
@@ -296,9 +343,33 @@ impl MeshPair {
             )
         } else if self.mesh_converged(threshold_rel) {
             "converged".into()
+        } else if self.coarse.wrinkles(threshold_rel).n == self.fine.wrinkles(threshold_rel).n {
+            "converged in n only".into()
         } else {
             "not converged in the mesh".into()
         }
+    }
+}
+
+/// A solved [`PointSpec`].
+pub struct FabricPoint {
+    /// What was solved.
+    pub spec: PointSpec,
+    /// The tension-field model with the config's Eq. 7.
+    pub tension_field: WrinkleResult,
+    /// Its solves on the points' two meshes.
+    pub pair: MeshPair,
+}
+
+impl FabricPoint {
+    /// "CASE/fabric-c7_0mm-G17Npm": the sheet's name in recordings.
+    pub fn label(&self) -> String {
+        let (c_b, g) = (
+            self.spec.reading.bending_length_m(&self.spec.inputs),
+            self.spec.reading.rigidities(&self.spec.inputs).2,
+        );
+        let mm = format!("{:.1}", 1e3 * c_b).replace('.', "_");
+        format!("{}/fabric-c{mm}mm-G{g:.0}Npm", self.spec.case)
     }
 }
 
@@ -316,8 +387,10 @@ pub struct WrinklesFull {
     pub tension_field_n: Vec<Vec<usize>>,
     /// The constant chosen by leave-one-out on agreement (±1) with the full simulation.
     pub constant: LeaveOneOut,
-    /// The same against the sheets read as fabric (issue 50), where every case has them.
-    pub constant_fabric: Option<LeaveOneOut>,
+    /// The map's and the photographs' fabric sheets (issue 50).
+    pub points: Vec<FabricPoint>,
+    /// Eq. 7 refitted to the fabric sheets (issue 50), where every case was read as fabric.
+    pub fabric_fit: Option<TensionFieldFit>,
 }
 
 impl WrinklesFull {
@@ -422,6 +495,30 @@ impl WrinklesSimulateParams {
         if !(self.fabric_shear_N_per_m.is_finite() && self.fabric_shear_N_per_m > 0.0) {
             return bad("fabric_shear_N_per_m", "must be a positive rigidity in N/m");
         }
+        for (coarse, fine, key) in [
+            (self.fabric_coarse_nx, self.fabric_fine_nx, "fabric_fine_nx"),
+            (self.points_coarse_nx, self.points_fine_nx, "points_fine_nx"),
+        ] {
+            if coarse < 5 || fine <= coarse {
+                return bad(
+                    key,
+                    "must be larger than its coarser mesh's, which must be at least 5",
+                );
+            }
+        }
+        let bad_list = |v: &[f64]| v.is_empty() || v.iter().any(|x| !(x.is_finite() && *x > 0.0));
+        if bad_list(&self.map_bending_lengths_m) {
+            return bad(
+                "map_bending_lengths_m",
+                "must be positive lengths in m, at least one",
+            );
+        }
+        if bad_list(&self.map_shear_N_per_m) {
+            return bad(
+                "map_shear_N_per_m",
+                "must be positive rigidities in N/m, at least one",
+            );
+        }
         Ok(())
     }
 }
@@ -429,20 +526,21 @@ impl WrinklesSimulateParams {
 /// Checks the parameters, and the cases they name against the config (names the bad key).
 pub fn check(ctx: &Job<'_>, cfg: &WrinkleConfig, p: &WrinklesSimulateParams) -> Result<()> {
     p.check().map_err(|(k, m)| ctx.param_error(k, m))?;
-    if let Some(name) = p
-        .cases
-        .iter()
-        .find(|n| !cfg.cases.iter().any(|c| &c.case == *n))
-    {
-        return Err(ctx
-            .param_error("cases", format!("no case `{name}` in the config"))
-            .into());
+    for (key, names) in [("cases", &p.cases), ("map_cases", &p.map_cases)] {
+        if let Some(name) = names
+            .iter()
+            .find(|n| !cfg.cases.iter().any(|c| &c.case == *n))
+        {
+            return Err(ctx
+                .param_error(key, format!("no case `{name}` in the config"))
+                .into());
+        }
     }
     Ok(())
 }
 
-/// Solves every case (or those named) on both meshes, in parallel, and makes the two
-/// leave-one-out choices.
+/// Solves every case (or those named) on both meshes, and the map's and the photographs' fabric
+/// sheets on theirs, in parallel, and makes the leave-one-out choices.
 pub fn simulate(
     ctx: &Job<'_>,
     cfg: &WrinkleConfig,
@@ -454,72 +552,113 @@ pub fn simulate(
         .iter()
         .filter(|c| p.cases.is_empty() || p.cases.contains(&c.case))
         .collect();
-    // Finer meshes first: the longest solves start first. Job (case, nx, setup): the plate's
-    // finer mesh, every variant's coarser one, then the fabric's finer and coarser meshes.
+    let inputs: Vec<WrinkleInputs> = chosen.iter().map(|c| c.inputs(&cfg.defaults)).collect();
+    let map = MapAxes {
+        cases: &p.map_cases,
+        bending_lengths_m: &p.map_bending_lengths_m,
+        shear_N_per_m: &p.map_shear_N_per_m,
+    };
+    let specs = point_specs(cfg, &map, p.fabric.then(|| p.fabric_reading()));
+    // Finer meshes first: the longest solves start first. Jobs (inputs, nx, setup): the plate's
+    // finer mesh, every variant's coarser one, the fabric's finer and coarser meshes, then the
+    // points' finer and coarser meshes.
     let variants = p.variants();
     let n = chosen.len();
     let fabric = HungSetup {
         reading: p.fabric_reading(),
         ..p.setup(variants[0])
     };
-    let mut jobs: Vec<(usize, usize, HungSetup)> = (0..n)
-        .map(|k| (k, p.fine_nx, p.setup(variants[0])))
-        .collect();
+    let each = |nx: usize, setup: HungSetup| inputs.iter().map(move |i| (i, nx, setup));
+    let mut jobs: Vec<(&WrinkleInputs, usize, HungSetup)> =
+        each(p.fine_nx, p.setup(variants[0])).collect();
     for v in &variants {
-        jobs.extend((0..n).map(|k| (k, p.coarse_nx, p.setup(*v))));
+        jobs.extend(each(p.coarse_nx, p.setup(*v)));
     }
     if p.fabric {
-        jobs.extend((0..n).map(|k| (k, p.fine_nx, fabric)));
-        jobs.extend((0..n).map(|k| (k, p.coarse_nx, fabric)));
+        jobs.extend(each(p.fabric_fine_nx, fabric));
+        jobs.extend(each(p.fabric_coarse_nx, fabric));
     }
+    for nx in [p.points_fine_nx, p.points_coarse_nx] {
+        jobs.extend(specs.iter().map(|s| {
+            let setup = HungSetup {
+                reading: s.reading,
+                ..fabric
+            };
+            (&s.inputs, nx, setup)
+        }));
+    }
+    let mut solves = solve_all(ctx, &jobs)?
+        .into_iter()
+        .map(Some)
+        .collect::<Vec<_>>();
+    let mut take = |slot: usize| solves[slot].take().expect("each solve once");
+    let fabric_at = (variants.len() + 1) * n;
+    let mut cases = Vec::with_capacity(n);
+    for (k, (c, inputs)) in chosen.iter().zip(inputs.iter()).enumerate() {
+        cases.push(SimulatedCase {
+            case: c.case.clone(),
+            tension_field: drapelab_core::wrinkles::solve(inputs),
+            inputs: inputs.clone(),
+            seed: c.seed.clone(),
+            plate: MeshPair {
+                fine: take(k),
+                coarse: take(n + k),
+            },
+            others: variants[1..]
+                .iter()
+                .enumerate()
+                .map(|(o, v)| (*v, take((o + 2) * n + k)))
+                .collect(),
+            fabric: p.fabric.then(|| MeshPair {
+                fine: take(fabric_at + k),
+                coarse: take(fabric_at + n + k),
+            }),
+        });
+    }
+    let points_at = fabric_at + if p.fabric { 2 * n } else { 0 };
+    let m = specs.len();
+    let points = specs
+        .into_iter()
+        .enumerate()
+        .map(|(k, spec)| FabricPoint {
+            tension_field: drapelab_core::wrinkles::solve(&spec.inputs),
+            spec,
+            pair: MeshPair {
+                fine: take(points_at + k),
+                coarse: take(points_at + m + k),
+            },
+        })
+        .collect();
+    Ok(choose(cases, points, p))
+}
+
+/// Solves every job (inputs, grid points along the supports, setup) in parallel, with progress.
+fn solve_all(
+    ctx: &Job<'_>,
+    jobs: &[(&WrinkleInputs, usize, HungSetup)],
+) -> Result<Vec<SheetSolve>> {
     ctx.started(jobs.len());
-    let mut solves: Vec<Option<SheetSolve>> = jobs
+    let solves = jobs
         .par_iter()
-        .map(|&(k, nx, setup)| {
-            let inp = chosen[k].inputs(&cfg.defaults);
-            let s = full::solve_hung(&inp, case_grid(&inp, nx), &setup);
+        .map(|&(inp, nx, setup)| {
+            let s = full::solve_hung(inp, case_grid(inp, nx), &setup);
             ctx.item_done();
             s.map(|s| SheetSolve {
                 grid: s.grid,
                 x: s.x,
                 report: s.report,
             })
-            .map(Some)
         })
         .collect::<std::result::Result<_, _>>()?;
-    let fabric_at = (variants.len() + 1) * n;
-    let cases: Vec<SimulatedCase> = chosen
-        .iter()
-        .enumerate()
-        .map(|(k, c)| {
-            let inputs = c.inputs(&cfg.defaults);
-            let mut take = |slot: usize| solves[slot].take().expect("each solve once");
-            SimulatedCase {
-                case: c.case.clone(),
-                tension_field: drapelab_core::wrinkles::solve(&inputs),
-                inputs,
-                seed: c.seed.clone(),
-                plate: MeshPair {
-                    fine: take(k),
-                    coarse: take(n + k),
-                },
-                others: variants[1..]
-                    .iter()
-                    .enumerate()
-                    .map(|(o, v)| (*v, take((o + 2) * n + k)))
-                    .collect(),
-                fabric: p.fabric.then(|| MeshPair {
-                    fine: take(fabric_at + k),
-                    coarse: take(fabric_at + n + k),
-                }),
-            }
-        })
-        .collect();
-    Ok(choose(cases, p))
+    Ok(solves)
 }
 
 /// The leave-one-out choices over the solved cases.
-fn choose(cases: Vec<SimulatedCase>, p: &WrinklesSimulateParams) -> WrinklesFull {
+fn choose(
+    cases: Vec<SimulatedCase>,
+    points: Vec<FabricPoint>,
+    p: &WrinklesSimulateParams,
+) -> WrinklesFull {
     let ok: Vec<Vec<bool>> = cases
         .iter()
         .map(|c| {
@@ -538,6 +677,7 @@ fn choose(cases: Vec<SimulatedCase>, p: &WrinklesSimulateParams) -> WrinklesFull
                 .map(|&b| {
                     let inp = WrinkleInputs {
                         buckling_constant: b,
+                        bending_length_m: None,
                         ..c.inputs.clone()
                     };
                     drapelab_core::wrinkles::solve(&inp).n
@@ -555,13 +695,46 @@ fn choose(cases: Vec<SimulatedCase>, p: &WrinklesSimulateParams) -> WrinklesFull
             chosen: 0,
             held_out: Vec::new(),
         },
-        constant_fabric: None,
+        points,
+        fabric_fit: None,
     };
     out.constant = leave_one_out(&out.agreement_rows());
-    out.constant_fabric = out
-        .fabric_counts()
-        .map(|n| leave_one_out(&out.agreement_with(&n)));
+    out.fabric_fit = fit_fabric(&out, p);
     out
+}
+
+/// Eq. 7 refitted to the fabric sheets: the cases' results, then the map's points (each in its
+/// case's group); none unless every case was read as fabric.
+fn fit_fabric(found: &WrinklesFull, p: &WrinklesSimulateParams) -> Option<TensionFieldFit> {
+    let t = found.threshold_rel();
+    let reading = p.fabric_reading();
+    let mut sheets: Vec<FitSheet<'_>> = Vec::new();
+    for (k, c) in found.cases.iter().enumerate() {
+        sheets.push(FitSheet {
+            group: k,
+            case: &c.case,
+            role: "table",
+            inputs: &c.inputs,
+            reading,
+            n: c.fabric.as_ref()?.fine.wrinkles(t).n,
+        });
+    }
+    for pt in found
+        .points
+        .iter()
+        .filter(|q| q.spec.role == PointRole::Map)
+    {
+        let group = found.cases.iter().position(|c| c.case == pt.spec.case);
+        sheets.push(FitSheet {
+            group: group.unwrap_or(found.cases.len() + sheets.len()),
+            case: &pt.spec.case,
+            role: "map",
+            inputs: &pt.spec.inputs,
+            reading: pt.spec.reading,
+            n: pt.pair.fine.wrinkles(t).n,
+        });
+    }
+    fit_tension_field(&p.buckling_constants, &sheets)
 }
 
 /// One case of seed 002: the seed's table, drapelab's tension-field model and the full
@@ -582,8 +755,9 @@ pub struct WrinkleFullRow {
     pub z_max_full_simulation_m: f64,
     /// Wall time of both solves, s.
     pub wall_time_s: f64,
-    /// "converged", "not converged in the mesh" (the meshes disagree on n or on z_max by more than
-    /// 10 %), or "not converged: STATUS (GRID)" for a solve that stopped early.
+    /// "converged", "converged in n only" (the meshes agree on n, not on z_max within 10 %), "not
+    /// converged in the mesh" (they disagree on n), or "not converged: STATUS (GRID)" for a solve
+    /// that stopped early.
     pub status: String,
     /// How the sheet's bending and shear were read from the case: "plate" (seed 002's E t³/12 and
     /// E t/2(1 + ν)) or "fabric" (a bending length and a shear rigidity of real fabrics).
@@ -592,6 +766,9 @@ pub struct WrinkleFullRow {
     pub bending_length_m: f64,
     /// The sheet's in-plane shear rigidity, N/m.
     pub shear_rigidity_N_per_m: f64,
+    /// Why the sheet was solved: "table" (the case's result under its reading), "map" (a point of
+    /// the map over bending length × shear rigidity) or "photograph" (the seed's Fig. 4).
+    pub role: String,
     /// The same on the coarser mesh, m.
     pub z_max_full_simulation_coarse_m: f64,
     /// The seed's z_max, m.
@@ -722,22 +899,70 @@ pub fn start_rows(found: &WrinklesFull, result_start: HungStart) -> Vec<StartRow
     out
 }
 
-/// The result table: every case read as a plate, then every case read as a fabric.
+/// The result table: every case read as a plate, every case read as a fabric, then the map's and
+/// the photographs' fabric sheets.
 pub fn rows(found: &WrinklesFull, p: &WrinklesSimulateParams) -> Vec<WrinkleFullRow> {
     let plate = SheetReading::Plate { shear_ratio: 1.0 };
     let fabric = p.fabric_reading();
-    let plates = found.cases.iter().map(|c| row(found, c, &plate, &c.plate));
+    let plates = found
+        .cases
+        .iter()
+        .map(|c| row(found, &c.source(), &plate, &c.plate));
     let fabrics = found
         .cases
         .iter()
-        .filter_map(|c| Some(row(found, c, &fabric, c.fabric.as_ref()?)));
-    plates.chain(fabrics).collect()
+        .filter_map(|c| Some(row(found, &c.source(), &fabric, c.fabric.as_ref()?)));
+    let points = found
+        .points
+        .iter()
+        .map(|q| row(found, &q.source(), &q.spec.reading, &q.pair));
+    plates.chain(fabrics).chain(points).collect()
 }
 
-/// One case under one reading.
+/// What a row says of a sheet besides its solves.
+pub struct RowSource<'a> {
+    /// Case name.
+    pub case: &'a str,
+    /// "table", "map" or "photograph".
+    pub role: &'static str,
+    /// The case's inputs.
+    pub inputs: &'a WrinkleInputs,
+    /// The seed's result, where it gives one.
+    pub seed: Option<&'a drapelab_core::wrinkles::SeedResult>,
+    /// The tension-field model's.
+    pub tension_field: &'a WrinkleResult,
+}
+
+impl SimulatedCase {
+    /// The case as a row's source.
+    pub fn source(&self) -> RowSource<'_> {
+        RowSource {
+            case: &self.case,
+            role: "table",
+            inputs: &self.inputs,
+            seed: self.seed.as_ref(),
+            tension_field: &self.tension_field,
+        }
+    }
+}
+
+impl FabricPoint {
+    /// The point as a row's source.
+    pub fn source(&self) -> RowSource<'_> {
+        RowSource {
+            case: &self.spec.case,
+            role: self.spec.role.name(),
+            inputs: &self.spec.inputs,
+            seed: self.spec.seed.as_ref(),
+            tension_field: &self.tension_field,
+        }
+    }
+}
+
+/// One sheet under one reading.
 fn row(
     found: &WrinklesFull,
-    c: &SimulatedCase,
+    c: &RowSource<'_>,
     reading: &SheetReading,
     pair: &MeshPair,
 ) -> WrinkleFullRow {
@@ -745,8 +970,8 @@ fn row(
     let (wf, wc) = (pair.fine.wrinkles(t), pair.coarse.wrinkles(t));
     let grid = |s: &SheetSolve| format!("{}x{}", s.grid.nx, s.grid.ny);
     WrinkleFullRow {
-        case: c.case.clone(),
-        n_seed: c.seed.as_ref().map(|r| r.n as i32),
+        case: c.case.to_string(),
+        n_seed: c.seed.map(|r| r.n as i32),
         n_tension_field: c.tension_field.n as i32,
         n_full_simulation: wf.n as i32,
         n_full_simulation_coarse: wc.n as i32,
@@ -754,12 +979,13 @@ fn row(
         wall_time_s: pair.fine.report.wall_time_s + pair.coarse.report.wall_time_s,
         status: pair.status(t),
         reading: reading.name().into(),
-        bending_length_m: reading.bending_length_m(&c.inputs),
-        shear_rigidity_N_per_m: reading.rigidities(&c.inputs).2,
+        bending_length_m: reading.bending_length_m(c.inputs),
+        shear_rigidity_N_per_m: reading.rigidities(c.inputs).2,
+        role: c.role.into(),
         z_max_full_simulation_coarse_m: wc.zmax_m,
-        z_max_seed_m: c.seed.as_ref().map(|r| r.zmax_cm / 100.0),
+        z_max_seed_m: c.seed.and_then(|r| r.zmax_cm).map(|z| z / 100.0),
         z_max_tension_field_m: c.tension_field.zmax_m,
-        q_seed: c.seed.as_ref().map(|r| r.q),
+        q_seed: c.seed.and_then(|r| r.q),
         q_tension_field: c.tension_field.q,
         q_full_simulation: wf.q,
         line_depths_full_simulation_m: wf.line_depths_m,
@@ -821,16 +1047,17 @@ pub fn write_outputs(
         drapelab_record::write_table(out, &fibre_rows(found))?;
     }
     if let Some(out) = ctx.optional_output("recording") {
-        let meshes: Vec<(String, WrinkleMesh)> = found
-            .cases
-            .iter()
-            .flat_map(|c| {
-                readings(c).flat_map(move |(reading, pair)| {
-                    [
-                        (format!("{}/{reading}/fine", c.case), pair.fine.mesh()),
-                        (format!("{}/{reading}/coarse", c.case), pair.coarse.mesh()),
-                    ]
-                })
+        let cases = found.cases.iter().flat_map(|c| {
+            readings(c).map(move |(reading, pair)| (format!("{}/{reading}", c.case), pair))
+        });
+        let points = found.points.iter().map(|q| (q.label(), &q.pair));
+        let meshes: Vec<(String, WrinkleMesh)> = cases
+            .chain(points)
+            .flat_map(|(label, pair)| {
+                [
+                    (format!("{label}/fine"), pair.fine.mesh()),
+                    (format!("{label}/coarse"), pair.coarse.mesh()),
+                ]
             })
             .collect();
         drapelab_record::write_wrinkle_meshes(out, &meshes)?;

@@ -12,5 +12,6 @@ pub mod format;
 pub mod montage;
 pub mod report;
 pub mod seed003_report;
+pub mod wrinkles_fabric;
 pub mod wrinkles_report;
 pub mod wrinkles_text;

@@ -48,21 +48,6 @@ pub fn comparison_table(rows: &[WrinkleFullRow]) -> String {
     s
 }
 
-/// Counts over the rows: (solved and converged in the mesh, tension field within ±1 of the
-/// simulation, seed within ±1 of the simulation).
-pub fn agreement_counts(rows: &[WrinkleFullRow]) -> (usize, usize, usize) {
-    let within = |a: i32, b: i32| (a - b).abs() <= 1;
-    (
-        rows.iter().filter(|r| r.status == "converged").count(),
-        rows.iter()
-            .filter(|r| within(r.n_tension_field, r.n_full_simulation))
-            .count(),
-        rows.iter()
-            .filter(|r| r.n_seed.is_some_and(|n| within(n, r.n_full_simulation)))
-            .count(),
-    )
-}
-
 /// The lobe threshold's leave-one-out: mesh agreement per candidate and the held-out score.
 pub fn threshold_section(found: &WrinklesFull) -> String {
     let n = found.cases.len();
@@ -104,7 +89,12 @@ mesh in **{} of {n}** (chosen per fold: {}).\n",
 pub fn constant_section(found: &WrinklesFull, cfg: &WrinkleConfig, shear_ratios: &[f64]) -> String {
     let n = found.cases.len();
     let nu = cfg.defaults.poisson_ratio;
-    let today = cfg.defaults.buckling_constant;
+    // The config's c where it reads Eq. 7 as the plate, as these candidates do.
+    let today = cfg
+        .defaults
+        .bending_length_m
+        .is_none()
+        .then_some(cfg.defaults.buckling_constant);
     // The same agreement against the sheets of lower shear stiffness (coarser mesh).
     let soft: Vec<(f64, Vec<Vec<bool>>)> = shear_ratios
         .iter()
@@ -118,7 +108,8 @@ pub fn constant_section(found: &WrinklesFull, cfg: &WrinkleConfig, shear_ratios:
         "---|".repeat(soft.len())
     );
     for (k, c) in found.buckling_constants.iter().enumerate() {
-        let mark = match (k == found.constant.chosen, (c - today).abs() < 1e-6 * c) {
+        let is_today = today.is_some_and(|t| (c - t).abs() < 1e-6 * c);
+        let mark = match (k == found.constant.chosen, is_today) {
             (true, true) => " (chosen; today's)",
             (true, false) => " (chosen)",
             (false, true) => " (today's)",
@@ -144,9 +135,14 @@ pub fn constant_section(found: &WrinklesFull, cfg: &WrinkleConfig, shear_ratios:
     let _ = write!(
         s,
         "\nHeld out: with c chosen on the other {} cases, the tension field is within ±1 of the simulation on \
-the case left out in **{} of {n}** (chosen on all cases: c = {chosen:.0}; today's c = {today:.0}).",
+the case left out in **{} of {n}** (chosen on all cases: c = {chosen:.0}; {}).",
         n.saturating_sub(1),
         found.constant.held_out_hits(),
+        today.map_or(
+            "the config reads Eq. 7 for a fabric instead: \"Eq. 7 refitted to fabric\" above"
+                .into(),
+            |t| format!("today's c = {t:.0}")
+        ),
     );
     for (r, ok) in &soft {
         let loo = drapelab_core::wrinkles::full::leave_one_out(ok);
@@ -285,8 +281,14 @@ pub fn fibres_svg(found: &WrinklesFull) -> Result<String> {
 }
 
 /// The simulated sheets (finer mesh), four to a row: each case read as a plate, then beside it
-/// read as a fabric where it was.
+/// read as a fabric where it was; then the photographed cloth (Fig. 4) read as fabric.
 pub fn sheets_png(found: &WrinklesFull) -> image::RgbImage {
+    use drapelab_app::wrinkles_points::PointRole;
+    let photographs = found
+        .points
+        .iter()
+        .filter(|q| q.spec.role == PointRole::Photograph)
+        .map(|q| (format!("{} fabric", q.spec.case), &q.pair.fine));
     let sheets: Vec<(String, &drapelab_app::wrinkles_full::SheetSolve)> = found
         .cases
         .iter()
@@ -297,6 +299,7 @@ pub fn sheets_png(found: &WrinklesFull) -> image::RgbImage {
                     .map(|f| (format!("{} fabric", c.case), &f.fine)),
             )
         })
+        .chain(photographs)
         .collect();
     let tiles: Vec<crate::montage::Tile<'_>> = sheets
         .iter()
@@ -309,118 +312,6 @@ pub fn sheets_png(found: &WrinklesFull) -> image::RgbImage {
         })
         .collect();
     crate::montage::montage(&tiles)
-}
-
-/// The twelve sheets read as fabric (issue 50) beside the plates: n on both meshes, the tension
-/// field's agreement with them and Eq. 7's constant chosen against them by leave-one-out, and
-/// each table's trend in sign against the seed's.
-pub fn fabric_section(
-    found: &WrinklesFull,
-    plates: &[WrinkleFullRow],
-    fabrics: &[WrinkleFullRow],
-) -> String {
-    if fabrics.is_empty() {
-        return String::new();
-    }
-    let mut s = format!(
-        "\n## The sheets read as fabric\n\n{}\n",
-        crate::wrinkles_text::FABRIC
-    );
-    s += "| case | n: seed | n: tension field | n: plate | **n: fabric** (coarse) | z_max cm: plate | fabric | bending length mm: plate | fabric | shear N/m: plate | fabric | status (fabric) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    for (p, f) in plates.iter().zip(fabrics) {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | **{}** ({}) | {:.1} | {:.1} | {:.0} | {:.1} | {:.0} | {:.0} | {} |",
-            p.case,
-            opt(p.n_seed.map(f64::from), 0),
-            p.n_tension_field,
-            p.n_full_simulation,
-            f.n_full_simulation,
-            f.n_full_simulation_coarse,
-            100.0 * p.z_max_full_simulation_m,
-            100.0 * f.z_max_full_simulation_m,
-            1000.0 * p.bending_length_m,
-            1000.0 * f.bending_length_m,
-            p.shear_rigidity_N_per_m,
-            f.shear_rigidity_N_per_m,
-            f.status,
-        );
-    }
-    let n = fabrics.len();
-    let (converged, tf, seed) = agreement_counts(fabrics);
-    let _ = write!(
-        s,
-        "\n**{converged} of {n}** fabric sheets converged in the mesh; the tension field (the config's c) is \
-within ±1 of them in **{tf} of {n}**, the seed's table in **{seed} of {n}**. {}\n\n{}",
-        fabric_constant(found),
-        trends(plates, fabrics)
-    );
-    s
-}
-
-/// Eq. 7's constant chosen by leave-one-out against the fabric sheets, with its held-out score.
-fn fabric_constant(found: &WrinklesFull) -> String {
-    let Some(loo) = &found.constant_fabric else {
-        return String::new();
-    };
-    format!(
-        "Eq. 7's constant chosen by leave-one-out on agreement (±1) with the fabric sheets: c = {:.0}, the \
-case left out within ±1 in **{} of {}** (per fold: {}).",
-        found.buckling_constants[loo.chosen],
-        loo.held_out_hits(),
-        loo.held_out.len(),
-        loo.held_out
-            .iter()
-            .map(|h| format!("{:.0}", found.buckling_constants[h.0]))
-            .collect::<Vec<_>>()
-            .join(", ")
-    )
-}
-
-/// Each table's trend (its cases in the config's order, the varied quantity rising): the sign of
-/// n's change from the first case to the last, the seed's against the plate's and the fabric's.
-fn trends(plates: &[WrinkleFullRow], fabrics: &[WrinkleFullRow]) -> String {
-    let table = |r: &WrinkleFullRow| r.case.split('-').next().unwrap_or("").to_string();
-    let sign = |a: i32, b: i32| match b.cmp(&a) {
-        std::cmp::Ordering::Greater => "rises",
-        std::cmp::Ordering::Less => "falls",
-        std::cmp::Ordering::Equal => "stays",
-    };
-    let mut s = String::from(
-        "| table | cases | seed's n | plate's n | fabric's n |\n|---|---|---|---|---|\n",
-    );
-    let mut names: Vec<String> = plates.iter().map(table).collect();
-    names.dedup();
-    for name in names {
-        let mine = |rows: &[WrinkleFullRow]| -> Vec<WrinkleFullRow> {
-            rows.iter().filter(|r| table(r) == name).cloned().collect()
-        };
-        let (p, f) = (mine(plates), mine(fabrics));
-        let seq = |rows: &[WrinkleFullRow], n: fn(&WrinkleFullRow) -> Option<i32>| {
-            let v: Vec<i32> = rows.iter().filter_map(n).collect();
-            match (v.first(), v.last()) {
-                (Some(&a), Some(&b)) => format!(
-                    "{} ({})",
-                    sign(a, b),
-                    v.iter().map(i32::to_string).collect::<Vec<_>>().join(", ")
-                ),
-                _ => "–".into(),
-            }
-        };
-        let _ = writeln!(
-            s,
-            "| {name} | {} | {} | {} | {} |",
-            p.iter()
-                .map(|r| r.case.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-            seq(&p, |r| r.n_seed),
-            seq(&p, |r| Some(r.n_full_simulation)),
-            seq(&f, |r| Some(r.n_full_simulation)),
-        );
-    }
-    s
 }
 
 /// The tension-field model's own table (the `wrinkles` stage's report body).
@@ -473,12 +364,15 @@ pub fn markdown(
     // Both tables once: each row counts its sheet's self-crossings.
     let all = rows(found, p);
     let reading = |name: &str| -> Vec<WrinkleFullRow> {
-        all.iter().filter(|x| x.reading == name).cloned().collect()
+        all.iter()
+            .filter(|x| x.reading == name && x.role == "table")
+            .cloned()
+            .collect()
     };
-    let (r, fabrics) = (reading("plate"), reading("fabric"));
+    let r = reading("plate");
     let starts = start_rows(found, p.start);
     let n = r.len();
-    let (converged, tf, seed) = agreement_counts(&r);
+    let (converged, tf, seed) = crate::wrinkles_fabric::agreement_counts(&r);
     let name = |slot: &str| {
         ctx.optional_output(slot)
             .and_then(|p| p.file_name())
@@ -505,7 +399,8 @@ mesh, the result; in brackets the coarser one. Self-crossing edges (the sheet pa
         let _ = write!(
             s,
             "\n![the simulated sheets, finer mesh]({png})\n\nThe simulated sheets on the finer mesh, 30° \
-above the horizon and turned 30°, in the order of the table: each case read as a plate, then as a fabric.\n"
+above the horizon and turned 30°, in the order of the table: each case read as a plate, then as a fabric; \
+then the photographed cloth (Fig. 4) read as fabric.\n"
         );
     }
     if let Some(svg) = name("fibres_plot") {
@@ -515,7 +410,7 @@ above the horizon and turned 30°, in the order of the table: each case read as 
 height below the supports, finer mesh dark, coarser light; red dots: the wrinkle lines counted.\n"
         );
     }
-    s += &fabric_section(found, &r, &fabrics);
+    s += &crate::wrinkles_fabric::fabric_section(found, &all);
     let _ = write!(
         s,
         "\n## Does the count depend on the start?\n\nThe result's start is \"{}\"; the coarser mesh is also \
@@ -549,7 +444,7 @@ must buckle away); \"folded-K\": K folds put in by hand across the sheet.\n\n{}"
         crate::wrinkles_text::EQ7,
         constant_section(found, cfg, &p.shear_ratios)
     );
-    s += &crate::wrinkles_text::findings(found, &r, &starts, cfg.defaults.buckling_constant);
+    s += &crate::wrinkles_text::findings(found, &r, &starts, &cfg.defaults);
     let _ = write!(
         s,
         "\n## The tension-field model (Eqs. 5–10) case by case\n\ndrapelab's values first, the seed's in \

@@ -44,8 +44,8 @@ on ties.\n";
 pub const EQ7: &str = "drapelab reads the seed's garbled Eq. 7 as plate buckling, σ_c = c E t²/(l²(1 − ν²)), which \
 gives the critical ratio Q_c = (1 + s)/(1 − s) with s = c E t³/(w h l² (1 − ν²)) and n = ln(a₀/a_n)/ln Q_c \
 (Eq. 10). The seed gives neither ν nor c; ν = 0.3, and c = 135 matches one row of the seed's Table I (Q = 1.29 at \
-h = 140 cm). Below, the tension-field model is run with every c tried, against the full \
-simulation's n on the finer mesh (only the cases that converged count as hits), and c is chosen by \
+h = 140 cm). Below, the tension-field model is run with every c tried, against the n of the \
+sheets simulated as plates (finer mesh) (only the cases that converged count as hits), and c is chosen by \
 leave-one-out.\n";
 
 /// Smallest and largest of some numbers.
@@ -105,7 +105,7 @@ pub fn findings(
     found: &WrinklesFull,
     rows: &[WrinkleFullRow],
     starts: &[StartRow],
-    config_c: f64,
+    config: &drapelab_core::wrinkles::Defaults,
 ) -> String {
     let mut s = String::from("\n## What the full simulations say\n\n");
     let span = |v: (f64, f64), d: usize| {
@@ -179,7 +179,10 @@ centimetres.",
         );
     }
     let c = found.buckling_constants[found.constant.chosen];
-    let used = if (c - config_c).abs() < 1e-6 * c {
+    let used = if config.bending_length_m.is_some() {
+        "the bundled config reads Eq. 7 for a fabric instead (\"Eq. 7 refitted to fabric\" above), so the \
+tension-field columns are that model"
+    } else if (c - config.buckling_constant).abs() < 1e-6 * c {
         "the bundled config (`datasets/wrinkles/seed_tables.toml`) uses it, so the tension-field column above \
 is the model with this reading"
     } else {

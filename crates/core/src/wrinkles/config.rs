@@ -14,8 +14,9 @@ pub struct Defaults {
     #[serde(default = "d_nu")]
     pub poisson_ratio: f64,
     /// Load constant c of Eq. 7 (the seed gives none). Default 135: Q_c = 1.29 for Table I's middle
-    /// row (h = 140 cm) with ν = 0.3, the seed's reading. The bundled config sets 1931, the reading
-    /// full simulations of the twelve sheets support (reports/wrinkles.md).
+    /// row (h = 140 cm) with ν = 0.3 and the plate's E t³, the seed's reading. The bundled config
+    /// reads Eq. 7 for a fabric (`bending_length_m` 14.3 mm) with c = 7197, the reading the full
+    /// simulations of the twelve sheets as fabric support (reports/wrinkles.md).
     #[serde(default = "d_c")]
     pub buckling_constant: f64,
     /// Relative tolerance on the length L' of Eq. 8 against L. Default 0.05 (the seed's).
@@ -30,6 +31,11 @@ pub struct Defaults {
     /// Simpson intervals for Eq. 8. Default 200.
     #[serde(default = "d_simpson")]
     pub simpson_intervals: usize,
+    /// Eq. 7 read for a fabric (issue 50): the sheet's bending length c_b, m, whose bending rigidity
+    /// w c_b³ stands for the plate's E t³/(12(1 − ν²)). None (the default): Eq. 7 as the seed writes
+    /// it, the plate. Set it when the sheet is a woven or knitted fabric, whose yarns slide.
+    #[serde(default)]
+    pub bending_length_m: Option<f64>,
 }
 
 fn d_nu() -> f64 {
@@ -60,6 +66,7 @@ impl Default for Defaults {
             max_iterations: d_iter(),
             initial_zmax_m: d_z(),
             simpson_intervals: d_simpson(),
+            bending_length_m: None,
         }
     }
 }
@@ -70,10 +77,12 @@ impl Default for Defaults {
 pub struct SeedResult {
     /// Number of wrinkles.
     pub n: usize,
-    /// z_max, cm.
-    pub zmax_cm: f64,
-    /// Ratio Q.
-    pub q: f64,
+    /// z_max, cm (none where the seed gives only a count, as for its photograph, Fig. 4).
+    #[serde(default)]
+    pub zmax_cm: Option<f64>,
+    /// Ratio Q (none where the seed gives only a count).
+    #[serde(default)]
+    pub q: Option<f64>,
 }
 
 /// One case as written in the file.
@@ -100,6 +109,9 @@ pub struct WrinkleCase {
     /// Override of the load constant c.
     #[serde(default)]
     pub buckling_constant: Option<f64>,
+    /// Override of the fabric's bending length of Eq. 7, m (see [`Defaults::bending_length_m`]).
+    #[serde(default)]
+    pub bending_length_m: Option<f64>,
     /// The seed's result, if it gives one.
     #[serde(default)]
     pub seed: Option<SeedResult>,
@@ -130,6 +142,10 @@ pub struct WrinkleConfig {
     /// Sweeps adding cases.
     #[serde(default)]
     pub sweeps: Vec<Sweep>,
+    /// Sheets the seed shows in a photograph rather than a table (Fig. 4's cloth): simulated by
+    /// `wrinkles-simulate` read as fabric, their counts beside the photograph's; not tabulated.
+    #[serde(default)]
+    pub photographs: Vec<WrinkleCase>,
 }
 
 impl WrinkleCase {
@@ -148,6 +164,7 @@ impl WrinkleCase {
             max_iterations: d.max_iterations,
             initial_zmax_m: d.initial_zmax_m,
             simpson_intervals: d.simpson_intervals,
+            bending_length_m: self.bending_length_m.or(d.bending_length_m),
         }
     }
 
@@ -161,6 +178,7 @@ impl WrinkleCase {
             "support_displacement_m" => self.support_displacement_m = v,
             "poisson_ratio" => self.poisson_ratio = Some(v),
             "buckling_constant" => self.buckling_constant = Some(v),
+            "bending_length_m" => self.bending_length_m = Some(v),
             _ => return false,
         }
         true
@@ -176,6 +194,7 @@ impl WrinkleCase {
             ("youngs_modulus_Pa", inp.youngs_modulus_Pa),
             ("weight_N_per_m2", inp.weight_N_per_m2),
             ("buckling_constant", inp.buckling_constant),
+            ("bending_length_m", inp.bending_length_m.unwrap_or(1.0)),
         ];
         for (k, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -257,9 +276,11 @@ pub fn load_config(path: &Path) -> Result<WrinkleConfig, InputError> {
     if cfg.cases.is_empty() {
         return Err(InputError::new(path, "cases", "no case given"));
     }
-    for (k, c) in cfg.cases.iter().enumerate() {
-        c.check(&cfg.defaults)
-            .map_err(|(key, m)| InputError::new(path, format!("cases[{k}].{key}"), m))?;
+    for (list, cases) in [("cases", &cfg.cases), ("photographs", &cfg.photographs)] {
+        for (k, c) in cases.iter().enumerate() {
+            c.check(&cfg.defaults)
+                .map_err(|(key, m)| InputError::new(path, format!("{list}[{k}].{key}"), m))?;
+        }
     }
     Ok(cfg)
 }

@@ -349,12 +349,19 @@ impl LeaveOneOut {
 /// the candidate that holds on most other cases (ties: the first), scored on the case left out.
 /// Candidates are given in order of preference (e.g. the smallest threshold first).
 pub fn leave_one_out(ok: &[Vec<bool>]) -> LeaveOneOut {
+    let groups: Vec<usize> = (0..ok.len()).collect();
+    leave_groups_out(ok, &groups)
+}
+
+/// Leave-one-group-out over `ok[row][candidate]`: each row is scored with the candidate that holds
+/// on most rows outside its group (`group[row]`, e.g. a case and its map points), ties to the first.
+pub fn leave_groups_out(ok: &[Vec<bool>], group: &[usize]) -> LeaveOneOut {
     let candidates = ok.first().map_or(0, Vec::len);
     let best = |skip: Option<usize>| -> usize {
         let hits = |c: usize| {
             ok.iter()
-                .enumerate()
-                .filter(|&(k, row)| Some(k) != skip && row[c])
+                .zip(group)
+                .filter(|&(row, &g)| Some(g) != skip && row[c])
                 .count()
         };
         (0..candidates).fold(0, |b, c| if hits(c) > hits(b) { c } else { b })
@@ -363,7 +370,7 @@ pub fn leave_one_out(ok: &[Vec<bool>]) -> LeaveOneOut {
         chosen: best(None),
         held_out: (0..ok.len())
             .map(|k| {
-                let c = best(Some(k));
+                let c = best(Some(group[k]));
                 (c, ok[k][c])
             })
             .collect(),
@@ -373,6 +380,20 @@ pub fn leave_one_out(ok: &[Vec<bool>]) -> LeaveOneOut {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Leaving a group out leaves all its rows out: a candidate that holds only on one group's two
+    /// rows wins row 0 back through its sibling row 1 when rows are left out one at a time, but not
+    /// when the group leaves together.
+    #[test]
+    fn leaving_a_group_out_leaves_its_rows_out_together() {
+        // Candidate 0 holds on rows 0 and 1 (group 0); candidate 1 on row 2 (group 1).
+        let ok = vec![vec![true, false], vec![true, false], vec![false, true]];
+        let rows = leave_one_out(&ok);
+        assert_eq!((rows.chosen, rows.held_out[0]), (0, (0, true)));
+        let grouped = leave_groups_out(&ok, &[0, 0, 1]);
+        assert_eq!(grouped.chosen, 0);
+        assert_eq!(grouped.held_out, vec![(1, false), (1, false), (0, false)]);
+    }
 
     /// A synthetic sheet whose centre fibre is a cosine of n half-waves: n sign changes, n + 1
     /// lines at the half-waves' extrema, z_max its amplitude.
@@ -425,6 +446,7 @@ mod tests {
             max_iterations: 50,
             initial_zmax_m: 0.014,
             simpson_intervals: 200,
+            bending_length_m: None,
         };
         let plate = SheetReading::Plate { shear_ratio: 1.0 };
         let loaded = hung_sheet_scene(&inp, 15, 15, &plate).expect("a valid scene");

@@ -8,6 +8,8 @@
 //! - Eq. 7, enforced with equality: w h (Q − 1)/(t (Q + 1)) = σ_c = c E t² / (l² (1 − ν²)), so the
 //!   critical ratio is Q_c = (1 + s)/(1 − s) with s = c E t³ / (w h l² (1 − ν²)); s ≥ 1 means the
 //!   sheet is stiff enough not to wrinkle (n = 0). The load constant c is not given by the seed.
+//! - Eq. 7 for a fabric (issue 50): E t³/(1 − ν²) = 12 D with the fabric's bending rigidity
+//!   w c_b³ (c_b its bending length) in place of the plate's D, where the case gives c_b.
 //! - Eq. 8: the upper boundary (x, a_n cos(πx/l), z_max cos(πx/l)) has the sheet's length L:
 //!   L = ∫_{−l/2}^{l/2} √(1 + (π/l)² (a_n² + z_max²) sin²(πx/l)) dx (Simpson).
 //! - Eq. 9: the vertical fibre at x = 0 keeps its length h across the n strips:
@@ -55,6 +57,9 @@ pub struct WrinkleInputs {
     pub initial_zmax_m: f64,
     /// Intervals of the Simpson rule (even).
     pub simpson_intervals: usize,
+    /// Eq. 7 read for a fabric: its bending length c_b, m, so that E t³/(1 − ν²) becomes 12 w c_b³
+    /// (the fabric's bending rigidity w c_b³ in place of the plate's); None: the seed's plate.
+    pub bending_length_m: Option<f64>,
 }
 
 /// The outcome of [`solve`].
@@ -95,11 +100,20 @@ pub fn support_span_m(inp: &WrinkleInputs) -> f64 {
     inp.length_m - 2.0 * inp.support_displacement_m
 }
 
+/// Eq. 7's bending term E t³/(1 − ν²) = 12 D, N·m: the plate's, or 12 w c_b³ for a fabric of
+/// bending length c_b.
+pub fn bending_term_N_m(inp: &WrinkleInputs) -> f64 {
+    match inp.bending_length_m {
+        Some(c) => 12.0 * inp.weight_N_per_m2 * c.powi(3),
+        None => inp.youngs_modulus_Pa * inp.thickness_m.powi(3) / (1.0 - inp.poisson_ratio.powi(2)),
+    }
+}
+
 /// Eq. 7 with equality: the critical ratio Q_c, or None when s ≥ 1 (no wrinkles).
 pub fn critical_ratio(inp: &WrinkleInputs) -> Option<f64> {
     let l = support_span_m(inp);
-    let s = inp.buckling_constant * inp.youngs_modulus_Pa * inp.thickness_m.powi(3)
-        / (inp.weight_N_per_m2 * inp.height_m * l * l * (1.0 - inp.poisson_ratio.powi(2)));
+    let s = inp.buckling_constant * bending_term_N_m(inp)
+        / (inp.weight_N_per_m2 * inp.height_m * l * l);
     (s < 1.0).then(|| (1.0 + s) / (1.0 - s))
 }
 

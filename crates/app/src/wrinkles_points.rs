@@ -1,0 +1,213 @@
+//! The fabric sheets of `wrinkles-simulate` beyond each case's result (issue 50): a map of the
+//! cases over bending length × shear rigidity, and the sheets the seed shows in a photograph
+//! (Fig. 4); and the tension-field model's Eq. 7 refitted to every fabric sheet by
+//! leave-one-case-out over both readings of its bending term (the plate's E t³, the fabric's 12 w c³).
+
+use drapelab_core::wrinkles::full::{LeaveOneOut, SheetReading, leave_groups_out};
+use drapelab_core::wrinkles::{SeedResult, WrinkleConfig, WrinkleInputs};
+
+/// Why a fabric sheet beyond the cases' results was solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointRole {
+    /// A point of the map over bending length × shear rigidity.
+    Map,
+    /// A sheet of the seed's photograph (Fig. 4).
+    Photograph,
+}
+
+impl PointRole {
+    /// "map" or "photograph", as in `wrinkles_full.parquet`'s `role`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PointRole::Map => "map",
+            PointRole::Photograph => "photograph",
+        }
+    }
+}
+
+/// A fabric sheet to solve: its case, why, and its reading.
+#[derive(Debug, Clone)]
+pub struct PointSpec {
+    /// Case name (the config's case, or the photograph's).
+    pub case: String,
+    /// Map point or photograph.
+    pub role: PointRole,
+    /// The case's inputs.
+    pub inputs: WrinkleInputs,
+    /// The seed's count, where it gives one (the photograph's n).
+    pub seed: Option<SeedResult>,
+    /// The fabric's bending length and shear rigidity.
+    pub reading: SheetReading,
+}
+
+/// Where the map's points lie: its cases, bending lengths (m) and shear rigidities (N/m).
+pub struct MapAxes<'a> {
+    /// The cases mapped.
+    pub cases: &'a [String],
+    /// Bending lengths, m.
+    pub bending_lengths_m: &'a [f64],
+    /// Shear rigidities, N/m.
+    pub shear_N_per_m: &'a [f64],
+}
+
+/// The map's points (each named case at every bending length × shear rigidity), then the config's
+/// photographs read as `fabric`; none when the sheets are not read as fabric at all.
+pub fn point_specs(
+    cfg: &WrinkleConfig,
+    map: &MapAxes<'_>,
+    fabric: Option<SheetReading>,
+) -> Vec<PointSpec> {
+    let Some(fabric) = fabric else {
+        return Vec::new();
+    };
+    let spec = |c: &drapelab_core::wrinkles::WrinkleCase, role, reading| PointSpec {
+        case: c.case.clone(),
+        role,
+        inputs: c.inputs(&cfg.defaults),
+        seed: c.seed.clone(),
+        reading,
+    };
+    let mut out = Vec::new();
+    for c in cfg.cases.iter().filter(|c| map.cases.contains(&c.case)) {
+        for &bending_length_m in map.bending_lengths_m {
+            for &shear_N_per_m in map.shear_N_per_m {
+                let reading = SheetReading::Fabric {
+                    bending_length_m,
+                    shear_N_per_m,
+                };
+                out.push(spec(c, PointRole::Map, reading));
+            }
+        }
+    }
+    for c in &cfg.photographs {
+        out.push(spec(c, PointRole::Photograph, fabric));
+    }
+    out
+}
+
+/// One fabric sheet the tension field is fitted to: its case group, its reading and count.
+#[derive(Debug, Clone)]
+pub struct FitRow {
+    /// Case name.
+    pub case: String,
+    /// "table" (the case's result) or "map".
+    pub role: &'static str,
+    /// The sheet's bending length, m.
+    pub bending_length_m: f64,
+    /// The sheet's shear rigidity, N/m.
+    pub shear_N_per_m: f64,
+    /// The simulated count (finer mesh).
+    pub n_simulated: usize,
+    /// The tension field's count under each candidate.
+    pub n_tension_field: Vec<usize>,
+}
+
+/// Eq. 7 refitted to the fabric sheets: candidates (its bending term read as the fabric's, the load
+/// constant c), scored within ±1 of each sheet's count, chosen by leave-one-case-out (a case's map
+/// points leave with it).
+#[derive(Debug, Clone)]
+pub struct TensionFieldFit {
+    /// (Eq. 7 reads the fabric's bending length rather than the plate's E t³, c).
+    pub candidates: Vec<(bool, f64)>,
+    /// The sheets: the cases' results first, then the map's points.
+    pub rows: Vec<FitRow>,
+    /// The choice and each sheet's held-out outcome.
+    pub loo: LeaveOneOut,
+}
+
+impl TensionFieldFit {
+    /// The chosen candidate.
+    pub fn chosen(&self) -> (bool, f64) {
+        self.candidates[self.loo.chosen]
+    }
+    /// (held-out hits, sheets) among the rows of `role`.
+    pub fn held_out(&self, role: &str) -> (usize, usize) {
+        let mine = || {
+            self.rows
+                .iter()
+                .zip(&self.loo.held_out)
+                .filter(move |(r, _)| r.role == role)
+        };
+        (mine().filter(|(_, h)| h.1).count(), mine().count())
+    }
+    /// (hits, sheets) of candidate `k` in-sample among the rows of `role`.
+    pub fn hits(&self, k: usize, role: &str) -> (usize, usize) {
+        let mine: Vec<&FitRow> = self.rows.iter().filter(|r| r.role == role).collect();
+        let hits = mine
+            .iter()
+            .filter(|r| r.n_tension_field[k].abs_diff(r.n_simulated) <= 1)
+            .count();
+        (hits, mine.len())
+    }
+}
+
+/// A sheet's count under Eq. 7 read as the plate (`fabric` false) or as a fabric of bending length
+/// `bending_length_m`, with load constant `c`.
+fn tension_field_n(inp: &WrinkleInputs, fabric: bool, bending_length_m: f64, c: f64) -> usize {
+    let inp = WrinkleInputs {
+        buckling_constant: c,
+        bending_length_m: fabric.then_some(bending_length_m),
+        ..inp.clone()
+    };
+    drapelab_core::wrinkles::solve(&inp).n
+}
+
+/// A simulated fabric sheet, as the fit sees it.
+pub struct FitSheet<'a> {
+    /// Its case group (a case and its map points share one).
+    pub group: usize,
+    /// Case name.
+    pub case: &'a str,
+    /// "table" or "map".
+    pub role: &'static str,
+    /// The case's inputs.
+    pub inputs: &'a WrinkleInputs,
+    /// Its fabric reading.
+    pub reading: SheetReading,
+    /// Its simulated count.
+    pub n: usize,
+}
+
+/// Fits Eq. 7 to `sheets` over the load constants `constants`, both readings of its bending term.
+pub fn fit_tension_field(constants: &[f64], sheets: &[FitSheet<'_>]) -> Option<TensionFieldFit> {
+    if sheets.is_empty() {
+        return None;
+    }
+    let candidates: Vec<(bool, f64)> = [false, true]
+        .iter()
+        .flat_map(|&f| constants.iter().map(move |&c| (f, c)))
+        .collect();
+    let rows: Vec<FitRow> = sheets
+        .iter()
+        .map(|s| {
+            let (inp, c_b) = (s.inputs, s.reading.bending_length_m(s.inputs));
+            FitRow {
+                case: s.case.to_string(),
+                role: s.role,
+                bending_length_m: c_b,
+                shear_N_per_m: s.reading.rigidities(inp).2,
+                n_simulated: s.n,
+                n_tension_field: candidates
+                    .iter()
+                    .map(|&(f, c)| tension_field_n(inp, f, c_b, c))
+                    .collect(),
+            }
+        })
+        .collect();
+    let ok: Vec<Vec<bool>> = rows
+        .iter()
+        .map(|r| {
+            r.n_tension_field
+                .iter()
+                .map(|&m| m.abs_diff(r.n_simulated) <= 1)
+                .collect()
+        })
+        .collect();
+    let groups: Vec<usize> = sheets.iter().map(|s| s.group).collect();
+    let loo = leave_groups_out(&ok, &groups);
+    Some(TensionFieldFit {
+        candidates,
+        rows,
+        loo,
+    })
+}
