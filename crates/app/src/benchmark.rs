@@ -51,20 +51,25 @@ pub struct BenchmarkParams {
     pub self_contact: Vec<drapelab_core::scene::SelfContactMode>,
 }
 
+/// Default of `self_contact`: ["auto"].
 pub fn default_self_contact() -> Vec<drapelab_core::scene::SelfContactMode> {
     vec![drapelab_core::scene::SelfContactMode::Auto]
 }
 
+/// Default of `default_sizes` (particles per side): [11, 21, 41].
 pub fn default_sizes() -> Vec<usize> {
     vec![11, 21, 41]
 }
+/// Default of `tolerances` (force tolerances): [1e-4, 1e-6, 1e-8].
 pub fn default_tols() -> Vec<f64> {
     vec![1e-4, 1e-6, 1e-8]
 }
+/// Default of `max_explicit_size` and of implicit Euler's largest side: 21.
 pub fn default_explicit() -> usize {
     21
 }
 
+/// Runs the benchmark: every scene, size, tolerance and solver, one row each (run time against error).
 pub fn run(ctx: &Job<'_>, p: &BenchmarkParams) -> Result<Vec<BenchRow>> {
     let scenes: Vec<Scene> = ctx
         .input_files("scenes")

@@ -77,18 +77,23 @@ pub struct CalibrateParams {
     pub levenberg_marquardt: bool,
 }
 
+/// Default `true` of the stage's switches (e.g. `include_systematic`).
 pub fn default_true() -> bool {
     true
 }
+/// Default of `runs`: 10 independent ICA runs per sample (seed 000).
 pub fn default_runs() -> usize {
     10
 }
+/// Default of `identifiable_rel`: 0.05.
 pub fn default_ident() -> f64 {
     0.05
 }
+/// Default of `polish_iterations`: 60 Nelder–Mead iterations.
 pub fn default_polish() -> u64 {
     60
 }
+/// Default of `identifiability_window`: 0.1 of each parameter's Table 3 range.
 pub fn default_window() -> f64 {
     0.1
 }

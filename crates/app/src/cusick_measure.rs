@@ -116,6 +116,8 @@ pub fn measure_dataset(
         .collect()
 }
 
+/// The shadow measures of a capture's mesh (or of its hem where only the hem was scanned), if
+/// either matches the template.
 pub fn mesh_measures(
     t: &Template,
     mesh: Option<&Vec<Vector3<f64>>>,
@@ -131,6 +133,7 @@ pub fn mesh_measures(
     }
 }
 
+/// One capture's row of the measure table.
 pub fn row(
     c: &drapelab_record::cusick::CaptureLabel,
     photo: &ShadowMeasures,

@@ -126,6 +126,7 @@ impl FabricPrediction {
     }
 }
 
+/// Mean and sample standard deviation of `v` (0 and 0 when empty; SD 0 for one value).
 pub fn mean_sd(v: &[f64]) -> (f64, f64) {
     let n = v.len().max(1) as f64;
     let m = v.iter().sum::<f64>() / n;
@@ -220,6 +221,8 @@ pub fn face_gap(own: &[&&ShadowRow]) -> Option<FaceGap> {
     })
 }
 
+/// A fabric's targets from its captures: the calibration (lowest-numbered) specimen's DC, nodes
+/// and face gap, and the other specimens' statistics the predictions are scored against.
 pub fn targets(rows: &[&ShadowRow]) -> Targets {
     let calib = rows.iter().map(|r| r.sample).min().unwrap_or(0);
     let own: Vec<&&ShadowRow> = rows.iter().filter(|r| r.sample == calib).collect();
@@ -258,6 +261,7 @@ pub fn targets(rows: &[&ShadowRow]) -> Targets {
     }
 }
 
+/// A prediction row with the fabric's targets and no prediction yet (filled in by the caller).
 pub fn empty_row(fabric: i32, tg: &Targets) -> PredictionRow {
     PredictionRow {
         fabric,
@@ -386,6 +390,7 @@ fn fill_faces(row: &mut PredictionRow, outcome: &FabricOutcome) -> Option<FacePr
     Some(FacePredictions { up, down, average })
 }
 
+/// Calibrates one fabric on its calibration specimen and predicts its other specimens.
 pub fn predict_fabric(
     fabric: i32,
     density_known: bool,

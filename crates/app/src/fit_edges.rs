@@ -20,6 +20,7 @@ pub struct FitEdgesParams {
     pub degree: usize,
 }
 
+/// Default of `degree`: 4 (seed 000's edge polynomials).
 pub fn default_degree() -> usize {
     4
 }
@@ -42,6 +43,7 @@ pub fn photo_edges(
     Ok(with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?.edges)
 }
 
+/// Fits each photo's edge polynomials (seed 000), one fit per photo.
 pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<Vec<(String, EdgeFit)>> {
     let photos: Vec<_> = ctx
         .input_files("photos")

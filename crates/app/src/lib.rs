@@ -6,6 +6,7 @@
 //! or the stage's parameter. The pipeline's stages, the command line, the tests and the Python
 //! package call them; the report stack (polars, plotters) is not here.
 
+#![warn(missing_docs)]
 #![allow(non_snake_case)]
 
 pub mod job;

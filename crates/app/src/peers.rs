@@ -55,12 +55,15 @@ pub struct PeersParams {
     pub explicit_steps: usize,
 }
 
+/// Default of `python`: the interpreter that runs the peer solvers.
 pub fn default_python() -> String {
     ".venv/bin/python".into()
 }
+/// Default of `explicit_sizes`: [21, 41].
 pub fn default_step_sizes() -> Vec<usize> {
     vec![21, 41]
 }
+/// Default of `explicit_steps`: 2000.
 pub fn default_steps() -> usize {
     2000
 }
@@ -125,6 +128,7 @@ fn ensure_peer_python(python: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
+/// Runs the peer solvers beside drapelab's and writes their table.
 pub fn run(ctx: &Job<'_>, p: &PeersParams) -> Result<()> {
     let scene = Scene::load(ctx.input("scene")?, &[])?.scene;
     let script =

@@ -16,6 +16,7 @@ pub struct ScoreParams {
     pub side_cm: f64,
 }
 
+/// Scores simulated edges against the photos' fitted edges, one row per photo.
 pub fn run(ctx: &Job<'_>, p: &ScoreParams) -> Result<Vec<ScoreRow>> {
     let measured_path = ctx.input("measured")?;
     let measured = read_edges(measured_path)

@@ -203,15 +203,19 @@ pub struct SurfaceParams {
     pub picture_px: [u32; 2],
 }
 
+/// Default of `repeats`: [1, 1].
 pub fn one_one() -> [f64; 2] {
     [1.0, 1.0]
 }
+/// Default of `resolution`: 200 lattice points per side.
 pub fn default_resolution() -> usize {
     200
 }
+/// Default of `view_deg`: azimuth and elevation [30, 30] degrees.
 pub fn default_view() -> [f64; 2] {
     [30.0, 30.0]
 }
+/// Default of `picture_px`: [1000, 750].
 pub fn default_picture() -> [u32; 2] {
     [1000, 750]
 }

@@ -60,6 +60,7 @@ pub struct SweepParams {
     pub set: BTreeMap<String, toml::Value>,
 }
 
+/// Default of `samples`: 16 points of a Latin hypercube.
 pub fn default_samples() -> usize {
     16
 }

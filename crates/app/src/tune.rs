@@ -70,11 +70,13 @@ pub struct TuneParams {
     pub side_cm: f64,
 }
 
+/// Default of `runs`: 1 ICA run per design row.
 pub fn one() -> usize {
     1
 }
 /// L27 columns used for the factors A..G (any seven columns of L27 are pairwise orthogonal).
 pub const COLUMNS: [usize; 7] = [0, 1, 4, 2, 5, 7, 8];
+/// The seven ICA settings the Taguchi L27 design varies (seed 000), in the design's column order.
 pub const FACTORS: [&str; 7] = [
     "A decades",
     "B imperialists",
@@ -134,6 +136,7 @@ impl Table for MainEffectRow {
         "One level of one ICA setting: its mean S/N over the L27 rows (seed 000 Fig. 5).";
 }
 
+/// The ICA settings of one row `l` of the design at `levels`.
 pub fn settings(levels: &Levels, l: &[u8], seed: u64) -> IcaSettings {
     let k = |f: usize| l[f] as usize;
     let countries = levels.countries[k(2)];

@@ -66,6 +66,7 @@ impl Table for ValidationRow {
         "One sample's calibrated parameters validated on the 2-corner hang (seed 000 Table 6).";
 }
 
+/// Validates the calibrated net on the 2-corner hang (seed 000), one row per photo.
 pub fn run(ctx: &Job<'_>, p: &ValidateParams) -> Result<Vec<ValidationRow>> {
     let densities = read_sample_densities(ctx.input("samples")?)?;
     let scene_file = ctx.input("scene")?;

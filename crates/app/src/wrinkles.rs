@@ -25,9 +25,11 @@ pub struct WrinklesParams {
     pub mesh_ny: usize,
 }
 
+/// Default of `mesh_nx`: 41 points per row.
 pub fn default_nx() -> usize {
     41
 }
+/// Default of `mesh_ny`.
 pub fn default_ny() -> usize {
     81
 }
@@ -164,6 +166,7 @@ impl Table for WrinkleMeshRow {
     const ROW: &'static str = "One grid point of a seed 002 case's wrinkled surface.";
 }
 
+/// Writes `wrinkles.parquet`: one row per solved case.
 pub fn write_table(out: &Path, cfg: &WrinkleConfig, solved: &[SolvedCase]) -> Result<()> {
     let rows: Vec<WrinkleRow> = solved
         .iter()
@@ -197,6 +200,7 @@ pub fn write_table(out: &Path, cfg: &WrinkleConfig, solved: &[SolvedCase]) -> Re
     drapelab_record::write_table(out, &rows)
 }
 
+/// Writes `mesh.parquet`: each case's wrinkled surface on a grid.
 pub fn write_mesh(
     out: &Path,
     cfg: &WrinkleConfig,
@@ -239,11 +243,13 @@ pub fn write_rrd(
     drapelab_record::write_wrinkle_meshes(out, &meshes)
 }
 
+/// The head of the tension-field report.
 pub const REPORT_HEAD: &str = "# Tension-field wrinkles (seed 002, Tables I–IV)\n\nMade by the `wrinkles` stage \
 (`drapelab wrinkles datasets/wrinkles/seed_tables.toml --out DIR` gives the same). drapelab's values first, \
 the seed's in brackets; Q_c is the critical ratio of Eq. 7, Q = (a₀/a_n)^(1/n) the ratio of Eq. 5 after \
 rounding n; L error is |L' − L|/L at convergence (tolerance 5 %, the seed's).\n\n";
 
+/// The tail of the tension-field report: where drapelab and the seed differ.
 pub const REPORT_TAIL: &str = "\n## Where drapelab and the seed differ, and why\n\n\
 - Read as the seed's plate with c = 135, the trends agree (n grows with h and w and falls with t and E; Q \
 falls with w and rises with t), the numbers only roughly (z_max within a factor of 1.5 where both have wrinkles; n off by up to a factor of 2).\n\

@@ -9,6 +9,7 @@
 //! [`optim`] and [`calibrate`] fit parameters (ICA, CMA-ES, Taguchi), [`wrinkles`] is seed 002's
 //! tension field, and [`benchmark`] measures time against error.
 
+#![warn(missing_docs)]
 #![allow(non_snake_case)] // units in names: stiffness_N_per_m, damping_Ns_per_m
 
 pub mod atomic;

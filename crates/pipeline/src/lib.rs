@@ -6,6 +6,7 @@
 //! stands for `runs/<pipeline>`. An input equal to (or a glob matching) another stage's output makes
 //! that stage a dependency.
 
+#![warn(missing_docs)]
 mod executor;
 mod files;
 mod items;

@@ -6,6 +6,7 @@
 //! exit code 2 does; a solve that does not converge is a status, never an exception. Long work
 //! releases the GIL; a solve checks for Ctrl-C between its iterations.
 
+#![warn(missing_docs)]
 #![allow(non_snake_case)]
 
 mod convert;

@@ -3,6 +3,7 @@
 //! solved scene. Every file is written to a temporary name in its folder and renamed when complete
 //! ([`drapelab_core::atomic`]), so a killed run never leaves an artifact that looks finished.
 
+#![warn(missing_docs)]
 #![allow(non_snake_case)]
 
 mod calibration_rrd;

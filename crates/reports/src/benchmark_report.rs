@@ -16,6 +16,7 @@ use std::fmt::Write as _;
 
 /// The names the benchmark table writes for a converged solve and the static solver.
 pub const CONVERGED: &str = Status::Converged.as_str();
+/// The static solver's name in the benchmark table.
 pub const STATIC: &str = SolverKind::Static.name();
 
 /// Parameters of a benchmark-report stage.
@@ -29,10 +30,12 @@ pub struct BenchmarkReportParams {
     pub scaling_tolerance: f64,
 }
 
+/// Default of `scaling_tolerance`: 1e-6.
 pub fn default_scaling_tol() -> f64 {
     1e-6
 }
 
+/// Reads a benchmark table.
 pub fn read(path: &std::path::Path) -> Result<DataFrame> {
     Ok(LazyFrame::scan_parquet(
         PlRefPath::from(path.to_string_lossy().as_ref()),
@@ -41,6 +44,7 @@ pub fn read(path: &std::path::Path) -> Result<DataFrame> {
     .collect()?)
 }
 
+/// Writes the benchmark report and its plots.
 pub fn run(ctx: &Job<'_>, p: &BenchmarkReportParams) -> Result<()> {
     ctx.started(1);
     let mut bench: Option<DataFrame> = None;

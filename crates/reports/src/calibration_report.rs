@@ -20,6 +20,7 @@ pub struct CalibrationReportParams {
     pub title: String,
 }
 
+/// Scans a calibration table lazily.
 pub fn scan(p: &Path) -> Result<LazyFrame> {
     Ok(LazyFrame::scan_parquet(
         PlRefPath::from(p.to_string_lossy().as_ref()),
@@ -32,6 +33,7 @@ pub fn read_csv(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
     Ok(drapelab_record::read_csv(path)?)
 }
 
+/// Writes the calibration report and its plots.
 pub fn run(ctx: &Job<'_>, p: &CalibrationReportParams) -> Result<()> {
     let find = |slot: &str| ctx.input(slot);
     ctx.started(1);
@@ -302,6 +304,7 @@ stiffness, LM | stiffness, ICA | natural length, LM | natural length, ICA |\n|--
     Ok(md)
 }
 
+/// The run-time section: each calibration's time beside its comparison's.
 pub fn run_time_section(res: &DataFrame, cmp: &DataFrame) -> Result<String> {
     let sims_col = res.column("simulations")?.cast(&DataType::UInt64)?;
     let sims_ca = sims_col.u64()?;

@@ -54,6 +54,7 @@ pub fn closed_mm(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     v
 }
 
+/// A circle of `radius_m` as (x, y) points in mm, for outline plots.
 pub fn circle_mm(radius_m: f64) -> Vec<(f64, f64)> {
     let pts: Vec<(f64, f64)> = (0..=180)
         .map(|i| (i as f64 / 180.0 * std::f64::consts::TAU, radius_m))
@@ -68,6 +69,7 @@ pub type Outlines = BTreeMap<i32, (Vec<Points>, Vec<Points>)>;
 /// The (θ in rad, r in m) points of one outline.
 pub type Points = Vec<(f64, f64)>;
 
+/// Per fabric, the outlines of its other specimens' photos and of the model's seeds.
 pub fn group_outlines(
     rows: &[PredictionRow],
     photos: &[OutlineRow],

@@ -1,6 +1,7 @@
 //! drapelab's reports: polars queries over the pipelines' tables, plotters figures, Markdown and
 //! pictures (the seed 003 montage), each a function over a [`drapelab_app::Job`].
 
+#![warn(missing_docs)]
 #![allow(non_snake_case)]
 
 pub mod benchmark_report;

@@ -120,13 +120,16 @@ pub type Lines = BTreeMap<String, Vec<(f64, f64)>>;
 /// Panels by facet value.
 pub type Panels = BTreeMap<String, Lines>;
 
+/// Default of `group`: the columns a report groups by.
 pub fn default_group() -> Vec<String> {
     vec!["scene".into()]
 }
+/// Default of `y`: the column a report plots.
 pub fn default_y() -> String {
     "centre_z_m".into()
 }
 
+/// Scans every input table lazily, as one frame.
 pub fn scan_all(inputs: &[std::path::PathBuf]) -> Result<LazyFrame> {
     let lfs = inputs
         .iter()
@@ -319,6 +322,7 @@ pub fn plot_panels(
     Ok(out)
 }
 
+/// Draws one line per group on a chart.
 pub fn draw_lines<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     lines: &Lines,

@@ -37,6 +37,7 @@ pub struct Seed003ReportParams {
     pub load_steps: usize,
 }
 
+/// Default of `load_steps`: 50 load increments (the seed's).
 pub fn default_steps() -> usize {
     50
 }
@@ -46,6 +47,7 @@ pub fn refined(scene: &Scene) -> Scene {
     scene.regridded(2 * scene.cloth.nx - 1, 2 * scene.cloth.ny - 1)
 }
 
+/// A scene solved on its grid and on one twice as fine, with the gap between the two drapes.
 pub struct Solved {
     scene: Scene,
     coarse: Solution,
@@ -53,6 +55,7 @@ pub struct Solved {
     gap_m: f64,
 }
 
+/// Solves a scene on its grid and on [`refined`]'s.
 pub fn solve_pair(scene: &Scene) -> Solved {
     let coarse = solve_scene(scene, &mut NoObserver);
     let fine = solve_scene(&refined(scene), &mut NoObserver);
@@ -73,10 +76,12 @@ pub fn solve_pair(scene: &Scene) -> Solved {
     }
 }
 
+/// Loads a seed 003 scene.
 pub fn load(path: &Path) -> Result<Scene> {
     Ok(Scene::load(path, &[])?.scene.into_inner())
 }
 
+/// Writes the seed 003 report.
 pub fn run(ctx: &Job<'_>, p: &Seed003ReportParams) -> Result<()> {
     let scenes: Vec<Scene> = ctx
         .input_files("scenes")

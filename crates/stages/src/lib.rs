@@ -2,6 +2,7 @@
 //! and parameters, and a call of its workflow (`drapelab-app`) or report (`drapelab-reports`) with
 //! the stage's files. [`registry`] lists every kind: adding one is a file here and a line there.
 
+#![warn(missing_docs)]
 #![allow(non_snake_case)]
 
 mod benchmark;
