@@ -32,7 +32,9 @@ pub mod tune;
 pub mod validate;
 pub mod wrinkles;
 pub mod wrinkles_full;
+pub mod wrinkles_params;
 pub mod wrinkles_points;
+pub mod wrinkles_tables;
 
 pub use job::{Job, Progress, Quiet};
 
@@ -57,9 +59,9 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<crate::tune::MainEffectRow>()?,
         md::<crate::wrinkles::WrinkleRow>()?,
         md::<crate::wrinkles::WrinkleMeshRow>()?,
-        md::<crate::wrinkles_full::WrinkleFullRow>()?,
-        md::<crate::wrinkles_full::FibreRow>()?,
-        md::<crate::wrinkles_full::StartRow>()?,
+        md::<crate::wrinkles_tables::WrinkleFullRow>()?,
+        md::<crate::wrinkles_tables::FibreRow>()?,
+        md::<crate::wrinkles_tables::StartRow>()?,
         md::<drapelab_core::benchmark::BenchRow>()?,
         md::<drapelab_core::benchmark::PopulationRow>()?,
         md::<drapelab_core::benchmark::SkipRow>()?,

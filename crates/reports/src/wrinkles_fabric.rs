@@ -3,8 +3,9 @@
 //! length × shear rigidity, and the seed's photographed cloth (Fig. 4).
 
 use crate::format::opt;
-use drapelab_app::wrinkles_full::{WrinkleFullRow, WrinklesFull};
+use drapelab_app::wrinkles_full::WrinklesFull;
 use drapelab_app::wrinkles_points::TensionFieldFit;
+use drapelab_app::wrinkles_tables::WrinkleFullRow;
 use std::fmt::Write;
 
 /// Counts over the rows: (solved and converged in the mesh, tension field within ±1 of the

@@ -7,9 +7,9 @@ use crate::format::opt;
 use anyhow::Result;
 use drapelab_app::Job;
 use drapelab_app::wrinkles::{SolvedCase, report_markdown};
-use drapelab_app::wrinkles_full::{
-    StartRow, WrinkleFullRow, WrinklesFull, WrinklesSimulateParams, rows, start_rows,
-};
+use drapelab_app::wrinkles_full::WrinklesFull;
+use drapelab_app::wrinkles_params::WrinklesSimulateParams;
+use drapelab_app::wrinkles_tables::{StartRow, WrinkleFullRow, rows, start_rows};
 use drapelab_core::wrinkles::WrinkleConfig;
 use drapelab_record::write_text;
 use plotters::prelude::*;

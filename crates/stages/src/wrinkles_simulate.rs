@@ -2,7 +2,9 @@
 //! seed 002's hung sheets as full simulations beside the seed and the tension-field model.
 
 use anyhow::Result;
-pub use drapelab_app::wrinkles_full::*;
+use drapelab_app::wrinkles_full::simulate;
+pub use drapelab_app::wrinkles_params::WrinklesSimulateParams;
+use drapelab_app::wrinkles_tables::write_outputs;
 use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
 
 /// The `wrinkles-simulate` stage kind.
