@@ -1,9 +1,11 @@
 //! `drapelab bench`: prints the engine benchmark table (see [`crate::benchmark`]).
 
+use super::args;
 use crate::benchmark::{hang4_rows, markdown_table, population_table, slack_net_population};
+use crate::error::EXIT_OK;
 use crate::scene::Scene;
 use anyhow::Result;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Runs the hang4 benchmark and prints its Markdown table to stdout, then the iterations and
 /// factorizations per solve of `population` solves of seed 000's slack net.
@@ -39,4 +41,52 @@ pub fn run_bench(
         );
     }
     Ok(())
+}
+
+/// The flags of `drapelab bench`.
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// The hang4 scene to benchmark.
+    #[arg(long, default_value = "datasets/scenes/hang4.toml")]
+    pub scene: PathBuf,
+    /// Particles per side to run (comma-separated, each 3..=1001).
+    #[arg(long, value_delimiter = ',', default_value = "11,21,41,81", value_parser = args::grid_side())]
+    pub sizes: Vec<usize>,
+    /// Largest size at which the explicit and symplectic integrators are run (they are slow).
+    #[arg(long, default_value_t = 21)]
+    pub max_explicit_size: usize,
+    /// Largest size at which implicit Euler is run.
+    #[arg(long, default_value_t = 41)]
+    pub max_implicit_size: usize,
+    /// Force tolerance of every solver, relative to the lightest particle's weight (> 0).
+    #[arg(long, default_value_t = 1e-6, value_parser = args::positive)]
+    pub tol: f64,
+    /// Static solves of seed 000's slack-net population (14 × 14 over Table 3's box) to run
+    /// after the hang4 table, for its iterations and factorizations per solve (0: none).
+    #[arg(long, default_value_t = 50)]
+    pub population: usize,
+    /// Run the whole benchmark pipeline instead (pipelines/benchmark.toml: every reference scene,
+    /// solver, size and tolerance, the scipy/numpy peers, the skips, reports/benchmark.md; only
+    /// stale stages run).
+    #[arg(long)]
+    pub all: bool,
+}
+
+/// `drapelab bench`: the hang4 table, or the whole benchmark pipeline with `--all`.
+pub fn run(a: BenchArgs) -> Result<i32> {
+    if a.all {
+        return super::pipeline::run_pipeline_command(
+            Path::new("pipelines/benchmark.toml"),
+            false,
+            Default::default(),
+        );
+    }
+    run_bench(
+        &a.scene,
+        &a.sizes,
+        (a.max_explicit_size, a.max_implicit_size),
+        a.tol,
+        a.population,
+    )?;
+    Ok(EXIT_OK)
 }
