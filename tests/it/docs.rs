@@ -161,3 +161,26 @@ fn the_link_reader_finds_links_and_skips_code() {
     let text = "see [a](b.md#x) and [c](https://e)\n```\n[d](e.md)\n```\n[f](../g.md)";
     assert_eq!(links(text), ["b.md", "../g.md"]);
 }
+
+/// The module map's "Where do I add…" table names only paths that exist: a newcomer who follows it
+/// lands in a real file or folder.
+#[test]
+fn every_path_the_module_map_names_exists() {
+    let text = std::fs::read_to_string(root().join("docs/src/reference/modules.md")).unwrap();
+    let (_, rest) = text
+        .split_once("## Where do I add")
+        .expect("the module map has a Where do I add section");
+    let section = rest.split("\n## ").next().unwrap();
+    let paths: Vec<&str> = section
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|t| t.contains('/') && !t.contains(' '))
+        .collect();
+    assert!(paths.len() >= 20, "too few paths: {paths:?}");
+    let missing: Vec<&&str> = paths.iter().filter(|p| !root().join(p).exists()).collect();
+    assert!(
+        missing.is_empty(),
+        "the module map names paths that do not exist: {missing:?}"
+    );
+}
