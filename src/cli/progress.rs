@@ -29,7 +29,7 @@ impl SolveProgress {
         tracing::debug!(
             "{}: {} iterations, {} factorizations ({} sparsity analyses), {} linear solves, \
 {:.3} s factorizing; {}",
-            r.solver,
+            r.solver.report_name(),
             r.iterations,
             r.factorizations,
             r.analyses,

@@ -83,7 +83,7 @@ fn simulate(
             "{}: {}{why} by {} in {} iterations, largest residual {:.3e} N ({:.2e} of a particle's weight), {:.3} s → {}",
             loaded.scene.name,
             report.status.as_str(),
-            report.solver,
+            report.solver.report_name(),
             report.iterations,
             report.max_residual_N,
             report.max_residual_rel,

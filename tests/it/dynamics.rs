@@ -55,7 +55,10 @@ fn implicit_euler_settles_on_the_static_drape_of_hang4_and_the_cantilever() {
             dynamic.report.factorizations
         );
         assert_eq!(dynamic.report.status, Status::Converged, "{file}");
-        assert_eq!(dynamic.report.solver, "implicit-euler");
+        assert_eq!(
+            dynamic.report.solver,
+            drapelab::solve::SolverKind::ImplicitEuler
+        );
         assert!(dynamic.report.iterations > 5, "{file}: a fall takes steps");
         assert!(d < 1e-4, "{file}: {d} m from the static drape");
     }

@@ -110,7 +110,7 @@ impl SweepOutcome {
         let fin = |v: f64| v.is_finite().then_some(v);
         SweepOutcome {
             particles: g.len() as u32,
-            solver: r.solver.clone(),
+            solver: r.solver.report_name().to_string(),
             status: r.status,
             iterations: r.iterations as u64,
             linear_solves: r.linear_solves as u64,

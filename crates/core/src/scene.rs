@@ -8,7 +8,7 @@ use crate::cloth::{Corner, Edge, Spacing};
 use crate::config::{from_table, read_toml_table, set_dotted};
 use crate::error::InputError;
 use crate::material::Material;
-use crate::solve::{DynamicOptions, Integrator, StaticOptions};
+use crate::solve::{DynamicOptions, StaticOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -212,52 +212,13 @@ impl Default for GravitySpec {
     }
 }
 
-/// Which solver runs the scene.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
-#[serde(rename_all = "kebab-case")]
-pub enum SolverKind {
-    /// Newton on the total potential energy with line search.
-    #[default]
-    Static,
-    /// Explicit Euler with Provot's correction (seed 000).
-    ExplicitEuler,
-    /// Symplectic Euler.
-    SymplecticEuler,
-    /// Implicit Euler as an optimisation of the incremental potential (Newton, adaptive steps).
-    ImplicitEuler,
-    /// Implicit Euler linearised once per step (Baraff–Witkin), fixed steps.
-    BaraffWitkin,
-}
+pub use crate::solve::SolverKind;
 
-impl SolverKind {
-    /// The name as written in scenes.
-    pub const fn name(self) -> &'static str {
-        match self {
-            SolverKind::Static => "static",
-            SolverKind::ExplicitEuler => "explicit-euler",
-            SolverKind::SymplecticEuler => "symplectic-euler",
-            SolverKind::ImplicitEuler => "implicit-euler",
-            SolverKind::BaraffWitkin => "baraff-witkin",
-        }
-    }
-    /// Whether the solver handles the sheet's self-contact (a barrier with a bounded step): the
-    /// static solve and implicit Euler.
-    pub fn supports_self_contact(self) -> bool {
-        matches!(self, SolverKind::Static | SolverKind::ImplicitEuler)
-    }
-    /// Whether the scene's sheet gets the self-contact term ([`ContactSpec::self_contact`]).
-    pub fn self_contact(self, mode: SelfContactMode) -> bool {
-        mode != SelfContactMode::Off && self.supports_self_contact()
-    }
-    /// The dynamic integrator, if this is one.
-    pub fn integrator(self) -> Option<Integrator> {
-        match self {
-            SolverKind::Static => None,
-            SolverKind::ExplicitEuler => Some(Integrator::ExplicitEuler),
-            SolverKind::SymplecticEuler => Some(Integrator::SymplecticEuler),
-            SolverKind::ImplicitEuler => Some(Integrator::ImplicitEuler),
-            SolverKind::BaraffWitkin => Some(Integrator::BaraffWitkin),
-        }
+impl SelfContactMode {
+    /// Whether a scene solved by `kind` gets the sheet's self-contact term under this mode
+    /// ([`ContactSpec::self_contact`]): not off, and a solver that handles it.
+    pub fn applies_to(self, kind: SolverKind) -> bool {
+        self != SelfContactMode::Off && kind.supports_self_contact()
     }
 }
 

@@ -26,10 +26,7 @@ impl Solution {
     /// The solution of a scene that failed its checks: no particles, status invalid, the error as
     /// the message.
     pub fn invalid(scene: &Scene, error: crate::error::InputError) -> Self {
-        let mut report = SolveReport::unsolved(match scene.solver.kind {
-            crate::scene::SolverKind::Static => "static-newton",
-            other => other.name(),
-        });
+        let mut report = SolveReport::unsolved(scene.solver.kind);
         report.stop_for(crate::solve::StopReason::Invalid);
         report.message = error.to_string();
         Solution {

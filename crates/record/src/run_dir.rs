@@ -324,7 +324,7 @@ fn state_files(
     let meta = [
         ("drapelab_version", drapelab_core::VERSION.to_string()),
         ("status", report.status.as_str().to_string()),
-        ("solver", report.solver.clone()),
+        ("solver", report.solver.report_name().to_string()),
         ("scene", scene.name.clone()),
     ];
     let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));

@@ -121,7 +121,7 @@ pub fn build_scene(scene: &ValidatedScene) -> BuiltScene {
     point_loads(scene, &grid, &absent, &x0, &mut b.terms);
     holds(scene, &grid, &mut b.held);
     contact_terms(scene, &x0, &mut b);
-    if scene.solver.kind.self_contact(scene.contact.self_contact) {
+    if scene.contact.self_contact.applies_to(scene.solver.kind) {
         let xi = self_thickness_m(scene);
         let triangles = sheet_triangles(&grid, &absent);
         b.self_contact(triangles, &x0, (xi, xi), kappa_gravity(scene));

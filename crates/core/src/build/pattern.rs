@@ -113,7 +113,7 @@ pub(super) fn build_mesh_scene(
     let absent = vec![false; grid.len()];
     super::point_loads(scene, &grid, &absent, &x0, &mut b.terms);
     super::contact_terms(scene, &x0, &mut b);
-    if scene.solver.kind.self_contact(scene.contact.self_contact) {
+    if scene.contact.self_contact.applies_to(scene.solver.kind) {
         let xi = super::self_thickness_m(scene);
         let triangles = super::scene_triangles(scene);
         b.self_contact(triangles, &x0, (xi, xi), super::kappa_gravity(scene));

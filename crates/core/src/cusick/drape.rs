@@ -323,7 +323,7 @@ fn solve_drape_once(
     let mut x = given.map_or_else(|| drape_start(mesh, p, tester), <[_]>::to_vec);
     let mut fall = None;
     if p.start == DrapeStart::Fall && given.is_none() {
-        let mut r = SolveReport::unsolved("implicit-euler");
+        let mut r = SolveReport::unsolved(crate::solve::SolverKind::ImplicitEuler);
         let mut v = vec![Vector3::zeros(); x.len()];
         let s = ImplicitSettings {
             dt_s: p.fall_max_dt_s * 0.25,

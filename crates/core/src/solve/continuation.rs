@@ -62,27 +62,30 @@ pub fn execute(
     let mut run: Option<NewtonRun> = None;
     let mut solved = false;
     loop {
-        let (load, goal) = match continuation.next(model, x, solved) {
-            Stage::Solve(load) => (load, Goal::Tolerance),
-            Stage::Increment(load) => (load, Goal::Increment),
-            Stage::Done(note) => {
-                let mut t = match run.take() {
-                    Some(r) => merged(total, r.finish(model, x)),
-                    None => total.unwrap_or_else(|| SolveReport::unsolved("static-newton")),
-                };
-                t.message += &note;
-                return t;
-            }
-            Stage::Stop(reason, message) => {
-                let mut t = match run.take() {
-                    Some(r) => merged(total, r.finish(model, x)),
-                    None => total.unwrap_or_else(|| SolveReport::unsolved("static-newton")),
-                };
-                t.stop_for(reason);
-                t.message = message;
-                return t;
-            }
-        };
+        let (load, goal) =
+            match continuation.next(model, x, solved) {
+                Stage::Solve(load) => (load, Goal::Tolerance),
+                Stage::Increment(load) => (load, Goal::Increment),
+                Stage::Done(note) => {
+                    let mut t = match run.take() {
+                        Some(r) => merged(total, r.finish(model, x)),
+                        None => total
+                            .unwrap_or_else(|| SolveReport::unsolved(super::SolverKind::Static)),
+                    };
+                    t.message += &note;
+                    return t;
+                }
+                Stage::Stop(reason, message) => {
+                    let mut t = match run.take() {
+                        Some(r) => merged(total, r.finish(model, x)),
+                        None => total
+                            .unwrap_or_else(|| SolveReport::unsolved(super::SolverKind::Static)),
+                    };
+                    t.stop_for(reason);
+                    t.message = message;
+                    return t;
+                }
+            };
         let mut current = match run.take() {
             Some(r) => r,
             None => match NewtonRun::new(model, x, opts) {

@@ -36,14 +36,9 @@ pub enum Integrator {
 }
 
 impl Integrator {
-    /// The name written into outputs.
+    /// The name written into outputs: its [`super::SolverKind`]'s.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Integrator::ExplicitEuler => "explicit-euler",
-            Integrator::SymplecticEuler => "symplectic-euler",
-            Integrator::ImplicitEuler => "implicit-euler",
-            Integrator::BaraffWitkin => "baraff-witkin",
-        }
+        super::SolverKind::from(self).name()
     }
 }
 
@@ -326,7 +321,7 @@ pub fn solve_dynamic(
         stop: StopReason::SimulatedTime,
         sim_time_s: Some(0.0),
         dt_s: Some(dt),
-        ..SolveReport::unsolved(integrator.as_str())
+        ..SolveReport::unsolved(integrator.into())
     };
     if !free.iter().any(|&f| f) || !w_ref.is_finite() || dt.is_nan() || dt <= 0.0 {
         report.stop_for(StopReason::Invalid);
@@ -407,7 +402,7 @@ fn solve_implicit(
         stop: StopReason::SimulatedTime,
         sim_time_s: Some(0.0),
         dt_s: Some(opts.dt_s),
-        ..SolveReport::unsolved(Integrator::ImplicitEuler.as_str())
+        ..SolveReport::unsolved(super::SolverKind::ImplicitEuler)
     };
     let free = model.fixed.iter().any(|f| !f);
     let steps_ok = opts.dt_s > 0.0 && opts.min_dt_s > 0.0 && opts.max_dt_s >= opts.min_dt_s;

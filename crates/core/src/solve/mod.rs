@@ -7,6 +7,7 @@ mod continuation;
 mod dynamic;
 mod equilibrium;
 mod incremental;
+mod kind;
 mod linear;
 mod newton;
 mod report;
@@ -21,6 +22,7 @@ pub use dynamic::{
 };
 pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
+pub use kind::{SolverKind, by_report_name};
 pub use linear::{DofMap, SparseSpd};
 pub use newton::{NeighbourFactor, StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{

@@ -253,7 +253,7 @@ impl NewtonRun {
         x: &[Vector3<f64>],
         opts: &StaticOptions,
     ) -> Result<Self, Box<SolveReport>> {
-        let mut report = SolveReport::unsolved("static-newton");
+        let mut report = SolveReport::unsolved(super::SolverKind::Static);
         let ws = Workspace::new(model, x, opts);
         if ws.dofs.n == 0 || !model.reference_weight().is_finite() {
             report.stop_for(StopReason::Invalid);

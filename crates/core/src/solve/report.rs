@@ -186,8 +186,10 @@ impl Globalization {
 /// The outcome of a solve.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SolveReport {
-    /// Solver name: "static-newton", "explicit-euler", "symplectic-euler", "implicit-euler".
-    pub solver: String,
+    /// The solver, written by its report name: "static-newton", "explicit-euler",
+    /// "symplectic-euler", "implicit-euler", "baraff-witkin".
+    #[serde(with = "super::kind::by_report_name")]
+    pub solver: super::SolverKind,
     /// How the solve ended.
     pub status: Status,
     /// Why it stopped.
@@ -247,9 +249,9 @@ pub struct SolveReport {
 impl SolveReport {
     /// The report a solve starts from: nothing done yet, stopped by its iteration budget until said
     /// otherwise, residual and energy unknown.
-    pub fn unsolved(solver: impl Into<String>) -> Self {
+    pub fn unsolved(solver: super::SolverKind) -> Self {
         SolveReport {
-            solver: solver.into(),
+            solver,
             status: Status::MaxIterations,
             stop: StopReason::Iterations,
             iterations: 0,
