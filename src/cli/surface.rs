@@ -63,7 +63,8 @@ pub fn surface(a: SurfaceArgs) -> Result<i32> {
         view_deg: pair(&a.view, "--view")?,
         picture_px: [1000, 750],
     };
-    params.check().map_err(|(k, m)| {
+    params.check().map_err(|e| {
+        let (k, m) = (e.key, e.message);
         let flag = if k == "view_deg" {
             "--view".to_string()
         } else {

@@ -11,6 +11,7 @@ use drapelab_core::calibrate::{
     Noise, Problem, SampleSettings, calibrate_sample, read_sample_densities, sample_scene,
 };
 use drapelab_core::edges::{EdgeFit, EdgeSource};
+use drapelab_core::error::KeyError;
 use drapelab_core::optim::{DecadeEvent, IcaSettings};
 use drapelab_record::{
     CalibrationRecorder, gather_parquet, merge_recordings, read_edges, write_table,
@@ -99,24 +100,25 @@ pub fn default_window() -> f64 {
 }
 
 impl CalibrateParams {
-    /// Checks the parameters: Err((key, message)).
-    pub fn check(&self) -> Result<(), (String, String)> {
+    /// Checks the parameters: Err(KeyError::new(key, message)).
+    pub fn check(&self) -> Result<(), KeyError> {
         match (&self.ica, self.ica_from_input) {
-            (Some(ica), false) => ica.check().map_err(|(k, m)| (format!("ica.{k}"), m))?,
+            (Some(ica), false) => ica
+                .check()
+                .map_err(|e| KeyError::new(format!("ica.{}", e.key), e.message))?,
             (None, true) => {}
             _ => {
-                return Err((
-                    "ica".into(),
-                    "give exactly one of `ica` (settings) and `ica_from_input = true` (the `ica` input)"
-                        .into(),
+                return Err(KeyError::new(
+                    "ica",
+                    "give exactly one of `ica` (settings) and `ica_from_input = true` (the `ica` input)",
                 ));
             }
         }
         if self.runs == 0 {
-            return Err(("runs".into(), "must be ≥ 1".into()));
+            return Err(KeyError::new("runs", "must be ≥ 1"));
         }
         if self.grid < 3 {
-            return Err(("grid".into(), "must be ≥ 3".into()));
+            return Err(KeyError::new("grid", "must be ≥ 3"));
         }
         for (key, v, lo, hi) in [
             (
@@ -134,7 +136,10 @@ impl CalibrateParams {
             ),
         ] {
             if !(v.is_finite() && v > lo && v <= hi) {
-                return Err((key.into(), format!("must be in ({lo}, {hi}], got {v}")));
+                return Err(KeyError::new(
+                    key,
+                    format!("must be in ({lo}, {hi}], got {v}"),
+                ));
             }
         }
         Ok(())
@@ -151,7 +156,7 @@ pub fn ica_settings(ctx: &Job<'_>, p: &CalibrateParams) -> Result<IcaSettings> {
         &std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?,
     )?;
     ica.check()
-        .map_err(|(k, m)| anyhow::anyhow!("{}: {k}: {m}", path.display()))?;
+        .map_err(|e| anyhow::anyhow!("{}: {}: {}", path.display(), e.key, e.message))?;
     Ok(ica)
 }
 

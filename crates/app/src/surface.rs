@@ -6,6 +6,7 @@ use crate::job::Job;
 use anyhow::{Context, Result, bail};
 use drapelab_core::build::{self, build_scene};
 use drapelab_core::error::InputError;
+use drapelab_core::error::KeyError;
 use drapelab_core::scene::{LoadedScene, Scene, ValidatedScene};
 use drapelab_core::solve::{NoObserver, Observer, Status};
 use drapelab_core::surface::{
@@ -234,16 +235,16 @@ impl Default for SurfaceParams {
 
 impl SurfaceParams {
     /// Checks the values: the offending key and what is wrong.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
+    pub fn check(&self) -> Result<(), KeyError> {
         if !self.repeats.iter().all(|r| r.is_finite() && *r > 0.0) {
             let m = format!(
                 "repeats must be > 0 along both directions (got {:?}), e.g. 6,6",
                 self.repeats
             );
-            return Err(("repeats", m));
+            return Err(KeyError::new("repeats", m));
         }
         if !(2..=2000).contains(&self.resolution) {
-            return Err((
+            return Err(KeyError::new(
                 "resolution",
                 format!("resolution must be 2..=2000 (got {})", self.resolution),
             ));
@@ -253,18 +254,18 @@ impl SurfaceParams {
                 "picture sides must be 16..=8000 px (got {:?})",
                 self.picture_px
             );
-            return Err(("picture_px", m));
+            return Err(KeyError::new("picture_px", m));
         }
         if !self.rotation_deg.is_finite() {
-            return Err((
+            return Err(KeyError::new(
                 "rotation_deg",
-                "the rotation must be a finite number of degrees".into(),
+                "the rotation must be a finite number of degrees",
             ));
         }
         if !self.view_deg.iter().all(|v| v.is_finite()) {
-            return Err((
+            return Err(KeyError::new(
                 "view_deg",
-                "the view's angles must be finite numbers of degrees".into(),
+                "the view's angles must be finite numbers of degrees",
             ));
         }
         Ok(())

@@ -5,6 +5,7 @@
 use crate::job::Job;
 use crate::sweep_table::{SweepOutcome, SweepPoint, as_f64, write_sweep};
 use anyhow::{Result, bail};
+use drapelab_core::error::KeyError;
 use drapelab_core::scene::Scene;
 use drapelab_core::simulate::solve_scene;
 use drapelab_core::solve::NoObserver;
@@ -66,32 +67,35 @@ pub fn default_samples() -> usize {
 }
 
 impl SweepParams {
-    /// Checks the axes against the design: Err((key, message)).
-    pub fn check(&self) -> Result<(), (String, String)> {
+    /// Checks the axes against the design: Err(KeyError::new(key, message)).
+    pub fn check(&self) -> Result<(), KeyError> {
         if self.axes.is_empty() && self.design == Design::Lhs {
-            return Err((
-                "axes".into(),
-                "a Latin hypercube needs at least one axis".into(),
+            return Err(KeyError::new(
+                "axes",
+                "a Latin hypercube needs at least one axis",
             ));
         }
         for (k, a) in &self.axes {
             match a {
                 Axis::Values(v) if v.is_empty() => {
-                    return Err((format!("axes.{k}"), "an empty list of values".into()));
+                    return Err(KeyError::new(
+                        format!("axes.{k}"),
+                        "an empty list of values",
+                    ));
                 }
                 Axis::Range { min, max } => {
                     if self.design == Design::Grid {
-                        return Err((
+                        return Err(KeyError::new(
                             format!("axes.{k}"),
-                            "a grid needs a list of values; ranges are for design = \"lhs\"".into(),
+                            "a grid needs a list of values; ranges are for design = \"lhs\"",
                         ));
                     }
                     match (as_f64(min), as_f64(max)) {
                         (Some(a), Some(b)) if a.is_finite() && b.is_finite() && a <= b => {}
                         _ => {
-                            return Err((
+                            return Err(KeyError::new(
                                 format!("axes.{k}"),
-                                "min and max must be finite numbers with min ≤ max".into(),
+                                "min and max must be finite numbers with min ≤ max",
                             ));
                         }
                     }
@@ -100,7 +104,7 @@ impl SweepParams {
             }
         }
         if self.design == Design::Lhs && self.samples == 0 {
-            return Err(("samples".into(), "must be ≥ 1".into()));
+            return Err(KeyError::new("samples", "must be ≥ 1"));
         }
         Ok(())
     }

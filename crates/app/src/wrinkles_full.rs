@@ -248,7 +248,7 @@ pub fn case_grid(inp: &WrinkleInputs, nx: usize) -> (usize, usize) {
 
 /// Checks the parameters, and the cases they name against the config (names the bad key).
 pub fn check(ctx: &Job<'_>, cfg: &WrinkleConfig, p: &WrinklesSimulateParams) -> Result<()> {
-    p.check().map_err(|(k, m)| ctx.param_error(k, m))?;
+    p.check().map_err(|e| ctx.param_error(&e.key, e.message))?;
     for (key, names) in [("cases", &p.cases), ("map_cases", &p.map_cases)] {
         if let Some(name) = names
             .iter()

@@ -2,6 +2,7 @@
 //! shear stiffnesses tried, the fabric reading, the map and the candidates of the two leave-one-out
 //! choices; each key's meaning, unit and default beside it, and their checks.
 
+use drapelab_core::error::KeyError;
 use drapelab_core::wrinkles::full::{HungSetup, HungStart, SheetReading};
 use serde::{Deserialize, Serialize};
 
@@ -209,8 +210,8 @@ impl WrinklesSimulateParams {
 
 impl WrinklesSimulateParams {
     /// Checks the parameters by themselves: the bad key and why.
-    pub fn check(&self) -> std::result::Result<(), (&'static str, String)> {
-        let bad = |key, m: &str| Err((key, m.to_string()));
+    pub fn check(&self) -> Result<(), KeyError> {
+        let bad = |key: &str, m: &str| Err(KeyError::new(key, m));
         if self.coarse_nx < 5 {
             return bad("coarse_nx", "must be at least 5");
         }

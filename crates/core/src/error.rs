@@ -40,17 +40,19 @@ impl fmt::Display for InputError {
 
 impl std::error::Error for InputError {}
 
-/// A bad stage parameter: the key under `params.` (empty for the whole table) and what is wrong.
+/// A bad key and what is wrong with it, before the file it is in is known: a stage parameter
+/// (the key under `params.`, empty for the whole table), a scene section's key, a config case's.
+/// [`InputError`] adds the file.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ParamError {
-    /// Dotted key under `params.`.
+pub struct KeyError {
+    /// Dotted key, relative to the table checked.
     pub key: String,
     /// What is wrong.
     pub message: String,
 }
 
-impl ParamError {
-    /// A new parameter error.
+impl KeyError {
+    /// A new key error.
     pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
         Self {
             key: key.into(),

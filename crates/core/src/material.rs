@@ -3,6 +3,7 @@
 //! Everything is SI inside. [`KesRigidities`] accepts the units of seed 003 Table 10.3
 //! (gf/cm, gf·cm²/cm, gf/cm², cm) and converts them with 1 gf = 9.80665e-3 N.
 
+use crate::error::KeyError;
 use serde::{Deserialize, Serialize};
 
 /// One gram-force in newtons.
@@ -186,23 +187,23 @@ pub fn gf_per_cm2_to_n_per_m2(v: f64) -> f64 {
 impl Continuum {
     /// Resolves to SI rigidities. Each rigidity must be given exactly once, in KES or SI units;
     /// the error names the key (relative to the `material.continuum` table) and says what to do.
-    pub fn rigidities(&self) -> Result<Rigidities, (String, String)> {
+    pub fn rigidities(&self) -> Result<Rigidities, KeyError> {
         fn pick(
             kes: Option<f64>,
             si: Option<f64>,
             kes_key: &str,
             si_key: &str,
             conv: fn(f64) -> f64,
-        ) -> Result<f64, (String, String)> {
+        ) -> Result<f64, KeyError> {
             match (kes, si) {
-                (Some(_), Some(_)) => Err((
-                    si_key.into(),
+                (Some(_), Some(_)) => Err(KeyError::new(
+                    si_key,
                     format!("given twice: remove either `{kes_key}` or `{si_key}`"),
                 )),
                 (Some(v), None) => Ok(conv(v)),
                 (None, Some(v)) => Ok(v),
-                (None, None) => Err((
-                    si_key.into(),
+                (None, None) => Err(KeyError::new(
+                    si_key,
                     format!("missing: give `{si_key}` or `{kes_key}`"),
                 )),
             }

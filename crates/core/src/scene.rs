@@ -7,6 +7,7 @@
 use crate::cloth::{Corner, Edge, Spacing};
 use crate::config::{from_table, read_toml_table, set_dotted};
 use crate::error::InputError;
+use crate::error::KeyError;
 use crate::material::Material;
 use crate::solve::{DynamicOptions, StaticOptions};
 use serde::{Deserialize, Serialize};
@@ -513,7 +514,7 @@ impl Scene {
             for (k, v) in overrides.iter().filter(|(k, _)| keep(k)) {
                 set_dotted(&mut table, k, v.clone()).map_err(|m| InputError::new(path, k, m))?;
             }
-            read_renamed_keys(&mut table).map_err(|(k, m)| InputError::new(path, k, m))?;
+            read_renamed_keys(&mut table).map_err(|e| InputError::new(path, e.key, e.message))?;
             let mut scene: Scene = from_table(path, "", table)?;
             scene.cloth.read_mesh(path)?;
             Ok(scene)
@@ -724,8 +725,8 @@ in the key's unit (SI)",
                 }
             }
             (None, Some(cont)) => {
-                let r = cont.rigidities().map_err(|(k, m)| {
-                    InputError::new(ck.path, format!("material.continuum.{k}"), m)
+                let r = cont.rigidities().map_err(|e| {
+                    InputError::new(ck.path, format!("material.continuum.{}", e.key), e.message)
                 })?;
                 for (k, v) in [
                     ("tensile_warp", r.tensile_warp_N_per_m),
@@ -892,8 +893,9 @@ would already touch itself; use a coarser grid or a thinner sheet"
         }
         let flat = self.initial_positions();
         for (k, o) in self.obstacles.iter().enumerate() {
-            o.check()
-                .map_err(|(key, m)| InputError::new(ck.path, format!("obstacles[{k}].{key}"), m))?;
+            o.check().map_err(|e| {
+                InputError::new(ck.path, format!("obstacles[{k}].{}", e.key), e.message)
+            })?;
             if let Some((p, d)) = flat
                 .iter()
                 .enumerate()
@@ -1094,7 +1096,7 @@ const RENAMED_KEYS: [(&str, &str, &str, &str, &str); 4] = [
 /// `solver.dynamic.reuse_factorization`) into the strategy keys that replaced them, so that scene
 /// files written before keep their meaning. Err (key, message) for a non-boolean value or an old
 /// key given together with its successor.
-fn read_renamed_keys(table: &mut toml::Table) -> Result<(), (String, String)> {
+fn read_renamed_keys(table: &mut toml::Table) -> Result<(), KeyError> {
     let Some(toml::Value::Table(solver)) = table.get_mut("solver") else {
         return Ok(());
     };
@@ -1103,7 +1105,7 @@ fn read_renamed_keys(table: &mut toml::Table) -> Result<(), (String, String)> {
         match t.remove(old) {
             None => Ok(None),
             Some(toml::Value::Boolean(b)) => Ok(Some(b)),
-            Some(v) => Err((
+            Some(v) => Err(KeyError::new(
                 key,
                 format!("expected a boolean, got the {} {v}", v.type_str()),
             )),
@@ -1126,7 +1128,7 @@ fn read_renamed_keys(table: &mut toml::Table) -> Result<(), (String, String)> {
             let start =
                 crate::solve::Start::from_flags(nested.unwrap_or(true), shaped.unwrap_or(true));
             let name = serde_json::to_value(start)
-                .map_err(|e| ("solver.static.start".into(), e.to_string()))?;
+                .map_err(|e| KeyError::new("solver.static.start", e.to_string()))?;
             let old = if nested.is_some() {
                 "coarse_start"
             } else {
@@ -1147,9 +1149,9 @@ fn rename_into(
     t: &mut toml::Table,
     (sub, old, new): (&str, &str, &str),
     value: &str,
-) -> Result<(), (String, String)> {
+) -> Result<(), KeyError> {
     if t.contains_key(new) {
-        return Err((
+        return Err(KeyError::new(
             format!("solver.{sub}.{old}"),
             format!("replaced by solver.{sub}.{new}, which is given too: keep only `{new}`"),
         ));

@@ -30,6 +30,4 @@ pub use runner::{
     RunOptions, RunSummary, StageState, load_checked_plan, manifest_path, run_pipeline, run_worker,
     stage_states,
 };
-pub use stage::{
-    ItemKind, ParamError, Registry, Slot, Stage, StageContext, StageKind, typed_params,
-};
+pub use stage::{ItemKind, KeyError, Registry, Slot, Stage, StageContext, StageKind, typed_params};

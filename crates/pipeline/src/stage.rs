@@ -66,7 +66,7 @@ impl Slot {
     }
 }
 
-pub use drapelab_core::error::ParamError;
+pub use drapelab_core::error::KeyError;
 
 /// The interface the engine knows a stage kind by (object safe).
 pub trait Stage: Send + Sync {
@@ -80,7 +80,7 @@ pub trait Stage: Send + Sync {
     fn outputs(&self) -> &'static [Slot];
     /// Checks a params table; the resolved parameters (defaults filled in) as JSON, part of the
     /// up-to-date key.
-    fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError>;
+    fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, KeyError>;
     /// Checks the parameters against the stage's input files, when the plan loads and every
     /// input already exists (a scene's overrides against the scene): an [`InputError`] refuses the
     /// plan in `status`, `run --dry-run` and `run` alike, before any work.
@@ -121,7 +121,7 @@ pub trait StageKind: Send + Sync + 'static {
     /// Output slots.
     const OUTPUTS: &'static [Slot];
     /// Checks beyond the types (ranges, consistency).
-    fn check(_params: &Self::Params) -> Result<(), ParamError> {
+    fn check(_params: &Self::Params) -> Result<(), KeyError> {
         Ok(())
     }
     /// [`Stage::precheck`] with the typed parameters. Default: nothing to check.
@@ -154,10 +154,10 @@ pub trait ItemKind: StageKind {
 }
 
 /// Deserializes a params table into `T`, naming the bad key.
-pub fn typed_params<T: DeserializeOwned>(params: &toml::Table) -> Result<T, ParamError> {
+pub fn typed_params<T: DeserializeOwned>(params: &toml::Table) -> Result<T, KeyError> {
     serde_path_to_error::deserialize(toml::Value::Table(params.clone())).map_err(|e| {
         let path = e.path().to_string();
-        ParamError::new(
+        KeyError::new(
             if path == "." { String::new() } else { path },
             e.into_inner()
                 .to_string()
@@ -193,10 +193,10 @@ macro_rules! typed_stage_methods {
         fn outputs(&self) -> &'static [Slot] {
             K::OUTPUTS
         }
-        fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, ParamError> {
+        fn resolve(&self, params: &toml::Table) -> Result<serde_json::Value, KeyError> {
             let p: K::Params = typed_params(params)?;
             K::check(&p)?;
-            serde_json::to_value(&p).map_err(|e| ParamError::new("", e.to_string()))
+            serde_json::to_value(&p).map_err(|e| KeyError::new("", e.to_string()))
         }
         fn precheck(&self, ctx: &StageContext<'_>) -> Result<()> {
             K::precheck(ctx, &params_of::<K>(ctx)?)

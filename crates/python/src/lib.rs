@@ -211,7 +211,7 @@ fn calibrate_params(params_json: &str, without_ica: bool) -> PyResult<CalibrateP
         p.ica_from_input = p.ica.is_none();
     }
     p.check()
-        .map_err(|(key, msg)| InputError::new_err(format!("params: key `{key}`: {msg}")))?;
+        .map_err(|e| InputError::new_err(format!("params: key `{}`: {}", e.key, e.message)))?;
     Ok(p)
 }
 

@@ -4,7 +4,7 @@
 
 use anyhow::{Result, bail};
 use drapelab_app::Job;
-use drapelab_core::error::ParamError;
+use drapelab_core::error::KeyError;
 use drapelab_record::write_text;
 use plotters::prelude::*;
 use polars::prelude::*;
@@ -77,11 +77,11 @@ fn sweep_columns() -> Vec<String> {
 
 /// Refuses, when the plan loads, a column that is neither a column of `sweep.parquet` nor a swept
 /// scene key (a dotted path such as `cloth.nx`): a report summarises sweep tables.
-pub fn check(p: &ReportParams) -> Result<(), ParamError> {
+pub fn check(p: &ReportParams) -> Result<(), KeyError> {
     let known = sweep_columns();
     for (key, c) in p.columns() {
         if !c.contains('.') && !known.iter().any(|k| k == c) {
-            return Err(ParamError::new(
+            return Err(KeyError::new(
                 key,
                 format!(
                     "unknown column `{c}`: name a column of sweep.parquet ({}) or a swept scene key \

@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 pub use drapelab_app::calibrate::*;
-use drapelab_pipeline::{ItemKind, ParamError, Slot, StageContext, StageKind};
+use drapelab_pipeline::{ItemKind, KeyError, Slot, StageContext, StageKind};
 use std::path::{Path, PathBuf};
 
 /// The `calibrate` stage kind.
@@ -38,8 +38,8 @@ impl StageKind for Calibrate {
             "comparison.parquet: ICA against the CMA-ES baseline per run",
         ),
     ];
-    fn check(p: &CalibrateParams) -> Result<(), ParamError> {
-        p.check().map_err(|(k, m)| ParamError::new(k, m))
+    fn check(p: &CalibrateParams) -> Result<(), KeyError> {
+        p.check()
     }
 }
 

@@ -2,7 +2,7 @@
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
+use drapelab_pipeline::{KeyError, Slot, StageContext, StageKind};
 pub use drapelab_reports::report::*;
 
 /// The `report` stage kind.
@@ -20,7 +20,7 @@ impl StageKind for Report {
         Slot::one("markdown", "the report, .md"),
         Slot::one("plot", "the plot, .svg"),
     ];
-    fn check(p: &ReportParams) -> Result<(), ParamError> {
+    fn check(p: &ReportParams) -> Result<(), KeyError> {
         check(p)
     }
     fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {

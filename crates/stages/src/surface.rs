@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 pub use drapelab_app::surface::*;
-use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
+use drapelab_pipeline::{KeyError, Slot, StageContext, StageKind};
 
 /// The `surface` stage kind.
 pub struct Surface;
@@ -31,8 +31,8 @@ impl StageKind for Surface {
         ),
         Slot::optional("summary", "counts, areas and settings, .json"),
     ];
-    fn check(p: &SurfaceParams) -> Result<(), ParamError> {
-        p.check().map_err(|(k, m)| ParamError::new(k, m))
+    fn check(p: &SurfaceParams) -> Result<(), KeyError> {
+        p.check()
     }
     fn run(ctx: &StageContext<'_>, p: &SurfaceParams) -> Result<()> {
         let ctx = &crate::job(ctx);

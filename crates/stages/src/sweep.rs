@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 pub use drapelab_app::sweep::*;
-use drapelab_pipeline::{ItemKind, ParamError, Slot, StageContext, StageKind};
+use drapelab_pipeline::{ItemKind, KeyError, Slot, StageContext, StageKind};
 use std::path::{Path, PathBuf};
 
 /// The `sweep` stage kind.
@@ -21,8 +21,8 @@ impl StageKind for Sweep {
         "table",
         "sweep.parquet: one row per scene and point",
     )];
-    fn check(p: &SweepParams) -> Result<(), ParamError> {
-        p.check().map_err(|(k, m)| ParamError::new(k, m))
+    fn check(p: &SweepParams) -> Result<(), KeyError> {
+        p.check()
     }
     /// Every scene loads at every point (a bad axis or `set` value is refused naming it).
     fn precheck(ctx: &StageContext<'_>, p: &SweepParams) -> Result<()> {

@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 pub use drapelab_app::tune::*;
-use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
+use drapelab_pipeline::{KeyError, Slot, StageContext, StageKind};
 
 /// The `tune` stage kind.
 pub struct Tune;
@@ -23,9 +23,9 @@ impl StageKind for Tune {
         Slot::one("best_ica", "best_ica.json: the best level of each factor"),
         Slot::optional("plot", "main_effects.svg"),
     ];
-    fn check(p: &TuneParams) -> Result<(), ParamError> {
+    fn check(p: &TuneParams) -> Result<(), KeyError> {
         if p.repeats == 0 {
-            Err(ParamError::new("repeats", "must be ≥ 1"))
+            Err(KeyError::new("repeats", "must be ≥ 1"))
         } else {
             Ok(())
         }

@@ -5,7 +5,7 @@ use anyhow::Result;
 use drapelab_app::wrinkles_full::simulate;
 pub use drapelab_app::wrinkles_params::WrinklesSimulateParams;
 use drapelab_app::wrinkles_tables::write_outputs;
-use drapelab_pipeline::{ParamError, Slot, StageContext, StageKind};
+use drapelab_pipeline::{KeyError, Slot, StageContext, StageKind};
 
 /// The `wrinkles-simulate` stage kind.
 pub struct WrinklesSimulate;
@@ -30,8 +30,8 @@ impl StageKind for WrinklesSimulate {
         Slot::optional("fibres_plot", "the centre fibres, .svg"),
         Slot::optional("markdown", "the report, .md"),
     ];
-    fn check(p: &WrinklesSimulateParams) -> Result<(), ParamError> {
-        p.check().map_err(|(k, m)| ParamError::new(k, m))
+    fn check(p: &WrinklesSimulateParams) -> Result<(), KeyError> {
+        p.check()
     }
     fn run(ctx: &StageContext<'_>, p: &WrinklesSimulateParams) -> Result<()> {
         let job = &crate::job(ctx);

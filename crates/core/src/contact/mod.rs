@@ -5,6 +5,7 @@
 
 pub mod proximity;
 
+use crate::error::KeyError;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -321,20 +322,20 @@ impl Obstacle {
         }
     }
 
-    /// Checks the definition: Err((key, message)).
-    pub fn check(&self) -> Result<(), (String, String)> {
+    /// Checks the definition: Err(KeyError::new(key, message)).
+    pub fn check(&self) -> Result<(), KeyError> {
         let finite = |k: &str, a: &[f64]| {
             if a.iter().all(|x| x.is_finite()) {
                 Ok(())
             } else {
-                Err((k.to_string(), "must be finite".to_string()))
+                Err(KeyError::new(k.to_string(), "must be finite".to_string()))
             }
         };
         let positive = |k: &str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())
             } else {
-                Err((
+                Err(KeyError::new(
                     k.to_string(),
                     format!("must be a finite number > 0, got {x}"),
                 ))
@@ -345,7 +346,10 @@ impl Obstacle {
             if v(a).norm() > 1e-12 {
                 Ok(())
             } else {
-                Err((k.to_string(), "must be a non-zero vector".to_string()))
+                Err(KeyError::new(
+                    k.to_string(),
+                    "must be a non-zero vector".to_string(),
+                ))
             }
         };
         match self {
@@ -359,7 +363,7 @@ impl Obstacle {
                 if (0..3).all(|k| max_m[k] > min_m[k]) {
                     Ok(())
                 } else {
-                    Err(("max_m".into(), "must exceed min_m in x, y and z".into()))
+                    Err(KeyError::new("max_m", "must exceed min_m in x, y and z"))
                 }
             }
             Obstacle::Cylinder {
@@ -387,19 +391,22 @@ impl Obstacle {
             Obstacle::Revolution { axis_m, profile_m } => {
                 finite("axis_m", axis_m)?;
                 if profile_m.len() < 2 {
-                    return Err((
-                        "profile_m".into(),
-                        "needs at least two (z, r) points".into(),
+                    return Err(KeyError::new(
+                        "profile_m",
+                        "needs at least two (z, r) points",
                     ));
                 }
                 for (k, p) in profile_m.iter().enumerate() {
                     if !(p[0].is_finite() && p[1].is_finite() && p[1] >= 0.0) {
-                        return Err((format!("profile_m[{k}]"), "needs finite z and r ≥ 0".into()));
+                        return Err(KeyError::new(
+                            format!("profile_m[{k}]"),
+                            "needs finite z and r ≥ 0",
+                        ));
                     }
                     if k > 0 && p[0] <= profile_m[k - 1][0] {
-                        return Err((
+                        return Err(KeyError::new(
                             format!("profile_m[{k}]"),
-                            "heights must increase strictly".into(),
+                            "heights must increase strictly",
                         ));
                     }
                 }

@@ -5,6 +5,7 @@
 //! Random numbers are drawn only in the serial parts, in a fixed order, and costs of a decade are
 //! evaluated in parallel (rayon) in a fixed order: a seed gives the same result on any thread count.
 
+use crate::error::KeyError;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -34,9 +35,9 @@ pub struct IcaSettings {
 }
 
 impl IcaSettings {
-    /// Checks the settings: Err((key, message)).
-    pub fn check(&self) -> Result<(), (String, String)> {
-        let bad = |k: &str, m: &str| Err((k.to_string(), m.to_string()));
+    /// Checks the settings: Err(KeyError::new(key, message)).
+    pub fn check(&self) -> Result<(), KeyError> {
+        let bad = |k: &str, m: &str| Err(KeyError::new(k.to_string(), m.to_string()));
         if self.countries == 0 {
             return bad("countries", "must be ≥ 1");
         }

@@ -3,6 +3,7 @@
 
 use super::WrinkleInputs;
 use crate::error::InputError;
+use crate::error::KeyError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -184,8 +185,8 @@ impl WrinkleCase {
         true
     }
 
-    /// Checks the values: Err((key, message)).
-    fn check(&self, d: &Defaults) -> Result<(), (String, String)> {
+    /// Checks the values: Err(KeyError::new(key, message)).
+    fn check(&self, d: &Defaults) -> Result<(), KeyError> {
         let inp = self.inputs(d);
         let positive = [
             ("length_m", inp.length_m),
@@ -198,20 +199,23 @@ impl WrinkleCase {
         ];
         for (k, v) in positive {
             if !(v.is_finite() && v > 0.0) {
-                return Err((k.into(), format!("must be a finite number > 0, got {v}")));
+                return Err(KeyError::new(
+                    k,
+                    format!("must be a finite number > 0, got {v}"),
+                ));
             }
         }
         let nu = inp.poisson_ratio;
         if !(nu.is_finite() && (0.0..0.5).contains(&nu)) {
-            return Err((
-                "poisson_ratio".into(),
+            return Err(KeyError::new(
+                "poisson_ratio",
                 format!("must be in [0, 0.5), got {nu}"),
             ));
         }
         let d_m = inp.support_displacement_m;
         if !(d_m.is_finite() && d_m > 0.0 && 2.0 * d_m < inp.length_m) {
-            return Err((
-                "support_displacement_m".into(),
+            return Err(KeyError::new(
+                "support_displacement_m",
                 format!(
                     "must be > 0 and leave the supports apart (2d < length_m = {}), got {d_m}",
                     inp.length_m
@@ -279,7 +283,7 @@ pub fn load_config(path: &Path) -> Result<WrinkleConfig, InputError> {
     for (list, cases) in [("cases", &cfg.cases), ("photographs", &cfg.photographs)] {
         for (k, c) in cases.iter().enumerate() {
             c.check(&cfg.defaults)
-                .map_err(|(key, m)| InputError::new(path, format!("{list}[{k}].{key}"), m))?;
+                .map_err(|e| InputError::new(path, format!("{list}[{k}].{}", e.key), e.message))?;
         }
     }
     Ok(cfg)
