@@ -1,0 +1,522 @@
+//! The checks of a scene, section by section, each naming the file and the key; the physical
+//! bounds drapelab computes in; [`ValidatedScene`], a scene that passed them.
+
+use super::*;
+use crate::error::InputError;
+use serde::Serialize;
+use std::path::Path;
+
+impl Scene {
+    /// Checks every value's range; the error names the key.
+    pub fn validate(&self, path: &Path) -> Result<(), InputError> {
+        let ck = Check { path };
+        self.check_magnitudes(&ck)?;
+        self.check_cloth(&ck)?;
+        self.check_material(&ck)?;
+        self.check_boundary(&ck)?;
+        self.check_obstacles(&ck)?;
+        self.check_solver(&ck)
+    }
+
+    /// Every physical number of the scene (its solver and recording options aside) is finite and
+    /// zero or of a size drapelab computes in ([`MAGNITUDES`]); the error names the key as the other
+    /// checks do (`loads[0].magnitude_N`, `obstacles[1].centre_m`).
+    fn check_magnitudes(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        // The key is spelled only for an error: a scene is checked once per solve, and a
+        // calibration solves tens of thousands.
+        fn walk(
+            ck: &Check<'_>,
+            key: &dyn Fn() -> String,
+            v: &toml::Value,
+        ) -> Result<(), InputError> {
+            match v {
+                toml::Value::Float(f) if !f.is_finite() => {
+                    ck.err(&key(), format!("must be a finite number, got {f}"))
+                }
+                toml::Value::Float(f)
+                    if *f != 0.0 && !(MAGNITUDES.0..=MAGNITUDES.1).contains(&f.abs()) =>
+                {
+                    ck.err(
+                        &key(),
+                        format!(
+                            "{f} is outside the sizes drapelab computes in: zero, or {:e} to {:e} \
+in the key's unit (SI)",
+                            MAGNITUDES.0, MAGNITUDES.1
+                        ),
+                    )
+                }
+                toml::Value::Table(t) => t
+                    .iter()
+                    .try_for_each(|(k, v)| walk(ck, &|| format!("{}.{k}", key()), v)),
+                // A list of tables names its entry as the other checks do (`loads[0].magnitude_N`);
+                // a list of numbers (a point, a profile) is named as a whole.
+                toml::Value::Array(a) => a.iter().enumerate().try_for_each(|(i, v)| match v {
+                    toml::Value::Table(_) => walk(ck, &|| format!("{}[{i}]", key()), v),
+                    _ => walk(ck, key, v),
+                }),
+                _ => Ok(()),
+            }
+        }
+        let Ok(toml::Value::Table(t)) = toml::Value::try_from(self) else {
+            return Ok(());
+        };
+        t.iter()
+            .filter(|(k, _)| !["solver", "record"].contains(&k.as_str()))
+            .try_for_each(|(k, v)| walk(ck, &|| k.clone(), v))
+    }
+
+    /// The cloth: sizes, density, grid, grading and refined lines.
+    fn check_cloth(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        if self.cloth.is_mesh() {
+            return self.check_mesh_cloth(ck);
+        }
+        self.check_grid_given(ck)?;
+        let c = &self.cloth;
+        ck.within("cloth.size_x_m", c.size_x_m, SHEET_SIDE_M)?;
+        ck.within("cloth.size_y_m", c.size_y_m, SHEET_SIDE_M)?;
+        ck.pos("cloth.areal_density_kg_per_m2", c.areal_density_kg_per_m2)?;
+        if !c.initial_perturbation_m.is_finite() {
+            return ck.err("cloth.initial_perturbation_m", "must be finite".into());
+        }
+        if c.nx < 2 || c.nx > 2049 {
+            return ck.err("cloth.nx", format!("must be in 2..=2049, got {}", c.nx));
+        }
+        if c.ny < 2 || c.ny > 2049 {
+            return ck.err("cloth.ny", format!("must be in 2..=2049, got {}", c.ny));
+        }
+        if !(0.0..1.0).contains(&c.grading) {
+            return ck.err(
+                "cloth.grading",
+                format!("must be in [0, 1), got {}", c.grading),
+            );
+        }
+        for (key, lines, origin, size, n) in [
+            (
+                "cloth.refine_x_m",
+                &c.refine_x_m,
+                c.origin_m[0],
+                c.size_x_m,
+                c.nx,
+            ),
+            (
+                "cloth.refine_y_m",
+                &c.refine_y_m,
+                c.origin_m[1],
+                c.size_y_m,
+                c.ny,
+            ),
+        ] {
+            if lines.is_empty() {
+                continue;
+            }
+            if c.spacing != Spacing::Graded {
+                return ck.err(key, "needs cloth.spacing = \"graded\"".into());
+            }
+            if let Some(v) = lines
+                .iter()
+                .find(|v| !(v.is_finite() && **v > origin && **v < origin + size))
+            {
+                return ck.err(
+                    key,
+                    format!(
+                        "{v} m is not inside the sheet ({origin} m to {} m): give lines strictly between its edges",
+                        origin + size
+                    ),
+                );
+            }
+            if lines.len() + 1 > n - 1 {
+                return ck.err(
+                    key,
+                    format!(
+                        "{} lines need at least {} particles along the side",
+                        lines.len(),
+                        lines.len() + 2
+                    ),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The material: mass-spring or continuum, every constant in range.
+    fn check_material(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        let c = &self.cloth;
+        match (&self.material.mass_spring, &self.material.continuum) {
+            (Some(_), Some(_)) => {
+                return ck.err(
+                    "material",
+                    "give either [material.mass_spring] or [material.continuum], not both".into(),
+                );
+            }
+            (None, None) => {
+                return ck.err(
+                    "material",
+                    "missing: add [material.mass_spring] or [material.continuum]".into(),
+                );
+            }
+            (Some(ms), None) => {
+                ck.pos(
+                    "material.mass_spring.stiffness_N_per_m",
+                    ms.stiffness_N_per_m,
+                )?;
+                for (k, v) in [
+                    (
+                        "structural_stiffness_N_per_m",
+                        ms.structural_stiffness_N_per_m,
+                    ),
+                    ("shear_stiffness_N_per_m", ms.shear_stiffness_N_per_m),
+                    ("bend_stiffness_N_per_m", ms.bend_stiffness_N_per_m),
+                    ("natural_length_m", ms.natural_length_m),
+                ] {
+                    if let Some(v) = v {
+                        ck.pos(&format!("material.mass_spring.{k}"), v)?;
+                    }
+                }
+                ck.nonneg("material.mass_spring.damping_Ns_per_m", ms.damping_Ns_per_m)?;
+                ck.pos("material.mass_spring.elongation_rate", ms.elongation_rate)?;
+                if ms.natural_length_m.is_some() && c.spacing != Spacing::Uniform {
+                    return ck.err(
+                        "material.mass_spring.natural_length_m",
+                        "needs cloth.spacing = \"uniform\"".into(),
+                    );
+                }
+            }
+            (None, Some(cont)) => {
+                let r = cont.rigidities().map_err(|e| {
+                    InputError::new(ck.path, format!("material.continuum.{}", e.key), e.message)
+                })?;
+                for (k, v) in [
+                    ("tensile_warp", r.tensile_warp_N_per_m),
+                    ("tensile_weft", r.tensile_weft_N_per_m),
+                    ("bending_warp", r.bending_warp_N_m),
+                    ("bending_weft", r.bending_weft_N_m),
+                ] {
+                    ck.pos(&format!("material.continuum.{k}"), v)?;
+                }
+                ck.nonneg("material.continuum.shear", r.shear_N_per_m)?;
+                ck.nonneg("material.continuum.bending_twist", r.bending_twist_N_m)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Pins, holds, point loads, clamps: inside the grid and enough to hold the sheet.
+    fn check_boundary(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        if self.cloth.is_mesh() {
+            self.check_mesh_boundary(ck)?;
+        }
+        let c = &self.cloth;
+        for (n, p) in self.boundary.pin_particles.iter().enumerate() {
+            if p[0] >= c.nx || p[1] >= c.ny {
+                return ck.err(
+                    &format!("boundary.pin_particles[{n}]"),
+                    format!(
+                        "[{}, {}] lies outside the {}×{} grid (i < nx, j < ny)",
+                        p[0], p[1], c.nx, c.ny
+                    ),
+                );
+            }
+        }
+        if !self.boundary.symmetry_edges.is_empty()
+            && (self.material.continuum.is_none() || self.solver.kind != SolverKind::Static)
+        {
+            return ck.err(
+                "boundary.symmetry_edges",
+                "symmetry planes need [material.continuum] and solver.kind = \"static\"".into(),
+            );
+        }
+        if !self.boundary.holds.is_empty() && self.solver.kind != SolverKind::Static {
+            return ck.err(
+                "boundary.holds",
+                "held coordinates need solver.kind = \"static\"".into(),
+            );
+        }
+        for (h, hold) in self.boundary.holds.iter().enumerate() {
+            if hold.components.is_empty() {
+                return ck.err(
+                    &format!("boundary.holds[{h}].components"),
+                    "name at least one of \"x\", \"y\", \"z\"".into(),
+                );
+            }
+            if let Some(p) = hold.particles.iter().find(|p| p[0] >= c.nx || p[1] >= c.ny) {
+                return ck.err(
+                    &format!("boundary.holds[{h}].particles"),
+                    format!(
+                        "[{}, {}] lies outside the {}×{} grid",
+                        p[0], p[1], c.nx, c.ny
+                    ),
+                );
+            }
+        }
+        self.check_loads(ck)?;
+        if !self.boundary.clamp_edges.is_empty() && (c.nx < 3 || c.ny < 3) {
+            return ck.err(
+                "boundary.clamp_edges",
+                "a clamp needs at least 3 particles along each side".into(),
+            );
+        }
+        if self.boundary.pin_corners.is_empty()
+            && self.boundary.pin_particles.is_empty()
+            && self.boundary.clamp_edges.is_empty()
+            && self.boundary.holds.is_empty()
+            && self.boundary.pin_groups.is_empty()
+            && (!self.contact.fix_supported || self.obstacles.is_empty())
+        {
+            return ck.err(
+                "boundary",
+                "nothing is pinned or clamped: the sheet would fall freely".into(),
+            );
+        }
+        if c.origin_m.iter().any(|v| !v.is_finite()) {
+            return ck.err("cloth.origin_m", "must be finite".into());
+        }
+        self.check_contact(ck)
+    }
+
+    /// Each `[[loads]]` entry: one particle on the grid or a finite position, a magnitude ≥ 0 N and
+    /// a finite non-zero direction.
+    fn check_loads(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        let c = &self.cloth;
+        for (k, l) in self.loads.iter().enumerate() {
+            let key = |f: &str| format!("loads[{k}].{f}");
+            match (l.particle, l.at_m) {
+                (Some(p), None) if p[0] >= c.nx || p[1] >= c.ny => {
+                    return ck.err(
+                        &key("particle"),
+                        format!(
+                            "[{}, {}] lies outside the {}×{} grid",
+                            p[0], p[1], c.nx, c.ny
+                        ),
+                    );
+                }
+                (None, Some(a)) if a.iter().any(|v| !v.is_finite()) => {
+                    return ck.err(&key("at_m"), "must be finite".into());
+                }
+                (Some(_), Some(_)) | (None, None) => {
+                    return ck.err(
+                        &key("particle"),
+                        "give exactly one of `particle` or `at_m`".into(),
+                    );
+                }
+                _ => {}
+            }
+            ck.nonneg(&key("magnitude_N"), l.magnitude_N)?;
+            let d = l.direction;
+            if d.iter().any(|v| !v.is_finite()) || d.iter().all(|v| *v == 0.0) {
+                return ck.err(&key("direction"), "must be finite and not zero".into());
+            }
+        }
+        Ok(())
+    }
+
+    /// The `[contact]` table: distances, friction and self-contact settings.
+    fn check_contact(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        ck.pos("contact.distance_m", self.contact.distance_m)?;
+        ck.nonneg(
+            "contact.friction_coefficient",
+            self.contact.friction_coefficient,
+        )?;
+        if let Some(t) = self.contact.self_thickness_m {
+            ck.pos("contact.self_thickness_m", t)?;
+            let h = self.sheet_spacing_m();
+            if t > 0.2 * h {
+                return ck.err(
+                    "contact.self_thickness_m",
+                    format!(
+                        "{t} m is over a fifth of the grid's shortest spacing ({h:.4} m): the flat sheet \
+would already touch itself; use a coarser grid or a thinner sheet"
+                    ),
+                );
+            }
+        }
+        if self.contact.self_contact == SelfContactMode::On
+            && !self.solver.kind.supports_self_contact()
+        {
+            return ck.err(
+                "contact.self",
+                format!(
+                    "\"on\" needs the static solver or implicit-euler, not {}; use \"auto\" or \"off\"",
+                    self.solver.kind.name()
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    /// Every obstacle valid and clear of the flat sheet.
+    fn check_obstacles(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        if self.obstacles.is_empty() {
+            return Ok(());
+        }
+        let flat = self.initial_positions();
+        for (k, o) in self.obstacles.iter().enumerate() {
+            o.check().map_err(|e| {
+                InputError::new(ck.path, format!("obstacles[{k}].{}", e.key), e.message)
+            })?;
+            if let Some((p, d)) = flat
+                .iter()
+                .enumerate()
+                .map(|(p, x)| (p, o.signed_distance(x).0))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .filter(|(_, d)| *d <= 0.0)
+            {
+                return ck.err(
+                    &format!("obstacles[{k}]"),
+                    format!(
+                        "the sheet starts inside this obstacle (particle {} is {:.3e} m deep): \
+                         move the obstacle down or the sheet up (cloth.origin_m)",
+                        self.particle_name(p),
+                        -d
+                    ),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Gravity, the solvers' tolerances and budgets, and the recording.
+    fn check_solver(&self, ck: &Check<'_>) -> Result<(), InputError> {
+        ck.nonneg("gravity.g_m_per_s2", self.gravity.g_m_per_s2)?;
+        ck.within(
+            "gravity.g_m_per_s2",
+            self.gravity.g_m_per_s2,
+            GRAVITY_M_PER_S2,
+        )?;
+        let s = &self.solver.static_;
+        ck.pos("solver.static.residual_tol_rel", s.residual_tol_rel)?;
+        ck.pos("solver.static.lm_damping_initial", s.lm_damping_initial)?;
+        ck.pos("solver.static.strain_bound", s.strain_bound)?;
+        if s.max_iterations == 0 || s.load_steps == 0 {
+            return ck.err(
+                "solver.static",
+                "max_iterations and load_steps must be ≥ 1".into(),
+            );
+        }
+        let d = &self.solver.dynamic;
+        ck.pos("solver.dynamic.dt_s", d.dt_s)?;
+        ck.pos("solver.dynamic.max_time_s", d.max_time_s)?;
+        if let Some(w) = d.max_wall_time_s {
+            ck.pos("solver.dynamic.max_wall_time_s", w)?;
+        }
+        ck.pos("solver.dynamic.residual_tol_rel", d.residual_tol_rel)?;
+        ck.pos("solver.dynamic.speed_tol_m_per_s", d.speed_tol_m_per_s)?;
+        ck.pos("solver.dynamic.strain_bound", d.strain_bound)?;
+        ck.pos("solver.dynamic.cg_tol_rel", d.cg_tol_rel)?;
+        if !(0.0..=100.0).contains(&d.auto_dt_fraction) {
+            return ck.err(
+                "solver.dynamic.auto_dt_fraction",
+                format!(
+                    "must be in [0, 100] (above 1 is beyond the estimated limit), got {}",
+                    d.auto_dt_fraction
+                ),
+            );
+        }
+        // Adaptive implicit steps grow from dt_s to max_dt_s: their count is bounded by the larger.
+        let adaptive = self.solver.kind == SolverKind::ImplicitEuler && d.adaptive_dt;
+        let step = if adaptive {
+            d.max_dt_s.max(d.dt_s)
+        } else {
+            d.dt_s
+        };
+        if d.max_time_s / step > 1e9 {
+            return ck.err(
+                "solver.dynamic.max_time_s",
+                "more than 1e9 steps: raise dt_s or lower max_time_s".into(),
+            );
+        }
+        if let Some(f) = self.record.frame_rate_hz
+            && !(f.is_finite() && f > 0.0)
+        {
+            return ck.err(
+                "record.frame_rate_hz",
+                format!("must be a number > 0, got {f}"),
+            );
+        }
+        if self.record.every == 0 {
+            return ck.err("record.every", "must be ≥ 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// A scene whose every value has been range-checked ([`Scene::validate`]): what the model builder
+/// ([`crate::build::build_scene`]) and the solvers take. Read it as a [`Scene`] (`Deref`); change it
+/// with [`ValidatedScene::modify`], which checks the result again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValidatedScene(pub(super) Scene);
+
+impl std::ops::Deref for ValidatedScene {
+    type Target = Scene;
+    fn deref(&self) -> &Scene {
+        &self.0
+    }
+}
+
+impl Serialize for ValidatedScene {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.serialize(s)
+    }
+}
+
+impl Scene {
+    /// Checks the scene (errors name the scene, not a file: it was built or changed in code).
+    pub fn validated(self) -> Result<ValidatedScene, InputError> {
+        self.validate(Path::new(&format!("scene `{}`", self.name)))?;
+        Ok(ValidatedScene(self))
+    }
+}
+
+impl ValidatedScene {
+    /// The scene, no longer known to be valid.
+    pub fn into_inner(self) -> Scene {
+        self.0
+    }
+    /// A changed copy, checked again.
+    pub fn modify(&self, change: impl FnOnce(&mut Scene)) -> Result<ValidatedScene, InputError> {
+        let mut s = self.0.clone();
+        change(&mut s);
+        s.validated()
+    }
+}
+
+/// The range checks of [`Scene::validate`], naming the file and the key.
+pub(super) struct Check<'a> {
+    pub(super) path: &'a Path,
+}
+
+impl Check<'_> {
+    pub(super) fn err(&self, key: &str, message: String) -> Result<(), InputError> {
+        Err(InputError::new(self.path, key, message))
+    }
+    pub(super) fn pos(&self, key: &str, v: f64) -> Result<(), InputError> {
+        if !v.is_finite() || v <= 0.0 {
+            return self.err(key, format!("must be a finite number > 0, got {v}"));
+        }
+        Ok(())
+    }
+    pub(super) fn nonneg(&self, key: &str, v: f64) -> Result<(), InputError> {
+        if !v.is_finite() || v < 0.0 {
+            return self.err(key, format!("must be a finite number ≥ 0, got {v}"));
+        }
+        Ok(())
+    }
+    /// `v` within the physical bounds `(lo, hi)` of the key (in its unit).
+    pub(super) fn within(&self, key: &str, v: f64, (lo, hi): (f64, f64)) -> Result<(), InputError> {
+        if !(v.is_finite() && (lo..=hi).contains(&v)) {
+            return self.err(key, format!("must be in {lo} to {hi}, got {v}"));
+        }
+        Ok(())
+    }
+}
+
+/// The sizes drapelab computes in: every physical number of a scene is zero or between these in
+/// size, in SI units (10⁻¹² to 10¹²): beyond them sums of forces and energies lose their digits or
+/// overflow, and a solve would end in NaN as if the physics had failed.
+pub const MAGNITUDES: (f64, f64) = (1e-12, 1e12);
+
+/// The sides a sheet may have, m: from 0.1 mm (a yarn's width) to 100 m.
+pub const SHEET_SIDE_M: (f64, f64) = (1e-4, 100.0);
+
+/// The gravitational accelerations a scene may have, m/s²: none (0, loads alone) to 1000 (a
+/// centrifuge's 100 g).
+pub const GRAVITY_M_PER_S2: (f64, f64) = (0.0, 1000.0);
