@@ -452,3 +452,37 @@ fn verbose_simulate_logs_the_iterations_and_the_work() {
     assert_eq!(steps(&v), 2, "{v}");
     assert!(steps(&vv) >= 11, "{vv}");
 }
+
+/// Issue 52: the solver options are checked beside their types (`StaticOptions::check`,
+/// `DynamicOptions::check`), the ones that were never checked included; each bad value exits 2
+/// naming the file and its key.
+#[test]
+fn every_solver_option_is_checked_and_a_bad_one_names_its_key() {
+    for (set, key) in [
+        (
+            "solver.static.shift_max_rel=0",
+            "solver.static.shift_max_rel",
+        ),
+        ("solver.static.max_iterations=0", "solver.static"),
+        (
+            "solver.dynamic.newton_iterations=0",
+            "solver.dynamic.newton_iterations",
+        ),
+        (
+            "solver.dynamic.rayleigh_mass_per_s=-1",
+            "solver.dynamic.rayleigh_mass_per_s",
+        ),
+        (
+            "solver.dynamic.rayleigh_stiffness_s=nan",
+            "solver.dynamic.rayleigh_stiffness_s",
+        ),
+        ("solver.dynamic.max_dt_s=0", "solver.dynamic.max_dt_s"),
+        ("solver.dynamic.check_every=0", "solver.dynamic.check_every"),
+        (
+            "solver.dynamic.auto_dt_fraction=200",
+            "solver.dynamic.auto_dt_fraction",
+        ),
+    ] {
+        assert_bad(Some(&hang4()), &["--set", set], key);
+    }
+}

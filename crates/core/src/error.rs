@@ -59,6 +59,30 @@ impl KeyError {
             message: message.into(),
         }
     }
+    /// Ok when `v` is a finite number > 0; else the error naming `key`.
+    pub fn positive(key: &str, v: f64) -> Result<(), KeyError> {
+        if !v.is_finite() || v <= 0.0 {
+            return Err(Self::new(
+                key,
+                format!("must be a finite number > 0, got {v}"),
+            ));
+        }
+        Ok(())
+    }
+    /// Ok when `v` is a finite number ≥ 0; else the error naming `key`.
+    pub fn non_negative(key: &str, v: f64) -> Result<(), KeyError> {
+        if !v.is_finite() || v < 0.0 {
+            return Err(Self::new(
+                key,
+                format!("must be a finite number ≥ 0, got {v}"),
+            ));
+        }
+        Ok(())
+    }
+    /// The same error under `prefix.` (a section's key seen from the file).
+    pub fn under(self, prefix: &str) -> Self {
+        Self::new(format!("{prefix}.{}", self.key), self.message)
+    }
 }
 
 /// Exit code for success.

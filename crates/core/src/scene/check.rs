@@ -382,48 +382,25 @@ would already touch itself; use a coarser grid or a thinner sheet"
             self.gravity.g_m_per_s2,
             GRAVITY_M_PER_S2,
         )?;
-        let s = &self.solver.static_;
-        ck.pos("solver.static.residual_tol_rel", s.residual_tol_rel)?;
-        ck.pos("solver.static.lm_damping_initial", s.lm_damping_initial)?;
-        ck.pos("solver.static.strain_bound", s.strain_bound)?;
-        if s.max_iterations == 0 || s.load_steps == 0 {
-            return ck.err(
-                "solver.static",
-                "max_iterations and load_steps must be ≥ 1".into(),
-            );
-        }
-        let d = &self.solver.dynamic;
-        ck.pos("solver.dynamic.dt_s", d.dt_s)?;
-        ck.pos("solver.dynamic.max_time_s", d.max_time_s)?;
-        if let Some(w) = d.max_wall_time_s {
-            ck.pos("solver.dynamic.max_wall_time_s", w)?;
-        }
-        ck.pos("solver.dynamic.residual_tol_rel", d.residual_tol_rel)?;
-        ck.pos("solver.dynamic.speed_tol_m_per_s", d.speed_tol_m_per_s)?;
-        ck.pos("solver.dynamic.strain_bound", d.strain_bound)?;
-        ck.pos("solver.dynamic.cg_tol_rel", d.cg_tol_rel)?;
-        if !(0.0..=100.0).contains(&d.auto_dt_fraction) {
-            return ck.err(
-                "solver.dynamic.auto_dt_fraction",
-                format!(
-                    "must be in [0, 100] (above 1 is beyond the estimated limit), got {}",
-                    d.auto_dt_fraction
-                ),
-            );
-        }
-        // Adaptive implicit steps grow from dt_s to max_dt_s: their count is bounded by the larger.
-        let adaptive = self.solver.kind == SolverKind::ImplicitEuler && d.adaptive_dt;
-        let step = if adaptive {
-            d.max_dt_s.max(d.dt_s)
-        } else {
-            d.dt_s
+        let in_file = |e: crate::error::KeyError, section: &str| {
+            let e = if e.key.is_empty() {
+                crate::error::KeyError::new(section, e.message)
+            } else {
+                e.under(section)
+            };
+            InputError::new(ck.path, e.key, e.message)
         };
-        if d.max_time_s / step > 1e9 {
-            return ck.err(
-                "solver.dynamic.max_time_s",
-                "more than 1e9 steps: raise dt_s or lower max_time_s".into(),
-            );
-        }
+        self.solver
+            .static_
+            .check()
+            .map_err(|e| in_file(e, "solver.static"))?;
+        // Adaptive implicit steps grow from dt_s to max_dt_s: their count is bounded by the larger.
+        let adaptive =
+            self.solver.kind == SolverKind::ImplicitEuler && self.solver.dynamic.adaptive_dt;
+        self.solver
+            .dynamic
+            .check(adaptive)
+            .map_err(|e| in_file(e, "solver.dynamic"))?;
         if let Some(f) = self.record.frame_rate_hz
             && !(f.is_finite() && f > 0.0)
         {

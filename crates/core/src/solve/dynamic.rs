@@ -115,6 +115,58 @@ pub struct DynamicOptions {
 fn default_dt() -> f64 {
     1e-4
 }
+impl DynamicOptions {
+    /// Checks every option (keys relative to `[solver.dynamic]`); `adaptive`: the steps grow from
+    /// `dt_s` to `max_dt_s` (implicit Euler with `adaptive_dt`), which bounds their count.
+    pub fn check(&self, adaptive: bool) -> Result<(), crate::error::KeyError> {
+        use crate::error::KeyError;
+        for (k, v) in [
+            ("dt_s", self.dt_s),
+            ("max_time_s", self.max_time_s),
+            ("max_dt_s", self.max_dt_s),
+            ("min_dt_s", self.min_dt_s),
+            ("residual_tol_rel", self.residual_tol_rel),
+            ("speed_tol_m_per_s", self.speed_tol_m_per_s),
+            ("strain_bound", self.strain_bound),
+            ("cg_tol_rel", self.cg_tol_rel),
+        ] {
+            KeyError::positive(k, v)?;
+        }
+        if let Some(w) = self.max_wall_time_s {
+            KeyError::positive("max_wall_time_s", w)?;
+        }
+        KeyError::non_negative("rayleigh_mass_per_s", self.rayleigh_mass_per_s)?;
+        KeyError::non_negative("rayleigh_stiffness_s", self.rayleigh_stiffness_s)?;
+        if self.newton_iterations == 0 {
+            return Err(KeyError::new("newton_iterations", "must be ≥ 1"));
+        }
+        if self.check_every == 0 {
+            return Err(KeyError::new("check_every", "must be ≥ 1"));
+        }
+        if !(0.0..=100.0).contains(&self.auto_dt_fraction) {
+            return Err(KeyError::new(
+                "auto_dt_fraction",
+                format!(
+                    "must be in [0, 100] (above 1 is beyond the estimated limit), got {}",
+                    self.auto_dt_fraction
+                ),
+            ));
+        }
+        let step = if adaptive {
+            self.max_dt_s.max(self.dt_s)
+        } else {
+            self.dt_s
+        };
+        if self.max_time_s / step > 1e9 {
+            return Err(KeyError::new(
+                "max_time_s",
+                "more than 1e9 steps: raise dt_s or lower max_time_s",
+            ));
+        }
+        Ok(())
+    }
+}
+
 fn default_max_dt() -> f64 {
     100.0
 }

@@ -81,6 +81,24 @@ pub struct StaticOptions {
     pub neighbour_factor: Option<NeighbourFactor>,
 }
 
+impl StaticOptions {
+    /// Checks every option (keys relative to `[solver.static]`).
+    pub fn check(&self) -> Result<(), crate::error::KeyError> {
+        use crate::error::KeyError;
+        KeyError::positive("residual_tol_rel", self.residual_tol_rel)?;
+        KeyError::positive("lm_damping_initial", self.lm_damping_initial)?;
+        KeyError::positive("strain_bound", self.strain_bound)?;
+        KeyError::positive("shift_max_rel", self.shift_max_rel)?;
+        if self.max_iterations == 0 || self.load_steps == 0 {
+            return Err(KeyError::new(
+                "",
+                "max_iterations and load_steps must be ≥ 1",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// A neighbouring equilibrium's factor, shared. As a preconditioner of conjugate gradients it
 /// needs no scale: a model whose energy is a multiple of the neighbour's takes the same steps.
 #[derive(Clone)]
