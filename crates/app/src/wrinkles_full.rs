@@ -282,34 +282,9 @@ pub fn simulate(
         shear_N_per_m: &p.map_shear_N_per_m,
     };
     let specs = point_specs(cfg, &map, p.fabric.then(|| p.fabric_reading()));
-    // Finer meshes first: the longest solves start first. Jobs (inputs, nx, setup): the plate's
-    // finer mesh, every variant's coarser one, the fabric's finer and coarser meshes, then the
-    // points' finer and coarser meshes.
     let variants = p.variants();
     let n = chosen.len();
-    let fabric = HungSetup {
-        reading: p.fabric_reading(),
-        ..p.setup(variants[0])
-    };
-    let each = |nx: usize, setup: HungSetup| inputs.iter().map(move |i| (i, nx, setup));
-    let mut jobs: Vec<(&WrinkleInputs, usize, HungSetup)> =
-        each(p.fine_nx, p.setup(variants[0])).collect();
-    for v in &variants {
-        jobs.extend(each(p.coarse_nx, p.setup(*v)));
-    }
-    if p.fabric {
-        jobs.extend(each(p.fabric_fine_nx, fabric));
-        jobs.extend(each(p.fabric_coarse_nx, fabric));
-    }
-    for nx in [p.points_fine_nx, p.points_coarse_nx] {
-        jobs.extend(specs.iter().map(|s| {
-            let setup = HungSetup {
-                reading: s.reading,
-                ..fabric
-            };
-            (&s.inputs, nx, setup)
-        }));
-    }
+    let jobs = solve_jobs(p, &inputs, &specs);
     let mut solves = solve_all(ctx, &jobs)?
         .into_iter()
         .map(Some)
@@ -353,6 +328,41 @@ pub fn simulate(
         })
         .collect();
     Ok(choose(cases, points, p))
+}
+
+/// The solves, finer meshes first (the longest start first), as (inputs, nx, setup): the plate's
+/// finer mesh, every variant's coarser one, the fabric's finer and coarser meshes, then the points'
+/// finer and coarser meshes.
+fn solve_jobs<'a>(
+    p: &WrinklesSimulateParams,
+    inputs: &'a [WrinkleInputs],
+    specs: &'a [PointSpec],
+) -> Vec<(&'a WrinkleInputs, usize, HungSetup)> {
+    let variants = p.variants();
+    let fabric = HungSetup {
+        reading: p.fabric_reading(),
+        ..p.setup(variants[0])
+    };
+    let each = |nx: usize, setup: HungSetup| inputs.iter().map(move |i| (i, nx, setup));
+    let mut jobs: Vec<(&WrinkleInputs, usize, HungSetup)> =
+        each(p.fine_nx, p.setup(variants[0])).collect();
+    for v in &variants {
+        jobs.extend(each(p.coarse_nx, p.setup(*v)));
+    }
+    if p.fabric {
+        jobs.extend(each(p.fabric_fine_nx, fabric));
+        jobs.extend(each(p.fabric_coarse_nx, fabric));
+    }
+    for nx in [p.points_fine_nx, p.points_coarse_nx] {
+        jobs.extend(specs.iter().map(|s| {
+            let setup = HungSetup {
+                reading: s.reading,
+                ..fabric
+            };
+            (&s.inputs, nx, setup)
+        }));
+    }
+    jobs
 }
 
 /// Solves every job (inputs, grid points along the supports, setup) in parallel, with progress.

@@ -411,6 +411,26 @@ height below the supports, finer mesh dark, coarser light; red dots: the wrinkle
         );
     }
     s += &crate::wrinkles_fabric::fabric_section(found, &all);
+    s += &method_sections(found, cfg, p, &starts);
+    s += &crate::wrinkles_text::findings(found, &r, &starts, &cfg.defaults);
+    let _ = write!(
+        s,
+        "\n## The tension-field model (Eqs. 5–10) case by case\n\ndrapelab's values first, the seed's in \
+brackets; Q_c is the critical ratio of Eq. 7; L error is |L' − L|/L at convergence.\n\n{}",
+        tension_field_table(found, cfg)
+    );
+    s
+}
+
+/// How the count was made robust: the starts, the shear stiffnesses, the lobe threshold and Eq. 7's
+/// constant against the plate sheets.
+fn method_sections(
+    found: &WrinklesFull,
+    cfg: &WrinkleConfig,
+    p: &WrinklesSimulateParams,
+    starts: &[StartRow],
+) -> String {
+    let mut s = String::new();
     let _ = write!(
         s,
         "\n## Does the count depend on the start?\n\nThe result's start is \"{}\"; the coarser mesh is also \
@@ -422,14 +442,14 @@ must buckle away); \"folded-K\": K folds put in by hand across the sheet.\n\n{}"
             .map(|s| format!("\"{s}\""))
             .collect::<Vec<_>>()
             .join(" and "),
-        starts_section(&starts)
+        starts_section(starts)
     );
     if !p.shear_ratios.is_empty() {
         let _ = write!(
             s,
             "\n## What a fabric's low shear stiffness does\n\n{}\n{}",
             crate::wrinkles_text::SHEAR,
-            shear_section(&starts, &p.start.to_string())
+            shear_section(starts, &p.start.to_string())
         );
     }
     let _ = write!(
@@ -443,13 +463,6 @@ must buckle away); \"folded-K\": K folds put in by hand across the sheet.\n\n{}"
         "\n## Which reading of Eq. 7 the simulations support\n\n{}\n{}",
         crate::wrinkles_text::EQ7,
         constant_section(found, cfg, &p.shear_ratios)
-    );
-    s += &crate::wrinkles_text::findings(found, &r, &starts, &cfg.defaults);
-    let _ = write!(
-        s,
-        "\n## The tension-field model (Eqs. 5–10) case by case\n\ndrapelab's values first, the seed's in \
-brackets; Q_c is the critical ratio of Eq. 7; L error is |L' − L|/L at convergence.\n\n{}",
-        tension_field_table(found, cfg)
     );
     s
 }

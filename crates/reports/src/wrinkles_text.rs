@@ -109,13 +109,6 @@ pub fn findings(
     config: &drapelab_core::wrinkles::Defaults,
 ) -> String {
     let mut s = String::from("\n## What the full simulations say\n\n");
-    let span = |v: (f64, f64), d: usize| {
-        if (v.1 - v.0).abs() < 1e-12 {
-            format!("{:.d$}", v.0)
-        } else {
-            format!("{:.d$}–{:.d$}", v.0, v.1)
-        }
-    };
     let n_full = range(rows.iter().map(|r| f64::from(r.n_full_simulation)));
     let n_seed = range(rows.iter().filter_map(|r| r.n_seed.map(f64::from)));
     let n_tf = range(rows.iter().map(|r| f64::from(r.n_tension_field)));
@@ -162,6 +155,23 @@ centimetres.",
             / (c.inputs.weight_N_per_m2 * c.inputs.height_m)
     }));
     s += &seed_reading(found, rows, stiff);
+    s += &shear_findings(starts);
+    s += &eq7_finding(found, rows.len(), config);
+    s
+}
+
+/// "3" or "1–4": a range of numbers with `d` decimals.
+fn span(v: (f64, f64), d: usize) -> String {
+    if (v.1 - v.0).abs() < 1e-12 {
+        format!("{:.d$}", v.0)
+    } else {
+        format!("{:.d$}–{:.d$}", v.0, v.1)
+    }
+}
+
+/// One finding per lowered shear stiffness: the counts and z_max it gives on the coarser mesh.
+fn shear_findings(starts: &[StartRow]) -> String {
+    let mut s = String::new();
     let mut ratios: Vec<f64> = starts
         .iter()
         .filter(|r| r.shear_ratio != 1.0)
@@ -179,6 +189,16 @@ centimetres.",
             span(range(mine.iter().map(|x| 100.0 * x.z_max_m)), 1),
         );
     }
+    s
+}
+
+/// Eq. 7's constant the plate sheets support, and what the bundled config reads.
+fn eq7_finding(
+    found: &WrinklesFull,
+    n_rows: usize,
+    config: &drapelab_core::wrinkles::Defaults,
+) -> String {
+    let mut s = String::new();
     let c = found.buckling_constants[found.constant.chosen];
     let used = if config.bending_length_m.is_some() {
         "the bundled config reads Eq. 7 for a fabric instead (\"Eq. 7 refitted to fabric\" above), so the \
@@ -198,7 +218,7 @@ field's folds are right. c = 135 reproduces the seed's trends (n rising with h a
 and models the seed's table, not the sheet's physics; against the sheets of fabric-like shear stiffness a \
 c between the two does best (the table above).",
         found.constant.held_out_hits(),
-        rows.len()
+        n_rows
     );
     s
 }
