@@ -5,6 +5,7 @@
 
 mod continuation;
 mod dynamic;
+mod dynamic_options;
 mod equilibrium;
 mod incremental;
 mod kind;
@@ -17,9 +18,8 @@ mod strategy;
 mod vertical_gap;
 
 pub use continuation::{Continuation, Stage, execute};
-pub use dynamic::{
-    DynamicOptions, Integrator, highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt,
-};
+pub use dynamic::{highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt};
+pub use dynamic_options::{DynamicOptions, Integrator};
 pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use kind::{SolverKind, by_report_name};
