@@ -130,6 +130,22 @@ impl TensionFieldFit {
         };
         (mine().filter(|(_, h)| h.1).count(), mine().count())
     }
+    /// Leave-one-case-out over the cases' own sheets alone (the map left aside): the choice and
+    /// each case's held-out outcome.
+    pub fn cases_only(&self) -> LeaveOneOut {
+        let ok: Vec<Vec<bool>> = self
+            .rows
+            .iter()
+            .filter(|r| r.role == "table")
+            .map(|r| {
+                r.n_tension_field
+                    .iter()
+                    .map(|&m| m.abs_diff(r.n_simulated) <= 1)
+                    .collect()
+            })
+            .collect();
+        drapelab_core::wrinkles::full::leave_one_out(&ok)
+    }
     /// (hits, sheets) of candidate `k` in-sample among the rows of `role`.
     pub fn hits(&self, k: usize, role: &str) -> (usize, usize) {
         let mine: Vec<&FitRow> = self.rows.iter().filter(|r| r.role == role).collect();
