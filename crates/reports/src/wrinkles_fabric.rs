@@ -347,3 +347,58 @@ meshes.\n\n| sheet | n: photograph | **n: fabric** (coarse) | z_max cm (coarse) 
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A map row of `case` at bending length `c_b` (m), shear `g` (N/m), with count `n`.
+    fn row(case: &str, c_b: f64, g: f64, n: i32) -> WrinkleFullRow {
+        WrinkleFullRow {
+            case: case.into(),
+            n_seed: None,
+            n_tension_field: 0,
+            n_full_simulation: n,
+            n_full_simulation_coarse: n,
+            z_max_full_simulation_m: 0.1,
+            wall_time_s: 1.0,
+            status: "converged".into(),
+            reading: "fabric".into(),
+            bending_length_m: c_b,
+            shear_rigidity_N_per_m: g,
+            role: "map".into(),
+            z_max_full_simulation_coarse_m: 0.1,
+            z_max_seed_m: None,
+            z_max_tension_field_m: 0.0,
+            q_seed: None,
+            q_tension_field: 1.0,
+            q_full_simulation: None,
+            line_depths_full_simulation_m: Vec::new(),
+            threshold_rel: 0.0,
+            grid: "9x9".into(),
+            grid_coarse: "5x5".into(),
+            iterations: 1,
+            iterations_coarse: 1,
+            wall_time_fine_s: 1.0,
+            energy_J: 0.0,
+            self_crossing_edges: 0,
+        }
+    }
+
+    /// A bending length read back as (B/w)^(1/3) differs between cases in its last bits: the trend
+    /// line still holds one entry per map point, with every case's count.
+    #[test]
+    fn map_points_that_differ_in_the_last_bits_are_one_point_of_the_trend() {
+        let c = 0.007;
+        let rows = [
+            row("I-h90", c, 17.0, 1),
+            row("I-h140", c * (1.0 + 1e-15), 17.0, 3),
+            row("I-h235", c * (1.0 - 1e-15), 17.0, 3),
+        ];
+        let refs: Vec<&WrinkleFullRow> = rows.iter().collect();
+        let s = map_trends(&refs);
+        assert_eq!(s.matches("mm,").count(), 1, "{s}");
+        assert!(s.contains("n rises (1, 3, 3)"), "{s}");
+        assert!(!s.contains('–'), "{s}");
+    }
+}
