@@ -9,7 +9,7 @@
 use crate::job::Job;
 use crate::wrinkles_params::{Variant, WrinklesSimulateParams};
 use crate::wrinkles_points::{
-    FitSheet, MapAxes, PointRole, PointSpec, TensionFieldFit, fit_tension_field, point_specs,
+    FitSheet, MapAxes, PointSpec, SheetRole, TensionFieldFit, fit_tension_field, point_specs,
 };
 use anyhow::Result;
 use drapelab_core::cloth::Grid;
@@ -446,7 +446,7 @@ fn fit_fabric(found: &WrinklesFull, p: &WrinklesSimulateParams) -> Option<Tensio
         sheets.push(FitSheet {
             group: k,
             case: &c.case,
-            role: "table",
+            role: SheetRole::Table,
             inputs: &c.inputs,
             reading,
             n: c.fabric.as_ref()?.fine.wrinkles(t).n,
@@ -455,13 +455,13 @@ fn fit_fabric(found: &WrinklesFull, p: &WrinklesSimulateParams) -> Option<Tensio
     for pt in found
         .points
         .iter()
-        .filter(|q| q.spec.role == PointRole::Map)
+        .filter(|q| q.spec.role == SheetRole::Map)
     {
         let group = found.cases.iter().position(|c| c.case == pt.spec.case);
         sheets.push(FitSheet {
             group: group.unwrap_or(found.cases.len() + sheets.len()),
             case: &pt.spec.case,
-            role: "map",
+            role: SheetRole::Map,
             inputs: &pt.spec.inputs,
             reading: pt.spec.reading,
             n: pt.pair.fine.wrinkles(t).n,

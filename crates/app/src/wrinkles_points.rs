@@ -6,21 +6,24 @@
 use drapelab_core::wrinkles::full::{LeaveOneOut, SheetReading, leave_groups_out};
 use drapelab_core::wrinkles::{SeedResult, WrinkleConfig, WrinkleInputs};
 
-/// Why a fabric sheet beyond the cases' results was solved.
+/// Why a sheet was solved: a case's result, a map point or a photograph.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PointRole {
+pub enum SheetRole {
+    /// A case's result under its reading.
+    Table,
     /// A point of the map over bending length × shear rigidity.
     Map,
     /// A sheet of the seed's photograph (Fig. 4).
     Photograph,
 }
 
-impl PointRole {
-    /// "map" or "photograph", as in `wrinkles_full.parquet`'s `role`.
+impl SheetRole {
+    /// "table", "map" or "photograph", as in `wrinkles_full.parquet`'s `role`.
     pub fn name(self) -> &'static str {
         match self {
-            PointRole::Map => "map",
-            PointRole::Photograph => "photograph",
+            SheetRole::Table => "table",
+            SheetRole::Map => "map",
+            SheetRole::Photograph => "photograph",
         }
     }
 }
@@ -31,7 +34,7 @@ pub struct PointSpec {
     /// Case name (the config's case, or the photograph's).
     pub case: String,
     /// Map point or photograph.
-    pub role: PointRole,
+    pub role: SheetRole,
     /// The case's inputs.
     pub inputs: WrinkleInputs,
     /// The seed's count, where it gives one (the photograph's n).
@@ -75,12 +78,12 @@ pub fn point_specs(
                     bending_length_m,
                     shear_N_per_m,
                 };
-                out.push(spec(c, PointRole::Map, reading));
+                out.push(spec(c, SheetRole::Map, reading));
             }
         }
     }
     for c in &cfg.photographs {
-        out.push(spec(c, PointRole::Photograph, fabric));
+        out.push(spec(c, SheetRole::Photograph, fabric));
     }
     out
 }
@@ -90,8 +93,8 @@ pub fn point_specs(
 pub struct FitRow {
     /// Case name.
     pub case: String,
-    /// "table" (the case's result) or "map".
-    pub role: &'static str,
+    /// A case's result ([`SheetRole::Table`]) or a map point.
+    pub role: SheetRole,
     /// The sheet's bending length, m.
     pub bending_length_m: f64,
     /// The sheet's shear rigidity, N/m.
@@ -100,6 +103,16 @@ pub struct FitRow {
     pub n_simulated: usize,
     /// The tension field's count under each candidate.
     pub n_tension_field: Vec<usize>,
+}
+
+impl FitRow {
+    /// For each candidate: is its count within ±1 of the simulated one?
+    pub fn holds(&self) -> Vec<bool> {
+        self.n_tension_field
+            .iter()
+            .map(|&m| m.abs_diff(self.n_simulated) <= 1)
+            .collect()
+    }
 }
 
 /// Eq. 7 refitted to the fabric sheets: candidates (its bending term read as the fabric's, the load
@@ -121,7 +134,7 @@ impl TensionFieldFit {
         self.candidates[self.loo.chosen]
     }
     /// (held-out hits, sheets) among the rows of `role`.
-    pub fn held_out(&self, role: &str) -> (usize, usize) {
+    pub fn held_out(&self, role: SheetRole) -> (usize, usize) {
         let mine = || {
             self.rows
                 .iter()
@@ -136,23 +149,15 @@ impl TensionFieldFit {
         let ok: Vec<Vec<bool>> = self
             .rows
             .iter()
-            .filter(|r| r.role == "table")
-            .map(|r| {
-                r.n_tension_field
-                    .iter()
-                    .map(|&m| m.abs_diff(r.n_simulated) <= 1)
-                    .collect()
-            })
+            .filter(|r| r.role == SheetRole::Table)
+            .map(FitRow::holds)
             .collect();
         drapelab_core::wrinkles::full::leave_one_out(&ok)
     }
     /// (hits, sheets) of candidate `k` in-sample among the rows of `role`.
-    pub fn hits(&self, k: usize, role: &str) -> (usize, usize) {
+    pub fn hits(&self, k: usize, role: SheetRole) -> (usize, usize) {
         let mine: Vec<&FitRow> = self.rows.iter().filter(|r| r.role == role).collect();
-        let hits = mine
-            .iter()
-            .filter(|r| r.n_tension_field[k].abs_diff(r.n_simulated) <= 1)
-            .count();
+        let hits = mine.iter().filter(|r| r.holds()[k]).count();
         (hits, mine.len())
     }
 }
@@ -174,8 +179,8 @@ pub struct FitSheet<'a> {
     pub group: usize,
     /// Case name.
     pub case: &'a str,
-    /// "table" or "map".
-    pub role: &'static str,
+    /// A case's result or a map point.
+    pub role: SheetRole,
     /// The case's inputs.
     pub inputs: &'a WrinkleInputs,
     /// Its fabric reading.
@@ -210,15 +215,7 @@ pub fn fit_tension_field(constants: &[f64], sheets: &[FitSheet<'_>]) -> Option<T
             }
         })
         .collect();
-    let ok: Vec<Vec<bool>> = rows
-        .iter()
-        .map(|r| {
-            r.n_tension_field
-                .iter()
-                .map(|&m| m.abs_diff(r.n_simulated) <= 1)
-                .collect()
-        })
-        .collect();
+    let ok: Vec<Vec<bool>> = rows.iter().map(FitRow::holds).collect();
     let groups: Vec<usize> = sheets.iter().map(|s| s.group).collect();
     let loo = leave_groups_out(&ok, &groups);
     Some(TensionFieldFit {

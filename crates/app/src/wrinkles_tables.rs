@@ -197,8 +197,8 @@ pub fn rows(found: &WrinklesFull, p: &WrinklesSimulateParams) -> Vec<WrinkleFull
 pub struct RowSource<'a> {
     /// Case name.
     pub case: &'a str,
-    /// "table", "map" or "photograph".
-    pub role: &'static str,
+    /// A case's result, a map point or a photograph.
+    pub role: crate::wrinkles_points::SheetRole,
     /// The case's inputs.
     pub inputs: &'a WrinkleInputs,
     /// The seed's result, where it gives one.
@@ -212,7 +212,7 @@ impl SimulatedCase {
     pub fn source(&self) -> RowSource<'_> {
         RowSource {
             case: &self.case,
-            role: "table",
+            role: crate::wrinkles_points::SheetRole::Table,
             inputs: &self.inputs,
             seed: self.seed.as_ref(),
             tension_field: &self.tension_field,
@@ -225,7 +225,7 @@ impl FabricPoint {
     pub fn source(&self) -> RowSource<'_> {
         RowSource {
             case: &self.spec.case,
-            role: self.spec.role.name(),
+            role: self.spec.role,
             inputs: &self.spec.inputs,
             seed: self.spec.seed.as_ref(),
             tension_field: &self.tension_field,
@@ -255,7 +255,7 @@ fn row(
         reading: reading.name().into(),
         bending_length_m: reading.bending_length_m(c.inputs),
         shear_rigidity_N_per_m: reading.rigidities(c.inputs).2,
-        role: c.role.into(),
+        role: c.role.name().into(),
         z_max_full_simulation_coarse_m: wc.zmax_m,
         z_max_seed_m: c.seed.and_then(|r| r.zmax_cm).map(|z| z / 100.0),
         z_max_tension_field_m: c.tension_field.zmax_m,

@@ -4,7 +4,7 @@
 
 use crate::format::opt;
 use drapelab_app::wrinkles_full::WrinklesFull;
-use drapelab_app::wrinkles_points::TensionFieldFit;
+use drapelab_app::wrinkles_points::{SheetRole, TensionFieldFit};
 use drapelab_app::wrinkles_tables::WrinkleFullRow;
 use std::fmt::Write;
 
@@ -172,12 +172,12 @@ fn candidate_name((fabric, c): (bool, f64)) -> String {
 
 /// Eq. 7 refitted to the fabric sheets, with its held-out scores.
 fn fit_section(found: &WrinklesFull, fit: &TensionFieldFit) -> String {
-    let (hits, n) = fit.held_out("table");
-    let (map_hits, m) = fit.held_out("map");
+    let (hits, n) = fit.held_out(SheetRole::Table);
+    let (map_hits, m) = fit.held_out(SheetRole::Map);
     let best = |fabric: bool| {
         (0..fit.candidates.len())
             .filter(|&k| fit.candidates[k].0 == fabric)
-            .map(|k| (fit.hits(k, "table").0, k))
+            .map(|k| (fit.hits(k, SheetRole::Table).0, k))
             .max()
             .map_or(String::new(), |(h, k)| {
                 format!("{h} of {n} with {}", candidate_name(fit.candidates[k]))
@@ -188,7 +188,7 @@ fn fit_section(found: &WrinklesFull, fit: &TensionFieldFit) -> String {
         .held_out
         .iter()
         .zip(&fit.rows)
-        .filter(|(_, r)| r.role == "table")
+        .filter(|(_, r)| r.role == SheetRole::Table)
         .map(|(h, _)| {
             let (f, c) = fit.candidates[h.0];
             format!("{}{c:.0}", if f { "fabric " } else { "plate " })
@@ -232,7 +232,7 @@ fn map_section(all: &[WrinkleFullRow], fit: Option<&TensionFieldFit>) -> String 
         Some(f) => f
             .rows
             .iter()
-            .filter(|r| r.role == "map")
+            .filter(|r| r.role == SheetRole::Map)
             .map(|r| chosen.map(|k| r.n_tension_field[k]))
             .collect(),
         None => vec![None; map.len()],

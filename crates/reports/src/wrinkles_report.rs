@@ -283,11 +283,11 @@ pub fn fibres_svg(found: &WrinklesFull) -> Result<String> {
 /// The simulated sheets (finer mesh), four to a row: each case read as a plate, then beside it
 /// read as a fabric where it was; then the photographed cloth (Fig. 4) read as fabric.
 pub fn sheets_png(found: &WrinklesFull) -> image::RgbImage {
-    use drapelab_app::wrinkles_points::PointRole;
+    use drapelab_app::wrinkles_points::SheetRole;
     let photographs = found
         .points
         .iter()
-        .filter(|q| q.spec.role == PointRole::Photograph)
+        .filter(|q| q.spec.role == SheetRole::Photograph)
         .map(|q| (format!("{} fabric", q.spec.case), &q.pair.fine));
     let sheets: Vec<(String, &drapelab_app::wrinkles_full::SheetSolve)> = found
         .cases
