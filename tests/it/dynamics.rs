@@ -113,7 +113,7 @@ fn implicit_euler_settles_hang2_on_its_static_drape_or_its_mirror_image() {
 }
 
 /// Records the deepest penetration into the obstacles over every step's state.
-struct Deepest(Vec<drapelab::contact::Obstacle>, f64, usize);
+struct Deepest(Vec<drapelab::obstacle::Obstacle>, f64, usize);
 
 impl Observer for Deepest {
     fn wants(&self, _: usize) -> bool {

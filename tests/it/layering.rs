@@ -73,13 +73,14 @@ const NOT_IN_CORE: [&str; 8] = [
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank. The
 /// error types (`error`: a bad key, a bad input) are below everything that checks its input.
-const CORE_RANKS: [(&str, u8); 27] = [
+const CORE_RANKS: [(&str, u8); 28] = [
     ("error", 0),
     ("provenance", 0),
     ("atomic", 0),
     ("table", 0),
     ("material", 1),
-    ("contact", 1),
+    ("obstacle", 1),
+    ("proximity", 1),
     ("optim", 1),
     ("surface", 3),
     ("raster", 1),

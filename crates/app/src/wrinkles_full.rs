@@ -48,7 +48,7 @@ impl SheetSolve {
     /// Edges of the triangulated sheet that cross a triangle sharing no vertex with them (the
     /// sheet passing through itself; 0 for one that does not).
     pub fn self_crossings(&self) -> usize {
-        use drapelab_core::contact::proximity::{MeshTopology, edge_triangle_crossings};
+        use drapelab_core::proximity::{MeshTopology, edge_triangle_crossings};
         let topo = MeshTopology::from_triangles(drapelab_core::cloth::cell_triangles(
             self.grid.nx,
             self.grid.ny,

@@ -3,7 +3,8 @@
 //!
 //! One concept per module, dependencies pointing down (see the README's module map):
 //! [`material`] and [`cloth`] describe the fabric, [`physics`] turns them into energy terms,
-//! [`contact`] holds the obstacles, [`solve`] finds equilibria and trajectories, [`scene`] reads and
+//! [`obstacle`] holds the rigid obstacles' geometry, [`proximity`] the sheet's distances to itself and
+//! their collision-free step, [`solve`] finds equilibria and trajectories, [`scene`] reads and
 //! validates TOML scenes, [`simulate`] solves a scene, [`measure`] and [`edges`] measure drape
 //! (seed 000's edge polynomials, seed 003's drape coefficient), [`elastica`] gives exact references,
 //! [`optim`] and [`calibrate`] fit parameters (ICA, CMA-ES, Taguchi), [`wrinkles`] is seed 002's
@@ -18,18 +19,19 @@ pub mod build;
 pub mod calibrate;
 pub mod cloth;
 pub mod config;
-pub mod contact;
 pub mod cusick;
 pub mod edges;
 pub mod elastica;
 pub mod error;
 pub mod material;
 pub mod measure;
+pub mod obstacle;
 pub mod optim;
 pub mod params;
 pub mod pattern;
 pub mod physics;
 pub mod provenance;
+pub mod proximity;
 pub mod raster;
 pub mod scene;
 pub mod sensitivity;

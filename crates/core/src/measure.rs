@@ -301,7 +301,7 @@ const PIXELS: usize = 600;
 /// sectors smoothed over ±3°, prominence 8 % of the mean radius: more than the steps of a disc cut
 /// from a square grid, far less than a fold).
 pub fn drape_measures(scene: &crate::scene::Scene, x: &[Vector3<f64>]) -> DrapeMeasures {
-    use crate::contact::Obstacle;
+    use crate::obstacle::Obstacle;
     let x0 = crate::build::initial_positions(scene);
     let triangles = crate::build::scene_triangles(scene);
     let proj = vertical_projection(x, &triangles, PIXELS);

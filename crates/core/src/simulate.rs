@@ -132,10 +132,8 @@ pub fn check_crossings(
 
 /// Mesh edges of the sheet at `x` that cross a triangle sharing no vertex with them.
 fn crossing_edges(scene: &Scene, x: &[Vector3<f64>]) -> usize {
-    let topo = crate::contact::proximity::MeshTopology::from_triangles(
-        crate::build::scene_triangles(scene),
-    );
-    crate::contact::proximity::edge_triangle_crossings(&topo, x)
+    let topo = crate::proximity::MeshTopology::from_triangles(crate::build::scene_triangles(scene));
+    crate::proximity::edge_triangle_crossings(&topo, x)
         .iter()
         .map(|c| c.0)
         .collect::<std::collections::BTreeSet<_>>()
@@ -448,7 +446,7 @@ const FRICTION_SETTLED_M: f64 = 1e-7;
 /// Lagged friction as a continuation: before each stage the anchors are the contacts where the
 /// last stage left them (the model's last term).
 struct FrictionLag {
-    contact: crate::physics::BarrierContact,
+    contact: crate::physics::ObstacleBarrier,
     mu: f64,
     /// The load factor of each stage.
     loads: Vec<f64>,

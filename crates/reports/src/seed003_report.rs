@@ -670,8 +670,8 @@ pub fn drapes_png(solved: &[Solved]) -> image::RgbImage {
                 from_above: s.scene.obstacles.iter().any(|o| {
                     matches!(
                         o,
-                        drapelab_core::contact::Obstacle::Box { .. }
-                            | drapelab_core::contact::Obstacle::Pedestal { .. }
+                        drapelab_core::obstacle::Obstacle::Box { .. }
+                            | drapelab_core::obstacle::Obstacle::Pedestal { .. }
                     )
                 }),
             }

@@ -4,7 +4,7 @@
 //! measured by the `skips` stage, which has the recorders and the pipeline engine.)
 
 use crate::calibrate::{Noise, Problem, identifiability};
-use crate::contact::Obstacle;
+use crate::obstacle::Obstacle;
 use crate::scene::Scene;
 use crate::simulate::solve_scene;
 use crate::solve::NoObserver;

@@ -265,7 +265,7 @@ fn holds(scene: &Scene, grid: &Grid, held: &mut Vec<[bool; 3]>) {
 /// the barrier method every other particle gets the barrier term (the vertical-gap method works in the
 /// solver instead, [`crate::simulate`]).
 pub(crate) fn contact_terms(scene: &Scene, x0: &[Vector3<f64>], b: &mut ModelBuilder) {
-    use crate::contact::Obstacle;
+    use crate::obstacle::Obstacle;
     use crate::scene::ContactMethod;
     if scene.obstacles.is_empty() {
         return;
@@ -303,13 +303,13 @@ fn kappa_gravity(scene: &Scene) -> f64 {
 }
 
 /// The barrier contact term of a scene: every free particle with mass against every obstacle, κ from
-/// its weight ([`BarrierContact::kappa_for_weight`](crate::physics::BarrierContact::kappa_for_weight)).
+/// its weight ([`ObstacleBarrier::kappa_for_weight`](crate::physics::ObstacleBarrier::kappa_for_weight)).
 pub fn barrier_contact(
     scene: &Scene,
     masses: &[f64],
     fixed: &[bool],
-) -> crate::physics::BarrierContact {
-    crate::physics::BarrierContact::for_particles(
+) -> crate::physics::ObstacleBarrier {
+    crate::physics::ObstacleBarrier::for_particles(
         scene.obstacles.clone(),
         scene.contact.distance_m,
         masses,

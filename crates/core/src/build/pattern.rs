@@ -261,7 +261,7 @@ mod tests {
         let corner = id[&(5, 5)] - 1;
         let mut b = pattern_builder(&sheet, 9.81, &[corner]).unwrap();
         let c = pattern.rest_m[corner];
-        let sphere = crate::contact::Obstacle::Sphere {
+        let sphere = crate::obstacle::Obstacle::Sphere {
             centre_m: [0.0, 0.0, -0.0505],
             radius_m: 0.05,
         };
@@ -291,7 +291,7 @@ mod tests {
         for p in &x {
             assert!((p - Vector3::new(0.0, 0.0, -0.0505)).norm() > 0.05);
         }
-        let topo = crate::contact::proximity::MeshTopology::from_triangles(tris);
-        assert!(crate::contact::proximity::edge_triangle_crossings(&topo, &x).is_empty());
+        let topo = crate::proximity::MeshTopology::from_triangles(tris);
+        assert!(crate::proximity::edge_triangle_crossings(&topo, &x).is_empty());
     }
 }

@@ -7,7 +7,7 @@
 //! seeded random perturbation; the spread over seeds is part of the prediction.
 
 use super::Tester;
-use crate::contact::Obstacle;
+use crate::obstacle::Obstacle;
 use crate::physics::{
     Model, ModelBuilder, SewnSheet, SpringFamily, Springs, hinge_curl, saturating_hinge_bending,
 };
@@ -291,8 +291,8 @@ pub fn solve_drape_from(
     };
     let (report, x) = solve_drape_once(mesh, &without, tester, start, observer);
     let tris: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| t.map(|v| v as u32)).collect();
-    let topo = crate::contact::proximity::MeshTopology::from_triangles(tris.clone());
-    let crossing = !crate::contact::proximity::edge_triangle_crossings(&topo, &x).is_empty();
+    let topo = crate::proximity::MeshTopology::from_triangles(tris.clone());
+    let crossing = !crate::proximity::edge_triangle_crossings(&topo, &x).is_empty();
     let probe = crate::physics::SelfContact::new(tris, &x, xi, xi, 1.0);
     if !crossing && probe.state(&x).min_distance_m >= 2.0 * xi {
         return (report, x, false);

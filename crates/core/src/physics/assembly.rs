@@ -3,8 +3,8 @@
 //! sheet gets the same way (gravity, the obstacles' barrier, self-contact) and the model itself are
 //! put together here, in this order.
 
-use super::{BarrierContact, EnergyTerm, Gravity, Model, SelfContact, Vecs};
-use crate::contact::Obstacle;
+use super::{EnergyTerm, Gravity, Model, ObstacleBarrier, SelfContact, Vecs};
+use crate::obstacle::Obstacle;
 
 /// A model under construction: the particles' masses and pins, the terms so far.
 pub struct ModelBuilder {
@@ -60,10 +60,10 @@ impl ModelBuilder {
 
     /// The barrier between every free particle with mass and `obstacles`, activation distance
     /// `d_hat_m`, each particle's κ from its weight under `g_kappa` (m/s²;
-    /// [`BarrierContact::kappa_for_weight`]).
+    /// [`ObstacleBarrier::kappa_for_weight`]).
     pub fn obstacles(&mut self, obstacles: Vec<Obstacle>, d_hat_m: f64, g_kappa: f64) {
         let b =
-            BarrierContact::for_particles(obstacles, d_hat_m, &self.masses, &self.fixed, g_kappa);
+            ObstacleBarrier::for_particles(obstacles, d_hat_m, &self.masses, &self.fixed, g_kappa);
         self.terms.push(Box::new(b));
     }
 

@@ -3,14 +3,15 @@
 //! the lumped masses and the pinned particles; solvers see nothing else.
 
 mod assembly;
+mod barrier;
 mod bending;
-mod contact;
 mod curl;
 mod friction;
 mod kernel;
 mod loads;
 mod membrane;
 mod mesh_bending;
+mod obstacle_barrier;
 mod patch_bending;
 mod self_contact;
 mod shear;
@@ -22,7 +23,6 @@ pub use assembly::ModelBuilder;
 pub use bending::{
     CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,
 };
-pub use contact::{BarrierContact, max_penetration_m};
 pub use curl::{Curl, CurlKernel, hinge_curl};
 pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
 pub use kernel::{Kernel, Local, Potential};
@@ -32,6 +32,7 @@ pub use mesh_bending::{
     SewnSheet, hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending,
     sewn_hinge_bending,
 };
+pub use obstacle_barrier::{ObstacleBarrier, max_penetration_m};
 pub use patch_bending::{patch_bending, reads_creases};
 pub use self_contact::{CandidateSet, SelfContact, SelfContactState};
 pub use shear::{CellShear, ShearKernel};

@@ -1,6 +1,6 @@
 //! Self-contact of the sheet (incremental potential contact, codimensional form): every vertex and
 //! triangle, and every two edges, that share no vertex repel by E = κ b(d − ξ) with the barrier b of
-//! [`super::BarrierContact`] over the band d̂, where d is their distance and ξ the fabric's
+//! [`super::ObstacleBarrier`] over the band d̂, where d is their distance and ξ the fabric's
 //! thickness: the mid-surfaces of two layers stay more than ξ apart and the force starts at ξ + d̂.
 //! The energy is infinite at d ≤ ξ, and [`EnergyTerm::max_step`] bounds every step by additive
 //! continuous collision detection so that no pair comes closer than ξ + 10 % of its gap along it: a
@@ -11,9 +11,9 @@
 //! a quarter of the shortest edge. On a smooth sheet no pair of non-adjacent primitives is within
 //! reach, the list is empty, and the term costs a comparison of positions with boxes.
 
-use super::contact::{barrier, barrier_band_derivatives};
+use super::barrier::{barrier, barrier_band_derivatives};
 use super::{EnergyTerm, HessianBlocks, Vecs};
-use crate::contact::proximity::{
+use crate::proximity::{
     Aabb, MeshTopology, Pair, additive_ccd, candidate_pairs, pair_distance, relative_motion,
 };
 use nalgebra::{Matrix3, Vector3};
@@ -136,7 +136,7 @@ impl SelfContact {
         } else {
             thickness_m + band_m
         };
-        let kappa_J = super::BarrierContact::kappa_for_weight(weight_N, band_m);
+        let kappa_J = super::ObstacleBarrier::kappa_for_weight(weight_N, band_m);
         Self {
             topo,
             thickness_m,

@@ -304,7 +304,7 @@ pub struct Scene {
     /// Rigid obstacles (seed 003): `[[obstacles]]` with `kind` = plane, box, cylinder, sphere, pedestal
     /// or revolution. Default none.
     #[serde(default)]
-    pub obstacles: Vec<crate::contact::Obstacle>,
+    pub obstacles: Vec<crate::obstacle::Obstacle>,
     /// How contact with the obstacles is treated.
     #[serde(default)]
     pub contact: ContactSpec,

@@ -11,7 +11,7 @@
 
 use super::continuation::{Continuation, Stage, execute};
 use super::{Observer, SolveReport, StaticOptions, StopReason};
-use crate::contact::Obstacle;
+use crate::obstacle::Obstacle;
 use crate::physics::Model;
 use nalgebra::Vector3;
 

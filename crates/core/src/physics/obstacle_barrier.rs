@@ -6,48 +6,19 @@
 //! the infinite energy inside an obstacle
 //! makes the line search reject any step that would still end inside.
 
+use super::barrier::{barrier, barrier_band_derivatives};
 use super::{EnergyTerm, HessianBlocks, Vecs};
-use crate::contact::Obstacle;
+use crate::obstacle::Obstacle;
 use nalgebra::{Matrix3, Vector3};
 
 /// Barrier contact between the free particles and the obstacles.
-pub struct BarrierContact {
+pub struct ObstacleBarrier {
     /// The obstacles.
     pub obstacles: Vec<Obstacle>,
     /// Activation distance d̂, m.
     pub d_hat_m: f64,
     /// Per particle: κ (J), zero for fixed particles.
     pub kappa_J: Vec<f64>,
-}
-
-/// b(d), b'(d), b''(d) of the barrier (zero for d ≥ d̂; infinite energy for d ≤ 0).
-pub(crate) fn barrier(d: f64, dh: f64) -> (f64, f64, f64) {
-    if d >= dh {
-        return (0.0, 0.0, 0.0);
-    }
-    if d <= 0.0 {
-        return (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY);
-    }
-    let l = (d / dh).ln();
-    let e = d - dh;
-    (
-        -e * e * l,
-        -2.0 * e * l - e * e / d,
-        -2.0 * l - 4.0 * e / d + e * e / (d * d),
-    )
-}
-
-/// ∂b/∂d̂ and ∂b′/∂d̂ of the barrier at distance d (zero beyond d̂, where b and b′ vanish for
-/// every d̂, and inside an obstacle).
-pub(crate) fn barrier_band_derivatives(d: f64, dh: f64) -> (f64, f64) {
-    if d >= dh || d <= 0.0 {
-        return (0.0, 0.0);
-    }
-    let (l, e) = ((d / dh).ln(), d - dh);
-    (
-        2.0 * e * l + e * e / dh,
-        2.0 * l + 2.0 * e / dh + 2.0 * e / d,
-    )
 }
 
 /// The change of a particle's gap (relative to the gap) that an obstacle's difference in its shape
@@ -62,7 +33,7 @@ const KINK_AGREEMENT: f64 = 1e-2;
 /// Times a shape difference's step shrinks (by 64) looking for two steps that agree.
 const KINK_RETRIES: usize = 4;
 
-impl BarrierContact {
+impl ObstacleBarrier {
     /// κ for a particle of weight `w` (N): the barrier's force reaches w at d ≈ d̂/10, so resting
     /// particles sit well inside the activation band and well away from the surface.
     pub fn kappa_for_weight(w: f64, d_hat: f64) -> f64 {
@@ -90,7 +61,7 @@ impl BarrierContact {
                 }
             })
             .collect();
-        BarrierContact {
+        ObstacleBarrier {
             obstacles,
             d_hat_m,
             kappa_J,
@@ -113,7 +84,7 @@ impl BarrierContact {
     }
 }
 
-impl EnergyTerm for BarrierContact {
+impl EnergyTerm for ObstacleBarrier {
     fn name(&self) -> String {
         "contact/barrier".into()
     }
@@ -225,7 +196,7 @@ impl EnergyTerm for BarrierContact {
     }
 }
 
-impl BarrierContact {
+impl ObstacleBarrier {
     /// The number of coefficients: κ per particle, d̂, then each obstacle's shape parameters.
     fn coefficient_count(&self) -> usize {
         self.kappa_J.len()
@@ -311,7 +282,7 @@ impl BarrierContact {
     }
 }
 
-impl BarrierContact {
+impl ObstacleBarrier {
     /// The contacts at `x`: (particle, outward normal, barrier force magnitude in N) for every free
     /// particle within d̂ of an obstacle.
     pub fn contacts(&self, x: &Vecs) -> Vec<(usize, Vector3<f64>, f64)> {
