@@ -15,6 +15,7 @@ mod report;
 mod sag;
 mod step;
 mod strategy;
+mod time_step;
 mod vertical_gap;
 
 pub use continuation::{Continuation, Stage, execute};

@@ -1,0 +1,114 @@
+//! The factorization of a Newton iteration: the Hessian shifted while it is indefinite, then
+//! projected, then damped (Levenberg–Marquardt), the shift carried between iterations.
+
+use super::*;
+
+impl Workspace {
+    /// Factorizes the Hessian in `h` (computed at `x`), shifted by the damping: the exact Hessian
+    /// (quadratic convergence; projected Newton stalls on a hanging net whose compressed springs'
+    /// transverse stiffness it drops), shifted further tenfold while it is indefinite up to
+    /// `shift_max` of the diagonal (for this iteration only), then the projected Hessian (every
+    /// term's indefinite part clamped) with the damping, raised tenfold while it fails. False when no
+    /// damping helps.
+    pub(super) fn factorize(
+        &mut self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        hessian: &mut Hessian,
+        scale: f64,
+        report: &mut SolveReport,
+    ) -> bool {
+        let mut shift = self.mu;
+        for attempt in 0..FACTORIZE_ATTEMPTS {
+            if self.try_shift(shift, scale, report) {
+                report.linear_solves += 1;
+                self.last_hessian = *hessian;
+                return true;
+            }
+            shift = match self.parts.regularization {
+                Regularization::CarriedDamping => self.carry_shift(model, x, hessian),
+                Regularization::ShiftLadder => {
+                    self.climb(model, x, hessian, (shift, attempt == 0, scale), report)
+                }
+            };
+        }
+        false
+    }
+
+    /// [`Regularization::ShiftLadder`]'s next shift after `shift` failed: straight to the projected
+    /// Hessian when the last iteration ended on it and the ladder's top fails too (tried on the
+    /// first failure only); else the shift tenfold up to the ladder's top; then the projected
+    /// Hessian with the damping; then the damping tenfold.
+    pub(super) fn climb(
+        &mut self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        hessian: &mut Hessian,
+        (shift, first, scale): (f64, bool, f64),
+        report: &mut SolveReport,
+    ) -> f64 {
+        let exact = !hessian.is_projected();
+        if first
+            && exact
+            && self.last_hessian.is_projected()
+            && self.top_fails(shift, scale, report)
+        {
+            *hessian = Hessian::Projected;
+            model.hessian(x, &mut self.h, true);
+            shift
+        } else if exact && shift * DAMPING_GROWTH <= self.parts.shift_max {
+            (shift * DAMPING_GROWTH).max(MU_MIN)
+        } else if exact {
+            *hessian = Hessian::Projected;
+            model.hessian(x, &mut self.h, true);
+            self.mu
+        } else {
+            self.mu = (shift * DAMPING_GROWTH).max(MU_MIN);
+            self.mu
+        }
+    }
+
+    /// Factorizes the Hessian in `h` shifted by `shift` × `scale` on the diagonal (held components
+    /// decoupled); counts it. False when that is not positive definite.
+    pub(super) fn try_shift(&mut self, shift: f64, scale: f64, report: &mut SolveReport) -> bool {
+        self.shift.iter_mut().for_each(|s| *s = shift * scale);
+        // Held components (symmetry planes): a diagonal far above the rest decouples them, and
+        // their step is set to zero.
+        for &(d, c) in &self.held {
+            self.shift[d + c] += crate::solve::equilibrium::HELD_SHIFT_REL * scale.max(1e-300);
+        }
+        report.factorizations += 1;
+        self.spd.factorize(&self.dofs, &self.h, &self.shift)
+    }
+
+    /// After the damping `shift` alone failed, where the iteration before ended on the projected
+    /// Hessian: whether the top of the ladder of shifts fails too. Positive definiteness only grows
+    /// with a diagonal shift, so then every shift in between fails as well and the ladder can be
+    /// skipped — the same step as climbing it, in one factorization instead of each rung's.
+    pub(super) fn top_fails(&mut self, shift: f64, scale: f64, report: &mut SolveReport) -> bool {
+        let mut top = shift;
+        while top * DAMPING_GROWTH <= self.parts.shift_max {
+            top = (top * DAMPING_GROWTH).max(MU_MIN);
+        }
+        if top == shift {
+            return false;
+        }
+        let fails = !self.try_shift(top, scale, report);
+        self.stats.skipped_shifts += usize::from(fails);
+        fails
+    }
+
+    /// [`Regularization::CarriedDamping`]: the damping raised tenfold, or the projected Hessian
+    /// with the damping back at its initial value once it reaches 1e-3; the
+    /// next shift.
+    pub(super) fn carry_shift(&mut self, model: &Model, x: &[Vector3<f64>], hessian: &mut Hessian) -> f64 {
+        if !hessian.is_projected() && self.mu >= CARRIED_DAMPING_MAX {
+            *hessian = Hessian::Projected;
+            model.hessian(x, &mut self.h, true);
+            self.mu = self.parts.mu_initial.min(self.mu);
+        } else {
+            self.mu = (self.mu * DAMPING_GROWTH).max(MU_MIN);
+        }
+        self.mu
+    }
+}
