@@ -9,8 +9,8 @@ mod sample;
 
 pub use gradient::{LmReport, LmSettings};
 pub use identifiability::{Identifiability, Noise, identifiability, quadratic_half_widths};
-pub use lattice::{SharedLattice, WarmStart};
 use lattice::TANGENT_KEYS;
+pub use lattice::{SharedLattice, WarmStart};
 pub use sample::{
     EvaluatedCountry, OptimizerRun, SampleCalibration, SampleSettings, calibrate_sample,
 };

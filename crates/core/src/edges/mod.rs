@@ -11,6 +11,7 @@ mod from_particles;
 mod photo;
 mod poly;
 mod render;
+mod segment;
 mod systematic;
 
 pub use from_image::{Calibration, FitImageOptions, ImageFit, fit_image, read_gray};

@@ -2,8 +2,8 @@
 //! 000 Eq. 4, Provot's correction) and Baraff & Witkin's linearised implicit Euler (conjugate
 //! gradients with a block-Jacobi preconditioner), each cut short where it would enter an obstacle.
 
-use super::dynamic_options::Integrator;
 use super::SolveReport;
+use super::dynamic_options::Integrator;
 use super::linear::DofMap;
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::{Matrix3, Vector3};

@@ -101,7 +101,12 @@ impl Workspace {
     /// [`Regularization::CarriedDamping`]: the damping raised tenfold, or the projected Hessian
     /// with the damping back at its initial value once it reaches 1e-3; the
     /// next shift.
-    pub(super) fn carry_shift(&mut self, model: &Model, x: &[Vector3<f64>], hessian: &mut Hessian) -> f64 {
+    pub(super) fn carry_shift(
+        &mut self,
+        model: &Model,
+        x: &[Vector3<f64>],
+        hessian: &mut Hessian,
+    ) -> f64 {
         if !hessian.is_projected() && self.mu >= CARRIED_DAMPING_MAX {
             *hessian = Hessian::Projected;
             model.hessian(x, &mut self.h, true);
