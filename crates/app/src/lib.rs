@@ -18,6 +18,7 @@ pub mod cusick_captures;
 pub mod cusick_measure;
 pub mod cusick_predict;
 pub mod cusick_tables;
+pub mod cusick_targets;
 pub mod defaults;
 pub mod fit_edges;
 pub mod peers;

@@ -215,6 +215,14 @@ pub fn mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
+/// Mean and sample standard deviation of `v` (0 and 0 when empty; SD 0 for one value).
+pub fn mean_sd(v: &[f64]) -> (f64, f64) {
+    let n = v.len().max(1) as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    (m, var.sqrt())
+}
+
 /// The median of the finite values of `v` (the mean of the middle two for an even count); NaN when
 /// none is finite.
 pub fn median(v: &[f64]) -> f64 {
@@ -224,54 +232,6 @@ pub fn median(v: &[f64]) -> f64 {
         0 => f64::NAN,
         n if n % 2 == 1 => s[n / 2],
         n => 0.5 * (s[n / 2 - 1] + s[n / 2]),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn lobed(k: usize, amp: f64) -> Projection {
-        let (nx, pixel) = (400, 0.001);
-        let mut covered = vec![false; nx * nx];
-        for row in 0..nx {
-            for col in 0..nx {
-                let (x, y) = (
-                    (col as f64 + 0.5) * pixel - 0.2,
-                    (row as f64 + 0.5) * pixel - 0.2,
-                );
-                let r = 0.12 * (1.0 + amp * (k as f64 * y.atan2(x)).cos());
-                covered[row * nx + col] = (x * x + y * y).sqrt() <= r;
-            }
-        }
-        Projection {
-            nx,
-            ny: nx,
-            pixel_m: pixel,
-            origin_m: [-0.2, -0.2],
-            covered,
-        }
-    }
-
-    #[test]
-    fn a_projection_with_k_lobes_has_k_nodes() {
-        for k in 3..=10 {
-            let p = lobed(k, 0.15);
-            let r = outline_radii(&p, [0.0, 0.0], 360);
-            assert_eq!(count_nodes(&r, 3, 0.03), k, "k = {k}");
-        }
-        // A circle has none.
-        let r = outline_radii(&lobed(5, 0.0), [0.0, 0.0], 360);
-        assert_eq!(count_nodes(&r, 3, 0.03), 0);
-    }
-
-    #[test]
-    fn the_projected_area_of_a_flat_square_is_its_area() {
-        let g = crate::cloth::Grid::uniform(11, 11, 0.2, 0.2);
-        let x = g.flat_positions();
-        let p = vertical_projection(&x, &crate::cloth::grid_triangles(&g), 800);
-        assert!((p.area_m2() - 0.04).abs() < 0.005 * 0.04, "{}", p.area_m2());
-        assert!((drape_coefficient_pct(p.area_m2(), 0.04, 0.01) - 100.0).abs() < 1.0);
     }
 }
 
@@ -352,5 +312,53 @@ pub fn drape_measures(scene: &crate::scene::Scene, x: &[Vector3<f64>]) -> DrapeM
             .filter(|_| k == 0)
             .map(|(_, c)| count_nodes(&outline_radii(&proj, c, 360), 3, 0.08)),
         max_penetration_m: crate::physics::max_penetration_m(&scene.obstacles, &x[..n]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lobed(k: usize, amp: f64) -> Projection {
+        let (nx, pixel) = (400, 0.001);
+        let mut covered = vec![false; nx * nx];
+        for row in 0..nx {
+            for col in 0..nx {
+                let (x, y) = (
+                    (col as f64 + 0.5) * pixel - 0.2,
+                    (row as f64 + 0.5) * pixel - 0.2,
+                );
+                let r = 0.12 * (1.0 + amp * (k as f64 * y.atan2(x)).cos());
+                covered[row * nx + col] = (x * x + y * y).sqrt() <= r;
+            }
+        }
+        Projection {
+            nx,
+            ny: nx,
+            pixel_m: pixel,
+            origin_m: [-0.2, -0.2],
+            covered,
+        }
+    }
+
+    #[test]
+    fn a_projection_with_k_lobes_has_k_nodes() {
+        for k in 3..=10 {
+            let p = lobed(k, 0.15);
+            let r = outline_radii(&p, [0.0, 0.0], 360);
+            assert_eq!(count_nodes(&r, 3, 0.03), k, "k = {k}");
+        }
+        // A circle has none.
+        let r = outline_radii(&lobed(5, 0.0), [0.0, 0.0], 360);
+        assert_eq!(count_nodes(&r, 3, 0.03), 0);
+    }
+
+    #[test]
+    fn the_projected_area_of_a_flat_square_is_its_area() {
+        let g = crate::cloth::Grid::uniform(11, 11, 0.2, 0.2);
+        let x = g.flat_positions();
+        let p = vertical_projection(&x, &crate::cloth::grid_triangles(&g), 800);
+        assert!((p.area_m2() - 0.04).abs() < 0.005 * 0.04, "{}", p.area_m2());
+        assert!((drape_coefficient_pct(p.area_m2(), 0.04, 0.01) - 100.0).abs() < 1.0);
     }
 }
