@@ -44,7 +44,11 @@ impl Aabb {
 }
 
 /// The boxes of the triangles and edges: the union of their vertices' boxes `vbox`, grown by `r`.
-pub(super) fn primitive_boxes(topo: &MeshTopology, vbox: &[Aabb], r: f64) -> (Vec<Aabb>, Vec<Aabb>) {
+pub(super) fn primitive_boxes(
+    topo: &MeshTopology,
+    vbox: &[Aabb],
+    r: f64,
+) -> (Vec<Aabb>, Vec<Aabb>) {
     let tboxes = topo
         .triangles
         .iter()

@@ -6,12 +6,12 @@ mod friction;
 mod start;
 
 use crate::build::{BuiltScene, build_scene};
-use friction::solve_with_friction;
-use start::{coarse_start, taut_start};
 use crate::cloth::Grid;
 use crate::scene::Scene;
 use crate::solve::{Observer, SolveReport, solve_dynamic, solve_static};
+use friction::solve_with_friction;
 use nalgebra::Vector3;
+use start::{coarse_start, taut_start};
 
 /// A solved scene.
 pub struct Solution {
@@ -406,4 +406,3 @@ fn static_solve(
         solve_static(model, x, opts, observer)
     }
 }
-

@@ -38,7 +38,11 @@ pub(super) fn taut_start(scene: &Scene, x: &mut [Vector3<f64>]) -> Option<SolveR
 /// the free particles of `x`. Only when both sides have an odd count ≥ 21, the coarse solve converges,
 /// no absolute natural length ties the springs to the fine spacing, and no hold or point load names
 /// particles of the fine grid.
-pub(super) fn coarse_start(scene: &Scene, grid: &Grid, x: &mut [Vector3<f64>]) -> Option<(SolveReport, ())> {
+pub(super) fn coarse_start(
+    scene: &Scene,
+    grid: &Grid,
+    x: &mut [Vector3<f64>],
+) -> Option<(SolveReport, ())> {
     let (nx, ny) = (grid.nx, grid.ny);
     let natural = scene
         .material
