@@ -18,6 +18,7 @@ mod progress;
 mod runner;
 mod slurm;
 mod stage;
+mod stale;
 
 pub use executor::{ExecutorKind, ExecutorSettings};
 pub use items::{Executor, Local, part_path, parts_dir};
@@ -26,8 +27,6 @@ pub use manifest::{Manifest, hash_file};
 pub use outcome::{FailureCause, StageOutcome, StaleReason};
 pub use plan::{Paths, Plan, PlannedStage, StageSpec, load_plan};
 pub use progress::{LogProgress, MultiBarProgress, Progress, progress_for_terminal};
-pub use runner::{
-    RunOptions, RunSummary, StageState, load_checked_plan, manifest_path, run_pipeline, run_worker,
-    stage_states,
-};
+pub use runner::{RunOptions, RunSummary, load_checked_plan, run_pipeline, run_worker};
 pub use stage::{ItemKind, KeyError, Registry, Slot, Stage, StageContext, StageKind, typed_params};
+pub use stale::{StageState, manifest_path, stage_states};
