@@ -177,28 +177,7 @@ impl Obstacle {
                 let n = v(*normal).normalize();
                 ((p - v(*point_m)).dot(&n), n)
             }
-            Obstacle::Box { min_m, max_m } => {
-                let (lo, hi) = (v(*min_m), v(*max_m));
-                let c = (lo + hi) * 0.5;
-                let half = (hi - lo) * 0.5;
-                let q = p - c;
-                let d = q.abs() - half;
-                let outside = d.map(|x| x.max(0.0));
-                if outside.norm() > 0.0 {
-                    let dir = Vector3::new(
-                        outside.x * q.x.signum(),
-                        outside.y * q.y.signum(),
-                        outside.z * q.z.signum(),
-                    );
-                    (outside.norm(), dir.normalize())
-                } else {
-                    // Inside: the nearest face.
-                    let k = d.imax();
-                    let mut n = Vector3::zeros();
-                    n[k] = q[k].signum();
-                    (d[k], n)
-                }
-            }
+            Obstacle::Box { min_m, max_m } => box_sdf(v(*min_m), v(*max_m), p),
             Obstacle::Cylinder {
                 point_m,
                 axis,
@@ -221,30 +200,7 @@ impl Obstacle {
                 centre_m,
                 radius_m,
                 height_m,
-            } => {
-                let c = v(*centre_m);
-                let q = p - c;
-                let rr = (q.x * q.x + q.y * q.y).sqrt();
-                let radial = if rr > 1e-15 {
-                    Vector3::new(q.x / rr, q.y / rr, 0.0)
-                } else {
-                    Vector3::x()
-                };
-                // 2D box in (r, z) with r ∈ [0, R], z ∈ [−H, 0].
-                let zc = -0.5 * height_m;
-                let (dr, dz) = (rr - radius_m, (q.z - zc).abs() - 0.5 * height_m);
-                let zs = (q.z - zc).signum();
-                if dr > 0.0 || dz > 0.0 {
-                    let (or, oz) = (dr.max(0.0), dz.max(0.0));
-                    let d = (or * or + oz * oz).sqrt();
-                    let n = radial * (or / d) + Vector3::z() * (oz * zs / d);
-                    (d, n)
-                } else if dr > dz {
-                    (dr, radial)
-                } else {
-                    (dz, Vector3::z() * zs)
-                }
-            }
+            } => pedestal_sdf(p - v(*centre_m), *radius_m, *height_m),
             Obstacle::Revolution { axis_m, profile_m } => {
                 let q = Vector3::new(p.x - axis_m[0], p.y - axis_m[1], p.z);
                 let rr = (q.x * q.x + q.y * q.y).sqrt();
@@ -322,34 +278,7 @@ impl Obstacle {
 
     /// Checks the definition: Err(KeyError::new(key, message)).
     pub fn check(&self) -> Result<(), KeyError> {
-        let finite = |k: &str, a: &[f64]| {
-            if a.iter().all(|x| x.is_finite()) {
-                Ok(())
-            } else {
-                Err(KeyError::new(k.to_string(), "must be finite".to_string()))
-            }
-        };
-        let positive = |k: &str, x: f64| {
-            if x.is_finite() && x > 0.0 {
-                Ok(())
-            } else {
-                Err(KeyError::new(
-                    k.to_string(),
-                    format!("must be a finite number > 0, got {x}"),
-                ))
-            }
-        };
-        let nonzero = |k: &str, a: [f64; 3]| {
-            finite(k, &a)?;
-            if v(a).norm() > 1e-12 {
-                Ok(())
-            } else {
-                Err(KeyError::new(
-                    k.to_string(),
-                    "must be a non-zero vector".to_string(),
-                ))
-            }
-        };
+        let positive = KeyError::positive;
         match self {
             Obstacle::Plane { point_m, normal } => {
                 finite("point_m", point_m)?;
@@ -388,30 +317,103 @@ impl Obstacle {
             }
             Obstacle::Revolution { axis_m, profile_m } => {
                 finite("axis_m", axis_m)?;
-                if profile_m.len() < 2 {
-                    return Err(KeyError::new(
-                        "profile_m",
-                        "needs at least two (z, r) points",
-                    ));
-                }
-                for (k, p) in profile_m.iter().enumerate() {
-                    if !(p[0].is_finite() && p[1].is_finite() && p[1] >= 0.0) {
-                        return Err(KeyError::new(
-                            format!("profile_m[{k}]"),
-                            "needs finite z and r ≥ 0",
-                        ));
-                    }
-                    if k > 0 && p[0] <= profile_m[k - 1][0] {
-                        return Err(KeyError::new(
-                            format!("profile_m[{k}]"),
-                            "heights must increase strictly",
-                        ));
-                    }
-                }
-                Ok(())
+                check_profile(profile_m)
             }
         }
     }
+}
+
+/// Signed distance and outward normal of the axis-aligned box from `lo` to `hi` at `p`.
+fn box_sdf(lo: Vector3<f64>, hi: Vector3<f64>, p: &Vector3<f64>) -> (f64, Vector3<f64>) {
+    let c = (lo + hi) * 0.5;
+    let half = (hi - lo) * 0.5;
+    let q = p - c;
+    let d = q.abs() - half;
+    let outside = d.map(|x| x.max(0.0));
+    if outside.norm() > 0.0 {
+        let dir = Vector3::new(
+            outside.x * q.x.signum(),
+            outside.y * q.y.signum(),
+            outside.z * q.z.signum(),
+        );
+        (outside.norm(), dir.normalize())
+    } else {
+        // Inside: the nearest face.
+        let k = d.imax();
+        let mut n = Vector3::zeros();
+        n[k] = q[k].signum();
+        (d[k], n)
+    }
+}
+
+/// Signed distance and outward normal of a pedestal (radius `radius_m`, `height_m` below its top
+/// face) at `q`, relative to the centre of its top face.
+fn pedestal_sdf(q: Vector3<f64>, radius_m: f64, height_m: f64) -> (f64, Vector3<f64>) {
+    let rr = (q.x * q.x + q.y * q.y).sqrt();
+    let radial = if rr > 1e-15 {
+        Vector3::new(q.x / rr, q.y / rr, 0.0)
+    } else {
+        Vector3::x()
+    };
+    // 2D box in (r, z) with r ∈ [0, R], z ∈ [−H, 0].
+    let zc = -0.5 * height_m;
+    let (dr, dz) = (rr - radius_m, (q.z - zc).abs() - 0.5 * height_m);
+    let zs = (q.z - zc).signum();
+    if dr > 0.0 || dz > 0.0 {
+        let (or, oz) = (dr.max(0.0), dz.max(0.0));
+        let d = (or * or + oz * oz).sqrt();
+        let n = radial * (or / d) + Vector3::z() * (oz * zs / d);
+        (d, n)
+    } else if dr > dz {
+        (dr, radial)
+    } else {
+        (dz, Vector3::z() * zs)
+    }
+}
+
+/// Ok when every number of `a` is finite; else the error naming `key`.
+fn finite(key: &str, a: &[f64]) -> Result<(), KeyError> {
+    if a.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(KeyError::new(key, "must be finite"))
+    }
+}
+
+/// Ok when `a` is a finite, non-zero vector; else the error naming `key`.
+fn nonzero(key: &str, a: [f64; 3]) -> Result<(), KeyError> {
+    finite(key, &a)?;
+    if v(a).norm() > 1e-12 {
+        Ok(())
+    } else {
+        Err(KeyError::new(key, "must be a non-zero vector"))
+    }
+}
+
+/// Ok when a body of revolution's profile has at least two (z, r) points, finite, r ≥ 0, heights
+/// rising strictly; else the error naming the first bad point.
+fn check_profile(profile_m: &[[f64; 2]]) -> Result<(), KeyError> {
+    if profile_m.len() < 2 {
+        return Err(KeyError::new(
+            "profile_m",
+            "needs at least two (z, r) points",
+        ));
+    }
+    for (k, p) in profile_m.iter().enumerate() {
+        if !(p[0].is_finite() && p[1].is_finite() && p[1] >= 0.0) {
+            return Err(KeyError::new(
+                format!("profile_m[{k}]"),
+                "needs finite z and r ≥ 0",
+            ));
+        }
+        if k > 0 && p[0] <= profile_m[k - 1][0] {
+            return Err(KeyError::new(
+                format!("profile_m[{k}]"),
+                "heights must increase strictly",
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -32,8 +32,7 @@ impl Solution {
     /// the message.
     pub fn invalid(scene: &Scene, error: crate::error::InputError) -> Self {
         let mut report = SolveReport::unsolved(scene.solver.kind);
-        report.stop_for(crate::solve::StopReason::Invalid);
-        report.message = error.to_string();
+        report.stop_with(crate::solve::StopReason::Invalid, error.to_string());
         Solution {
             grid: Grid {
                 nx: 0,

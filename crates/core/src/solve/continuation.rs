@@ -81,8 +81,7 @@ pub fn execute(
                         None => total
                             .unwrap_or_else(|| SolveReport::unsolved(super::SolverKind::Static)),
                     };
-                    t.stop_for(reason);
-                    t.message = message;
+                    t.stop_with(reason, message);
                     return t;
                 }
             };

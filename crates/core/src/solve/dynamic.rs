@@ -155,13 +155,7 @@ pub fn solve_dynamic(
     } else {
         0.0
     };
-    let dt = match (
-        opts.auto_dt_fraction > 0.0,
-        stability_limit_dt(model, x, integrator, c),
-    ) {
-        (true, Some(lim)) if lim > 0.0 && lim.is_finite() => opts.auto_dt_fraction * lim,
-        _ => opts.dt_s,
-    };
+    let dt = fixed_dt(model, x, integrator, c, opts);
     let free: Vec<bool> = model.fixed.iter().map(|f| !f).collect();
     let w_ref = model.reference_weight();
     let mut report = SolveReport {
@@ -171,8 +165,10 @@ pub fn solve_dynamic(
         ..SolveReport::unsolved(integrator.into())
     };
     if !free.iter().any(|&f| f) || !w_ref.is_finite() || dt.is_nan() || dt <= 0.0 {
-        report.stop_for(StopReason::Invalid);
-        report.message = "nothing free to integrate, or a non-positive time step".into();
+        report.stop_with(
+            StopReason::Invalid,
+            "nothing free to integrate, or a non-positive time step",
+        );
         return report;
     }
     let limits = Limits::new(model, x, v, opts, dt, start);
@@ -216,13 +212,7 @@ pub fn solve_dynamic(
             break;
         }
     }
-    model.gradient(x, 1.0, &mut g);
-    report.iterations = step;
-    report.sim_time_s = Some(step as f64 * dt);
-    report.max_residual_N = model.max_residual(&g);
-    report.max_residual_rel = report.max_residual_N / w_ref;
-    report.energy_J = model.energy(x, 1.0);
-    report.wall_time_s = start.elapsed().as_secs_f64();
+    finish(model, x, step, dt, start, &mut report);
     if stepper.cut_steps > 0 && integrator == Integrator::BaraffWitkin {
         report.contact_cut_steps = stepper.cut_steps;
         report.message = format!(
@@ -231,6 +221,43 @@ pub fn solve_dynamic(
         );
     }
     report
+}
+
+/// The fixed step of an explicit or Baraff–Witkin integration: `auto_dt_fraction` of the stability
+/// limit at `x` when asked and known, else `dt_s`.
+fn fixed_dt(
+    model: &Model,
+    x: &[Vector3<f64>],
+    integrator: Integrator,
+    c: f64,
+    opts: &DynamicOptions,
+) -> f64 {
+    match (
+        opts.auto_dt_fraction > 0.0,
+        stability_limit_dt(model, x, integrator, c),
+    ) {
+        (true, Some(lim)) if lim > 0.0 && lim.is_finite() => opts.auto_dt_fraction * lim,
+        _ => opts.dt_s,
+    }
+}
+
+/// The report's final state after `steps` steps of `dt`: residual, energy, times.
+fn finish(
+    model: &Model,
+    x: &[Vector3<f64>],
+    steps: usize,
+    dt: f64,
+    start: Instant,
+    report: &mut SolveReport,
+) {
+    let mut g = Vec::with_capacity(model.len());
+    model.gradient(x, 1.0, &mut g);
+    report.iterations = steps;
+    report.sim_time_s = Some(steps as f64 * dt);
+    report.max_residual_N = model.max_residual(&g);
+    report.max_residual_rel = report.max_residual_N / model.reference_weight();
+    report.energy_J = model.energy(x, 1.0);
+    report.wall_time_s = start.elapsed().as_secs_f64();
 }
 
 /// Implicit Euler as an optimisation ([`integrate_implicit`]) with the options' steps, damping and
@@ -254,8 +281,7 @@ fn solve_implicit(
     let free = model.fixed.iter().any(|f| !f);
     let steps_ok = opts.dt_s > 0.0 && opts.min_dt_s > 0.0 && opts.max_dt_s >= opts.min_dt_s;
     if !free || !w_ref.is_finite() || !steps_ok {
-        report.stop_for(StopReason::Invalid);
-        report.message = "nothing free to integrate, or time steps that are not 0 < min_dt_s ≤ max_dt_s, dt_s > 0".into();
+        report.stop_with(StopReason::Invalid, "nothing free to integrate, or time steps that are not 0 < min_dt_s ≤ max_dt_s, dt_s > 0");
         return report;
     }
     for (vi, f) in v.iter_mut().zip(&model.fixed) {
@@ -293,8 +319,10 @@ fn solve_implicit(
     };
     let frame_s = observer.frame_interval_s();
     if let Err(e) = observe_start(model, x, v, frame_s, observer) {
-        report.stop_for(StopReason::Observer);
-        report.message = format!("an observer failed at t = 0: {e:#}");
+        report.stop_with(
+            StopReason::Observer,
+            format!("an observer failed at t = 0: {e:#}"),
+        );
         return report;
     }
     integrate_implicit(

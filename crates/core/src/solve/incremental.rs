@@ -263,91 +263,143 @@ pub fn integrate_implicit(
     report: &mut SolveReport,
 ) {
     let start = Instant::now();
-    let (mut t, mut h, mut steps, mut frame) = (0.0f64, s.dt_s, 0usize, 1usize);
-    let mut g = Vec::new();
-    let (mut largest, mut cooldown, mut last_dt) = (0.0f64, 0usize, 0.0f64);
-    // Whether the state is at a frame time (t = 0 is one).
-    let mut at_frame = true;
-    let mut carried = None;
+    let (mut h, mut cooldown, mut g, mut carried) = (s.dt_s, 0usize, Vec::new(), None);
+    let mut c = Clock::default();
     loop {
         model.gradient(x, 1.0, &mut g);
         let r = model.max_residual(&g);
         let speed = v.iter().map(|p| p.norm()).fold(0.0, f64::max);
         if !r.is_finite() {
-            report.diverge(steps, Some(h), DivergenceReason::NonFinite);
+            report.diverge(c.steps, Some(h), DivergenceReason::NonFinite);
             return;
         }
         // Recording frames, the state is judged on frame times only (the last one recorded is the
         // final state).
-        let on_frame = frame_s.is_none() || at_frame;
-        if on_frame && settled(model, x, settle, (r, speed, last_dt)) {
-            report.stop_for(StopReason::Converged);
-            report.message = format!(
-                "settled at t = {t:.4} s after {steps} steps (largest residual {r:.2e} N, largest speed {speed:.2e} m/s, kinetic energy {:.2e} J; largest step {largest:.1e} s)",
-                super::kinetic_energy(model, v),
-            );
+        let on_frame = frame_s.is_none() || c.at_frame;
+        if on_frame && settled(model, x, settle, (r, speed, c.last_dt)) {
+            report.stop_with(StopReason::Converged, c.settled(model, v, r, speed));
             break;
         }
-        if let Some((reason, message)) = out_of_budget(t, (max_time_s, max_wall_s), start, r, speed)
+        if let Some((reason, message)) =
+            out_of_budget(c.t, (max_time_s, max_wall_s), start, r, speed)
         {
-            report.stop_for(reason);
-            report.message = message;
+            report.stop_with(reason, message);
             break;
         }
         // The step: capped by the time budget and, when recording frames, landing on the next one.
-        let mut dt = h.min(max_time_s - t);
-        let next_frame = frame_s.map(|f| f * frame as f64);
-        if let Some(tf) = next_frame {
-            dt = dt.min(tf - t);
-        }
+        let (t, next_frame) = (c.t, frame_s.map(|f| f * c.frame as f64));
+        let dt = next_frame.map_or(h, |tf| h.min(tf - t)).min(max_time_s - t);
         match step(model, x, v, dt, s, &mut carried, report) {
             Attempt::Accepted(iterations) => {
-                steps += 1;
-                last_dt = dt;
-                largest = largest.max(dt);
-                t += dt;
-                let landed = next_frame.is_some_and(|tf| (tf - t).abs() <= 1e-9 * tf.max(1.0));
-                at_frame = landed;
-                if landed {
-                    t = next_frame.unwrap_or(t);
-                    frame += 1;
-                }
-                if (landed || (frame_s.is_none() && observer.wants(steps)))
-                    && let Err(e) = observe_state(observer, model, x, v, (steps, t, r))
+                c.accept(dt, next_frame);
+                let t = c.t;
+                if (c.at_frame || (frame_s.is_none() && observer.wants(c.steps)))
+                    && let Err(e) = observe_state(observer, model, x, v, (c.steps, t, r))
                 {
-                    report.stop_for(StopReason::Observer);
-                    report.message = format!("an observer failed at t = {t:.4} s: {e:#}");
+                    report.stop_with(
+                        StopReason::Observer,
+                        format!("an observer failed at t = {t:.4} s: {e:#}"),
+                    );
                     break;
                 }
                 // A step shortened to land on a frame does not set the next one, and for three
                 // steps after a rejected one the step does not grow.
                 cooldown = cooldown.saturating_sub(1);
-                if dt >= h * (1.0 - 1e-12) {
-                    h = next_dt(h, iterations, s).min(if cooldown > 0 { h } else { f64::INFINITY });
-                }
+                h = grown(h, dt, iterations, cooldown, s);
             }
             Attempt::Diverged(reason) => {
-                report.diverge(steps, Some(dt), reason);
+                report.diverge(c.steps, Some(dt), reason);
                 report.message = format!("diverged at t = {t:.4} s (step {dt:e} s): {reason}");
                 break;
             }
             Attempt::Rejected => {
-                h = dt * 0.5;
-                cooldown = 3;
+                (h, cooldown) = (dt * 0.5, 3);
                 if h < s.min_dt_s {
-                    report.stop_for(StopReason::StepTooSmall);
-                    report.message = format!(
-                        "Newton failed at every step down to {:.1e} s at t = {t:.4} s",
-                        s.min_dt_s
+                    report.stop_with(
+                        StopReason::StepTooSmall,
+                        format!(
+                            "Newton failed at every step down to {:.1e} s at t = {t:.4} s",
+                            s.min_dt_s
+                        ),
                     );
                     break;
                 }
             }
         }
     }
-    report.iterations = steps;
-    report.sim_time_s = Some(t);
-    report.dt_s = Some(if steps > 0 { largest } else { s.dt_s });
+    report.iterations = c.steps;
+    report.sim_time_s = Some(c.t);
+    report.dt_s = Some(if c.steps > 0 { c.largest } else { s.dt_s });
+}
+
+/// Where an integration is: its time, steps, the largest and the last step, and the frames.
+struct Clock {
+    t: f64,
+    steps: usize,
+    largest: f64,
+    last_dt: f64,
+    /// The number of the next frame (1 first).
+    frame: usize,
+    /// Whether the state is at a frame time (t = 0 is one).
+    at_frame: bool,
+}
+
+impl Default for Clock {
+    fn default() -> Self {
+        Self {
+            t: 0.0,
+            steps: 0,
+            largest: 0.0,
+            last_dt: 0.0,
+            frame: 1,
+            at_frame: true,
+        }
+    }
+}
+
+impl Clock {
+    /// An accepted step of `dt`: the time landed on the next frame time `next_frame` when it is
+    /// within round-off of it.
+    fn accept(&mut self, dt: f64, next_frame: Option<f64>) {
+        self.steps += 1;
+        self.last_dt = dt;
+        self.largest = self.largest.max(dt);
+        (self.t, self.at_frame) = advance(self.t, dt, next_frame, &mut self.frame);
+    }
+
+    /// The message of a settled state with largest residual `r` (N) and speed (m/s).
+    fn settled(&self, model: &Model, v: &[Vector3<f64>], r: f64, speed: f64) -> String {
+        format!(
+            "settled at t = {:.4} s after {} steps (largest residual {r:.2e} N, largest speed {speed:.2e} m/s, kinetic energy {:.2e} J; largest step {:.1e} s)",
+            self.t,
+            self.steps,
+            super::kinetic_energy(model, v),
+            self.largest
+        )
+    }
+}
+
+/// The time after an accepted step of `dt` from `t`, landed on the next frame time `next_frame`
+/// (counted in `frame`) when it is within round-off of it; and whether it landed.
+fn advance(t: f64, dt: f64, next_frame: Option<f64>, frame: &mut usize) -> (f64, bool) {
+    let t = t + dt;
+    match next_frame {
+        Some(tf) if (tf - t).abs() <= 1e-9 * tf.max(1.0) => {
+            *frame += 1;
+            (tf, true)
+        }
+        _ => (t, false),
+    }
+}
+
+/// The next step after an accepted step of `dt` that took `iterations` Newton iterations: a step
+/// shortened to land on a frame does not set the next one, and while `cooldown` lasts (after a
+/// rejected step) the step does not grow.
+fn grown(h: f64, dt: f64, iterations: usize, cooldown: usize, s: &ImplicitSettings) -> f64 {
+    if dt < h * (1.0 - 1e-12) {
+        return h;
+    }
+    next_dt(h, iterations, s).min(if cooldown > 0 { h } else { f64::INFINITY })
 }
 
 /// Whether a state with largest residual `r` N and speed m/s after a step of `last_dt` s has

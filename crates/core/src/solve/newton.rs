@@ -274,8 +274,10 @@ impl NewtonRun {
         let mut report = SolveReport::unsolved(super::SolverKind::Static);
         let ws = Workspace::new(model, x, opts);
         if ws.dofs.n == 0 || !model.reference_weight().is_finite() {
-            report.stop_for(StopReason::Invalid);
-            report.message = "no free particle with mass: nothing to solve".into();
+            report.stop_with(
+                StopReason::Invalid,
+                "no free particle with mass: nothing to solve",
+            );
             return Err(Box::new(report));
         }
         Ok(Self {
@@ -312,8 +314,10 @@ impl NewtonRun {
                 return false;
             }
             if let Err(err) = observe_iterate(observer, self.iter, x, (r, e)) {
-                report.stop_for(StopReason::Observer);
-                report.message = format!("an observer failed at iteration {}: {err:#}", self.iter);
+                report.stop_with(
+                    StopReason::Observer,
+                    format!("an observer failed at iteration {}: {err:#}", self.iter),
+                );
                 return false;
             }
             if r <= tol && last {
@@ -346,10 +350,12 @@ impl NewtonRun {
                     report.stop_for(StopReason::Converged);
                     return true;
                 }
-                report.stop_for(StopReason::LineSearch);
-                report.message = format!(
-                    "line search failed at iteration {} with residual {r:.3e} N",
-                    self.iter
+                report.stop_with(
+                    StopReason::LineSearch,
+                    format!(
+                        "line search failed at iteration {} with residual {r:.3e} N",
+                        self.iter
+                    ),
                 );
                 return false;
             }

@@ -284,6 +284,11 @@ impl SolveReport {
         self.stop = reason;
         self.status = reason.status();
     }
+    /// Stops for `reason` with `message`.
+    pub fn stop_with(&mut self, reason: StopReason, message: impl Into<String>) {
+        self.stop_for(reason);
+        self.message = message.into();
+    }
     /// Records a divergence detected at `step`.
     pub fn diverge(&mut self, step: usize, dt_s: Option<f64>, reason: DivergenceReason) {
         self.stop_for(StopReason::Diverged);
