@@ -111,10 +111,7 @@ pub(super) fn continuum_terms(
     b: &mut ModelBuilder,
     x0: &mut Vec<Vector3<f64>>,
 ) {
-    let (nx, ny) = (grid.nx, grid.ny);
-    let (fixed, masses, terms) = (&mut b.fixed, &mut b.masses, &mut b.terms);
-    let wx = tributary_lengths(&grid.xs);
-    let wy = tributary_lengths(&grid.ys);
+    let terms = &mut b.terms;
     terms.push(Box::new(tensile_springs(grid, r, absent)));
     // Shear.
     if r.shear_N_per_m > 0.0 {
@@ -130,6 +127,24 @@ pub(super) fn continuum_terms(
             r.bending_twist_N_m,
         )));
     }
+    line_bending(grid, r, absent, clamps, b, x0);
+}
+
+/// Quadratic bending along grid lines (warp along x, weft along y; k = D·w/h̄), a clamped edge's
+/// particles pinned with virtual fixed points mirrored across it (zero slope at the edge).
+#[allow(clippy::needless_range_loop)] // grid loops index several parallel arrays
+fn line_bending(
+    grid: &Grid,
+    r: &Rigidities,
+    absent: &[bool],
+    clamps: &[crate::cloth::Edge],
+    b: &mut ModelBuilder,
+    x0: &mut Vec<Vector3<f64>>,
+) {
+    let (nx, ny) = (grid.nx, grid.ny);
+    let (fixed, masses, terms) = (&mut b.fixed, &mut b.masses, &mut b.terms);
+    let wx = tributary_lengths(&grid.xs);
+    let wy = tributary_lengths(&grid.ys);
     // Bending along x lines (warp) and y lines (weft).
     let mut triples = Vec::new();
     let mut coef = Vec::new();

@@ -35,20 +35,8 @@ pub fn cmaes(
 ) -> CmaesReport {
     let n = dim as f64;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let lambda = 4 + (3.0 * n.ln()).floor() as usize;
-    let mu = lambda / 2;
-    let raw: Vec<f64> = (0..mu)
-        .map(|i| (mu as f64 + 0.5).ln() - ((i + 1) as f64).ln())
-        .collect();
-    let sum: f64 = raw.iter().sum();
-    let w: Vec<f64> = raw.iter().map(|v| v / sum).collect();
-    let mu_eff = 1.0 / w.iter().map(|v| v * v).sum::<f64>();
-    let c_sigma = (mu_eff + 2.0) / (n + mu_eff + 5.0);
-    let d_sigma = 1.0 + 2.0 * (((mu_eff - 1.0) / (n + 1.0)).sqrt() - 1.0).max(0.0) + c_sigma;
-    let c_c = (4.0 + mu_eff / n) / (n + 4.0 + 2.0 * mu_eff / n);
-    let c_1 = 2.0 / ((n + 1.3).powi(2) + mu_eff);
-    let c_mu = (1.0 - c_1).min(2.0 * (mu_eff - 2.0 + 1.0 / mu_eff) / ((n + 2.0).powi(2) + mu_eff));
-    let chi_n = n.sqrt() * (1.0 - 1.0 / (4.0 * n) + 1.0 / (21.0 * n * n));
+    let st = Strategy::new(dim);
+    let (lambda, mu, mu_eff, w) = (st.lambda, st.mu, st.mu_eff, &st.w);
     let mut m = DVector::from_element(dim, 0.5);
     let mut sigma = 0.3;
     let mut c = DMatrix::<f64>::identity(dim, dim);
@@ -65,19 +53,7 @@ pub fn cmaes(
             .map(|_| &b * DVector::from_fn(dim, |i, _| d[i] * normal(&mut rng)))
             .collect();
         let xs: Vec<DVector<f64>> = ys.iter().map(|y| &m + y * sigma).collect();
-        let costs: Vec<f64> = xs
-            .par_iter()
-            .map(|x| {
-                let clamped: Vec<f64> = x.iter().map(|v| v.clamp(0.0, 1.0)).collect();
-                let out: f64 = x.iter().zip(&clamped).map(|(a, b)| (a - b).powi(2)).sum();
-                let v = cost(&clamped);
-                if v.is_nan() {
-                    f64::INFINITY
-                } else {
-                    v + 1e3 * out
-                }
-            })
-            .collect();
+        let costs: Vec<f64> = xs.par_iter().map(|x| penalised(cost, x)).collect();
         evaluations += lambda;
         let mut order: Vec<usize> = (0..lambda).collect();
         order.sort_by(|&a, &b| costs[a].total_cmp(&costs[b]));
@@ -89,29 +65,29 @@ pub fn cmaes(
         let y_w: DVector<f64> = order
             .iter()
             .take(mu)
-            .zip(&w)
+            .zip(w)
             .map(|(&k, wi)| &ys[k] * *wi)
             .fold(DVector::zeros(dim), |a, b| a + b);
         m += &y_w * sigma;
         let inv_sqrt_c = &b * DMatrix::from_diagonal(&d.map(|v| 1.0 / v)) * b.transpose();
-        p_sigma = &p_sigma * (1.0 - c_sigma)
-            + &inv_sqrt_c * &y_w * (c_sigma * (2.0 - c_sigma) * mu_eff).sqrt();
+        p_sigma = &p_sigma * (1.0 - st.c_sigma)
+            + &inv_sqrt_c * &y_w * (st.c_sigma * (2.0 - st.c_sigma) * mu_eff).sqrt();
         g += 1;
-        let h_sigma = p_sigma.norm() / (1.0 - (1.0 - c_sigma).powi(2 * g as i32)).sqrt()
-            < (1.4 + 2.0 / (n + 1.0)) * chi_n;
+        let h_sigma = p_sigma.norm() / (1.0 - (1.0 - st.c_sigma).powi(2 * g as i32)).sqrt()
+            < (1.4 + 2.0 / (n + 1.0)) * st.chi_n;
         let hs = if h_sigma { 1.0 } else { 0.0 };
-        p_c = &p_c * (1.0 - c_c) + &y_w * (hs * (c_c * (2.0 - c_c) * mu_eff).sqrt());
+        p_c = &p_c * (1.0 - st.c_c) + &y_w * (hs * (st.c_c * (2.0 - st.c_c) * mu_eff).sqrt());
         let rank_mu = order
             .iter()
             .take(mu)
-            .zip(&w)
+            .zip(w)
             .fold(DMatrix::zeros(dim, dim), |acc, (&k, wi)| {
                 acc + &ys[k] * ys[k].transpose() * *wi
             });
-        c = &c * (1.0 - c_1 - c_mu)
-            + (&p_c * p_c.transpose() + &c * ((1.0 - hs) * c_c * (2.0 - c_c))) * c_1
-            + rank_mu * c_mu;
-        sigma *= ((c_sigma / d_sigma) * (p_sigma.norm() / chi_n - 1.0)).exp();
+        c = &c * (1.0 - st.c_1 - st.c_mu)
+            + (&p_c * p_c.transpose() + &c * ((1.0 - hs) * st.c_c * (2.0 - st.c_c))) * st.c_1
+            + rank_mu * st.c_mu;
+        sigma *= ((st.c_sigma / st.d_sigma) * (p_sigma.norm() / st.chi_n - 1.0)).exp();
         if !sigma.is_finite() || sigma < 1e-14 {
             break;
         }
@@ -121,6 +97,64 @@ pub fn cmaes(
         best_cost,
         evaluations,
         history,
+    }
+}
+
+/// The cost at `x` clamped to the unit box, plus 10³ times the squared distance clamped away (a
+/// NaN cost is infinite).
+fn penalised(cost: &(dyn Fn(&[f64]) -> f64 + Sync), x: &DVector<f64>) -> f64 {
+    let clamped: Vec<f64> = x.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+    let out: f64 = x.iter().zip(&clamped).map(|(a, b)| (a - b).powi(2)).sum();
+    let v = cost(&clamped);
+    if v.is_nan() {
+        f64::INFINITY
+    } else {
+        v + 1e3 * out
+    }
+}
+
+/// Hansen's default strategy parameters for dimension n ("The CMA Evolution Strategy: A
+/// Tutorial", 2016, Table 1): population λ, parents μ with weights w, the learning rates.
+struct Strategy {
+    lambda: usize,
+    mu: usize,
+    w: Vec<f64>,
+    mu_eff: f64,
+    c_sigma: f64,
+    d_sigma: f64,
+    c_c: f64,
+    c_1: f64,
+    c_mu: f64,
+    /// E‖N(0, I)‖.
+    chi_n: f64,
+}
+
+impl Strategy {
+    fn new(dim: usize) -> Self {
+        let n = dim as f64;
+        let lambda = 4 + (3.0 * n.ln()).floor() as usize;
+        let mu = lambda / 2;
+        let raw: Vec<f64> = (0..mu)
+            .map(|i| (mu as f64 + 0.5).ln() - ((i + 1) as f64).ln())
+            .collect();
+        let sum: f64 = raw.iter().sum();
+        let w: Vec<f64> = raw.iter().map(|v| v / sum).collect();
+        let mu_eff = 1.0 / w.iter().map(|v| v * v).sum::<f64>();
+        let c_sigma = (mu_eff + 2.0) / (n + mu_eff + 5.0);
+        let c_1 = 2.0 / ((n + 1.3).powi(2) + mu_eff);
+        Self {
+            lambda,
+            mu,
+            w,
+            mu_eff,
+            c_sigma,
+            d_sigma: 1.0 + 2.0 * (((mu_eff - 1.0) / (n + 1.0)).sqrt() - 1.0).max(0.0) + c_sigma,
+            c_c: (4.0 + mu_eff / n) / (n + 4.0 + 2.0 * mu_eff / n),
+            c_1,
+            c_mu: (1.0 - c_1)
+                .min(2.0 * (mu_eff - 2.0 + 1.0 / mu_eff) / ((n + 2.0).powi(2) + mu_eff)),
+            chi_n: n.sqrt() * (1.0 - 1.0 / (4.0 * n) + 1.0 / (21.0 * n * n)),
+        }
     }
 }
 

@@ -163,26 +163,7 @@ impl SparseSpd {
     /// Factorizes H + diag(shift) over the free DOFs. Returns false when the matrix is not
     /// positive definite (the caller raises its damping or projects the Hessian and tries again).
     pub fn factorize(&mut self, dofs: &DofMap, h: &HessianBlocks, shift: &[f64]) -> bool {
-        let stale = self.pattern.as_ref().is_none_or(|p| !p.holds(dofs, h));
-        if stale {
-            let start = Instant::now();
-            let Some((pattern, analysed)) = Pattern::next(dofs, h, self.pattern.as_ref()) else {
-                return false;
-            };
-            self.analyses += usize::from(analysed);
-            let symbolic = &pattern.structure.symbolic;
-            let same_structure = self
-                .pattern
-                .as_ref()
-                .is_some_and(|p| Arc::ptr_eq(&p.structure, &pattern.structure));
-            if !same_structure {
-                let nnz = pattern.structure.sym.row_idx().len();
-                self.prepare_buffers(symbolic, nnz);
-            }
-            self.pattern = Some(pattern);
-            self.analysis_time_s += start.elapsed().as_secs_f64();
-        }
-        let Some(pattern) = self.pattern.clone() else {
+        let Some(pattern) = self.pattern_for(dofs, h) else {
             return false;
         };
         if !self.factor_scratch || Arc::strong_count(&self.l_values) > 1 {
@@ -250,6 +231,28 @@ impl SparseSpd {
         .is_ok();
         self.factor_time_s += start.elapsed().as_secs_f64();
         ok
+    }
+
+    /// The pattern of `h` over `dofs`: the one held while it holds them, else the next one (from
+    /// the process's cache, or analysed), its buffers prepared. None when no pattern maps them.
+    fn pattern_for(&mut self, dofs: &DofMap, h: &HessianBlocks) -> Option<Arc<Pattern>> {
+        let stale = self.pattern.as_ref().is_none_or(|p| !p.holds(dofs, h));
+        if stale {
+            let start = Instant::now();
+            let (pattern, analysed) = Pattern::next(dofs, h, self.pattern.as_ref())?;
+            self.analyses += usize::from(analysed);
+            let same_structure = self
+                .pattern
+                .as_ref()
+                .is_some_and(|p| Arc::ptr_eq(&p.structure, &pattern.structure));
+            if !same_structure {
+                let nnz = pattern.structure.sym.row_idx().len();
+                self.prepare_buffers(&pattern.structure.symbolic, nnz);
+            }
+            self.pattern = Some(pattern);
+            self.analysis_time_s += start.elapsed().as_secs_f64();
+        }
+        self.pattern.clone()
     }
 
     /// Solves (H + diag(shift)) y = rhs in place with the last successful factorization.
