@@ -109,6 +109,19 @@ pub struct DecadeEvent<'a> {
     pub evaluations: usize,
 }
 
+impl<'a> DecadeEvent<'a> {
+    /// The event after `decade` with the `empires`, the best cost so far and the evaluations.
+    fn of(decade: usize, empires: &'a [Empire], best_cost: f64, evaluations: usize) -> Self {
+        Self {
+            decade,
+            empires,
+            best_cost,
+            mean_cost: mean_cost(empires),
+            evaluations,
+        }
+    }
+}
+
 /// The result of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IcaReport {
@@ -239,21 +252,12 @@ impl Ica {
         let init: Vec<Vec<f64>> = (0..s.countries)
             .map(|_| (0..self.dim).map(|_| rng.random::<f64>()).collect())
             .collect();
-        let mut countries = eval(init);
+        let countries = eval(init);
         let mut evaluations = countries.len();
-        countries.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-        let mut colonies: Vec<Country> = countries.split_off(s.imperialists);
-        colonies.shuffle(&mut rng);
-        let mut empires = form_empires(countries, colonies);
+        let mut empires = first_empires(countries, s.imperialists, &mut rng);
         let mut best_c = best_country(&empires).expect("at least one imperialist");
         let mut history = vec![best_c.cost];
-        observe(&DecadeEvent {
-            decade: 0,
-            empires: &empires,
-            best_cost: best_c.cost,
-            mean_cost: mean_cost(&empires),
-            evaluations,
-        });
+        observe(&DecadeEvent::of(0, &empires, best_c.cost, evaluations));
         let mut decade = 0;
         let several = empires.len() > 1;
         while decade < s.decades {
@@ -276,17 +280,7 @@ impl Ica {
                 for c in e.colonies.iter_mut() {
                     *c = moved.next().expect("one per colony");
                 }
-                // A colony better than its imperialist takes its place.
-                if let Some(k) = e
-                    .colonies
-                    .iter()
-                    .enumerate()
-                    .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
-                    .map(|(k, _)| k)
-                    && e.colonies[k].cost < e.imperialist.cost
-                {
-                    std::mem::swap(&mut e.colonies[k], &mut e.imperialist);
-                }
+                promote_best_colony(e);
             }
             compete(&mut empires, s.xi, &mut rng);
             if let Some(b) = best_country(&empires)
@@ -295,13 +289,7 @@ impl Ica {
                 best_c = b;
             }
             history.push(best_c.cost);
-            observe(&DecadeEvent {
-                decade,
-                empires: &empires,
-                best_cost: best_c.cost,
-                mean_cost: mean_cost(&empires),
-                evaluations,
-            });
+            observe(&DecadeEvent::of(decade, &empires, best_c.cost, evaluations));
             // Stop when one empire remains (a run started with one empire runs all its decades).
             if several && empires.len() == 1 {
                 break;
@@ -316,6 +304,32 @@ impl Ica {
         }
     }
 }
+/// The first empires: the `imperialists` best countries, the rest shuffled among them as colonies.
+fn first_empires(
+    mut countries: Vec<Country>,
+    imperialists: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<Empire> {
+    countries.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+    let mut colonies: Vec<Country> = countries.split_off(imperialists);
+    colonies.shuffle(rng);
+    form_empires(countries, colonies)
+}
+
+/// A colony better than its imperialist takes its place.
+fn promote_best_colony(e: &mut Empire) {
+    if let Some(k) = e
+        .colonies
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
+        .map(|(k, _)| k)
+        && e.colonies[k].cost < e.imperialist.cost
+    {
+        std::mem::swap(&mut e.colonies[k], &mut e.imperialist);
+    }
+}
+
 
 /// The first empires (Atashpaz-Gargari & Lucas 2007): the colonies shared among the imperialists
 /// by normalised power (the best cost's distance from the worst), the rounding remainder to the
