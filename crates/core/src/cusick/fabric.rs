@@ -328,23 +328,7 @@ pub fn calibrate_fabric(
         });
     }
     let solves = continuation.solves + seeded;
-    let miss = |r: &LawCandidate| (r.drapes.nodes_mean - target.nodes).abs();
-    let best = candidates
-        .iter()
-        .min_by(|a, b| miss(a).total_cmp(&miss(b)))
-        .ok_or("no candidate's drapes converged")?
-        .clone();
-    let near: Vec<BendingLaw> = candidates
-        .iter()
-        .filter(|r| miss(r) <= 1.0)
-        .map(|r| r.law)
-        .collect();
-    let (lo, hi) = candidates
-        .iter()
-        .map(|r| r.drapes.nodes_mean)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, m| {
-            (a.0.min(m), a.1.max(m))
-        });
+    let (best, near, law_identifiable) = choose_law(&candidates, target.nodes)?;
     let sigma = target.dc_se_pct.hypot(best.drapes.dc_sd_pct);
     // c puts the seed-0 drape on the target; the prediction is a mean over other seeds. One secant
     // step along dDC/d ln c moves c to where the calibration seeds' mean would meet the target
@@ -361,10 +345,36 @@ pub fn calibrate_fabric(
         dc_sensitivity_pct: cal.sensitivity_pct(1.3),
         law: best.law,
         laws_within_one_node: near,
-        law_identifiable: hi - lo > 1.0,
+        law_identifiable,
         candidates,
         solves,
     })
+}
+
+/// The candidate whose drapes' mean node count is nearest `nodes`, the laws within one node of it,
+/// and whether the laws' node counts spread over more than one node (the law identifiable).
+fn choose_law(
+    candidates: &[LawCandidate],
+    nodes: f64,
+) -> Result<(LawCandidate, Vec<BendingLaw>, bool), String> {
+    let miss = |r: &LawCandidate| (r.drapes.nodes_mean - nodes).abs();
+    let best = candidates
+        .iter()
+        .min_by(|a, b| miss(a).total_cmp(&miss(b)))
+        .ok_or("no candidate's drapes converged")?
+        .clone();
+    let near: Vec<BendingLaw> = candidates
+        .iter()
+        .filter(|r| miss(r) <= 1.0)
+        .map(|r| r.law)
+        .collect();
+    let (lo, hi) = candidates
+        .iter()
+        .map(|r| r.drapes.nodes_mean)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, m| {
+            (a.0.min(m), a.1.max(m))
+        });
+    Ok((best, near, hi - lo > 1.0))
 }
 
 /// A fabric's calibrate → predict outcome.

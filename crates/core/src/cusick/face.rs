@@ -76,29 +76,7 @@ pub fn fit_curl(
     };
     let dc =
         |x: &[Vector3<f64>]| shadow_measures(&mesh_projection(x, mesh.triangles), tester).dc_pct;
-    let (report, x0, with_self) = solve_drape_from(mesh, &flat, tester, None, &mut NoObserver);
-    if !report.is_converged() {
-        return Err(format!(
-            "the curl-free drape did not converge ({})",
-            report.message
-        ));
-    }
-    let solved = DrapeParams {
-        self_thickness_m: flat.self_thickness_m.filter(|_| with_self),
-        ..flat.clone()
-    };
-    let model = drape_model(mesh, &solved, tester);
-    let specimen = SpecimenParameters {
-        mesh,
-        params: solved.clone(),
-        tester,
-    };
-    let mut eq = Equilibrium::of(Box::new(specimen), &model, &x0, &report)
-        .map_err(|e| format!("no sensitivity at the curl-free drape: {e}"))?;
-    let t = eq
-        .sensitivity("curl_per_m")
-        .map_err(|e| format!("no sensitivity to the curl: {e}"))?
-        .dx;
+    let (x0, t) = curl_free_tangent(mesh, &flat, tester)?;
     let along =
         |k: f64| -> Vec<Vector3<f64>> { x0.iter().zip(&t).map(|(x, t)| x + t * k).collect() };
     let mut slope =
@@ -159,4 +137,38 @@ pub fn fit_curl(
     fit.at_bound = fit.curl_per_m.abs() >= MAX_CURL_PER_M;
     fit.identifiable = fit.curl_per_m.abs() > half && !fit.at_bound;
     Ok(fit)
+}
+
+/// The curl-free drape of `flat` and its tangent dx/dκ in the curl (from the factor of its exact
+/// Hessian): where a curled face's solve starts.
+fn curl_free_tangent(
+    mesh: DiscMesh<'_>,
+    flat: &DrapeParams,
+    tester: &Tester,
+) -> Result<(Vec<Vector3<f64>>, Vec<Vector3<f64>>), String> {
+    let (report, x0, with_self) = solve_drape_from(mesh, flat, tester, None, &mut NoObserver);
+    if !report.is_converged() {
+        return Err(format!(
+            "the curl-free drape did not converge ({})",
+            report.message
+        ));
+    }
+    let solved = DrapeParams {
+        self_thickness_m: flat.self_thickness_m.filter(|_| with_self),
+        ..flat.clone()
+    };
+    let model = drape_model(mesh, &solved, tester);
+    let specimen = SpecimenParameters {
+        mesh,
+        params: solved.clone(),
+        tester,
+    };
+    let mut eq = Equilibrium::of(Box::new(specimen), &model, &x0, &report)
+        .map_err(|e| format!("no sensitivity at the curl-free drape: {e}"))?;
+    let t = eq
+        .sensitivity("curl_per_m")
+        .map_err(|e| format!("no sensitivity to the curl: {e}"))?
+        .dx;
+    drop(eq);
+    Ok((x0, t))
 }
