@@ -110,18 +110,7 @@ pub fn calibrate_sample(
         };
         let mut observer_error: Option<anyhow::Error> = None;
         let report = Ica { settings, dim: 5 }.run(&|u: &[f64]| problem.cost(u), |ev| {
-            for (k, e) in ev.empires.iter().enumerate() {
-                for c in std::iter::once(&e.imperialist).chain(&e.colonies) {
-                    evaluations.push(EvaluatedCountry {
-                        run: r as u32,
-                        decade: ev.decade as u32,
-                        empire: k as u32,
-                        cost_pct: c.cost,
-                        params: problem.bounds.decode(&c.x),
-                        evaluation: problem.lookup(&c.x),
-                    });
-                }
-            }
+            record_decade(problem, r, ev, &mut evaluations);
             if observer_error.is_none() {
                 observer_error = observe(r, ev).err();
             }
@@ -138,20 +127,12 @@ pub fn calibrate_sample(
             estimate: None,
         });
         if s.baseline_cmaes {
-            let fresh = problem.fresh();
-            let cm = Cmaes {
-                dim: 5,
-                budget: report.evaluations,
-                seed: s.ica.seed + r as u64,
-            }
-            .minimize(&|u: &[f64]| fresh.cost(u), None);
-            runs.push(OptimizerRun {
-                optimizer: "cma-es",
-                run: r as u32,
-                evaluations: cm.evaluations as u64,
-                best_cost_pct: cm.best_cost,
-                estimate: None,
-            });
+            runs.push(cmaes_baseline(
+                problem,
+                report.evaluations,
+                s.ica.seed + r as u64,
+                r,
+            ));
         }
         if best.as_ref().is_none_or(|b| report.best_cost < b.0) {
             best = Some((report.best_cost, report.best_x.clone()));
@@ -186,6 +167,45 @@ pub fn calibrate_sample(
         runs,
         evaluations,
     })
+}
+
+/// Every country of a decade `ev` of ICA run `r`, with its cost and the evaluation behind it.
+fn record_decade(
+    problem: &Problem,
+    r: usize,
+    ev: &DecadeEvent<'_>,
+    evaluations: &mut Vec<EvaluatedCountry>,
+) {
+    for (k, e) in ev.empires.iter().enumerate() {
+        for c in std::iter::once(&e.imperialist).chain(&e.colonies) {
+            evaluations.push(EvaluatedCountry {
+                run: r as u32,
+                decade: ev.decade as u32,
+                empire: k as u32,
+                cost_pct: c.cost,
+                params: problem.bounds.decode(&c.x),
+                evaluation: problem.lookup(&c.x),
+            });
+        }
+    }
+}
+
+/// CMA-ES with ICA run `r`'s budget on a fresh cache (a baseline for the comparison table).
+fn cmaes_baseline(problem: &Problem, budget: usize, seed: u64, r: usize) -> OptimizerRun {
+    let fresh = problem.fresh();
+    let cm = Cmaes {
+        dim: 5,
+        budget,
+        seed,
+    }
+    .minimize(&|u: &[f64]| fresh.cost(u), None);
+    OptimizerRun {
+        optimizer: "cma-es",
+        run: r as u32,
+        evaluations: cm.evaluations as u64,
+        best_cost_pct: cm.best_cost,
+        estimate: None,
+    }
 }
 
 /// The calibration by gradients ([`Problem::run_lm`]) as one optimizer run: on its own problem

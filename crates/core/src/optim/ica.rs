@@ -330,7 +330,6 @@ fn promote_best_colony(e: &mut Empire) {
     }
 }
 
-
 /// The first empires (Atashpaz-Gargari & Lucas 2007): the colonies shared among the imperialists
 /// by normalised power (the best cost's distance from the worst), the rounding remainder to the
 /// strongest.
