@@ -34,6 +34,18 @@ pub enum Noise {
 }
 
 impl Noise {
+    /// δ: the rise of the squared cost that this noise explains at the optimum `best_u` (the
+    /// residual's share per degree of freedom of the fit, or the given noise's square).
+    fn cost_rise(self, problem: &Problem, best_u: &[f64]) -> f64 {
+        let c0 = problem.cost(best_u);
+        let dof = (5 * problem.measured.len()).saturating_sub(2).max(1) as f64;
+        match self {
+            Noise::Given(n) => n * n,
+            Noise::FromResidual => 4.0 * c0 * c0 / dof,
+            Noise::ResidualPlusSystematic(s) => 4.0 * c0 * c0 / dof + 4.0 * s * s,
+        }
+    }
+
     /// The noise model for `measured` edges: a `given` bound if any; else the residual, with the
     /// edges' systematic part (their RMS) when `systematic` and every edge carries one.
     pub fn for_edges(given: Option<f64>, measured: &[EdgeFit], systematic: bool) -> Noise {
@@ -92,32 +104,12 @@ pub fn identifiability(
     let offsets: Vec<f64> = (0..steps)
         .map(|k| -window + 2.0 * window * k as f64 / (steps - 1) as f64)
         .collect();
-    // Squared costs at best_u moved by `t` along `dims` (clamped to the box); failed drapes left out.
-    let sample = |dims: &[usize], grid: Vec<Vec<f64>>| -> Vec<(Vec<f64>, f64)> {
-        grid.into_iter()
-            .filter_map(|t| {
-                let mut u = best_u.to_vec();
-                let mut moved = Vec::with_capacity(dims.len());
-                for (&d, &td) in dims.iter().zip(&t) {
-                    u[d] = (best_u[d] + td).clamp(0.0, 1.0);
-                    moved.push(u[d] - best_u[d]);
-                }
-                let c = problem.cost(&u);
-                (c < problem.penalty).then_some((moved, c * c))
-            })
-            .collect()
-    };
+    let sample = |dims: &[usize], grid: Vec<Vec<f64>>| sample_costs(problem, best_u, dims, grid);
     let mut half_widths = [f64::INFINITY; 4];
     let joint = [0usize, 3];
     // Per axis, a step over which the cost rises by a few times the noise: the quadratic model holds
     // there, and the fit sees curvature rather than round-off.
-    let c0 = problem.cost(best_u);
-    let dof = (5 * problem.measured.len()).saturating_sub(2).max(1) as f64;
-    let delta = match noise {
-        Noise::Given(n) => n * n,
-        Noise::FromResidual => 4.0 * c0 * c0 / dof,
-        Noise::ResidualPlusSystematic(s) => 4.0 * c0 * c0 / dof + 4.0 * s * s,
-    };
+    let delta = noise.cost_rise(problem, best_u);
     let noise_pct = 0.5 * delta.sqrt();
     let reach: Vec<f64> = joint
         .iter()
@@ -152,6 +144,28 @@ pub fn identifiability(
         .collect();
     out.push(topology_identifiability(problem, best_u, delta));
     out
+}
+
+/// Squared costs at `best_u` moved by each `t` of `grid` along `dims` (clamped to the box), with the
+/// moves; failed drapes left out.
+fn sample_costs(
+    problem: &Problem,
+    best_u: &[f64],
+    dims: &[usize],
+    grid: Vec<Vec<f64>>,
+) -> Vec<(Vec<f64>, f64)> {
+    grid.into_iter()
+        .filter_map(|t| {
+            let mut u = best_u.to_vec();
+            let mut moved = Vec::with_capacity(dims.len());
+            for (&d, &td) in dims.iter().zip(&t) {
+                u[d] = (best_u[d] + td).clamp(0.0, 1.0);
+                moved.push(u[d] - best_u[d]);
+            }
+            let c = problem.cost(&u);
+            (c < problem.penalty).then_some((moved, c * c))
+        })
+        .collect()
 }
 
 /// The topology is identified when every other topology (the best point otherwise) costs more than
