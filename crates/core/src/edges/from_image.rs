@@ -3,7 +3,7 @@
 //! grey levels of the boundary pixels, convert to cm relative to the reference line through the two
 //! fixed corners, and fit polynomials. Bad images are [`InputError`]s naming the file.
 
-use super::segment::{EDGE_WINDOW, is_marker, segment};
+use super::segment::{EDGE_WINDOW, Segmented, is_marker, segment};
 use super::{EdgeFit, View};
 use crate::error::InputError;
 use image::{Rgb, RgbImage};
@@ -184,8 +184,6 @@ pub fn fit_image(
     let (w, h) = img.dimensions();
     let (corners, s, guard) = calibrate(img, opts, file)?;
     let seg = segment(img, file)?;
-    let at = |u: u32, v: u32| seg.at(u, v);
-    let fabric = seg.fabric;
     let mask = |u: i64, v: i64| {
         u >= 0 && v >= 0 && u < w as i64 && v < h as i64 && seg.fabric_at(u as u32, v as u32)
     };
@@ -203,29 +201,8 @@ pub fn fit_image(
     };
     let span_cm = len / s;
     let (u_lo, u_hi) = ((c0.0 + guard).ceil() as i64, (c1.0 - guard).floor() as i64);
-    let grey = |u: i64, v: i64| {
-        (u >= 0 && v >= 0 && u < w as i64 && v < h as i64).then(|| at(u as u32, v as u32))
-    };
-    // The boundary along one line of pixels `px(k)`, k in 0..len: the last (or first) fabric pixel
-    // that has a fabric neighbour on the line, refined to sub-pixel ([`subpixel_edge`]).
-    let trace = |len: i64, px: &dyn Fn(i64) -> (i64, i64), last: bool| -> Option<f64> {
-        let fab = |k: i64| {
-            let (u, v) = px(k);
-            mask(u, v)
-        };
-        let mut hits = (0..len).filter(|&k| fab(k) && (fab(k + 1) || fab(k - 1)));
-        let kb = if last { hits.next_back() } else { hits.next() }?;
-        let line = |k: i64| {
-            let (u, v) = px(k);
-            grey(u, v).map(|g| (g, seg.background_at(u, v)))
-        };
-        Some(subpixel_edge(
-            &line,
-            &fab,
-            kb,
-            if last { 1 } else { -1 },
-            fabric,
-        ))
+    let trace = |len: i64, px: &dyn Fn(i64) -> (i64, i64), last: bool| {
+        trace_edge(&seg, (w, h), len, px, last)
     };
     let mut edges = Vec::new();
     let mut points_cm = Vec::new();
@@ -269,6 +246,36 @@ pub fn fit_image(
         corners,
         px_per_cm: s,
     })
+}
+
+/// The boundary along one line of pixels `px(k)`, k in 0..len, of a `(w, h)` photo segmented as
+/// `seg`: the last (or first) fabric pixel that has a fabric neighbour on the line, refined to
+/// sub-pixel ([`subpixel_edge`]).
+fn trace_edge(
+    seg: &Segmented,
+    (w, h): (u32, u32),
+    len: i64,
+    px: &dyn Fn(i64) -> (i64, i64),
+    last: bool,
+) -> Option<f64> {
+    let inside = |u: i64, v: i64| u >= 0 && v >= 0 && u < w as i64 && v < h as i64;
+    let fab = |k: i64| {
+        let (u, v) = px(k);
+        inside(u, v) && seg.fabric_at(u as u32, v as u32)
+    };
+    let mut hits = (0..len).filter(|&k| fab(k) && (fab(k + 1) || fab(k - 1)));
+    let kb = if last { hits.next_back() } else { hits.next() }?;
+    let line = |k: i64| {
+        let (u, v) = px(k);
+        inside(u, v).then(|| (seg.at(u as u32, v as u32), seg.background_at(u, v)))
+    };
+    Some(subpixel_edge(
+        &line,
+        &fab,
+        kb,
+        if last { 1 } else { -1 },
+        seg.fabric,
+    ))
 }
 
 /// Refuses a calibration whose corners the fabric does not touch (within the guard and 3 px).
