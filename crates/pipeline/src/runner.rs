@@ -35,6 +35,16 @@ pub struct RunOptions {
     pub wait: LockWait,
 }
 
+impl RunOptions {
+    /// The stages' worker threads: `jobs`, or every core when 0.
+    fn threads(&self) -> usize {
+        match self.jobs {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n,
+        }
+    }
+}
+
 /// What a run did.
 #[derive(Debug, Clone, Default)]
 pub struct RunSummary {
@@ -68,9 +78,7 @@ fn check_stage_names(plan: &Plan, opts: &RunOptions) -> Result<(), InputError> {
 pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> Result<RunSummary> {
     check_stage_names(plan, opts)?;
     let mut settings = plan.executor.clone();
-    if let Some(kind) = opts.executor {
-        settings.kind = kind;
-    }
+    settings.kind = opts.executor.unwrap_or(settings.kind);
     if settings.kind == ExecutorKind::Slurm && !opts.dry_run {
         crate::slurm::preflight(&settings, &plan.file)?;
     }
@@ -92,14 +100,9 @@ pub fn run_pipeline(plan: &Plan, opts: &RunOptions, progress: &dyn Progress) -> 
         .iter()
         .flat_map(|f| plan.descendants(f))
         .collect();
-    let jobs = if opts.jobs == 0 {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    } else {
-        opts.jobs
-    };
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads())
+        .build()?;
     let mut summary = RunSummary::default();
     let mut will_run: BTreeSet<String> = BTreeSet::new();
     for s in plan.stages.iter().filter(|s| selected.contains(&s.name)) {
