@@ -172,20 +172,10 @@ pub fn run(ctx: &Job<'_>, p: &PeersParams) -> Result<()> {
     }
     for &n in &p.explicit_sizes {
         let peer = run_py(&explicit, &[n.to_string(), p.explicit_steps.to_string()])?;
-        let mut s = bench_scene(&scene, n, SolverKind::ExplicitEuler, 1e-30);
-        // A fixed number of steps at half the stability limit: stop by time, not by convergence.
-        let built = drapelab_core::build::build_scene(&s.clone().validated()?);
-        let dt = 0.5
-            * drapelab_core::solve::stability_limit_dt(
-                &built.model,
-                &built.x0,
-                drapelab_core::solve::Integrator::ExplicitEuler,
-                built.model.damping_Ns_per_m,
-            )
-            .unwrap_or(1e-4);
-        s.solver.dynamic.auto_dt_fraction = 0.0;
-        s.solver.dynamic.dt_s = dt;
-        s.solver.dynamic.max_time_s = dt * p.explicit_steps as f64;
+        let s = fixed_steps(
+            bench_scene(&scene, n, SolverKind::ExplicitEuler, 1e-30),
+            p.explicit_steps,
+        )?;
         let sol = solve_scene(&s, &mut NoObserver);
         let steps = sol.report.iterations.max(1) as f64;
         rows.push((
@@ -212,4 +202,22 @@ pub fn run(ctx: &Job<'_>, p: &PeersParams) -> Result<()> {
         })
         .collect();
     write_table(ctx.output("table")?, &rows)
+}
+
+/// An explicit scene that takes `steps` steps at half its stability limit: it stops by time, not
+/// by convergence.
+fn fixed_steps(mut s: Scene, steps: usize) -> Result<Scene> {
+    let built = drapelab_core::build::build_scene(&s.clone().validated()?);
+    let dt = 0.5
+        * drapelab_core::solve::stability_limit_dt(
+            &built.model,
+            &built.x0,
+            drapelab_core::solve::Integrator::ExplicitEuler,
+            built.model.damping_Ns_per_m,
+        )
+        .unwrap_or(1e-4);
+    s.solver.dynamic.auto_dt_fraction = 0.0;
+    s.solver.dynamic.dt_s = dt;
+    s.solver.dynamic.max_time_s = dt * steps as f64;
+    Ok(s)
 }
