@@ -186,25 +186,7 @@ pub fn run(ctx: &Job<'_>, p: &ReportParams) -> Result<()> {
     let mut lf = scan_all(ctx.input_files("tables"))?;
     check_schema(ctx, &mut lf, p)?;
     let group: Vec<Expr> = p.group_by.iter().map(|c| col(c.as_str())).collect();
-    let mut aggs = vec![
-        len().alias("points"),
-        col("status")
-            .eq(lit(drapelab_core::solve::Status::Converged.as_str()))
-            .sum()
-            .alias("converged"),
-    ];
-    if p.timings {
-        aggs.push(
-            (col("wall_time_s") * lit(1000.0))
-                .mean()
-                .alias("mean_wall_time_ms"),
-        );
-    }
-    aggs.extend([
-        col("iterations").mean().alias("mean_iterations"),
-        col(p.y.as_str()).min().alias(format!("min_{}", p.y)),
-        col(p.y.as_str()).max().alias(format!("max_{}", p.y)),
-    ]);
+    let aggs = summary_columns(p);
     let summary = lf
         .clone()
         .group_by(group.clone())
@@ -259,6 +241,31 @@ pub fn run(ctx: &Job<'_>, p: &ReportParams) -> Result<()> {
     write_text(md, &text)?;
     ctx.item_done();
     Ok(())
+}
+
+/// The summary's columns per group: points, converged, the mean wall time (with `timings`), the
+/// mean iterations and the y column's range.
+fn summary_columns(p: &ReportParams) -> Vec<Expr> {
+    let mut aggs = vec![
+        len().alias("points"),
+        col("status")
+            .eq(lit(drapelab_core::solve::Status::Converged.as_str()))
+            .sum()
+            .alias("converged"),
+    ];
+    if p.timings {
+        aggs.push(
+            (col("wall_time_s") * lit(1000.0))
+                .mean()
+                .alias("mean_wall_time_ms"),
+        );
+    }
+    aggs.extend([
+        col("iterations").mean().alias("mean_iterations"),
+        col(p.y.as_str()).min().alias(format!("min_{}", p.y)),
+        col(p.y.as_str()).max().alias(format!("max_{}", p.y)),
+    ]);
+    aggs
 }
 
 /// The plot's points by panel (facet value) and line (series values), from the columns `__x`,
