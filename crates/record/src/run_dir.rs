@@ -3,8 +3,9 @@
 
 use crate::{RerunRecorder, Sampled, TimelineRecorder, write_particles};
 use anyhow::{Context, Result};
-use drapelab_core::atomic::write_atomic;
 use drapelab_core::build::{BuiltScene, build_scene};
+use drapelab_core::cloth::Grid;
+use drapelab_core::physics::Model;
 use drapelab_core::scene::{LoadedScene, Scene};
 use drapelab_core::simulate::{solve_model, solve_model_warm};
 use drapelab_core::solve::{Observer, Observers, SolveReport, StateEvent, Status, StopReason};
@@ -83,6 +84,19 @@ pub struct SimulateExtras {
     pub start: Option<(Vec<nalgebra::Vector3<f64>>, String)>,
     /// Also write the converged drape as `drape.obj` (`simulate --obj`).
     pub obj: bool,
+}
+
+impl SimulateExtras {
+    /// Copies the given start into `x` when it has one position per particle of `x`; whether it did.
+    fn start_into(&self, x: &mut [nalgebra::Vector3<f64>]) -> bool {
+        match &self.start {
+            Some((start, _)) if start.len() == x.len() => {
+                x.copy_from_slice(start);
+                true
+            }
+            _ => false,
+        }
+    }
 }
 
 /// Solves `loaded` and writes its outputs into `out` (created if needed). Returns the report; a
@@ -229,34 +243,22 @@ fn simulate_into(
     let absent = drapelab_core::build::absent_particles(scene, &x0);
     let (mut timeline, mut rrd) = recorders(scene, out, &grid, &model, &x0)?;
     let mut x = x0;
-    let warm = match &extras.start {
-        Some((start, _)) if start.len() == grid.len() => {
-            x[..grid.len()].copy_from_slice(start);
-            true
-        }
-        _ => false,
-    };
-    let mut history = crate::History::every(match scene.solver.kind.integrator() {
-        Some(_) => scene.solver.dynamic.check_every,
-        None => 1,
-    });
-    let report = {
-        let mut obs: Vec<&mut dyn Observer> = vec![progress, &mut history];
-        if let Some(t) = timeline.as_mut() {
-            obs.push(t);
-        }
-        if let Some(r) = rrd.as_mut() {
-            obs.push(r);
-        }
-        let obs = &mut Observers(obs);
-        let mut r = if warm {
-            solve_model_warm(scene, &grid, &mut model, &mut x, obs)
-        } else {
-            solve_model(scene, &grid, &mut model, &mut x, obs)
-        };
-        drapelab_core::simulate::check_crossings(scene, &grid, &model, &x, &mut r);
-        r
-    };
+    let warm = extras.start_into(&mut x[..grid.len()]);
+    let every = scene
+        .solver
+        .kind
+        .integrator()
+        .map_or(1, |_| scene.solver.dynamic.check_every);
+    let mut history = crate::History::every(every);
+    let mut obs: Vec<&mut dyn Observer> = vec![progress, &mut history];
+    obs.extend(timeline.as_mut().map(|t| t as &mut dyn Observer));
+    obs.extend(rrd.as_mut().map(|r| r as &mut dyn Observer));
+    let report = observed_solve(
+        scene,
+        (&grid, &mut model, &mut x),
+        warm,
+        &mut Observers(obs),
+    );
     let mut outputs = vec!["run.json", "iterations.parquet"];
     history.write(&out.join("iterations.parquet"))?;
     finish_recorders(&report, &x, (timeline, rrd), &mut outputs)?;
@@ -286,13 +288,11 @@ fn simulate_into(
         start_file: extras.start.as_ref().map(|s| s.1.clone()),
         scene,
     };
-    let json = serde_json::to_string_pretty(&record)?;
     let written = record.outputs.clone();
-    write_atomic(&out.join("run.json"), |f| {
-        use std::io::Write;
-        f.write_all(json.as_bytes())?;
-        Ok(())
-    })?;
+    crate::write_text(
+        &out.join("run.json"),
+        &serde_json::to_string_pretty(&record)?,
+    )?;
     Ok((
         Simulated {
             report,
@@ -303,6 +303,23 @@ fn simulate_into(
         },
         written,
     ))
+}
+
+/// Solves `scene`'s model from `x` (warm: from a given start) under the observers, then checks that
+/// the sheet does not pass through itself.
+fn observed_solve(
+    scene: &Scene,
+    (grid, model, x): (&Grid, &mut Model, &mut [nalgebra::Vector3<f64>]),
+    warm: bool,
+    obs: &mut Observers<'_>,
+) -> SolveReport {
+    let mut r = if warm {
+        solve_model_warm(scene, grid, model, x, obs)
+    } else {
+        solve_model(scene, grid, model, x, obs)
+    };
+    drapelab_core::simulate::check_crossings(scene, grid, model, x, &mut r);
+    r
 }
 
 /// The final state: `particles.parquet` of a converged drape, else `last_state.parquet` of a
