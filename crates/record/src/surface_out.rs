@@ -60,35 +60,14 @@ pub fn glb_bytes(surface: &TexturedSurface<'_>) -> Result<Vec<u8>> {
         st.len() == mesh.positions.len(),
         "one texture coordinate per vertex"
     );
-    let f32s = |v: &mut Vec<u8>, xs: &[f32]| {
-        xs.iter()
-            .for_each(|x| v.extend_from_slice(&x.to_le_bytes()))
-    };
-    let (mut pos, mut nor, mut tex, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
-        let q = y_up(p);
-        for c in 0..3 {
-            lo[c] = lo[c].min(q[c]);
-            hi[c] = hi[c].max(q[c]);
-        }
-        f32s(&mut pos, &q);
-        let m = y_up(n);
-        let len = m
-            .iter()
-            .map(|c| c * c)
-            .sum::<f32>()
-            .sqrt()
-            .max(f32::MIN_POSITIVE);
-        f32s(&mut nor, &m.map(|c| c / len));
-    }
-    for s in st {
-        f32s(&mut tex, &[s[0] as f32, s[1] as f32]);
-    }
-    for t in &mesh.triangles {
-        t.iter()
-            .for_each(|k| idx.extend_from_slice(&k.to_le_bytes()));
-    }
+    let Attributes {
+        pos,
+        nor,
+        tex,
+        idx,
+        lo,
+        hi,
+    } = attributes(mesh, st);
     let png = png_bytes(texture)?;
     let mut bin = Vec::new();
     let views: Vec<(usize, usize)> = [&pos, &nor, &tex, &idx, &png]
@@ -135,6 +114,58 @@ pub fn glb_bytes(surface: &TexturedSurface<'_>) -> Result<Vec<u8>> {
         "buffers": [{"byteLength": bin.len()}],
     });
     glb_container(&serde_json::to_vec(&doc)?, &bin)
+}
+
+/// The vertex attributes of a glTF mesh as little-endian bytes (positions and unit normals turned
+/// y-up, texture coordinates, triangle indices) with the positions' bounds.
+struct Attributes {
+    pos: Vec<u8>,
+    nor: Vec<u8>,
+    tex: Vec<u8>,
+    idx: Vec<u8>,
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+/// The [`Attributes`] of `mesh` with texture coordinates `st`.
+fn attributes(mesh: &SurfaceMesh, st: &[[f64; 2]]) -> Attributes {
+    let f32s = |v: &mut Vec<u8>, xs: &[f32]| {
+        xs.iter()
+            .for_each(|x| v.extend_from_slice(&x.to_le_bytes()))
+    };
+    let (mut pos, mut nor, mut tex, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        let q = y_up(p);
+        for c in 0..3 {
+            lo[c] = lo[c].min(q[c]);
+            hi[c] = hi[c].max(q[c]);
+        }
+        f32s(&mut pos, &q);
+        let m = y_up(n);
+        let len = m
+            .iter()
+            .map(|c| c * c)
+            .sum::<f32>()
+            .sqrt()
+            .max(f32::MIN_POSITIVE);
+        f32s(&mut nor, &m.map(|c| c / len));
+    }
+    for s in st {
+        f32s(&mut tex, &[s[0] as f32, s[1] as f32]);
+    }
+    for t in &mesh.triangles {
+        t.iter()
+            .for_each(|k| idx.extend_from_slice(&k.to_le_bytes()));
+    }
+    Attributes {
+        pos,
+        nor,
+        tex,
+        idx,
+        lo,
+        hi,
+    }
 }
 
 /// The binary glTF container (glTF 2.0 §4.4): a 12-byte header, the JSON chunk padded with spaces
