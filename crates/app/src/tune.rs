@@ -9,9 +9,12 @@ use anyhow::Result;
 use drapelab_core::calibrate::{Problem, read_sample_densities, sample_scene};
 use drapelab_core::edges::EdgeFit;
 use drapelab_core::optim::{Ica, IcaSettings, l27, main_effects, sn_smaller_the_better};
-use drapelab_record::{Table, read_edges, write_atomic, write_table};
+use drapelab_record::{Table, read_edges, write_table, write_text};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+
+/// Plot panels: panel → series → (x, y) points.
+pub type Panels = BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>>;
 
 /// The seven factors of Table 1 and their three levels.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -156,7 +159,7 @@ pub fn settings(levels: &Levels, l: &[u8], seed: u64) -> IcaSettings {
 /// (level 1..3 → dB) on one panel, "main effects" (the adapter draws them).
 pub struct TuneOutcome {
     /// Panel → factor → (level, mean S/N dB).
-    pub main_effects: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>>,
+    pub main_effects: Panels,
 }
 
 /// Runs the L27 experiments and writes the tables and the best settings.
@@ -204,11 +207,24 @@ pub fn run(ctx: &Job<'_>, p: &TuneParams) -> Result<TuneOutcome> {
         .map(|e| (0..3).max_by(|&a, &b| e[a].total_cmp(&e[b])).unwrap_or(0) as u8)
         .collect();
     let best = settings(&p.levels, &best_levels, p.seed);
-    // tune.parquet
+    let table = tune_rows(&rows, &costs, &sn);
+    write_table(ctx.output("table")?, &table)?;
+    let (me, panels) = main_effect_rows(&effects);
+    write_table(ctx.output("main_effects")?, &me)?;
+    write_text(
+        ctx.output("best_ica")?,
+        &serde_json::to_string_pretty(&best)?,
+    )?;
+    Ok(TuneOutcome {
+        main_effects: panels,
+    })
+}
+
+/// tune.parquet's rows: each L27 row's levels (1–3), its runs' mean cost and its S/N ratio.
+fn tune_rows(rows: &[Vec<u8>], costs: &[f64], sn: &[f64]) -> Vec<TuneRow> {
     let level = |r: &[u8], f: usize| r[f] as u32 + 1;
-    let table: Vec<TuneRow> = rows
-        .iter()
-        .zip(costs.iter().zip(&sn))
+    rows.iter()
+        .zip(costs.iter().zip(sn))
         .enumerate()
         .map(|(k, (r, (&mean_cost_pct, &sn_db)))| TuneRow {
             row: k as u32 + 1,
@@ -222,9 +238,11 @@ pub fn run(ctx: &Job<'_>, p: &TuneParams) -> Result<TuneOutcome> {
             mean_cost_pct,
             sn_db,
         })
-        .collect();
-    write_table(ctx.output("table")?, &table)?;
-    // main_effects.parquet
+        .collect()
+}
+
+/// main_effects.parquet's rows (the mean S/N of each factor's level) and the same as plot panels.
+fn main_effect_rows(effects: &[[f64; 3]]) -> (Vec<MainEffectRow>, Panels) {
     let mut me = Vec::new();
     let mut panels: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>> = BTreeMap::new();
     for (f, e) in effects.iter().enumerate() {
@@ -243,14 +261,5 @@ pub fn run(ctx: &Job<'_>, p: &TuneParams) -> Result<TuneOutcome> {
                 .collect(),
         );
     }
-    write_table(ctx.output("main_effects")?, &me)?;
-    let json = serde_json::to_vec_pretty(&best)?;
-    write_atomic(ctx.output("best_ica")?, |f| {
-        use std::io::Write;
-        f.write_all(&json)?;
-        Ok(())
-    })?;
-    Ok(TuneOutcome {
-        main_effects: panels,
-    })
+    (me, panels)
 }
