@@ -13,8 +13,8 @@ use crate::cusick_targets::{empty_row, fill_distribution, fill_faces, fill_fit, 
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{
-    DiscMesh, DrapeParams, FabricSettings, Tester, calibrate_and_predict, height_profile,
-    polar_disc, sector_angle_rad, subdivide_disc, two_fold,
+    DiscMesh, DrapeParams, FabricSettings, SeededDrape, Tester, calibrate_and_predict,
+    height_profile, polar_disc, sector_angle_rad, subdivide_disc, two_fold,
 };
 use drapelab_core::measure::mean_sd;
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -222,27 +222,7 @@ pub fn predict_fabric(
         out.captures = capture_rows(rows, tg.calib, &faces);
     }
     let drapes = outcome.drapes;
-    // The warp: the two-fold maximum of the calibration specimen's face-up photos (turned over, the
-    // direction mirrors about an unknown axis, so the face-down ones are left out).
-    let up: Vec<Vec<f64>> = rows
-        .iter()
-        .filter(|r| r.sample == tg.calib && r.face == "up")
-        .filter_map(|r| {
-            measured
-                .photo_outlines
-                .get(&(r.fabric, r.sample, r.capture))
-                .cloned()
-        })
-        .collect();
-    if !up.is_empty() {
-        let (amp, dir) = two_fold(&up);
-        out.row.outline_two_fold_measured_m = Some(amp);
-        out.row.warp_direction_deg = Some(dir.to_degrees());
-    }
-    let sim: Vec<Vec<f64>> = drapes.iter().map(|d| d.outline_m.clone()).collect();
-    if !sim.is_empty() {
-        out.row.outline_two_fold_predicted_m = Some(two_fold(&sim).0);
-    }
+    fill_two_fold(&mut out.row, rows, measured, tg.calib, &drapes);
     if !drapes.is_empty() {
         let meas: Vec<Vec<f64>> = out
             .measured
@@ -265,6 +245,37 @@ pub fn predict_fabric(
     out.drapes = drapes.into_iter().map(|d| (d.seed, d.x)).collect();
     out.row.wall_time_s = start.elapsed().as_secs_f64();
     out
+}
+
+/// The warp: the two-fold maximum of the calibration specimen `calib`'s face-up photos (turned
+/// over, the direction mirrors about an unknown axis, so the face-down ones are left out), and the
+/// simulated drapes' two-fold amplitude.
+fn fill_two_fold(
+    row: &mut PredictionRow,
+    rows: &[&ShadowRow],
+    measured: &Measured<'_>,
+    calib: i32,
+    drapes: &[SeededDrape],
+) {
+    let up: Vec<Vec<f64>> = rows
+        .iter()
+        .filter(|r| r.sample == calib && r.face == "up")
+        .filter_map(|r| {
+            measured
+                .photo_outlines
+                .get(&(r.fabric, r.sample, r.capture))
+                .cloned()
+        })
+        .collect();
+    if !up.is_empty() {
+        let (amp, dir) = two_fold(&up);
+        row.outline_two_fold_measured_m = Some(amp);
+        row.warp_direction_deg = Some(dir.to_degrees());
+    }
+    let sim: Vec<Vec<f64>> = drapes.iter().map(|d| d.outline_m.clone()).collect();
+    if !sim.is_empty() {
+        row.outline_two_fold_predicted_m = Some(two_fold(&sim).0);
+    }
 }
 
 /// `work(k)` for every k of `order`, started in that order by as many workers as rayon has threads
