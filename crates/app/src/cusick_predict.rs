@@ -324,26 +324,11 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>>
     let index = ctx.input("index")?;
     let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
     let shadows = read_table::<ShadowRow>(ctx.input("shadows")?)?;
-    let mut photo_outlines: BTreeMap<CaptureKey, Vec<f64>> = BTreeMap::new();
-    for o in read_table::<OutlineRow>(ctx.input("photo_outlines")?)? {
-        if let (Some(sample), Some(capture)) = (o.sample, o.capture) {
-            // Rows come in sector order per capture.
-            photo_outlines
-                .entry((o.fabric, sample, capture))
-                .or_default()
-                .push(o.radius_m);
-        }
-    }
+    let photo_outlines =
+        outlines_by_capture(read_table::<OutlineRow>(ctx.input("photo_outlines")?)?);
     let template = data.template()?;
     let meshes = data.meshes()?;
-    let radius = Tester::default().specimen_radius_m;
-    let mut model_mesh = match p.polar_rings {
-        0 => (template.rest_xy.clone(), template.triangles.clone()),
-        rings => polar_disc(radius, rings),
-    };
-    for _ in 0..p.subdivisions {
-        model_mesh = subdivide_disc(&model_mesh.0, &model_mesh.1, radius);
-    }
+    let model_mesh = model_mesh(&template, p);
     let measured = Measured {
         template: &template,
         meshes: &meshes,
@@ -414,4 +399,31 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>>
         &overlay,
     )?;
     Ok(rows)
+}
+
+/// Each capture's photographed outline radii, m, in sector order (rows come in that order).
+fn outlines_by_capture(rows: Vec<OutlineRow>) -> BTreeMap<CaptureKey, Vec<f64>> {
+    let mut out: BTreeMap<CaptureKey, Vec<f64>> = BTreeMap::new();
+    for o in rows {
+        if let (Some(sample), Some(capture)) = (o.sample, o.capture) {
+            out.entry((o.fabric, sample, capture))
+                .or_default()
+                .push(o.radius_m);
+        }
+    }
+    out
+}
+
+/// The disc the drapes are solved on: the template's mesh, or a polar disc of `polar_rings`
+/// rings, subdivided `subdivisions` times (rest positions, triangles).
+fn model_mesh(template: &Template, p: &CusickPredictParams) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
+    let radius = Tester::default().specimen_radius_m;
+    let mut mesh = match p.polar_rings {
+        0 => (template.rest_xy.clone(), template.triangles.clone()),
+        rings => polar_disc(radius, rings),
+    };
+    for _ in 0..p.subdivisions {
+        mesh = subdivide_disc(&mesh.0, &mesh.1, radius);
+    }
+    mesh
 }
