@@ -2,7 +2,7 @@
 //! depend only on crates below them, the core crate pulls in no I/O stack (not even transitively)
 //! and the application layer no report stack, no module of the core imports a module above it, no
 //! crate's modules import each other in a cycle, a stage file is an adapter (at most 100 lines of
-//! code), and no function outside tests runs over 100 lines.
+//! code), no function outside tests runs over 80 lines and no source file over 500 before its tests.
 
 use crate::support::root;
 use std::collections::BTreeMap;
@@ -436,16 +436,22 @@ fn long_functions(text: &str, limit: usize) -> Vec<(String, usize)> {
     out
 }
 
-#[test]
-fn no_function_is_over_100_lines() {
+/// The library and binary sources: every `.rs` under `crates/` and `src/` outside a `tests/` folder.
+fn source_files() -> Vec<std::path::PathBuf> {
     let mut files = Vec::new();
     for dir in ["crates", "src"] {
         rust_files(&root().join(dir), &mut files);
     }
+    files.retain(|f| !f.components().any(|c| c.as_os_str() == "tests"));
+    files
+}
+
+#[test]
+fn no_function_is_over_80_lines() {
     let mut long = Vec::new();
-    for f in &files {
+    for f in &source_files() {
         let text = std::fs::read_to_string(f).unwrap();
-        for (name, len) in long_functions(&text, 100) {
+        for (name, len) in long_functions(&text, 80) {
             long.push(format!(
                 "{}: {name} ({len} lines)",
                 f.strip_prefix(root()).unwrap().display()
@@ -454,9 +460,42 @@ fn no_function_is_over_100_lines() {
     }
     assert!(
         long.is_empty(),
-        "functions over 100 lines:\n{}",
+        "functions over 80 lines (split out a step with a name of its own):\n{}",
         long.join("\n")
     );
+}
+
+/// Lines of a Rust file before its `#[cfg(test)]` module (all of them without one).
+fn lines_before_tests(text: &str) -> usize {
+    text.lines()
+        .position(|l| l.trim_start().starts_with("#[cfg(test)]"))
+        .unwrap_or_else(|| text.lines().count())
+}
+
+#[test]
+fn no_source_file_is_over_500_lines_before_its_tests() {
+    let long: Vec<String> = source_files()
+        .iter()
+        .filter_map(|f| {
+            let n = lines_before_tests(&std::fs::read_to_string(f).unwrap());
+            (n > 500).then(|| format!("{}: {n} lines", f.strip_prefix(root()).unwrap().display()))
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "source files over 500 lines before their tests (one concept per module: split one out):\n{}",
+        long.join("\n")
+    );
+}
+
+#[test]
+fn the_file_length_check_counts_up_to_the_tests() {
+    let text = format!(
+        "{}#[cfg(test)]\nmod tests {{}}\n",
+        "fn f() {}\n".repeat(501)
+    );
+    assert_eq!(lines_before_tests(&text), 501);
+    assert_eq!(lines_before_tests("fn f() {}\n"), 1);
 }
 
 #[test]

@@ -15,124 +15,12 @@
 
 use super::dynamic_options::{DynamicOptions, Integrator};
 use super::incremental::{ImplicitSettings, Settle, integrate_implicit, observe_start};
+use super::stability::{kinetic_energy, stability_limit_dt};
 use super::time_step::Stepper;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
-use crate::physics::{HessianBlocks, Model};
+use crate::physics::Model;
 use nalgebra::Vector3;
 use std::time::Instant;
-
-/// The highest natural frequency ω_max (rad/s) at `x` and the effective mass (kg) of its mode, by
-/// power iteration on M^{-1/2} K M^{-1/2} with the projected Hessian K (60 iterations from a fixed
-/// start; a lower bound that converges to ω_max).
-pub fn highest_mode(model: &Model, x: &[Vector3<f64>]) -> (f64, f64) {
-    let mut h = HessianBlocks::default();
-    model.hessian(x, &mut h, true);
-    let n = model.len();
-    let free: Vec<bool> = model
-        .fixed
-        .iter()
-        .zip(&model.masses)
-        .map(|(f, m)| !f && *m > 0.0)
-        .collect();
-    let inv_sqrt_m: Vec<f64> = model
-        .masses
-        .iter()
-        .zip(&free)
-        .map(|(m, f)| if *f { 1.0 / m.sqrt() } else { 0.0 })
-        .collect();
-    // A deterministic, non-symmetric start so that every mode is present.
-    let mut v: Vec<Vector3<f64>> = (0..n)
-        .map(|p| {
-            let t = p as f64;
-            Vector3::new(
-                (1.3 * t).sin() + 0.1,
-                (2.1 * t + 0.4).cos(),
-                (0.7 * t + 1.1).sin(),
-            ) * if free[p] { 1.0 } else { 0.0 }
-        })
-        .collect();
-    let mut lambda = 0.0;
-    let mut tmp = vec![Vector3::zeros(); n];
-    let mut out = vec![Vector3::zeros(); n];
-    for _ in 0..60 {
-        let norm = v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
-        if norm == 0.0 {
-            return (0.0, 0.0);
-        }
-        for p in 0..n {
-            v[p] /= norm;
-            tmp[p] = v[p] * inv_sqrt_m[p];
-        }
-        out.iter_mut().for_each(|o| *o = Vector3::zeros());
-        h.mul_add(&tmp, &mut out);
-        for p in 0..n {
-            out[p] *= inv_sqrt_m[p];
-        }
-        lambda = v.iter().zip(&out).map(|(a, b)| a.dot(b)).sum::<f64>();
-        std::mem::swap(&mut v, &mut out);
-    }
-    let (mut num, mut den) = (0.0, 0.0);
-    for p in 0..n {
-        if free[p] {
-            let w = v[p].norm_squared();
-            num += w * model.masses[p];
-            den += w;
-        }
-    }
-    (
-        lambda.max(0.0).sqrt(),
-        if den > 0.0 { num / den } else { 0.0 },
-    )
-}
-
-/// The largest stable time step of an explicit integrator at `x`, from the highest mode
-/// ([`highest_mode`]): symplectic Euler needs Δt < (√(γ² + 4ω²) − γ)/ω² with γ = c/m (2/ω without
-/// damping); forward Euler with damping c needs
-/// |1 + Δt λ| < 1 for λ = −c/2m ± iω√(1 − ζ²), i.e. Δt < c/(m ω²) when underdamped and
-/// Δt < 2/|λ_fast| when overdamped; without damping it is unstable at any Δt (0 is returned).
-/// None for implicit Euler (unconditionally stable).
-pub fn stability_limit_dt(
-    model: &Model,
-    x: &[Vector3<f64>],
-    integrator: Integrator,
-    damping_Ns_per_m: f64,
-) -> Option<f64> {
-    if matches!(
-        integrator,
-        Integrator::ImplicitEuler | Integrator::BaraffWitkin
-    ) {
-        return None;
-    }
-    let (w, m) = highest_mode(model, x);
-    if w <= 0.0 || m <= 0.0 {
-        return Some(f64::INFINITY);
-    }
-    let c = damping_Ns_per_m;
-    Some(match integrator {
-        // v' = v + Δt(−ω²x − γv), x' = x + Δt v' (γ = c/m) is stable for Δt²ω² + 2Δtγ < 4, i.e.
-        // Δt < (√(γ² + 4ω²) − γ)/ω²: 2/ω undamped, 2/γ when damping dominates.
-        Integrator::SymplecticEuler => {
-            let g = c / m;
-            ((g * g + 4.0 * w * w).sqrt() - g) / (w * w)
-        }
-        _ if c <= 0.0 => 0.0,
-        _ if c < 2.0 * m * w => c / (m * w * w),
-        _ => {
-            let fast = c / (2.0 * m) * (1.0 + (1.0 - 4.0 * m * m * w * w / (c * c)).sqrt());
-            2.0 / fast
-        }
-    })
-}
-
-/// Kinetic energy in J.
-pub fn kinetic_energy(model: &Model, v: &[Vector3<f64>]) -> f64 {
-    model
-        .masses
-        .iter()
-        .zip(v)
-        .map(|(m, vi)| 0.5 * m * vi.norm_squared())
-        .sum()
-}
 
 /// Integrates from rest at `x` (updated in place) until equilibrium, divergence or the time limit.
 /// `v` holds the velocities (in: initial, out: final).
@@ -150,11 +38,7 @@ pub fn solve_dynamic(
     let model = &*model;
     let start = Instant::now();
     let n = model.len();
-    let c = if opts.damping {
-        model.damping_Ns_per_m
-    } else {
-        0.0
-    };
+    let c = viscous_damping(model, opts);
     let dt = fixed_dt(model, x, integrator, c, opts);
     let free: Vec<bool> = model.fixed.iter().map(|f| !f).collect();
     let w_ref = model.reference_weight();
@@ -172,11 +56,7 @@ pub fn solve_dynamic(
         return report;
     }
     let limits = Limits::new(model, x, v, opts, dt, start);
-    for (vi, f) in v.iter_mut().zip(&free) {
-        if !f {
-            *vi = Vector3::zeros();
-        }
-    }
+    hold_fixed(model, v);
     let mut stepper = Stepper::new(model, integrator, x, c, dt, free);
     let mut g = Vec::with_capacity(n);
     let check = opts.check_every.max(1);
@@ -250,14 +130,37 @@ fn finish(
     start: Instant,
     report: &mut SolveReport,
 ) {
-    let mut g = Vec::with_capacity(model.len());
-    model.gradient(x, 1.0, &mut g);
     report.iterations = steps;
     report.sim_time_s = Some(steps as f64 * dt);
+    final_state(model, x, start, report);
+}
+
+/// The report's final residual, energy and wall time at `x`.
+fn final_state(model: &Model, x: &[Vector3<f64>], start: Instant, report: &mut SolveReport) {
+    let mut g = Vec::with_capacity(model.len());
+    model.gradient(x, 1.0, &mut g);
     report.max_residual_N = model.max_residual(&g);
     report.max_residual_rel = report.max_residual_N / model.reference_weight();
     report.energy_J = model.energy(x, 1.0);
     report.wall_time_s = start.elapsed().as_secs_f64();
+}
+
+/// The viscous damping coefficient c of the integration, N·s/m (0 without damping).
+fn viscous_damping(model: &Model, opts: &DynamicOptions) -> f64 {
+    if opts.damping {
+        model.damping_Ns_per_m
+    } else {
+        0.0
+    }
+}
+
+/// Zero velocity on the fixed particles.
+fn hold_fixed(model: &Model, v: &mut [Vector3<f64>]) {
+    for (vi, f) in v.iter_mut().zip(&model.fixed) {
+        if *f {
+            *vi = Vector3::zeros();
+        }
+    }
 }
 
 /// Implicit Euler as an optimisation ([`integrate_implicit`]) with the options' steps, damping and
@@ -284,34 +187,8 @@ fn solve_implicit(
         report.stop_with(StopReason::Invalid, "nothing free to integrate, or time steps that are not 0 < min_dt_s ≤ max_dt_s, dt_s > 0");
         return report;
     }
-    for (vi, f) in v.iter_mut().zip(&model.fixed) {
-        if *f {
-            *vi = Vector3::zeros();
-        }
-    }
-    let c = if opts.damping {
-        model.damping_Ns_per_m
-    } else {
-        0.0
-    };
-    let (alpha, beta) = if opts.damping {
-        (opts.rayleigh_mass_per_s, opts.rayleigh_stiffness_s)
-    } else {
-        (0.0, 0.0)
-    };
-    let settings = ImplicitSettings {
-        dt_s: opts.dt_s,
-        max_dt_s: opts.max_dt_s,
-        min_dt_s: opts.min_dt_s,
-        adaptive: opts.adaptive_dt,
-        damping: (c, alpha, beta),
-        newton_iterations: opts.newton_iterations,
-        factor_reuse: opts.factor_reuse,
-        // Each step well below the settle tolerance: a step's leftover force would move a soft mode
-        // by force/stiffness every step, a speed that never settles.
-        newton_tol_rel: 1e-2 * opts.residual_tol_rel,
-        strain_bound: opts.strain_bound,
-    };
+    hold_fixed(model, v);
+    let settings = ImplicitSettings::of(opts, viscous_damping(model, opts));
     let settle = Settle {
         residual_N: opts.residual_tol_rel * w_ref,
         speed_m_per_s: opts.speed_tol_m_per_s,
@@ -336,12 +213,7 @@ fn solve_implicit(
         observer,
         &mut report,
     );
-    let mut g = Vec::new();
-    model.gradient(x, 1.0, &mut g);
-    report.max_residual_N = model.max_residual(&g);
-    report.max_residual_rel = report.max_residual_N / w_ref;
-    report.energy_J = model.energy(x, 1.0);
-    report.wall_time_s = start.elapsed().as_secs_f64();
+    final_state(model, x, start, &mut report);
     report
 }
 

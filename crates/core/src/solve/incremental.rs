@@ -11,6 +11,7 @@
 //! and are halved and retried when it does not, and land on every frame time a recorder asks for.
 
 use super::FactorReuse;
+use super::clock::{Clock, grown};
 use super::newton::StaticOptions;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
 use crate::physics::{EnergyTerm, HessianBlocks, Model, Vecs};
@@ -139,6 +140,30 @@ pub struct ImplicitSettings {
     pub strain_bound: f64,
 }
 
+impl ImplicitSettings {
+    /// The settings of `opts` with viscous damping `c` (N·s/m; Rayleigh's α and β only with damping).
+    pub fn of(opts: &super::DynamicOptions, c: f64) -> Self {
+        let (alpha, beta) = if opts.damping {
+            (opts.rayleigh_mass_per_s, opts.rayleigh_stiffness_s)
+        } else {
+            (0.0, 0.0)
+        };
+        Self {
+            dt_s: opts.dt_s,
+            max_dt_s: opts.max_dt_s,
+            min_dt_s: opts.min_dt_s,
+            adaptive: opts.adaptive_dt,
+            damping: (c, alpha, beta),
+            newton_iterations: opts.newton_iterations,
+            factor_reuse: opts.factor_reuse,
+            // Each step well below the settle tolerance: a step's leftover force would move a soft
+            // mode by force/stiffness every step, a speed that never settles.
+            newton_tol_rel: 1e-2 * opts.residual_tol_rel,
+            strain_bound: opts.strain_bound,
+        }
+    }
+}
+
 /// The outcome of one step attempt.
 enum Attempt {
     /// Accepted after this many Newton iterations.
@@ -221,20 +246,6 @@ fn step(
         x.copy_from_slice(&x_n);
         Attempt::Rejected
     }
-}
-
-/// The next step after one that took `iterations` Newton iterations (chord steps not counted: they
-/// factorize nothing): doubled when Newton converged within 6, kept up to 12, halved beyond.
-fn next_dt(h: f64, iterations: usize, s: &ImplicitSettings) -> f64 {
-    if !s.adaptive {
-        return h;
-    }
-    let f = match iterations {
-        0..=6 => 2.0,
-        7..=12 => 1.0,
-        _ => 0.5,
-    };
-    (h * f).clamp(s.min_dt_s, s.max_dt_s)
 }
 
 /// What a settled (or stopped) integration is checked against, and where it stands.
@@ -330,76 +341,6 @@ pub fn integrate_implicit(
     report.iterations = c.steps;
     report.sim_time_s = Some(c.t);
     report.dt_s = Some(if c.steps > 0 { c.largest } else { s.dt_s });
-}
-
-/// Where an integration is: its time, steps, the largest and the last step, and the frames.
-struct Clock {
-    t: f64,
-    steps: usize,
-    largest: f64,
-    last_dt: f64,
-    /// The number of the next frame (1 first).
-    frame: usize,
-    /// Whether the state is at a frame time (t = 0 is one).
-    at_frame: bool,
-}
-
-impl Default for Clock {
-    fn default() -> Self {
-        Self {
-            t: 0.0,
-            steps: 0,
-            largest: 0.0,
-            last_dt: 0.0,
-            frame: 1,
-            at_frame: true,
-        }
-    }
-}
-
-impl Clock {
-    /// An accepted step of `dt`: the time landed on the next frame time `next_frame` when it is
-    /// within round-off of it.
-    fn accept(&mut self, dt: f64, next_frame: Option<f64>) {
-        self.steps += 1;
-        self.last_dt = dt;
-        self.largest = self.largest.max(dt);
-        (self.t, self.at_frame) = advance(self.t, dt, next_frame, &mut self.frame);
-    }
-
-    /// The message of a settled state with largest residual `r` (N) and speed (m/s).
-    fn settled(&self, model: &Model, v: &[Vector3<f64>], r: f64, speed: f64) -> String {
-        format!(
-            "settled at t = {:.4} s after {} steps (largest residual {r:.2e} N, largest speed {speed:.2e} m/s, kinetic energy {:.2e} J; largest step {:.1e} s)",
-            self.t,
-            self.steps,
-            super::kinetic_energy(model, v),
-            self.largest
-        )
-    }
-}
-
-/// The time after an accepted step of `dt` from `t`, landed on the next frame time `next_frame`
-/// (counted in `frame`) when it is within round-off of it; and whether it landed.
-fn advance(t: f64, dt: f64, next_frame: Option<f64>, frame: &mut usize) -> (f64, bool) {
-    let t = t + dt;
-    match next_frame {
-        Some(tf) if (tf - t).abs() <= 1e-9 * tf.max(1.0) => {
-            *frame += 1;
-            (tf, true)
-        }
-        _ => (t, false),
-    }
-}
-
-/// The next step after an accepted step of `dt` that took `iterations` Newton iterations: a step
-/// shortened to land on a frame does not set the next one, and while `cooldown` lasts (after a
-/// rejected step) the step does not grow.
-fn grown(h: f64, dt: f64, iterations: usize, cooldown: usize, s: &ImplicitSettings) -> f64 {
-    if dt < h * (1.0 - 1e-12) {
-        return h;
-    }
-    next_dt(h, iterations, s).min(if cooldown > 0 { h } else { f64::INFINITY })
 }
 
 /// Whether a state with largest residual `r` N and speed m/s after a step of `last_dt` s has

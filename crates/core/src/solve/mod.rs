@@ -3,6 +3,7 @@
 //! Every solve returns a [`SolveReport`] with a [`Status`]; solvers never print and never panic on
 //! bad numerics. Observers ([`Observer`]) receive states and do the I/O.
 
+mod clock;
 mod continuation;
 mod dynamic;
 mod dynamic_options;
@@ -13,13 +14,14 @@ mod linear;
 mod newton;
 mod report;
 mod sag;
+mod stability;
 mod step;
 mod strategy;
 mod time_step;
 mod vertical_gap;
 
 pub use continuation::{Continuation, Stage, execute};
-pub use dynamic::{highest_mode, kinetic_energy, solve_dynamic, stability_limit_dt};
+pub use dynamic::solve_dynamic;
 pub use dynamic_options::{DynamicOptions, Integrator};
 pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
@@ -30,6 +32,7 @@ pub use report::{
     Divergence, DivergenceReason, Globalization, Part, SolveReport, Status, StopReason,
 };
 pub use sag::{folded_start, sagged_start};
+pub use stability::{highest_mode, kinetic_energy, stability_limit_dt};
 pub use strategy::{
     Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Start, Verdict,
 };
