@@ -102,7 +102,6 @@ fn tensile_springs(grid: &Grid, r: &Rigidities, absent: &[bool]) -> Springs {
 /// The continuum model on the grid: tensile springs along grid lines (k = E·w/h), cell shear (G) and
 /// quadratic bending along grid lines (k = D·w/h̄) and cell twist (D_t). A clamped edge pins its particles and adds
 /// virtual fixed points mirrored across it, so the bending term sees a zero slope at the edge.
-#[allow(clippy::needless_range_loop, clippy::too_many_arguments)] // grid loops index several parallel arrays
 pub(super) fn continuum_terms(
     grid: &Grid,
     r: &Rigidities,

@@ -139,13 +139,16 @@ pub fn fit_curl(
     Ok(fit)
 }
 
+/// Particle positions or displacements, m.
+type Positions = Vec<Vector3<f64>>;
+
 /// The curl-free drape of `flat` and its tangent dx/dκ in the curl (from the factor of its exact
 /// Hessian): where a curled face's solve starts.
 fn curl_free_tangent(
     mesh: DiscMesh<'_>,
     flat: &DrapeParams,
     tester: &Tester,
-) -> Result<(Vec<Vector3<f64>>, Vec<Vector3<f64>>), String> {
+) -> Result<(Positions, Positions), String> {
     let (report, x0, with_self) = solve_drape_from(mesh, flat, tester, None, &mut NoObserver);
     if !report.is_converged() {
         return Err(format!(
