@@ -39,6 +39,11 @@ pub mod wrinkles_tables;
 
 pub use job::{Job, Progress, Quiet};
 
+/// Points of each series (by label) on one panel of a plot, (x, y).
+pub type Lines = std::collections::BTreeMap<String, Vec<(f64, f64)>>;
+/// A plot's panels by facet value: what a workflow hands a report to draw.
+pub type Panels = std::collections::BTreeMap<String, Lines>;
+
 /// Every Parquet table drapelab writes, each traced from its row type, as the Markdown of the
 /// book's Tables page (`drapelab tables` prints it).
 pub fn tables_markdown() -> anyhow::Result<String> {

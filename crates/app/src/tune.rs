@@ -4,6 +4,7 @@
 //! Outputs: `tune.parquet` (one row per design row), `main_effects.parquet`, `best_ica.json` (the best
 //! combination, which `calibrate` reads from its `ica` input) and `main_effects.svg`.
 
+use crate::Panels;
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::calibrate::{Problem, read_sample_densities, sample_scene};
@@ -11,10 +12,6 @@ use drapelab_core::edges::EdgeFit;
 use drapelab_core::optim::{Ica, IcaSettings, l27, main_effects, sn_smaller_the_better};
 use drapelab_record::{Table, read_edges, write_table, write_text};
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
-
-/// Plot panels: panel → series → (x, y) points.
-pub type Panels = BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>>;
 
 /// The seven factors of Table 1 and their three levels.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -244,7 +241,7 @@ fn tune_rows(rows: &[Vec<u8>], costs: &[f64], sn: &[f64]) -> Vec<TuneRow> {
 /// main_effects.parquet's rows (the mean S/N of each factor's level) and the same as plot panels.
 fn main_effect_rows(effects: &[[f64; 3]]) -> (Vec<MainEffectRow>, Panels) {
     let mut me = Vec::new();
-    let mut panels: BTreeMap<String, BTreeMap<String, Vec<(f64, f64)>>> = BTreeMap::new();
+    let mut panels = Panels::new();
     for (f, e) in effects.iter().enumerate() {
         for (k, v) in e.iter().enumerate() {
             me.push(MainEffectRow {

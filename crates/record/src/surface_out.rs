@@ -60,17 +60,10 @@ pub fn glb_bytes(surface: &TexturedSurface<'_>) -> Result<Vec<u8>> {
         st.len() == mesh.positions.len(),
         "one texture coordinate per vertex"
     );
-    let Attributes {
-        pos,
-        nor,
-        tex,
-        idx,
-        lo,
-        hi,
-    } = attributes(mesh, st);
+    let a = attributes(mesh, st);
     let png = png_bytes(texture)?;
     let mut bin = Vec::new();
-    let views: Vec<(usize, usize)> = [&pos, &nor, &tex, &idx, &png]
+    let views: Vec<(usize, usize)> = [&a.pos, &a.nor, &a.tex, &a.idx, &png]
         .iter()
         .map(|b| push_view(&mut bin, b))
         .collect();
@@ -104,7 +97,7 @@ pub fn glb_bytes(surface: &TexturedSurface<'_>) -> Result<Vec<u8>> {
         "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}],
         "images": [{"bufferView": 4, "mimeType": "image/png"}],
         "accessors": [
-            {"bufferView": 0, "componentType": FLOAT, "count": n, "type": "VEC3", "min": lo, "max": hi},
+            {"bufferView": 0, "componentType": FLOAT, "count": n, "type": "VEC3", "min": a.lo, "max": a.hi},
             {"bufferView": 1, "componentType": FLOAT, "count": n, "type": "VEC3"},
             {"bufferView": 2, "componentType": FLOAT, "count": n, "type": "VEC2"},
             {"bufferView": 3, "componentType": UNSIGNED_INT, "count": mesh.triangles.len() * 3, "type": "SCALAR"},

@@ -115,10 +115,7 @@ pub fn check_schema(ctx: &Job<'_>, lf: &mut LazyFrame, p: &ReportParams) -> Resu
     Ok(())
 }
 
-/// Points of each series (by label) on one panel.
-pub type Lines = BTreeMap<String, Vec<(f64, f64)>>;
-/// Panels by facet value.
-pub type Panels = BTreeMap<String, Lines>;
+pub use drapelab_app::{Lines, Panels};
 
 /// Default of `group`: the columns a report groups by.
 pub fn default_group() -> Vec<String> {
