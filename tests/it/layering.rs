@@ -201,12 +201,17 @@ fn the_core_crate_pulls_in_no_io_stack() {
 
 /// The `crate::MODULE` paths a source file names (comments left out).
 fn crate_refs(text: &str) -> Vec<String> {
+    refs_after(text, "crate::")
+}
+
+/// The names that follow `prefix` in code (comments aside).
+fn refs_after(text: &str, prefix: &str) -> Vec<String> {
     let mut refs = Vec::new();
     for line in text.lines() {
         let code = line.split("//").next().unwrap_or("");
         let mut rest = code;
-        while let Some(i) = rest.find("crate::") {
-            let tail = &rest[i + 7..];
+        while let Some(i) = rest.find(prefix) {
+            let tail = &rest[i + prefix.len()..];
             let name: String = tail
                 .chars()
                 .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
@@ -279,9 +284,18 @@ fn module_graph(src: &Path) -> BTreeMap<String, std::collections::BTreeSet<Strin
     rust_files(src, &mut files);
     let mut graph: BTreeMap<String, std::collections::BTreeSet<String>> = BTreeMap::new();
     for f in &files {
-        let m = module_of(f.strip_prefix(src).unwrap());
+        let rel = f.strip_prefix(src).unwrap();
+        let m = module_of(rel);
         let deps = graph.entry(m.clone()).or_default();
-        for d in crate_refs(&std::fs::read_to_string(f).unwrap()) {
+        let text = std::fs::read_to_string(f).unwrap();
+        let mut refs = crate_refs(&text);
+        // In a file at the crate's root, `super::` is the crate (before its tests, where it is
+        // the file's own module).
+        if rel.components().count() == 1 {
+            let code = &text[..text.find("#[cfg(test)]").unwrap_or(text.len())];
+            refs.extend(refs_after(code, "super::"));
+        }
+        for d in refs {
             if d != m {
                 deps.insert(d);
             }

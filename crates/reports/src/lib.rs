@@ -15,6 +15,7 @@ pub mod report;
 pub mod seed003_drawings;
 pub mod seed003_report;
 pub mod seed003_rod;
+pub mod seed003_scenes;
 pub mod wrinkles_fabric;
 pub mod wrinkles_report;
 pub mod wrinkles_text;

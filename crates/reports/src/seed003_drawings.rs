@@ -1,7 +1,7 @@
 //! Seed 003's drapes drawn: each from above and from the side (SVG), and the montage of their
 //! rendered surfaces (PNG).
 
-use super::seed003_report::Solved;
+use super::seed003_scenes::Solved;
 use anyhow::Result;
 use plotters::prelude::*;
 

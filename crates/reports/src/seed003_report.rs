@@ -9,6 +9,7 @@
 use crate::report::{Panels, markdown, plot_panels};
 use crate::seed003_drawings::{drapes_png, drapes_svg};
 use crate::seed003_rod::table_10_4;
+pub use crate::seed003_scenes::{Solved, load, refined, solve_pair};
 use anyhow::Result;
 use drapelab_app::Job;
 use drapelab_core::measure::drape_measures;
@@ -41,45 +42,6 @@ pub struct Seed003ReportParams {
 /// Default of `load_steps`: 50 load increments (the seed's).
 pub fn default_steps() -> usize {
     50
-}
-
-/// The scene on a grid twice as fine (2n − 1 lines per side; pinned particles moved with it).
-pub fn refined(scene: &Scene) -> Scene {
-    scene.regridded(2 * scene.cloth.nx - 1, 2 * scene.cloth.ny - 1)
-}
-
-/// A scene solved on its grid and on one twice as fine, with the gap between the two drapes.
-pub struct Solved {
-    pub(crate) scene: Scene,
-    pub(crate) coarse: Solution,
-    pub(crate) fine: Solution,
-    pub(crate) gap_m: f64,
-}
-
-/// Solves a scene on its grid and on [`refined`]'s.
-pub fn solve_pair(scene: &Scene) -> Solved {
-    let coarse = solve_scene(scene, &mut NoObserver);
-    let fine = solve_scene(&refined(scene), &mut NoObserver);
-    let gap_m = if coarse.report.is_converged() && fine.report.is_converged() {
-        let g = &coarse.grid;
-        (0..g.ny)
-            .flat_map(|j| (0..g.nx).map(move |i| (i, j)))
-            .map(|(i, j)| (coarse.at(i, j) - fine.at_material(g.xs[i], g.ys[j])).norm())
-            .fold(0.0, f64::max)
-    } else {
-        f64::NAN
-    };
-    Solved {
-        scene: scene.clone(),
-        coarse,
-        fine,
-        gap_m,
-    }
-}
-
-/// Loads a seed 003 scene.
-pub fn load(path: &Path) -> Result<Scene> {
-    Ok(Scene::load(path, &[])?.scene.into_inner())
 }
 
 /// Writes the seed 003 report.

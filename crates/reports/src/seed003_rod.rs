@@ -1,7 +1,7 @@
 //! Seed 003's rod (Table 10.4): corner A of the polyester sheet under every contact treatment and
 //! material, and its grid study, beside the experiment and the finite elements.
 
-use super::seed003_report::Solved;
+use super::seed003_scenes::Solved;
 use anyhow::{Context, Result};
 use drapelab_core::scene::{ContactMethod, Scene};
 use drapelab_core::simulate::{Solution, solve_scene};

@@ -1,7 +1,6 @@
 //! The clock of an implicit integration (its time, steps and frames) and its step-size control:
 //! steps grow with few Newton iterations, halve on a rejected step, land on frame times.
 
-use super::incremental::ImplicitSettings;
 use crate::physics::Model;
 use nalgebra::Vector3;
 
@@ -73,17 +72,17 @@ pub(super) fn grown(
     dt: f64,
     iterations: usize,
     cooldown: usize,
-    s: &ImplicitSettings,
+    bounds: StepBounds,
 ) -> f64 {
     if dt < h * (1.0 - 1e-12) {
         return h;
     }
-    next_dt(h, iterations, s).min(if cooldown > 0 { h } else { f64::INFINITY })
+    next_dt(h, iterations, bounds).min(if cooldown > 0 { h } else { f64::INFINITY })
 }
 
 /// The next step after one that took `iterations` Newton iterations (chord steps not counted: they
 /// factorize nothing): doubled when Newton converged within 6, kept up to 12, halved beyond.
-fn next_dt(h: f64, iterations: usize, s: &ImplicitSettings) -> f64 {
+fn next_dt(h: f64, iterations: usize, s: StepBounds) -> f64 {
     if !s.adaptive {
         return h;
     }
@@ -93,4 +92,12 @@ fn next_dt(h: f64, iterations: usize, s: &ImplicitSettings) -> f64 {
         _ => 0.5,
     };
     (h * f).clamp(s.min_dt_s, s.max_dt_s)
+}
+
+/// What bounds an adaptive step: whether it adapts at all, and its smallest and largest length, s.
+#[derive(Clone, Copy)]
+pub(super) struct StepBounds {
+    pub(super) adaptive: bool,
+    pub(super) min_dt_s: f64,
+    pub(super) max_dt_s: f64,
 }

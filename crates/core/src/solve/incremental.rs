@@ -11,7 +11,7 @@
 //! and are halved and retried when it does not, and land on every frame time a recorder asks for.
 
 use super::FactorReuse;
-use super::clock::{Clock, grown};
+use super::clock::{Clock, StepBounds, grown};
 use super::newton::StaticOptions;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
 use crate::physics::{EnergyTerm, HessianBlocks, Model, Vecs};
@@ -141,6 +141,15 @@ pub struct ImplicitSettings {
 }
 
 impl ImplicitSettings {
+    /// The bounds of its adaptive steps.
+    fn bounds(&self) -> StepBounds {
+        StepBounds {
+            adaptive: self.adaptive,
+            min_dt_s: self.min_dt_s,
+            max_dt_s: self.max_dt_s,
+        }
+    }
+
     /// The settings of `opts` with viscous damping `c` (N·s/m; Rayleigh's α and β only with damping).
     pub fn of(opts: &super::DynamicOptions, c: f64) -> Self {
         let (alpha, beta) = if opts.damping {
@@ -316,7 +325,7 @@ pub fn integrate_implicit(
                 // A step shortened to land on a frame does not set the next one, and for three
                 // steps after a rejected one the step does not grow.
                 cooldown = cooldown.saturating_sub(1);
-                h = grown(h, dt, iterations, cooldown, s);
+                h = grown(h, dt, iterations, cooldown, s.bounds());
             }
             Attempt::Diverged(reason) => {
                 report.diverge(c.steps, Some(dt), reason);
