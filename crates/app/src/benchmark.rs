@@ -69,10 +69,17 @@ pub fn default_explicit() -> usize {
     21
 }
 
+/// The input of a benchmark stage.
+pub struct BenchmarkInputs {
+    /// The scene TOMLs benchmarked.
+    pub scenes: Vec<std::path::PathBuf>,
+}
+
 /// Runs the benchmark: every scene, size, tolerance and solver, one row each (run time against error).
-pub fn run(ctx: &Job<'_>, p: &BenchmarkParams) -> Result<Vec<BenchRow>> {
+pub fn run(ctx: &Job<'_, BenchmarkInputs>, p: &BenchmarkParams) -> Result<Vec<BenchRow>> {
     let scenes: Vec<Scene> = ctx
-        .input_files("scenes")
+        .inputs
+        .scenes
         .iter()
         .map(|f| Ok(Scene::load(f, &[])?.scene.into_inner()))
         .collect::<Result<_>>()?;

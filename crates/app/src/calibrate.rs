@@ -146,12 +146,36 @@ impl CalibrateParams {
     }
 }
 
+/// The files of the calibration workflows (calibrate, tune, validate): a sample's measured edges,
+/// Table 2's densities and the hang scene.
+pub struct SampleInputs {
+    /// The measured edges of every sample (a fit-edges table).
+    pub edges: PathBuf,
+    /// Table 2's densities (knitted_samples.csv).
+    pub samples: PathBuf,
+    /// The hang scene each sample is simulated in.
+    pub scene: PathBuf,
+}
+
+/// The inputs of a calibrate stage.
+pub struct CalibrateInputs {
+    /// The samples' files.
+    pub samples: SampleInputs,
+    /// ICA's settings as JSON (a tune stage's best_ica.json), read with `ica_from_input`.
+    pub ica: Option<PathBuf>,
+}
+
 /// The ICA settings: given, or read from the `ica` input.
-pub fn ica_settings(ctx: &Job<'_>, p: &CalibrateParams) -> Result<IcaSettings> {
+pub fn ica_settings(ctx: &Job<'_, CalibrateInputs>, p: &CalibrateParams) -> Result<IcaSettings> {
     if let Some(ica) = &p.ica {
         return Ok(ica.clone());
     }
-    let path = ctx.input("ica")?;
+    let Some(path) = ctx.inputs.ica.as_deref() else {
+        bail!(
+            "`{}` reads ICA's settings from input `ica`: add `inputs.ica = \"PATH\"`",
+            ctx.stage
+        );
+    };
     let ica: IcaSettings = serde_json::from_slice(
         &std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?,
     )?;
@@ -161,8 +185,7 @@ pub fn ica_settings(ctx: &Job<'_>, p: &CalibrateParams) -> Result<IcaSettings> {
 }
 
 /// The measured edges of every sample of the `edges` input, by sample (the items, in this order).
-pub fn edges_by_sample(ctx: &Job<'_>) -> Result<BTreeMap<String, Vec<EdgeFit>>> {
-    let edges_file = ctx.input("edges")?;
+pub fn edges_by_sample(edges_file: &Path) -> Result<BTreeMap<String, Vec<EdgeFit>>> {
     let mut by_sample: BTreeMap<String, Vec<EdgeFit>> = BTreeMap::new();
     for (s, e) in read_edges(edges_file)? {
         by_sample.entry(s).or_default().push(e);
@@ -180,13 +203,19 @@ pub fn side(part: &Path, name: &str) -> PathBuf {
 
 /// Calibrates sample `item` (in sample order) and writes its part: the results row at `part` (last),
 /// its evaluations, CMA-ES comparison and recording beside it when the stage writes them.
-pub fn compute(ctx: &Job<'_>, p: &CalibrateParams, item: usize, part: &Path) -> Result<()> {
-    let by_sample = edges_by_sample(ctx)?;
+pub fn compute(
+    ctx: &Job<'_, CalibrateInputs>,
+    p: &CalibrateParams,
+    item: usize,
+    part: &Path,
+) -> Result<()> {
+    let files = &ctx.inputs.samples;
+    let by_sample = edges_by_sample(&files.edges)?;
     let Some((sample, measured)) = by_sample.iter().nth(item) else {
-        bail!("no sample {item} in {}", ctx.input("edges")?.display());
+        bail!("no sample {item} in {}", files.edges.display());
     };
     let (problem, settings) = sample_setup(
-        (ctx.input("scene")?, ctx.input("samples")?),
+        (&files.scene, &files.samples),
         sample,
         measured,
         p,
@@ -350,7 +379,7 @@ pub fn calibrate_one(
 
 /// `results.parquet`, and `evaluations.parquet`, `comparison.parquet` and `calibration.rrd` when
 /// asked, from the samples' parts.
-pub fn gather(ctx: &Job<'_>, parts: &[PathBuf]) -> Result<()> {
+pub fn gather(ctx: &Job<'_, CalibrateInputs>, parts: &[PathBuf]) -> Result<()> {
     gather_parquet(parts, ctx.output("results")?)?;
     let sides = |name: &str| -> Vec<PathBuf> { parts.iter().map(|p| side(p, name)).collect() };
     if let Some(out) = ctx.optional_output("evaluations") {
@@ -399,8 +428,8 @@ pub fn record_decade(
 }
 
 /// The `count` of the stage kind over this workflow.
-pub fn count(ctx: &Job<'_>, p: &CalibrateParams) -> Result<usize> {
+pub fn count(ctx: &Job<'_, CalibrateInputs>, p: &CalibrateParams) -> Result<usize> {
     ica_settings(ctx, p)?;
-    read_sample_densities(ctx.input("samples")?)?;
-    Ok(edges_by_sample(ctx)?.len())
+    read_sample_densities(&ctx.inputs.samples.samples)?;
+    Ok(edges_by_sample(&ctx.inputs.samples.edges)?.len())
 }

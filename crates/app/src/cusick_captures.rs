@@ -11,7 +11,7 @@
 //! calibration specimen's), and says so.
 
 use crate::cusick_measure::ShadowRow;
-use drapelab_core::cusick::NodeDistribution;
+use drapelab_core::cusick::{Face, NodeDistribution};
 use drapelab_core::measure::mean;
 use drapelab_core::table::Table;
 use serde::{Deserialize, Serialize};
@@ -26,7 +26,7 @@ pub struct CaptureRow {
     /// Capture number (1–2 face up, 3–4 face down in the bundled dataset).
     pub capture: i32,
     /// "up", "down" or "unknown".
-    pub face: String,
+    pub face: Face,
     /// Predicted DC for this face, %: the mean over the face's perturbation seeds.
     pub dc_predicted_pct: f64,
     /// Lower end of the 90 % prediction interval, %.
@@ -78,21 +78,13 @@ pub struct FacePredictions {
 }
 
 impl FacePredictions {
-    fn of(&self, face: &str) -> &NodeDistribution {
+    fn of(&self, face: Face) -> &NodeDistribution {
         let own = match face {
-            "up" => self.up.as_ref(),
-            "down" => self.down.as_ref(),
-            _ => None,
+            Face::Up => self.up.as_ref(),
+            Face::Down => self.down.as_ref(),
+            Face::Unknown => None,
         };
         own.unwrap_or(&self.average)
-    }
-}
-
-/// A capture's face as the table writes it.
-fn face_of(r: &ShadowRow) -> &str {
-    match r.face.as_str() {
-        "up" | "down" => &r.face,
-        _ => "unknown",
     }
 }
 
@@ -112,15 +104,15 @@ pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> 
     rows.iter()
         .filter(|r| r.sample != calib)
         .map(|r| {
-            let face = face_of(r);
+            let face = r.face;
             let p = pred.of(face);
-            let known = face != "unknown";
-            let same_face = |o: &ShadowRow| known && face_of(o) == face;
+            let known = face != Face::Unknown;
+            let same_face = |o: &ShadowRow| known && o.face == face;
             CaptureRow {
                 fabric: r.fabric,
                 sample: r.sample,
                 capture: r.capture,
-                face: face.to_string(),
+                face,
                 dc_predicted_pct: p.dc_mean_pct,
                 dc_low_pct: f64::NAN,
                 dc_high_pct: f64::NAN,
@@ -161,10 +153,10 @@ pub fn fill_intervals(rows: &mut [CaptureRow], spread: impl Fn(i32) -> f64) {
     };
     let snapshot = rows.to_vec();
     for r in rows.iter_mut() {
-        let average = r.face == "unknown";
+        let average = r.face == Face::Unknown;
         let mut pool: Vec<f64> = snapshot
             .iter()
-            .filter(|o| o.fabric != r.fabric && (average || o.face != "unknown"))
+            .filter(|o| o.fabric != r.fabric && (average || o.face != Face::Unknown))
             .map(|o| residual(o, average))
             .filter(|v| v.is_finite())
             .collect();
@@ -194,7 +186,7 @@ mod tests {
             fabric,
             sample: 2,
             capture: 1,
-            face: face.into(),
+            face: Face::of(face),
             dc_predicted_pct: predicted,
             dc_low_pct: f64::NAN,
             dc_high_pct: f64::NAN,

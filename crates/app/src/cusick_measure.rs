@@ -6,8 +6,8 @@ use crate::cusick_tables::OutlineRow;
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{
-    ShadowMeasures, SilhouetteScale, Tester, hem_projection, mesh_projection, sector_angle_rad,
-    shadow_measures, silhouette_projection,
+    Face, ShadowMeasures, SilhouetteScale, Tester, hem_projection, mesh_projection,
+    sector_angle_rad, shadow_measures, silhouette_projection,
 };
 use drapelab_core::table::Table;
 use drapelab_record::cusick::{CusickDataset, Template};
@@ -35,8 +35,8 @@ pub struct ShadowRow {
     pub sample: i32,
     /// Capture number.
     pub capture: i32,
-    /// "up" or "down".
-    pub face: String,
+    /// "up", "down", or "unknown" where the dataset's index does not say.
+    pub face: Face,
     /// `template_registered`, `hem_curve_loft`, or empty without a mesh.
     pub mesh_kind: String,
     /// Whether the mesh is stored in a frame rotated by 90° about +z (irrelevant to DC and nodes).
@@ -148,7 +148,7 @@ pub fn row(
         fabric: c.fabric,
         sample: c.sample,
         capture: c.capture,
-        face: c.face.clone(),
+        face: Face::of(&c.face),
         mesh_kind: c.mesh_kind.clone(),
         mesh_rotated: c.mesh_rotated(),
         dc_photo_pct: photo.dc_pct,
@@ -162,9 +162,15 @@ pub fn row(
     }
 }
 
+/// The input of a cusick-measure stage (its other files are read through the index's folder).
+pub struct CusickMeasureInputs {
+    /// captures_index.csv of a Cusick dataset.
+    pub index: std::path::PathBuf,
+}
+
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &CusickMeasureParams) -> Result<Vec<ShadowRow>> {
-    let index = ctx.input("index")?;
+pub fn run(ctx: &Job<'_, CusickMeasureInputs>, p: &CusickMeasureParams) -> Result<Vec<ShadowRow>> {
+    let index = &ctx.inputs.index;
     let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
     ctx.started(data.captures.len());
     let measured = measure_dataset(&data, &p.scale, &|| ctx.item_done())?;

@@ -13,7 +13,7 @@ use crate::cusick_targets::{empty_row, fill_distribution, fill_faces, fill_fit, 
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{
-    DiscMesh, DrapeParams, FabricSettings, SeededDrape, Tester, calibrate_and_predict,
+    DiscMesh, DrapeParams, FabricSettings, Face, SeededDrape, Tester, calibrate_and_predict,
     height_profile, polar_disc, sector_angle_rad, subdivide_disc, two_fold,
 };
 use drapelab_core::measure::mean_sd;
@@ -259,7 +259,7 @@ fn fill_two_fold(
 ) {
     let up: Vec<Vec<f64>> = rows
         .iter()
-        .filter(|r| r.sample == calib && r.face == "up")
+        .filter(|r| r.sample == calib && r.face == Face::Up)
         .filter_map(|r| {
             measured
                 .photo_outlines
@@ -319,13 +319,25 @@ pub fn simulated_outline(fabric: i32, seed: u64, outline_m: &[f64]) -> Vec<Outli
         .collect()
 }
 
+/// The inputs of a cusick-predict stage.
+pub struct CusickPredictInputs {
+    /// captures_index.csv of a Cusick dataset (its folder holds the rest).
+    pub index: std::path::PathBuf,
+    /// A cusick-measure stage's shadows.parquet.
+    pub shadows: std::path::PathBuf,
+    /// A cusick-measure stage's outlines.parquet (the photos' outlines r(θ)).
+    pub photo_outlines: std::path::PathBuf,
+}
+
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>> {
-    let index = ctx.input("index")?;
-    let data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
-    let shadows = read_table::<ShadowRow>(ctx.input("shadows")?)?;
-    let photo_outlines =
-        outlines_by_capture(read_table::<OutlineRow>(ctx.input("photo_outlines")?)?);
+pub fn run(
+    ctx: &Job<'_, CusickPredictInputs>,
+    p: &CusickPredictParams,
+) -> Result<Vec<PredictionRow>> {
+    let files = &ctx.inputs;
+    let data = CusickDataset::open(files.index.parent().unwrap_or(std::path::Path::new(".")))?;
+    let shadows = read_table::<ShadowRow>(&files.shadows)?;
+    let photo_outlines = outlines_by_capture(read_table::<OutlineRow>(&files.photo_outlines)?);
     let template = data.template()?;
     let meshes = data.meshes()?;
     let model_mesh = model_mesh(&template, p);
@@ -333,12 +345,7 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>>
         template: &template,
         meshes: &meshes,
         photo_outlines,
-        rotated: data
-            .captures
-            .iter()
-            .filter(|c| c.mesh_rotated())
-            .map(|c| c.key())
-            .collect(),
+        rotated: rotated_captures(&data),
     };
     ctx.started(data.fabrics.len());
     let rows_of = |fabric: i32| -> Vec<&ShadowRow> {
@@ -399,6 +406,14 @@ pub fn run(ctx: &Job<'_>, p: &CusickPredictParams) -> Result<Vec<PredictionRow>>
         &overlay,
     )?;
     Ok(rows)
+}
+
+/// The captures whose meshes the dataset rotated.
+fn rotated_captures(data: &CusickDataset) -> std::collections::BTreeSet<CaptureKey> {
+    (data.captures.iter())
+        .filter(|c| c.mesh_rotated())
+        .map(|c| c.key())
+        .collect()
 }
 
 /// Each capture's photographed outline radii, m, in sector order (rows come in that order).

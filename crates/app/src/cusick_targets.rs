@@ -27,13 +27,13 @@ pub struct Targets {
 /// without a capture on each face. With one capture per face (no repeat) the error is the gap
 /// itself: the curl is then fitted but not identifiable.
 pub fn face_gap(own: &[&&ShadowRow]) -> Option<FaceGap> {
-    let of = |face: &str| -> Vec<f64> {
+    let of = |face: Face| -> Vec<f64> {
         own.iter()
             .filter(|r| r.face == face)
             .map(|r| r.dc_photo_pct)
             .collect()
     };
-    let (up, down) = (of("up"), of("down"));
+    let (up, down) = (of(Face::Up), of(Face::Down));
     if up.is_empty() || down.is_empty() {
         return None;
     }

@@ -43,10 +43,17 @@ pub fn photo_edges(
     Ok(with_systematics(&img, &opts, fit_image(&img, &opts, photo)?, photo)?.edges)
 }
 
+/// The input of a fit-edges stage (the cameras beside the photos are read through them).
+pub struct FitEdgesInputs {
+    /// Photos (.png, .jpg), each with its camera.json beside it; other files are passed over.
+    pub photos: Vec<std::path::PathBuf>,
+}
+
 /// Fits each photo's edge polynomials (seed 000), one fit per photo.
-pub fn run(ctx: &Job<'_>, p: &FitEdgesParams) -> Result<Vec<(String, EdgeFit)>> {
+pub fn run(ctx: &Job<'_, FitEdgesInputs>, p: &FitEdgesParams) -> Result<Vec<(String, EdgeFit)>> {
     let photos: Vec<_> = ctx
-        .input_files("photos")
+        .inputs
+        .photos
         .iter()
         .filter(|f| {
             f.extension()

@@ -1,5 +1,5 @@
-//! What a workflow gets to run: its files by name, where to report progress, and how to name a bad
-//! parameter. A plain value that a pipeline stage, the command line, a test or the Python package
+//! What a workflow gets to run: its typed input files, its outputs by name, where to report
+//! progress, and how to name a bad parameter. A plain value that a pipeline stage, the command line, a test or the Python package
 //! builds; a workflow sees nothing of the engine.
 
 use anyhow::Result;
@@ -23,23 +23,24 @@ impl Progress for Quiet {
     fn item_done(&self) {}
 }
 
-/// A workflow's files and surroundings.
-pub struct Job<'a> {
+/// A workflow's files and surroundings; `I` is the workflow's typed inputs (its `…Inputs` struct,
+/// built by the stage adapter from the declared slots).
+pub struct Job<'a, I = ()> {
     /// Its name (the stage's name in a pipeline), for messages.
     pub stage: String,
     /// Where its parameters come from (the pipeline file), for provenance lines and errors.
     pub source: PathBuf,
     /// The folder paths in tables and reports are written relative to.
     pub root: PathBuf,
-    /// Input files by name, absolute, sorted within a name.
-    pub inputs: BTreeMap<String, Vec<PathBuf>>,
+    /// The workflow's input files, absolute.
+    pub inputs: I,
     /// Output files by name, absolute.
     pub outputs: BTreeMap<String, PathBuf>,
     /// Where progress goes.
     pub progress: Box<dyn Progress + 'a>,
 }
 
-impl Job<'_> {
+impl<I> Job<'_, I> {
     /// "Made by `drapelab run SOURCE` (drapelab VERSION)": the provenance line of every report.
     pub fn made_by(&self) -> String {
         format!(
@@ -68,33 +69,6 @@ impl Job<'_> {
             format!("stages.{}.params.{key}", self.stage),
             message,
         )
-    }
-    /// The one file of input `name`.
-    pub fn input(&self, name: &str) -> Result<&Path> {
-        match self.inputs.get(name).map(Vec::as_slice) {
-            Some([one]) => Ok(one),
-            Some(many) => anyhow::bail!(
-                "input `{name}` of `{}` matched {} files; it takes one",
-                self.stage,
-                many.len()
-            ),
-            None => anyhow::bail!(
-                "`{}` needs input `{name}`: add `inputs.{name} = \"PATH\"`",
-                self.stage
-            ),
-        }
-    }
-    /// The file of an optional input, if given.
-    pub fn optional_input(&self, name: &str) -> Result<Option<&Path>> {
-        if self.inputs.contains_key(name) {
-            self.input(name).map(Some)
-        } else {
-            Ok(None)
-        }
-    }
-    /// The files of input `name` (empty when not given).
-    pub fn input_files(&self, name: &str) -> &[PathBuf] {
-        self.inputs.get(name).map_or(&[], Vec::as_slice)
     }
     /// The path of output `name`.
     pub fn output(&self, name: &str) -> Result<&Path> {

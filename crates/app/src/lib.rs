@@ -1,7 +1,7 @@
-//! drapelab's workflows, each a function over a [`Job`] (its files by name, its progress) with
-//! typed parameters: simulate to a folder, fit photos and score them, tune and run the ICA
-//! calibration, validate it, sweep scenes, measure and predict Cusick drapes, the benchmark grids,
-//! seed 002's wrinkles and §10.8's surfaces. Each returns what it found as typed values (the rows
+//! drapelab's workflows, each a function over a [`Job`] (its typed input files, its outputs, its
+//! progress) with typed parameters: simulate to a folder, fit photos and score them, tune and run
+//! the ICA calibration, validate it, sweep scenes, measure and predict Cusick drapes, the benchmark
+//! grids, seed 002's wrinkles, seed 003's scenes and studies, and §10.8's surfaces. Each returns what it found as typed values (the rows
 //! it wrote, a solve report, a tuning's main effects); bad input is an `InputError` naming the file
 //! or the stage's parameter. The pipeline's stages, the command line, the tests and the Python
 //! package call them; the report stack (polars, plotters) is not here.
@@ -24,6 +24,9 @@ pub mod fit_edges;
 pub mod peers;
 pub mod scene_keys;
 pub mod score;
+pub mod seed003_solve;
+pub mod seed003_studies;
+pub mod seed003_tables;
 pub mod simulate;
 pub mod skips;
 pub mod surface;
@@ -77,6 +80,13 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<crate::cusick_captures::CaptureRow>()?,
         md::<crate::cusick_tables::OutlineRow>()?,
         md::<crate::cusick_tables::ProfileRow>()?,
+        md::<crate::seed003_tables::Seed003SceneRow>()?,
+        md::<crate::seed003_tables::DrapeParticleRow>()?,
+        md::<crate::seed003_tables::TableEdgeRow>()?,
+        md::<crate::seed003_tables::RodCornerRow>()?,
+        md::<crate::seed003_tables::RodGridRow>()?,
+        md::<crate::seed003_tables::CantileverGridRow>()?,
+        md::<crate::seed003_tables::LoadStepRow>()?,
     ];
     Ok(sections.join("\n"))
 }

@@ -10,6 +10,7 @@ use drapelab_core::simulate::solve_scene;
 use drapelab_core::solve::NoObserver;
 use drapelab_record::{Table, write_table};
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// One comparison of drapelab with an independent implementation (`peers.parquet`).
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -128,14 +129,27 @@ fn ensure_peer_python(python: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
+/// The inputs of a peers stage.
+pub struct PeersInputs {
+    /// The hang4 scene.
+    pub scene: PathBuf,
+    /// benches/peers/scipy_newton.py.
+    pub scipy_newton: PathBuf,
+    /// benches/peers/numpy_explicit.py.
+    pub numpy_explicit: PathBuf,
+    /// benches/peers/cholmod_newton.py (runs when given).
+    pub cholmod_newton: Option<PathBuf>,
+}
+
 /// Runs the peer solvers beside drapelab's and writes their table.
-pub fn run(ctx: &Job<'_>, p: &PeersParams) -> Result<()> {
-    let scene = Scene::load(ctx.input("scene")?, &[])?.scene;
-    let script =
-        |slot: &str| -> Result<std::path::PathBuf> { Ok(std::fs::canonicalize(ctx.input(slot)?)?) };
-    let (newton, explicit) = (script("scipy_newton")?, script("numpy_explicit")?);
-    let cholmod = ctx
-        .optional_input("cholmod_newton")?
+pub fn run(ctx: &Job<'_, PeersInputs>, p: &PeersParams) -> Result<()> {
+    let files = &ctx.inputs;
+    let scene = Scene::load(&files.scene, &[])?.scene;
+    let newton = std::fs::canonicalize(&files.scipy_newton)?;
+    let explicit = std::fs::canonicalize(&files.numpy_explicit)?;
+    let cholmod = files
+        .cholmod_newton
+        .as_ref()
         .map(std::fs::canonicalize)
         .transpose()?;
     let python = std::path::absolute(ctx.root.join(&p.python))?;

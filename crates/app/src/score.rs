@@ -16,12 +16,20 @@ pub struct ScoreParams {
     pub side_cm: f64,
 }
 
+/// The inputs of a score stage.
+pub struct ScoreInputs {
+    /// The measured edges (a fit-edges table).
+    pub measured: std::path::PathBuf,
+    /// edges_truth.parquet files, one per sample folder (the folder names the sample).
+    pub simulated: Vec<std::path::PathBuf>,
+}
+
 /// Scores simulated edges against the photos' fitted edges, one row per photo.
-pub fn run(ctx: &Job<'_>, p: &ScoreParams) -> Result<Vec<ScoreRow>> {
-    let measured_path = ctx.input("measured")?;
+pub fn run(ctx: &Job<'_, ScoreInputs>, p: &ScoreParams) -> Result<Vec<ScoreRow>> {
+    let measured_path = &ctx.inputs.measured;
     let measured = read_edges(measured_path)
         .with_context(|| format!("measured edges {}", measured_path.display()))?;
-    let truths = ctx.input_files("simulated");
+    let truths = &ctx.inputs.simulated;
     if truths.is_empty() {
         bail!("input `simulated` matched no file");
     }

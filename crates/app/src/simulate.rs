@@ -6,6 +6,7 @@ use drapelab_core::solve::{NoObserver, SolveReport, Status};
 use drapelab_record::simulate_to_dir;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 
 /// Parameters of a simulate stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -16,8 +17,14 @@ pub struct SimulateParams {
     pub set: BTreeMap<String, toml::Value>,
 }
 
+/// The input of a simulate stage.
+pub struct SimulateInputs {
+    /// The scene TOML.
+    pub scene: PathBuf,
+}
+
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &SimulateParams) -> Result<SolveReport> {
+pub fn run(ctx: &Job<'_, SimulateInputs>, p: &SimulateParams) -> Result<SolveReport> {
     let dir = ctx
         .output("run")?
         .parent()
@@ -32,7 +39,7 @@ pub fn run(ctx: &Job<'_>, p: &SimulateParams) -> Result<SolveReport> {
     }
     let overrides: Vec<(String, toml::Value)> =
         p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
-    let loaded = ctx.load_scene(ctx.input("scene")?, &overrides, |k| format!("set.{k}"))?;
+    let loaded = ctx.load_scene(&ctx.inputs.scene, &overrides, |k| format!("set.{k}"))?;
     ctx.started(1);
     let report = simulate_to_dir(&loaded, &dir, &mut NoObserver)?;
     ctx.item_done();

@@ -18,28 +18,41 @@ use std::time::Instant;
 #[serde(deny_unknown_fields)]
 pub struct SkipsParams {}
 
+/// The inputs of a skips stage.
+pub struct SkipsInputs {
+    /// A drape on a table, whole (table_wool.toml).
+    pub full: std::path::PathBuf,
+    /// The same drape as a quarter model (table_wool_quarter.toml).
+    pub quarter: std::path::PathBuf,
+    /// A hang without obstacles (hang4.toml).
+    pub hang: std::path::PathBuf,
+}
+
 /// Runs a skips stage: each skip the engine makes (a quarter model, recording off, the cost cache, an
 /// up-to-date stage (`up_to_date`: the engine's, measured by the caller), a contact term a scene does not need), and the second thread of a calibration
 /// population, measured on and off in the same run, into a Parquet table (`skip`, `scene`,
 /// `time_with_skip_s`, `time_without_skip_s`, `saved_fraction`).
 pub fn run(
-    ctx: &Job<'_>,
+    ctx: &Job<'_, SkipsInputs>,
     _p: &SkipsParams,
     up_to_date: impl Fn(&Path, &str) -> Result<SkipRow>,
 ) -> Result<()> {
-    let load = |slot: &str| -> Result<Scene> {
-        Ok(Scene::load(ctx.input(slot)?, &[])?.scene.into_inner())
-    };
-    let (full, quarter, hang) = (load("full")?, load("quarter")?, load("hang")?);
+    let files = &ctx.inputs;
+    let load = |file: &Path| -> Result<Scene> { Ok(Scene::load(file, &[])?.scene.into_inner()) };
+    let (full, quarter, hang) = (
+        load(&files.full)?,
+        load(&files.quarter)?,
+        load(&files.hang)?,
+    );
     ctx.started(6);
     let done = || ctx.item_done();
     let mut rows = vec![skip_symmetry(&full, &quarter)];
     done();
-    rows.push(skip_recording(&hang, ctx.input("hang")?)?);
+    rows.push(skip_recording(&hang, &files.hang)?);
     done();
     rows.push(skip_cost_cache(&hang)?);
     done();
-    rows.push(up_to_date(ctx.input("hang")?, &hang.name)?);
+    rows.push(up_to_date(&files.hang, &hang.name)?);
     done();
     rows.push(skip_unneeded_terms(&hang));
     done();

@@ -435,10 +435,18 @@ pub fn make_surface(
     Ok(d.summary)
 }
 
+/// The inputs of a surface stage.
+pub struct SurfaceInputs {
+    /// A scene TOML (solved here) or a run's run.json (its particles.parquet beside it).
+    pub drape: PathBuf,
+    /// The texture image, PNG or JPEG (default: drapelab's woven check).
+    pub texture: Option<PathBuf>,
+}
+
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &SurfaceParams) -> Result<()> {
-    let path = ctx.input("drape")?;
-    let texture_path = ctx.optional_input("texture")?;
+pub fn run(ctx: &Job<'_, SurfaceInputs>, p: &SurfaceParams) -> Result<()> {
+    let path = ctx.inputs.drape.as_path();
+    let texture_path = ctx.inputs.texture.as_deref();
     let texture = load_texture(texture_path, "inputs.texture")?;
     ctx.started(1);
     let drape = if path.extension().is_some_and(|e| e == "toml") {

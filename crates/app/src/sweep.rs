@@ -164,7 +164,7 @@ pub fn sweep_points(p: &SweepParams) -> Vec<Vec<toml::Value>> {
 /// The scene of item `k`: scene file `k / points`, design point `k % points`, with the sweep's keys
 /// set (recording off).
 pub fn item_scene(
-    ctx: &Job<'_>,
+    ctx: &Job<'_, SweepInputs>,
     files: &[std::path::PathBuf],
     p: &SweepParams,
     points: &[Vec<toml::Value>],
@@ -191,9 +191,15 @@ pub fn item_scene(
     Ok((i as u32, scene))
 }
 
+/// The input of a sweep stage.
+pub struct SweepInputs {
+    /// Scene TOMLs, each solved at every point.
+    pub scenes: Vec<std::path::PathBuf>,
+}
+
 /// The scene files of the stage, at least one.
-pub fn scene_files<'a>(ctx: &'a Job<'_>) -> Result<&'a [std::path::PathBuf]> {
-    let files = ctx.input_files("scenes");
+pub fn scene_files<'a>(ctx: &'a Job<'_, SweepInputs>) -> Result<&'a [std::path::PathBuf]> {
+    let files = ctx.inputs.scenes.as_slice();
     if files.is_empty() {
         bail!("input `scenes` matched no scene file");
     }
@@ -211,7 +217,7 @@ pub fn solve_point(scene: &Scene, i: u32) -> (SweepPoint, SweepOutcome) {
 }
 
 /// The `count` of the stage kind over this workflow.
-pub fn count(ctx: &Job<'_>, p: &SweepParams) -> Result<usize> {
+pub fn count(ctx: &Job<'_, SweepInputs>, p: &SweepParams) -> Result<usize> {
     let files = scene_files(ctx)?;
     let points = sweep_points(p);
     let n = files.len() * points.len();
@@ -222,7 +228,12 @@ pub fn count(ctx: &Job<'_>, p: &SweepParams) -> Result<usize> {
 }
 
 /// The `compute` of the stage kind over this workflow.
-pub fn compute(ctx: &Job<'_>, p: &SweepParams, item: usize, part: &Path) -> Result<()> {
+pub fn compute(
+    ctx: &Job<'_, SweepInputs>,
+    p: &SweepParams,
+    item: usize,
+    part: &Path,
+) -> Result<()> {
     let points = sweep_points(p);
     let (i, scene) = item_scene(ctx, scene_files(ctx)?, p, &points, item)?;
     let keys: Vec<&String> = p.axes.keys().collect();

@@ -5,6 +5,7 @@
 //! combination, which `calibrate` reads from its `ica` input) and `main_effects.svg`.
 
 use crate::Panels;
+use crate::calibrate::SampleInputs;
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::calibrate::{Problem, read_sample_densities, sample_scene};
@@ -160,10 +161,10 @@ pub struct TuneOutcome {
 }
 
 /// Runs the L27 experiments and writes the tables and the best settings.
-pub fn run(ctx: &Job<'_>, p: &TuneParams) -> Result<TuneOutcome> {
-    let densities = read_sample_densities(ctx.input("samples")?)?;
-    let scene_file = ctx.input("scene")?;
-    let measured: Vec<EdgeFit> = read_edges(ctx.input("edges")?)?
+pub fn run(ctx: &Job<'_, SampleInputs>, p: &TuneParams) -> Result<TuneOutcome> {
+    let densities = read_sample_densities(&ctx.inputs.samples)?;
+    let scene_file = &ctx.inputs.scene;
+    let measured: Vec<EdgeFit> = read_edges(&ctx.inputs.edges)?
         .into_iter()
         .filter(|(s, _)| *s == p.sample)
         .map(|(_, e)| e)

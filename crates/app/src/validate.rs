@@ -2,6 +2,7 @@
 //! hang, scored against the sample's measured 2-corner edges (a fit-edges table): `validation.parquet`
 //! with `sample`, `objective_pct` (Eq. 5, mean over the edges) and `curve_distance_pct` (seed 000 Table 6).
 
+use crate::calibrate::SampleInputs;
 use crate::calibration_tables::ResultRow;
 use crate::job::Job;
 use anyhow::{Context, Result};
@@ -66,12 +67,21 @@ impl Table for ValidationRow {
         "One sample's calibrated parameters validated on the 2-corner hang (seed 000 Table 6).";
 }
 
+/// The inputs of a validate stage.
+pub struct ValidateInputs {
+    /// The 2-corner edges, Table 2's densities and the 2-corner hang scene.
+    pub samples: SampleInputs,
+    /// A calibrate stage's results.parquet.
+    pub calibration: std::path::PathBuf,
+}
+
 /// Validates the calibrated net on the 2-corner hang (seed 000), one row per photo.
-pub fn run(ctx: &Job<'_>, p: &ValidateParams) -> Result<Vec<ValidationRow>> {
-    let densities = read_sample_densities(ctx.input("samples")?)?;
-    let scene_file = ctx.input("scene")?;
-    let results = read_results(ctx.input("calibration")?)?;
-    let edges_file = ctx.input("edges")?;
+pub fn run(ctx: &Job<'_, ValidateInputs>, p: &ValidateParams) -> Result<Vec<ValidationRow>> {
+    let files = &ctx.inputs.samples;
+    let densities = read_sample_densities(&files.samples)?;
+    let scene_file = &files.scene;
+    let results = read_results(&ctx.inputs.calibration)?;
+    let edges_file = &files.edges;
     let mut by_sample: BTreeMap<String, Vec<(String, EdgeFit)>> = BTreeMap::new();
     for (s, e) in read_edges(edges_file)? {
         by_sample.entry(s.clone()).or_default().push((s, e));

@@ -296,9 +296,15 @@ pub fn report_markdown(cfg: &WrinkleConfig, solved: &[SolvedCase]) -> String {
     s
 }
 
+/// The input of a wrinkles stage.
+pub struct WrinklesInputs {
+    /// The wrinkle config TOML.
+    pub config: std::path::PathBuf,
+}
+
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, p: &WrinklesParams) -> Result<Vec<SolvedCase>> {
-    let cfg = load_config(ctx.input("config")?)?;
+pub fn run(ctx: &Job<'_, WrinklesInputs>, p: &WrinklesParams) -> Result<Vec<SolvedCase>> {
+    let cfg = load_config(&ctx.inputs.config)?;
     ctx.started(cfg.cases.len());
     let out = |slot: &str| ctx.optional_output(slot).map(Path::to_path_buf);
     let outputs = WrinkleOutputs {

@@ -9,7 +9,8 @@
 use crate::job::Job;
 use crate::wrinkles_params::{Variant, WrinklesSimulateParams};
 use crate::wrinkles_points::{
-    FitSheet, MapAxes, PointSpec, SheetRole, TensionFieldFit, fit_tension_field, point_specs,
+    FitSheet, MapAxes, PointSpec, SheetRole, SheetVerdict, TensionFieldFit, fit_tension_field,
+    point_specs,
 };
 use anyhow::Result;
 use drapelab_core::cloth::Grid;
@@ -126,23 +127,20 @@ impl MeshPair {
             && c.n == f.n
             && (c.zmax_m - f.zmax_m).abs() <= ZMAX_AGREEMENT_REL * f.zmax_m.max(1e-12)
     }
-    /// "converged", "converged in n only" (z_max apart by more than [`ZMAX_AGREEMENT_REL`]), "not
-    /// converged in the mesh", or why a solve stopped.
-    pub fn status(&self, threshold_rel: f64) -> String {
-        if let Some(s) = [&self.coarse, &self.fine]
+    /// Converged, converged in n only (z_max apart by more than [`ZMAX_AGREEMENT_REL`]), not
+    /// converged in the mesh, or not converged (a solve stopped early).
+    pub fn status(&self, threshold_rel: f64) -> SheetVerdict {
+        if [&self.coarse, &self.fine]
             .into_iter()
-            .find(|s| s.report.status != Status::Converged)
+            .any(|s| s.report.status != Status::Converged)
         {
-            format!(
-                "not converged: {} ({}x{})",
-                s.report.status, s.grid.nx, s.grid.ny
-            )
+            SheetVerdict::NotConverged
         } else if self.mesh_converged(threshold_rel) {
-            "converged".into()
+            SheetVerdict::Converged
         } else if self.coarse.wrinkles(threshold_rel).n == self.fine.wrinkles(threshold_rel).n {
-            "converged in n only".into()
+            SheetVerdict::ConvergedInNOnly
         } else {
-            "not converged in the mesh".into()
+            SheetVerdict::NotConvergedInMesh
         }
     }
 }

@@ -6,8 +6,9 @@
 use drapelab_core::wrinkles::full::{LeaveOneOut, SheetReading, leave_groups_out};
 use drapelab_core::wrinkles::{SeedResult, WrinkleConfig, WrinkleInputs};
 
-/// Why a sheet was solved: a case's result, a map point or a photograph.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Why a sheet was solved: a case's result, a map point or a photograph (the `role` column).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum SheetRole {
     /// A case's result under its reading.
     Table,
@@ -17,14 +18,45 @@ pub enum SheetRole {
     Photograph,
 }
 
-impl SheetRole {
-    /// "table", "map" or "photograph", as in `wrinkles_full.parquet`'s `role`.
-    pub fn name(self) -> &'static str {
+/// How a sheet's two meshes agree (the `status` column of `wrinkles_full.parquet`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum SheetVerdict {
+    /// Both meshes converged and agree on n and on z_max.
+    #[serde(rename = "converged")]
+    Converged,
+    /// They agree on n, not on z_max.
+    #[serde(rename = "converged in n only")]
+    ConvergedInNOnly,
+    /// They disagree on n.
+    #[serde(rename = "not converged in the mesh")]
+    NotConvergedInMesh,
+    /// A solve stopped early (its status in `status_fine` or `status_coarse`).
+    #[serde(rename = "not converged")]
+    NotConverged,
+}
+
+impl SheetVerdict {
+    /// Whether the meshes agree on the count n (converged, or in n only).
+    pub fn agrees_on_n(self) -> bool {
+        matches!(
+            self,
+            SheetVerdict::Converged | SheetVerdict::ConvergedInNOnly
+        )
+    }
+    /// Its text in the table and the reports.
+    pub fn as_str(self) -> &'static str {
         match self {
-            SheetRole::Table => "table",
-            SheetRole::Map => "map",
-            SheetRole::Photograph => "photograph",
+            SheetVerdict::Converged => "converged",
+            SheetVerdict::ConvergedInNOnly => "converged in n only",
+            SheetVerdict::NotConvergedInMesh => "not converged in the mesh",
+            SheetVerdict::NotConverged => "not converged",
         }
+    }
+}
+
+impl std::fmt::Display for SheetVerdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
     }
 }
 
@@ -223,4 +255,26 @@ pub fn fit_tension_field(constants: &[f64], sheets: &[FitSheet<'_>]) -> Option<T
         rows,
         loo,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every verdict is written as the text the table held when it was a string.
+    #[test]
+    fn a_sheets_verdict_is_written_as_its_text() {
+        for v in [
+            SheetVerdict::Converged,
+            SheetVerdict::ConvergedInNOnly,
+            SheetVerdict::NotConvergedInMesh,
+            SheetVerdict::NotConverged,
+        ] {
+            assert_eq!(serde_json::to_value(v).unwrap(), v.as_str());
+            let back: SheetVerdict = serde_json::from_value(v.as_str().into()).unwrap();
+            assert_eq!(back, v);
+        }
+        assert!(SheetVerdict::ConvergedInNOnly.agrees_on_n());
+        assert!(!SheetVerdict::NotConvergedInMesh.agrees_on_n());
+    }
 }

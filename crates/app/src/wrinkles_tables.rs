@@ -5,9 +5,11 @@
 use crate::job::Job;
 use crate::wrinkles_full::{FabricPoint, MeshPair, SheetSolve, SimulatedCase, WrinklesFull};
 use crate::wrinkles_params::{Variant, WrinklesSimulateParams};
+use crate::wrinkles_points::{SheetRole, SheetVerdict};
 use anyhow::Result;
+use drapelab_core::solve::Status;
 use drapelab_core::table::Table;
-use drapelab_core::wrinkles::full::{HungStart, SheetReading};
+use drapelab_core::wrinkles::full::{HungStart, ReadingKind, SheetReading};
 use drapelab_core::wrinkles::{WrinkleInputs, WrinkleMesh, WrinkleResult};
 use serde::{Deserialize, Serialize};
 
@@ -30,19 +32,19 @@ pub struct WrinkleFullRow {
     /// Wall time of both solves, s.
     pub wall_time_s: f64,
     /// "converged", "converged in n only" (the meshes agree on n, not on z_max within 10 %), "not
-    /// converged in the mesh" (they disagree on n), or "not converged: STATUS (GRID)" for a solve
-    /// that stopped early.
-    pub status: String,
+    /// converged in the mesh" (they disagree on n), or "not converged" (a solve stopped early:
+    /// `status_fine`, `status_coarse`).
+    pub status: SheetVerdict,
     /// How the sheet's bending and shear were read from the case: "plate" (seed 002's E t³/12 and
     /// E t/2(1 + ν)) or "fabric" (a bending length and a shear rigidity of real fabrics).
-    pub reading: String,
+    pub reading: ReadingKind,
     /// The sheet's bending length (B/w)^(1/3), m.
     pub bending_length_m: f64,
     /// The sheet's in-plane shear rigidity, N/m.
     pub shear_rigidity_N_per_m: f64,
     /// Why the sheet was solved: "table" (the case's result under its reading), "map" (a point of
     /// the map over bending length × shear rigidity) or "photograph" (the seed's Fig. 4).
-    pub role: String,
+    pub role: SheetRole,
     /// The same on the coarser mesh, m.
     pub z_max_full_simulation_coarse_m: f64,
     /// The seed's z_max, m.
@@ -73,6 +75,10 @@ pub struct WrinkleFullRow {
     pub energy_J: f64,
     /// Edges of the finer sheet that pass through it (no self-contact term: 0 says none was needed).
     pub self_crossing_edges: u32,
+    /// Status of the finer mesh's solve.
+    pub status_fine: Status,
+    /// Status of the coarser mesh's solve.
+    pub status_coarse: Status,
 }
 
 impl Table for WrinkleFullRow {
@@ -87,9 +93,9 @@ pub struct FibreRow {
     /// Case name.
     pub case: String,
     /// "plate" or "fabric".
-    pub reading: String,
+    pub reading: ReadingKind,
     /// "fine" or "coarse".
-    pub mesh: String,
+    pub mesh: Mesh,
     /// Grid row from the top (0: the supports' row).
     pub row: i32,
     /// Depth below the supports, m.
@@ -129,9 +135,19 @@ pub struct StartRow {
     /// Newton iterations.
     pub iterations: u32,
     /// The solve's status.
-    pub status: String,
+    pub status: Status,
     /// Edges of the sheet that pass through it.
     pub self_crossing_edges: u32,
+}
+
+/// Which of a sheet's two meshes (the `mesh` column).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mesh {
+    /// The finer.
+    Fine,
+    /// The coarser.
+    Coarse,
 }
 
 impl Table for StartRow {
@@ -165,7 +181,7 @@ pub fn start_rows(found: &WrinklesFull, result_start: HungStart) -> Vec<StartRow
                 z_max_m: w.zmax_m,
                 energy_J: s.report.energy_J,
                 iterations: s.report.iterations as u32,
-                status: s.report.status.to_string(),
+                status: s.report.status,
                 self_crossing_edges: s.self_crossings() as u32,
             });
         }
@@ -252,10 +268,10 @@ fn row(
         z_max_full_simulation_m: wf.zmax_m,
         wall_time_s: pair.fine.report.wall_time_s + pair.coarse.report.wall_time_s,
         status: pair.status(t),
-        reading: reading.name().into(),
+        reading: reading.kind(),
         bending_length_m: reading.bending_length_m(c.inputs),
         shear_rigidity_N_per_m: reading.rigidities(c.inputs).2,
-        role: c.role.name().into(),
+        role: c.role,
         z_max_full_simulation_coarse_m: wc.zmax_m,
         z_max_seed_m: c.seed.and_then(|r| r.zmax_cm).map(|z| z / 100.0),
         z_max_tension_field_m: c.tension_field.zmax_m,
@@ -271,12 +287,15 @@ fn row(
         wall_time_fine_s: pair.fine.report.wall_time_s,
         energy_J: pair.fine.report.energy_J,
         self_crossing_edges: pair.fine.self_crossings() as u32,
+        status_fine: pair.fine.report.status,
+        status_coarse: pair.coarse.report.status,
     }
 }
 
-/// Each case's readings: ("plate", its solves), then ("fabric", its solves) where solved.
-fn readings(c: &SimulatedCase) -> impl Iterator<Item = (&'static str, &MeshPair)> {
-    std::iter::once(("plate", &c.plate)).chain(c.fabric.as_ref().map(|f| ("fabric", f)))
+/// Each case's readings: (plate, its solves), then (fabric, its solves) where solved.
+fn readings(c: &SimulatedCase) -> impl Iterator<Item = (ReadingKind, &MeshPair)> {
+    std::iter::once((ReadingKind::Plate, &c.plate))
+        .chain(c.fabric.as_ref().map(|f| (ReadingKind::Fabric, f)))
 }
 
 /// The centre fibres of both meshes.
@@ -284,15 +303,15 @@ pub fn fibre_rows(found: &WrinklesFull) -> Vec<FibreRow> {
     let mut out = Vec::new();
     for c in &found.cases {
         for (reading, pair) in readings(c) {
-            for (mesh, s) in [("fine", &pair.fine), ("coarse", &pair.coarse)] {
+            for (mesh, s) in [(Mesh::Fine, &pair.fine), (Mesh::Coarse, &pair.coarse)] {
                 out.extend(
                     s.fibre()
                         .into_iter()
                         .enumerate()
                         .map(|(k, (d, y))| FibreRow {
                             case: c.case.clone(),
-                            reading: reading.into(),
-                            mesh: mesh.into(),
+                            reading,
+                            mesh,
                             row: k as i32,
                             depth_m: d,
                             out_of_plane_m: y,
@@ -322,7 +341,7 @@ pub fn write_outputs(
     }
     if let Some(out) = ctx.optional_output("recording") {
         let cases = found.cases.iter().flat_map(|c| {
-            readings(c).map(move |(reading, pair)| (format!("{}/{reading}", c.case), pair))
+            readings(c).map(move |(reading, pair)| (format!("{}/{}", c.case, reading.name()), pair))
         });
         let points = found.points.iter().map(|q| (q.label(), &q.pair));
         let meshes: Vec<(String, WrinkleMesh)> = cases
@@ -337,12 +356,4 @@ pub fn write_outputs(
         drapelab_record::write_wrinkle_meshes(out, &meshes)?;
     }
     Ok(())
-}
-
-/// Loads the config (input `config`), simulates and writes the tables and recording.
-pub fn run(ctx: &Job<'_>, p: &WrinklesSimulateParams) -> Result<WrinklesFull> {
-    let cfg = drapelab_core::wrinkles::load_config(ctx.input("config")?)?;
-    let found = crate::wrinkles_full::simulate(ctx, &cfg, p)?;
-    write_outputs(ctx, &found, p)?;
-    Ok(found)
 }

@@ -299,4 +299,32 @@ impl StageContext<'_> {
     pub fn item_done(&self) {
         self.progress.item_done(&self.stage);
     }
+    /// The one file of input `slot`.
+    pub fn file(&self, slot: &Slot) -> anyhow::Result<PathBuf> {
+        self.optional_file(slot)?.ok_or_else(|| {
+            anyhow::anyhow!(
+                "`{}` needs input `{}`: add `inputs.{} = \"PATH\"`",
+                self.stage,
+                slot.name,
+                slot.name
+            )
+        })
+    }
+    /// The file of optional input `slot`, if given.
+    pub fn optional_file(&self, slot: &Slot) -> anyhow::Result<Option<PathBuf>> {
+        match self.inputs.get(slot.name).map(Vec::as_slice) {
+            None => Ok(None),
+            Some([one]) => Ok(Some(one.clone())),
+            Some(many) => anyhow::bail!(
+                "input `{}` of `{}` matched {} files; it takes one",
+                slot.name,
+                self.stage,
+                many.len()
+            ),
+        }
+    }
+    /// The files of input `slot` (empty when not given), sorted.
+    pub fn files(&self, slot: &Slot) -> Vec<PathBuf> {
+        self.inputs.get(slot.name).cloned().unwrap_or_default()
+    }
 }

@@ -44,11 +44,26 @@ pub fn read(path: &std::path::Path) -> Result<DataFrame> {
     .collect()?)
 }
 
+/// The tables a benchmark report reads.
+pub struct BenchmarkReportInputs {
+    /// bench.parquet tables of benchmark stages.
+    pub bench: Vec<std::path::PathBuf>,
+    /// population.parquet of a benchmark stage.
+    pub population: Option<std::path::PathBuf>,
+    /// peers.parquet.
+    pub peers: Option<std::path::PathBuf>,
+    /// skips.parquet.
+    pub skips: Option<std::path::PathBuf>,
+    /// bench.parquet of a benchmark stage run with self-contact on and off.
+    pub self_contact: Option<std::path::PathBuf>,
+}
+
 /// Writes the benchmark report and its plots.
-pub fn run(ctx: &Job<'_>, p: &BenchmarkReportParams) -> Result<()> {
+pub fn run(ctx: &Job<'_, BenchmarkReportInputs>, p: &BenchmarkReportParams) -> Result<()> {
     ctx.started(1);
+    let files = &ctx.inputs;
     let mut bench: Option<DataFrame> = None;
-    for f in ctx.input_files("bench") {
+    for f in &files.bench {
         let df = read(f)?;
         bench = Some(match bench {
             None => df,
@@ -69,20 +84,20 @@ point below comes from `bench.parquet` and `peers.parquet` of this run.\n\n",
     md += &endings_section(&c);
     md += &newton_work_section(&bench)?;
     md += &settling_section(&c, &bench)?;
-    if let Some(pop) = ctx.optional_input("population")? {
+    if let Some(pop) = &files.population {
         md += &population_section(&drapelab_record::read_table(pop)?);
     }
-    if let Some(sc) = ctx.optional_input("self_contact")? {
+    if let Some(sc) = &files.self_contact {
         md += &self_contact_section(&read(sc)?)?;
     }
     md += "\n## Every point\n\n";
     md += &markdown(&bench);
-    if let Some(skips) = ctx.optional_input("skips")? {
+    if let Some(skips) = &files.skips {
         md += "\n## What skipping saves, measured on and off in the same run\n\n";
         md += &markdown(&read(skips)?);
         md += "\nsaved_fraction = 1 − time with the skip / time without it.\n";
     }
-    if let Some(peers) = ctx.optional_input("peers")? {
+    if let Some(peers) = &files.peers {
         md += "\n## Peers, run beside drapelab in the same stage\n\n";
         md += &markdown(&read(peers)?);
         md += "\nratio = peer time / drapelab time (> 1: drapelab is faster). The scipy script solves the same \

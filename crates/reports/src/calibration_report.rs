@@ -10,7 +10,7 @@ use drapelab_record::write_text;
 use polars::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Parameters of a calibration-report stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -33,36 +33,54 @@ pub fn read_csv(path: &Path) -> Result<Vec<BTreeMap<String, String>>> {
     Ok(drapelab_record::read_csv(path)?)
 }
 
+/// The tables a calibration report reads.
+pub struct CalibrationReportInputs {
+    /// A calibrate stage's results.parquet.
+    pub results: PathBuf,
+    /// A validate stage's validation.parquet.
+    pub validation: PathBuf,
+    /// A calibrate stage's evaluations.parquet.
+    pub evaluations: PathBuf,
+    /// A calibrate stage's comparison.parquet.
+    pub comparison: PathBuf,
+    /// A tune stage's main_effects.parquet.
+    pub main_effects: PathBuf,
+    /// Seed 000's 4-corner optima (ica_optimum_4corner.csv).
+    pub seed_optimum: PathBuf,
+    /// Seed 000's 2-corner errors (ica_validation_2corner.csv).
+    pub seed_validation: PathBuf,
+}
+
 /// Writes the calibration report and its plots.
-pub fn run(ctx: &Job<'_>, p: &CalibrationReportParams) -> Result<()> {
-    let find = |slot: &str| ctx.input(slot);
+pub fn run(ctx: &Job<'_, CalibrationReportInputs>, p: &CalibrationReportParams) -> Result<()> {
+    let files = &ctx.inputs;
     ctx.started(1);
     let md = ctx.output("markdown")?;
     let (conv_svg, effects_svg) = (
         ctx.optional_output("convergence_plot"),
         ctx.optional_output("main_effects_plot"),
     );
-    let truth4: BTreeMap<u32, BTreeMap<String, String>> = read_csv(find("seed_optimum")?)?
+    let truth4: BTreeMap<u32, BTreeMap<String, String>> = read_csv(&files.seed_optimum)?
         .into_iter()
         .filter_map(|r| Some((r.get("sample")?.parse().ok()?, r)))
         .collect();
-    let seed6: BTreeMap<u32, String> = read_csv(find("seed_validation")?)?
+    let seed6: BTreeMap<u32, String> = read_csv(&files.seed_validation)?
         .into_iter()
         .filter_map(|r| Some((r.get("sample")?.parse().ok()?, r.get("error_pct")?.clone())))
         .collect();
-    let res = scan(find("results")?)?.collect()?;
+    let res = scan(&files.results)?.collect()?;
     let t4 = table_4(&res, &truth4)?;
-    let t6 = table_6(&scan(find("validation")?)?.collect()?, &seed6)?;
-    let convergence = fig_13(find("evaluations")?)?;
+    let t6 = table_6(&scan(&files.validation)?.collect()?, &seed6)?;
+    let convergence = fig_13(&files.evaluations)?;
     if let Some(svg) = conv_svg {
         write_text(svg, &convergence)?;
     }
-    let effects = fig_10(&scan(find("main_effects")?)?.collect()?)?;
+    let effects = fig_10(&scan(&files.main_effects)?.collect()?)?;
     if let Some(svg) = effects_svg {
         write_text(svg, &effects)?;
     }
     // ICA against CMA-ES at the same budget.
-    let cmp = scan(find("comparison")?)?
+    let cmp = scan(&files.comparison)?
         .group_by([col("optimizer")])
         .agg([
             len().alias("runs"),
@@ -84,7 +102,7 @@ pub fn run(ctx: &Job<'_>, p: &CalibrationReportParams) -> Result<()> {
         rel(conv_svg),
         rel(effects_svg),
         markdown(&cmp)
-    ) + &lm_intervals_section(find("comparison")?, &res)?
+    ) + &lm_intervals_section(&files.comparison, &res)?
         + &run_time_section(&res, &cmp)?;
     write_text(md, &text)?;
     ctx.item_done();

@@ -5,6 +5,7 @@
 use crate::format::opt;
 use drapelab_app::cusick_captures::CaptureRow;
 use drapelab_app::cusick_tables::PredictionRow;
+use drapelab_core::cusick::Face;
 use drapelab_core::measure::mean;
 use std::collections::BTreeMap;
 
@@ -14,10 +15,10 @@ fn measured_gaps(caps: &[CaptureRow]) -> BTreeMap<i32, f64> {
     let mut by: BTreeMap<i32, (Vec<f64>, Vec<f64>)> = BTreeMap::new();
     for c in caps {
         let e = by.entry(c.fabric).or_default();
-        match c.face.as_str() {
-            "up" => e.0.push(c.dc_measured_pct),
-            "down" => e.1.push(c.dc_measured_pct),
-            _ => {}
+        match c.face {
+            Face::Up => e.0.push(c.dc_measured_pct),
+            Face::Down => e.1.push(c.dc_measured_pct),
+            Face::Unknown => {}
         }
     }
     by.into_iter()
@@ -58,7 +59,7 @@ fn curl_table(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
 /// a value: (MAE, captures scored).
 fn mae(
     caps: &[CaptureRow],
-    face: Option<&str>,
+    face: Option<Face>,
     predict: impl Fn(&CaptureRow) -> Option<f64>,
 ) -> (Option<f64>, usize) {
     let errors: Vec<f64> = caps
@@ -102,8 +103,8 @@ fn score_table(caps: &[CaptureRow], rows: &[PredictionRow]) -> String {
     );
     for (name, p) in &predictors {
         let (all, n) = mae(caps, None, p);
-        let (up, _) = mae(caps, Some("up"), p);
-        let (down, _) = mae(caps, Some("down"), p);
+        let (up, _) = mae(caps, Some(Face::Up), p);
+        let (down, _) = mae(caps, Some(Face::Down), p);
         s += &format!(
             "| {name} | {} | {} | {} | {n} |\n",
             opt(all, 2),
@@ -150,10 +151,10 @@ fn face_down_from_face_up(caps: &[CaptureRow], rows: &[PredictionRow]) -> String
     let mut faces: BTreeMap<(i32, i32), (Vec<f64>, Vec<f64>)> = BTreeMap::new();
     for c in caps {
         let e = faces.entry((c.fabric, c.sample)).or_default();
-        match c.face.as_str() {
-            "up" => e.0.push(c.dc_measured_pct),
-            "down" => e.1.push(c.dc_measured_pct),
-            _ => {}
+        match c.face {
+            Face::Up => e.0.push(c.dc_measured_pct),
+            Face::Down => e.1.push(c.dc_measured_pct),
+            Face::Unknown => {}
         }
     }
     let up_mean: BTreeMap<(i32, i32), f64> = faces
@@ -187,7 +188,7 @@ fn face_down_from_face_up(caps: &[CaptureRow], rows: &[PredictionRow]) -> String
     };
     let (mut carry, mut population, mut model, mut robust) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for c in caps.iter().filter(|c| c.face == "down") {
+    for c in caps.iter().filter(|c| c.face == Face::Down) {
         let Some(up) = up_mean.get(&(c.fabric, c.sample)) else {
             continue;
         };

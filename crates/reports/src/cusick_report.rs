@@ -13,7 +13,7 @@ use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use drapelab_core::cusick::Tester;
 use drapelab_record::{read_table, write_text};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Parameters of a cusick-report stage (none yet).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -365,13 +365,28 @@ pub fn report_markdown(
     s
 }
 
+/// The tables a cusick-report reads.
+pub struct CusickReportInputs {
+    /// A cusick-predict stage's predictions.parquet.
+    pub predictions: PathBuf,
+    /// A cusick-measure stage's outlines.parquet (the photos).
+    pub photo_outlines: PathBuf,
+    /// A cusick-predict stage's outlines.parquet (the simulated drapes).
+    pub model_outlines: PathBuf,
+    /// A cusick-predict stage's profiles.parquet.
+    pub profiles: PathBuf,
+    /// A cusick-predict stage's predictions_by_capture.parquet.
+    pub by_capture: PathBuf,
+}
+
 /// The `run` of the stage kind over this workflow.
-pub fn run(ctx: &Job<'_>, _: &CusickReportParams) -> Result<()> {
-    let rows = read_table::<PredictionRow>(ctx.input("predictions")?)?;
-    let captures = read_table::<CaptureRow>(ctx.input("by_capture")?)?;
-    let photos = read_table::<OutlineRow>(ctx.input("photo_outlines")?)?;
-    let model = read_table::<OutlineRow>(ctx.input("model_outlines")?)?;
-    let profiles = read_table::<ProfileRow>(ctx.input("profiles")?)?;
+pub fn run(ctx: &Job<'_, CusickReportInputs>, _: &CusickReportParams) -> Result<()> {
+    let files = &ctx.inputs;
+    let rows = read_table::<PredictionRow>(&files.predictions)?;
+    let captures = read_table::<CaptureRow>(&files.by_capture)?;
+    let photos = read_table::<OutlineRow>(&files.photo_outlines)?;
+    let model = read_table::<OutlineRow>(&files.model_outlines)?;
+    let profiles = read_table::<ProfileRow>(&files.profiles)?;
     let t = Tester::default();
     let md = ctx.output("markdown")?;
     let (shadows, profile_plot) = (ctx.output("shadows")?, ctx.output("profile_plot")?);

@@ -96,7 +96,7 @@ pub fn check(p: &ReportParams) -> Result<(), KeyError> {
 
 /// Refuses, before any query runs, a named column that the tables do not have: an input error
 /// naming the pipeline, `stages.STAGE.params.KEY`, the column and the tables' columns (exit 2).
-pub fn check_schema(ctx: &Job<'_>, lf: &mut LazyFrame, p: &ReportParams) -> Result<()> {
+pub fn check_schema<I>(ctx: &Job<'_, I>, lf: &mut LazyFrame, p: &ReportParams) -> Result<()> {
     let schema = lf.collect_schema()?;
     for (key, c) in p.columns() {
         if schema.get(c).is_none() {
@@ -175,12 +175,18 @@ pub fn markdown(df: &DataFrame) -> String {
     s
 }
 
+/// The tables a report reads.
+pub struct ReportInputs {
+    /// Sweep tables (a sweep stage's sweep.parquet).
+    pub tables: Vec<std::path::PathBuf>,
+}
+
 /// Runs the stage.
-pub fn run(ctx: &Job<'_>, p: &ReportParams) -> Result<()> {
+pub fn run(ctx: &Job<'_, ReportInputs>, p: &ReportParams) -> Result<()> {
     let md = ctx.output("markdown")?;
     let svg = ctx.output("plot")?;
     ctx.started(2);
-    let mut lf = scan_all(ctx.input_files("tables"))?;
+    let mut lf = scan_all(&ctx.inputs.tables)?;
     check_schema(ctx, &mut lf, p)?;
     let group: Vec<Expr> = p.group_by.iter().map(|c| col(c.as_str())).collect();
     let aggs = summary_columns(p);
@@ -223,7 +229,7 @@ pub fn run(ctx: &Job<'_>, p: &ReportParams) -> Result<()> {
         text += &format!("{}\n\n", p.notes.trim());
     }
     text += &format!("{} from:\n\n", ctx.made_by());
-    for i in ctx.input_files("tables") {
+    for i in &ctx.inputs.tables {
         text += &format!("- `{}`\n", i.strip_prefix(&ctx.root).unwrap_or(i).display());
     }
     text += &format!(

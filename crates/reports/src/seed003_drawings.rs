@@ -1,51 +1,40 @@
 //! Seed 003's drapes drawn: each from above and from the side (SVG), and the montage of their
 //! rendered surfaces (PNG).
 
-use super::seed003_scenes::Solved;
+use super::seed003_scenes::Drape;
 use anyhow::Result;
 use plotters::prelude::*;
 
 /// Every drape's tile of the montage (a drape on a table or pedestal also from above).
-pub fn drapes_png(solved: &[Solved]) -> image::RgbImage {
-    let tiles: Vec<crate::montage::Tile<'_>> = solved
+pub fn drapes_png(drapes: &[Drape]) -> image::RgbImage {
+    let tiles: Vec<crate::montage::Tile<'_>> = drapes
         .iter()
-        .map(|s| {
-            let n = s.coarse.grid.len();
-            crate::montage::Tile {
-                name: &s.scene.name,
-                grid: &s.coarse.grid,
-                x: &s.coarse.x[..n],
-                present: drapelab_core::build::present_particles(&s.scene),
-                from_above: s.scene.obstacles.iter().any(|o| {
-                    matches!(
-                        o,
-                        drapelab_core::obstacle::Obstacle::Box { .. }
-                            | drapelab_core::obstacle::Obstacle::Pedestal { .. }
-                    )
-                }),
-            }
+        .map(|d| crate::montage::Tile {
+            name: &d.name,
+            grid: &d.grid,
+            x: &d.x,
+            present: d.present.clone(),
+            from_above: d.from_above,
         })
         .collect();
     crate::montage::montage(&tiles)
 }
 
 /// Each drape seen from above (x, y; darker is lower) and from the side (x, z), two panels per scene.
-pub fn drapes_svg(solved: &[Solved]) -> Result<String> {
+pub fn drapes_svg(drapes: &[Drape]) -> Result<String> {
     let mut out = String::new();
     {
-        let k = solved.len().max(1);
+        let k = drapes.len().max(1);
         let root = SVGBackend::with_string(&mut out, (900, 420 * k as u32)).into_drawing_area();
         root.fill(&WHITE)?;
         let rows = root.split_evenly((k, 2));
-        for (s, pair) in solved.iter().zip(rows.chunks(2)) {
-            let x = s.coarse.grid_positions();
-            let present = drapelab_core::build::present_particles(&s.scene);
-            let pts: Vec<_> = x
-                .iter()
-                .zip(&present)
-                .filter(|(_, p)| **p)
-                .map(|(q, _)| *q)
-                .collect();
+        for (s, pair) in drapes.iter().zip(rows.chunks(2)) {
+            let pts: Vec<_> =
+                s.x.iter()
+                    .zip(&s.present)
+                    .filter(|(_, p)| **p)
+                    .map(|(q, _)| *q)
+                    .collect();
             let (zmin, zmax) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, q| {
                 (a.0.min(q.z), a.1.max(q.z))
             });
@@ -67,7 +56,7 @@ pub fn drapes_svg(solved: &[Solved]) -> Result<String> {
                     .caption(
                         format!(
                             "{} — {}",
-                            s.scene.name,
+                            s.name,
                             if side { "side (x, z)" } else { "above (x, y)" }
                         ),
                         ("sans-serif", 16),

@@ -1,47 +1,63 @@
-//! Seed 003's scenes, each solved at its grid and at twice its resolution, with the gap between the
-//! two drapes: what the report's sections, the rod's table and the drawings read.
+//! Seed 003's drapes read back from a `seed003-solve` stage's tables: each scene's grid, positions
+//! and sheet particles, what the drawings and the montage show.
 
-use anyhow::Result;
-use drapelab_core::scene::Scene;
-use drapelab_core::simulate::{Solution, solve_scene};
-use drapelab_core::solve::NoObserver;
-use std::path::Path;
+use anyhow::{Result, bail};
+use drapelab_app::seed003_tables::{DrapeParticleRow, Seed003SceneRow};
+use drapelab_core::cloth::Grid;
+use nalgebra::Vector3;
 
-/// The scene on a grid twice as fine (2n − 1 lines per side; pinned particles moved with it).
-pub fn refined(scene: &Scene) -> Scene {
-    scene.regridded(2 * scene.cloth.nx - 1, 2 * scene.cloth.ny - 1)
+/// One scene's drape at its grid.
+pub struct Drape {
+    /// The scene's name.
+    pub name: String,
+    /// Its grid (lines at the material coordinates of the table).
+    pub grid: Grid,
+    /// Positions in grid order, m.
+    pub x: Vec<Vector3<f64>>,
+    /// Which particles belong to the sheet.
+    pub present: Vec<bool>,
+    /// Also show it from above (a drape on a table or pedestal).
+    pub from_above: bool,
 }
 
-/// A scene solved on its grid and on one twice as fine, with the gap between the two drapes.
-pub struct Solved {
-    pub(crate) scene: Scene,
-    pub(crate) coarse: Solution,
-    pub(crate) fine: Solution,
-    pub(crate) gap_m: f64,
-}
-
-/// Solves a scene on its grid and on [`refined`]'s.
-pub fn solve_pair(scene: &Scene) -> Solved {
-    let coarse = solve_scene(scene, &mut NoObserver);
-    let fine = solve_scene(&refined(scene), &mut NoObserver);
-    let gap_m = if coarse.report.is_converged() && fine.report.is_converged() {
-        let g = &coarse.grid;
-        (0..g.ny)
-            .flat_map(|j| (0..g.nx).map(move |i| (i, j)))
-            .map(|(i, j)| (coarse.at(i, j) - fine.at_material(g.xs[i], g.ys[j])).norm())
-            .fold(0.0, f64::max)
-    } else {
-        f64::NAN
-    };
-    Solved {
-        scene: scene.clone(),
-        coarse,
-        fine,
-        gap_m,
-    }
-}
-
-/// Loads a seed 003 scene.
-pub fn load(path: &Path) -> Result<Scene> {
-    Ok(Scene::load(path, &[])?.scene.into_inner())
+/// Each scene's drape, in the scenes table's order, from the drapes table's particles.
+pub fn drapes(scenes: &[Seed003SceneRow], particles: &[DrapeParticleRow]) -> Result<Vec<Drape>> {
+    scenes
+        .iter()
+        .map(|s| {
+            let rows: Vec<&DrapeParticleRow> =
+                particles.iter().filter(|p| p.scene == s.scene).collect();
+            let (nx, ny) = (s.nx as usize, s.ny as usize);
+            if rows.len() != nx * ny {
+                bail!(
+                    "scene `{}`: {} particles in the drapes table, its grid has {nx} × {ny}",
+                    s.scene,
+                    rows.len()
+                );
+            }
+            let mut grid = Grid {
+                nx,
+                ny,
+                xs: vec![0.0; nx],
+                ys: vec![0.0; ny],
+            };
+            let mut x = vec![Vector3::zeros(); nx * ny];
+            let mut present = vec![true; nx * ny];
+            for p in rows {
+                let (i, j) = (p.i as usize, p.j as usize);
+                grid.xs[i] = p.u_m;
+                grid.ys[j] = p.v_m;
+                let k = grid.index(i, j);
+                x[k] = Vector3::new(p.x_m, p.y_m, p.z_m);
+                present[k] = p.present;
+            }
+            Ok(Drape {
+                name: s.scene.clone(),
+                grid,
+                x,
+                present,
+                from_above: s.from_above,
+            })
+        })
+        .collect()
 }

@@ -4,8 +4,9 @@
 
 use crate::format::opt;
 use drapelab_app::wrinkles_full::WrinklesFull;
-use drapelab_app::wrinkles_points::{SheetRole, TensionFieldFit};
+use drapelab_app::wrinkles_points::{SheetRole, SheetVerdict, TensionFieldFit};
 use drapelab_app::wrinkles_tables::WrinkleFullRow;
+use drapelab_core::wrinkles::full::ReadingKind;
 use std::fmt::Write;
 
 /// Counts over the rows: (solved and converged in the mesh, tension field within ±1 of the
@@ -13,7 +14,9 @@ use std::fmt::Write;
 pub fn agreement_counts(rows: &[WrinkleFullRow]) -> (usize, usize, usize) {
     let within = |a: i32, b: i32| (a - b).abs() <= 1;
     (
-        rows.iter().filter(|r| r.status == "converged").count(),
+        rows.iter()
+            .filter(|r| r.status == SheetVerdict::Converged)
+            .count(),
         rows.iter()
             .filter(|r| within(r.n_tension_field, r.n_full_simulation))
             .count(),
@@ -24,7 +27,7 @@ pub fn agreement_counts(rows: &[WrinkleFullRow]) -> (usize, usize, usize) {
 }
 
 /// The rows of one reading and role.
-fn select<'a>(all: &'a [WrinkleFullRow], reading: &str, role: &str) -> Vec<&'a WrinkleFullRow> {
+fn select(all: &[WrinkleFullRow], reading: ReadingKind, role: SheetRole) -> Vec<&WrinkleFullRow> {
     all.iter()
         .filter(|r| r.reading == reading && r.role == role)
         .collect()
@@ -33,8 +36,8 @@ fn select<'a>(all: &'a [WrinkleFullRow], reading: &str, role: &str) -> Vec<&'a W
 /// The whole fabric section; empty when no sheet was read as fabric.
 pub fn fabric_section(found: &WrinklesFull, all: &[WrinkleFullRow]) -> String {
     let (plates, fabrics) = (
-        select(all, "plate", "table"),
-        select(all, "fabric", "table"),
+        select(all, ReadingKind::Plate, SheetRole::Table),
+        select(all, ReadingKind::Fabric, SheetRole::Table),
     );
     if fabrics.is_empty() {
         return String::new();
@@ -47,10 +50,7 @@ pub fn fabric_section(found: &WrinklesFull, all: &[WrinkleFullRow]) -> String {
     let n = fabrics.len();
     let owned: Vec<WrinkleFullRow> = fabrics.iter().map(|r| (*r).clone()).collect();
     let (converged, tf, seed) = agreement_counts(&owned);
-    let n_equal = fabrics
-        .iter()
-        .filter(|r| r.status.starts_with("converged"))
-        .count();
+    let n_equal = fabrics.iter().filter(|r| r.status.agrees_on_n()).count();
     let zmax_moves: Vec<f64> = fabrics
         .iter()
         .map(|r| 100.0 * (r.z_max_full_simulation_coarse_m / r.z_max_full_simulation_m - 1.0))
@@ -223,7 +223,7 @@ out **{} of {n}**. In-sample, the best of each reading on the {n} cases: {}; {}.
 /// The map: each named case at every bending length × shear rigidity, with the refitted tension
 /// field's count and each table's trend at every point.
 fn map_section(all: &[WrinkleFullRow], fit: Option<&TensionFieldFit>) -> String {
-    let map = select(all, "fabric", "map");
+    let map = select(all, ReadingKind::Fabric, SheetRole::Map);
     if map.is_empty() {
         return String::new();
     }
@@ -318,7 +318,7 @@ fn map_trends(map: &[&WrinkleFullRow]) -> String {
 
 /// The seed's photographed cloth (Fig. 4) read as fabric at each support displacement.
 fn photograph_section(all: &[WrinkleFullRow]) -> String {
-    let rows = select(all, "fabric", "photograph");
+    let rows = select(all, ReadingKind::Fabric, SheetRole::Photograph);
     if rows.is_empty() {
         return String::new();
     }
@@ -362,11 +362,11 @@ mod tests {
             n_full_simulation_coarse: n,
             z_max_full_simulation_m: 0.1,
             wall_time_s: 1.0,
-            status: "converged".into(),
-            reading: "fabric".into(),
+            status: SheetVerdict::Converged,
+            reading: ReadingKind::Fabric,
             bending_length_m: c_b,
             shear_rigidity_N_per_m: g,
-            role: "map".into(),
+            role: SheetRole::Map,
             z_max_full_simulation_coarse_m: 0.1,
             z_max_seed_m: None,
             z_max_tension_field_m: 0.0,
@@ -382,6 +382,8 @@ mod tests {
             wall_time_fine_s: 1.0,
             energy_J: 0.0,
             self_crossing_edges: 0,
+            status_fine: drapelab_core::solve::Status::Converged,
+            status_coarse: drapelab_core::solve::Status::Converged,
         }
     }
 

@@ -9,8 +9,10 @@ use drapelab_app::Job;
 use drapelab_app::wrinkles::{SolvedCase, report_markdown};
 use drapelab_app::wrinkles_full::WrinklesFull;
 use drapelab_app::wrinkles_params::WrinklesSimulateParams;
+use drapelab_app::wrinkles_points::SheetRole;
 use drapelab_app::wrinkles_tables::{StartRow, WrinkleFullRow, rows, start_rows};
 use drapelab_core::wrinkles::WrinkleConfig;
+use drapelab_core::wrinkles::full::ReadingKind;
 use drapelab_record::write_text;
 use plotters::prelude::*;
 use std::fmt::Write;
@@ -197,7 +199,7 @@ pub fn starts_section(all: &[StartRow]) -> String {
         let result_n = mine.iter().find(|r| r.result_start).map(|r| r.n);
         let best = mine
             .iter()
-            .filter(|r| r.status == "converged")
+            .filter(|r| r.status == drapelab_core::solve::Status::Converged)
             .min_by(|a, b| a.energy_J.total_cmp(&b.energy_J));
         lowest += usize::from(best.is_some_and(|b| b.result_start));
         same_n += usize::from(best.is_some_and(|b| Some(b.n) == result_n));
@@ -283,7 +285,6 @@ pub fn fibres_svg(found: &WrinklesFull) -> Result<String> {
 /// The simulated sheets (finer mesh), four to a row: each case read as a plate, then beside it
 /// read as a fabric where it was; then the photographed cloth (Fig. 4) read as fabric.
 pub fn sheets_png(found: &WrinklesFull) -> image::RgbImage {
-    use drapelab_app::wrinkles_points::SheetRole;
     let photographs = found
         .points
         .iter()
@@ -363,13 +364,13 @@ pub fn markdown(
 ) -> String {
     // Both tables once: each row counts its sheet's self-crossings.
     let all = rows(found, p);
-    let reading = |name: &str| -> Vec<WrinkleFullRow> {
+    let reading = |kind: ReadingKind| -> Vec<WrinkleFullRow> {
         all.iter()
-            .filter(|x| x.reading == name && x.role == "table")
+            .filter(|x| x.reading == kind && x.role == SheetRole::Table)
             .cloned()
             .collect()
     };
-    let r = reading("plate");
+    let r = reading(ReadingKind::Plate);
     let starts = start_rows(found, p.start);
     let n = r.len();
     let (converged, tf, seed) = crate::wrinkles_fabric::agreement_counts(&r);

@@ -6,6 +6,9 @@ pub use drapelab_app::benchmark::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
 /// Runs a benchmark stage.
+/// The scenes benchmarked.
+const SCENES: Slot = Slot::many("scenes", "scene TOMLs");
+
 /// The `benchmark` stage kind.
 pub struct Benchmark;
 
@@ -14,7 +17,7 @@ impl StageKind for Benchmark {
     const KIND: &'static str = "benchmark";
     const SUMMARY: &'static str =
         "Every scene × size × tolerance × solver: time, work, memory, error";
-    const INPUTS: &'static [Slot] = &[Slot::many("scenes", "scene TOMLs")];
+    const INPUTS: &'static [Slot] = &[SCENES];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("table", "bench.parquet: one row per point"),
         Slot::optional(
@@ -23,7 +26,8 @@ impl StageKind for Benchmark {
         ),
     ];
     fn run(ctx: &StageContext<'_>, p: &BenchmarkParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let scenes = ctx.files(&SCENES);
+        let ctx = &crate::job(ctx, BenchmarkInputs { scenes });
         run(ctx, p).map(drop)
     }
 }

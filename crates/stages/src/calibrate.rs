@@ -6,6 +6,23 @@ pub use drapelab_app::calibrate::*;
 use drapelab_pipeline::{ItemKind, KeyError, Slot, StageContext, StageKind};
 use std::path::{Path, PathBuf};
 
+/// ICA's settings from a file.
+const ICA: Slot = Slot::optional(
+    "ica",
+    "ICA settings as JSON (a tune stage's best_ica.json), with params.ica_from_input",
+);
+
+/// The workflow's inputs from the stage's files.
+fn inputs(ctx: &StageContext<'_>) -> Result<CalibrateInputs> {
+    Ok(CalibrateInputs {
+        samples: crate::sample_inputs(
+            ctx,
+            [&crate::EDGES_SLOT, &crate::SAMPLES_SLOT, &crate::SCENE_SLOT],
+        )?,
+        ica: ctx.optional_file(&ICA)?,
+    })
+}
+
 /// The `calibrate` stage kind.
 pub struct Calibrate;
 
@@ -18,10 +35,7 @@ impl StageKind for Calibrate {
         crate::EDGES_SLOT,
         crate::SAMPLES_SLOT,
         crate::SCENE_SLOT,
-        Slot::optional(
-            "ica",
-            "ICA settings as JSON (a tune stage's best_ica.json), with params.ica_from_input",
-        ),
+        ICA,
     ];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("results", "results.parquet: one row per sample"),
@@ -47,7 +61,7 @@ impl StageKind for Calibrate {
 /// (they share the sample's cost cache, and its results do not depend on the executor).
 impl ItemKind for Calibrate {
     fn count(ctx: &StageContext<'_>, p: &CalibrateParams) -> Result<usize> {
-        let ctx = &crate::job(ctx);
+        let ctx = &crate::job(ctx, inputs(ctx)?);
         count(ctx, p)
     }
     fn compute(
@@ -56,11 +70,11 @@ impl ItemKind for Calibrate {
         item: usize,
         part: &Path,
     ) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let ctx = &crate::job(ctx, inputs(ctx)?);
         compute(ctx, p, item, part)
     }
     fn gather(ctx: &StageContext<'_>, _p: &CalibrateParams, parts: &[PathBuf]) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let ctx = &crate::job(ctx, inputs(ctx)?);
         gather(ctx, parts)
     }
 }

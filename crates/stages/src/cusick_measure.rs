@@ -14,10 +14,7 @@ impl StageKind for CusickMeasure {
     const SUMMARY: &'static str =
         "DC and node count of every Cusick capture, from its photo and from its 3D mesh";
     const INPUTS: &'static [Slot] = &[
-        Slot::one(
-            "index",
-            "captures_index.csv of a Cusick dataset (its folder holds the rest)",
-        ),
+        crate::CUSICK_INDEX_SLOT,
         Slot::many(
             "files",
             "every file of the dataset (for the up-to-date check), e.g. datasets/cusick/*.* and its silhouettes",
@@ -31,7 +28,8 @@ impl StageKind for CusickMeasure {
         ),
     ];
     fn run(ctx: &StageContext<'_>, p: &CusickMeasureParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let index = ctx.file(&crate::CUSICK_INDEX_SLOT)?;
+        let ctx = &crate::job(ctx, CusickMeasureInputs { index });
         run(ctx, p).map(drop)
     }
 }

@@ -5,6 +5,14 @@ use anyhow::Result;
 pub use drapelab_app::cusick_predict::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
+/// The captures measured.
+const SHADOWS: Slot = Slot::one("shadows", "a cusick-measure stage's shadows.parquet");
+/// The photos' outlines.
+const PHOTO_OUTLINES: Slot = Slot::one(
+    "photo_outlines",
+    "a cusick-measure stage's outlines.parquet (the photos' outlines r(θ))",
+);
+
 /// The `cusick-predict` stage kind.
 pub struct CusickPredict;
 
@@ -13,17 +21,7 @@ impl StageKind for CusickPredict {
     const KIND: &'static str = "cusick-predict";
     const SUMMARY: &'static str =
         "Calibrate each Cusick fabric's bending length on one specimen, predict the others";
-    const INPUTS: &'static [Slot] = &[
-        Slot::one(
-            "index",
-            "captures_index.csv of a Cusick dataset (its folder holds the rest)",
-        ),
-        Slot::one("shadows", "a cusick-measure stage's shadows.parquet"),
-        Slot::one(
-            "photo_outlines",
-            "a cusick-measure stage's outlines.parquet (the photos' outlines r(θ))",
-        ),
-    ];
+    const INPUTS: &'static [Slot] = &[crate::CUSICK_INDEX_SLOT, SHADOWS, PHOTO_OUTLINES];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("predictions", "predictions.parquet: one row per fabric"),
         Slot::one(
@@ -44,7 +42,12 @@ impl StageKind for CusickPredict {
         ),
     ];
     fn run(ctx: &StageContext<'_>, p: &CusickPredictParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let inputs = CusickPredictInputs {
+            index: ctx.file(&crate::CUSICK_INDEX_SLOT)?,
+            shadows: ctx.file(&SHADOWS)?,
+            photo_outlines: ctx.file(&PHOTO_OUTLINES)?,
+        };
+        let ctx = &crate::job(ctx, inputs);
         run(ctx, p).map(drop)
     }
 }

@@ -5,6 +5,12 @@ use anyhow::Result;
 pub use drapelab_app::fit_edges::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
+/// The photos fitted.
+const PHOTOS: Slot = Slot::many(
+    "photos",
+    "photos (.png, .jpg), each with its camera.json beside it",
+);
+
 /// The `fit-edges` stage kind.
 pub struct FitEdges;
 
@@ -13,10 +19,7 @@ impl StageKind for FitEdges {
     const KIND: &'static str = "fit-edges";
     const SUMMARY: &'static str = "Fit edge polynomials to photos (seed 000 Figs 11-12)";
     const INPUTS: &'static [Slot] = &[
-        Slot::many(
-            "photos",
-            "photos (.png, .jpg), each with its camera.json beside it",
-        ),
+        PHOTOS,
         Slot::optional_many(
             "cameras",
             "the camera.json files beside the photos (listed so that a changed calibration reruns)",
@@ -24,7 +27,8 @@ impl StageKind for FitEdges {
     ];
     const OUTPUTS: &'static [Slot] = &[Slot::one("edges", "edges.parquet of every photo")];
     fn run(ctx: &StageContext<'_>, p: &FitEdgesParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let photos = ctx.files(&PHOTOS);
+        let ctx = &crate::job(ctx, FitEdgesInputs { photos });
         run(ctx, p).map(drop)
     }
 }

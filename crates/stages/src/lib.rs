@@ -17,6 +17,7 @@ mod peers;
 pub mod report;
 mod score;
 mod seed003_report;
+mod seed003_solve;
 mod simulate;
 mod skips;
 mod surface;
@@ -39,6 +40,7 @@ pub use peers::{Peers, PeersParams};
 pub use report::{Report, ReportParams};
 pub use score::{Score, ScoreParams};
 pub use seed003_report::{Seed003Report, Seed003ReportParams};
+pub use seed003_solve::{Seed003Solve, Seed003SolveParams};
 pub use simulate::{Simulate, SimulateParams};
 pub use skips::{Skips, SkipsParams};
 pub use surface::{
@@ -65,14 +67,38 @@ const SAMPLES_SLOT: Slot = Slot::one("samples", "Table 2's densities (knitted_sa
 /// The hang scene of the calibration stages.
 const SCENE_SLOT: Slot = Slot::one("scene", "the hang scene each sample is simulated in");
 
-/// The workflow's view of a stage's context: its files, its name, and progress forwarded to the
-/// engine's display.
-pub(crate) fn job<'c>(ctx: &'c drapelab_pipeline::StageContext<'_>) -> drapelab_app::Job<'c> {
+/// The three files of the calibration stages from their slots (edges, samples, scene in order).
+fn sample_inputs(
+    ctx: &drapelab_pipeline::StageContext<'_>,
+    [edges, samples, scene]: [&Slot; 3],
+) -> anyhow::Result<drapelab_app::calibrate::SampleInputs> {
+    Ok(drapelab_app::calibrate::SampleInputs {
+        edges: ctx.file(edges)?,
+        samples: ctx.file(samples)?,
+        scene: ctx.file(scene)?,
+    })
+}
+
+/// The index of a Cusick dataset, for the Cusick stages.
+const CUSICK_INDEX_SLOT: Slot = Slot::one(
+    "index",
+    "captures_index.csv of a Cusick dataset (its folder holds the rest)",
+);
+
+/// The wrinkle config of the wrinkles stages.
+const WRINKLE_CONFIG_SLOT: Slot = Slot::one("config", "the wrinkle config TOML");
+
+/// The workflow's view of a stage's context: its typed inputs (built from the kind's slots), its
+/// outputs, its name, and progress forwarded to the engine's display.
+pub(crate) fn job<'c, I>(
+    ctx: &'c drapelab_pipeline::StageContext<'_>,
+    inputs: I,
+) -> drapelab_app::Job<'c, I> {
     drapelab_app::Job {
         stage: ctx.stage.clone(),
         source: ctx.pipeline_file.clone(),
         root: ctx.root.clone(),
-        inputs: ctx.inputs.clone(),
+        inputs,
         outputs: ctx.outputs.clone(),
         progress: Box::new(Forward(ctx)),
     }
@@ -104,6 +130,7 @@ pub fn registry() -> Registry {
         .with::<CalibrationReport>()
         .with::<Wrinkles>()
         .with::<WrinklesSimulate>()
+        .with::<Seed003Solve>()
         .with::<Seed003Report>()
         .with::<Benchmark>()
         .with::<Peers>()

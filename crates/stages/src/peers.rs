@@ -5,6 +5,18 @@ use anyhow::Result;
 pub use drapelab_app::peers::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
+/// The scene the peers solve.
+const SCENE: Slot = Slot::one("scene", "the hang4 scene");
+/// scipy's Newton peer.
+const SCIPY_NEWTON: Slot = Slot::one("scipy_newton", "benches/peers/scipy_newton.py");
+/// numpy's explicit peer.
+const NUMPY_EXPLICIT: Slot = Slot::one("numpy_explicit", "benches/peers/numpy_explicit.py");
+/// CHOLMOD's Newton peer.
+const CHOLMOD_NEWTON: Slot = Slot::optional(
+    "cholmod_newton",
+    "benches/peers/cholmod_newton.py (runs when given)",
+);
+
 /// The `peers` stage kind.
 pub struct Peers;
 
@@ -13,18 +25,21 @@ impl StageKind for Peers {
     const KIND: &'static str = "peers";
     const SUMMARY: &'static str = "scipy, CHOLMOD and numpy peers run beside drapelab";
     const INPUTS: &'static [Slot] = &[
-        Slot::one("scene", "the hang4 scene"),
-        Slot::one("scipy_newton", "benches/peers/scipy_newton.py"),
-        Slot::one("numpy_explicit", "benches/peers/numpy_explicit.py"),
-        Slot::optional(
-            "cholmod_newton",
-            "benches/peers/cholmod_newton.py (runs when given)",
-        ),
+        SCENE,
+        SCIPY_NEWTON,
+        NUMPY_EXPLICIT,
+        CHOLMOD_NEWTON,
         Slot::optional_many("support", "modules the scripts import (model.py)"),
     ];
     const OUTPUTS: &'static [Slot] = &[Slot::one("table", "peers.parquet")];
     fn run(ctx: &StageContext<'_>, p: &PeersParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let inputs = PeersInputs {
+            scene: ctx.file(&SCENE)?,
+            scipy_newton: ctx.file(&SCIPY_NEWTON)?,
+            numpy_explicit: ctx.file(&NUMPY_EXPLICIT)?,
+            cholmod_newton: ctx.optional_file(&CHOLMOD_NEWTON)?,
+        };
+        let ctx = &crate::job(ctx, inputs);
         run(ctx, p)
     }
 }

@@ -5,6 +5,9 @@ use anyhow::Result;
 use drapelab_pipeline::{KeyError, Slot, StageContext, StageKind};
 pub use drapelab_reports::report::*;
 
+/// The tables summarised.
+const TABLES: Slot = Slot::many("tables", "sweep tables (a sweep stage's sweep.parquet)");
+
 /// The `report` stage kind.
 pub struct Report;
 
@@ -12,10 +15,7 @@ impl StageKind for Report {
     type Params = ReportParams;
     const KIND: &'static str = "report";
     const SUMMARY: &'static str = "Summaries and a plot over sweep tables, as Markdown";
-    const INPUTS: &'static [Slot] = &[Slot::many(
-        "tables",
-        "sweep tables (a sweep stage's sweep.parquet)",
-    )];
+    const INPUTS: &'static [Slot] = &[TABLES];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("markdown", "the report, .md"),
         Slot::one("plot", "the plot, .svg"),
@@ -24,7 +24,8 @@ impl StageKind for Report {
         check(p)
     }
     fn run(ctx: &StageContext<'_>, p: &ReportParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let tables = ctx.files(&TABLES);
+        let ctx = &crate::job(ctx, ReportInputs { tables });
         run(ctx, p)
     }
 }

@@ -5,6 +5,16 @@ use anyhow::Result;
 pub use drapelab_app::simulate::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
+/// The scene solved.
+const SCENE: Slot = Slot::one("scene", "the scene TOML");
+
+/// The workflow's inputs from the stage's files.
+fn inputs(ctx: &StageContext<'_>) -> Result<SimulateInputs> {
+    Ok(SimulateInputs {
+        scene: ctx.file(&SCENE)?,
+    })
+}
+
 /// The `simulate` stage kind.
 pub struct Simulate;
 
@@ -12,7 +22,7 @@ impl StageKind for Simulate {
     type Params = SimulateParams;
     const KIND: &'static str = "simulate";
     const SUMMARY: &'static str = "Solve one scene (with overrides) and record it";
-    const INPUTS: &'static [Slot] = &[Slot::one("scene", "the scene TOML")];
+    const INPUTS: &'static [Slot] = &[SCENE];
     const OUTPUTS: &'static [Slot] = &[
         Slot::one("particles", "particles.parquet, the converged drape"),
         Slot::one("run", "run.json, the solve report"),
@@ -21,13 +31,13 @@ impl StageKind for Simulate {
     ];
     /// The scene loads with the overrides (a bad value is refused naming `params.set.KEY`).
     fn precheck(ctx: &StageContext<'_>, p: &SimulateParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let ctx = &crate::job(ctx, inputs(ctx)?);
         let overrides: Vec<_> = p.set.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
-        ctx.load_scene(ctx.input("scene")?, &overrides, |k| format!("set.{k}"))
+        ctx.load_scene(&ctx.inputs.scene, &overrides, |k| format!("set.{k}"))
             .map(drop)
     }
     fn run(ctx: &StageContext<'_>, p: &SimulateParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let ctx = &crate::job(ctx, inputs(ctx)?);
         run(ctx, p).map(drop)
     }
 }

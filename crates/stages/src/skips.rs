@@ -8,6 +8,16 @@ use drapelab_pipeline::{Slot, StageContext, StageKind};
 use std::path::Path;
 use std::time::Instant;
 
+/// The whole drape.
+const FULL: Slot = Slot::one("full", "a drape on a table, whole (table_wool.toml)");
+/// The quarter model of it.
+const QUARTER: Slot = Slot::one(
+    "quarter",
+    "the same drape as a quarter model (table_wool_quarter.toml)",
+);
+/// The hang.
+const HANG: Slot = Slot::one("hang", "a hang without obstacles (hang4.toml)");
+
 /// The `skips` stage kind.
 pub struct Skips;
 
@@ -15,17 +25,15 @@ impl StageKind for Skips {
     type Params = SkipsParams;
     const KIND: &'static str = "skips";
     const SUMMARY: &'static str = "Each skip the engine makes, measured on and off";
-    const INPUTS: &'static [Slot] = &[
-        Slot::one("full", "a drape on a table, whole (table_wool.toml)"),
-        Slot::one(
-            "quarter",
-            "the same drape as a quarter model (table_wool_quarter.toml)",
-        ),
-        Slot::one("hang", "a hang without obstacles (hang4.toml)"),
-    ];
+    const INPUTS: &'static [Slot] = &[FULL, QUARTER, HANG];
     const OUTPUTS: &'static [Slot] = &[Slot::one("table", "skips.parquet")];
     fn run(ctx: &StageContext<'_>, p: &SkipsParams) -> Result<()> {
-        run(&crate::job(ctx), p, skip_up_to_date_stage)
+        let inputs = SkipsInputs {
+            full: ctx.file(&FULL)?,
+            quarter: ctx.file(&QUARTER)?,
+            hang: ctx.file(&HANG)?,
+        };
+        run(&crate::job(ctx, inputs), p, skip_up_to_date_stage)
     }
 }
 

@@ -31,7 +31,8 @@ impl StageKind for Tune {
         }
     }
     fn run(ctx: &StageContext<'_>, p: &TuneParams) -> Result<()> {
-        let job = crate::job(ctx);
+        let files = [&crate::EDGES_SLOT, &crate::SAMPLES_SLOT, &crate::SCENE_SLOT];
+        let job = crate::job(ctx, crate::sample_inputs(ctx, files)?);
         let outcome = run(&job, p)?;
         if let Some(svg) = job.optional_output("plot") {
             let text = drapelab_reports::report::plot_panels(

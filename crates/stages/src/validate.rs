@@ -5,6 +5,24 @@ use anyhow::Result;
 pub use drapelab_app::validate::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
+/// The calibrated parameters.
+const CALIBRATION: Slot = Slot::one("calibration", "a calibrate stage's results.parquet");
+/// The 2-corner edges.
+const EDGES: Slot = Slot::one(
+    "edges",
+    "measured 2-corner edges of every sample (a fit-edges table)",
+);
+/// The 2-corner hang.
+const SCENE: Slot = Slot::one("scene", "the 2-corner hang scene");
+
+/// The workflow's inputs from the stage's files.
+fn inputs(ctx: &StageContext<'_>) -> Result<ValidateInputs> {
+    Ok(ValidateInputs {
+        samples: crate::sample_inputs(ctx, [&EDGES, &crate::SAMPLES_SLOT, &SCENE])?,
+        calibration: ctx.file(&CALIBRATION)?,
+    })
+}
+
 /// The `validate` stage kind.
 pub struct Validate;
 
@@ -13,21 +31,13 @@ impl StageKind for Validate {
     const KIND: &'static str = "validate";
     const SUMMARY: &'static str =
         "Calibrated parameters on the 2-corner hang against its measured edges (seed 000 Table 6)";
-    const INPUTS: &'static [Slot] = &[
-        Slot::one("calibration", "a calibrate stage's results.parquet"),
-        Slot::one(
-            "edges",
-            "measured 2-corner edges of every sample (a fit-edges table)",
-        ),
-        Slot::one("samples", "Table 2's densities (knitted_samples.csv)"),
-        Slot::one("scene", "the 2-corner hang scene"),
-    ];
+    const INPUTS: &'static [Slot] = &[CALIBRATION, EDGES, crate::SAMPLES_SLOT, SCENE];
     const OUTPUTS: &'static [Slot] = &[Slot::one(
         "validation",
         "validation.parquet: one row per sample",
     )];
     fn run(ctx: &StageContext<'_>, p: &ValidateParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let ctx = &crate::job(ctx, inputs(ctx)?);
         run(ctx, p).map(drop)
     }
 }

@@ -12,7 +12,7 @@ impl StageKind for Wrinkles {
     type Params = WrinklesParams;
     const KIND: &'static str = "wrinkles";
     const SUMMARY: &'static str = "Seed 002's tension-field wrinkles of every case of a config";
-    const INPUTS: &'static [Slot] = &[Slot::one("config", "the wrinkle config TOML")];
+    const INPUTS: &'static [Slot] = &[crate::WRINKLE_CONFIG_SLOT];
     const OUTPUTS: &'static [Slot] = &[
         Slot::optional("table", "wrinkles.parquet: one row per case"),
         Slot::optional("mesh", "the deformed grids, Parquet"),
@@ -20,7 +20,8 @@ impl StageKind for Wrinkles {
         Slot::optional("markdown", "the report, .md"),
     ];
     fn run(ctx: &StageContext<'_>, p: &WrinklesParams) -> Result<()> {
-        let ctx = &crate::job(ctx);
+        let config = ctx.file(&crate::WRINKLE_CONFIG_SLOT)?;
+        let ctx = &crate::job(ctx, WrinklesInputs { config });
         run(ctx, p).map(drop)
     }
 }

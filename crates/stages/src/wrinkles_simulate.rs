@@ -14,7 +14,7 @@ impl StageKind for WrinklesSimulate {
     type Params = WrinklesSimulateParams;
     const KIND: &'static str = "wrinkles-simulate";
     const SUMMARY: &'static str = "Seed 002's hung sheets as full continuum simulations on two meshes, beside the seed's tables and the tension-field model";
-    const INPUTS: &'static [Slot] = &[Slot::one("config", "the wrinkle config TOML")];
+    const INPUTS: &'static [Slot] = &[crate::WRINKLE_CONFIG_SLOT];
     const OUTPUTS: &'static [Slot] = &[
         Slot::optional(
             "table",
@@ -34,8 +34,8 @@ impl StageKind for WrinklesSimulate {
         p.check()
     }
     fn run(ctx: &StageContext<'_>, p: &WrinklesSimulateParams) -> Result<()> {
-        let job = &crate::job(ctx);
-        let cfg = drapelab_core::wrinkles::load_config(job.input("config")?)?;
+        let cfg = drapelab_core::wrinkles::load_config(&ctx.file(&crate::WRINKLE_CONFIG_SLOT)?)?;
+        let job = &crate::job(ctx, ());
         let found = simulate(job, &cfg, p)?;
         write_outputs(job, &found, p)?;
         drapelab_reports::wrinkles_report::write_report(job, &cfg, &found, p)

@@ -18,6 +18,29 @@ use crate::solve::NoObserver;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+/// The face a specimen lies on in a capture (the `face` column of the Cusick tables).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Face {
+    /// Face up.
+    Up,
+    /// Face down.
+    Down,
+    /// Not given by the dataset's index: predicted as the average of both faces.
+    Unknown,
+}
+
+impl Face {
+    /// The face a dataset's index writes: "up", "down", anything else unknown.
+    pub fn of(label: &str) -> Face {
+        match label {
+            "up" => Face::Up,
+            "down" => Face::Down,
+            _ => Face::Unknown,
+        }
+    }
+}
+
 /// What the calibration specimen's two faces show.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FaceGap {

@@ -27,7 +27,7 @@ pub use fabric::{
     SeededDrape, SpecimenTargets, calibrate_and_predict, calibrate_fabric, histogram,
     histogram_label, seeded_drapes,
 };
-pub use face::{CurlFit, FaceGap, GAP_TOL_PCT, MAX_CURL_PER_M, fit_curl};
+pub use face::{CurlFit, Face, FaceGap, GAP_TOL_PCT, MAX_CURL_PER_M, fit_curl};
 pub use params::{SPECIMEN_KEYS, SpecimenParameters};
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};

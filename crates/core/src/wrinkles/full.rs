@@ -9,7 +9,7 @@ use crate::error::InputError;
 use crate::scene::{LoadedScene, Scene};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// How a hung sheet's bending and shear are read from its case (issue 50): seed 002 gives only
@@ -36,12 +36,33 @@ pub enum SheetReading {
     },
 }
 
-impl SheetReading {
+/// Which reading a sheet was solved under, without its numbers: the `reading` column of the
+/// wrinkle tables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ReadingKind {
+    /// Seed 002's isotropic plate.
+    Plate,
+    /// A fabric's bending length and shear rigidity.
+    Fabric,
+}
+
+impl ReadingKind {
     /// "plate" or "fabric".
-    pub fn name(&self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
-            SheetReading::Plate { .. } => "plate",
-            SheetReading::Fabric { .. } => "fabric",
+            ReadingKind::Plate => "plate",
+            ReadingKind::Fabric => "fabric",
+        }
+    }
+}
+
+impl SheetReading {
+    /// Plate or fabric.
+    pub fn kind(&self) -> ReadingKind {
+        match self {
+            SheetReading::Plate { .. } => ReadingKind::Plate,
+            SheetReading::Fabric { .. } => ReadingKind::Fabric,
         }
     }
     /// (bending warp = weft, twist, shear) of a case under this reading: N·m, N·m, N/m.
