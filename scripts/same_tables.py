@@ -12,8 +12,9 @@ the same rows in the same order and, column by column, equal values (floats with
 not counted as a difference (say why in the commit); a column or file only BEFORE has is a
 difference. Also left out, as derived from wall time: `ratio` (a peer's time over drapelab's) and
 `saved_fraction` (a skip's saving), and the work columns (iterations, linear solves,
-factorizations) of a row that did not converge in either run (a point stopped by its wall-time
-budget). Exit code 0 when nothing differs, 1 otherwise, 2 for bad arguments.
+factorizations) and the residual left (`max_residual_N`) of a row that did not converge in either
+run (a point stopped by its wall-time budget: how far it got depends on the machine's load).
+Exit code 0 when nothing differs, 1 otherwise, 2 for bad arguments.
 """
 import math
 import pathlib
@@ -23,7 +24,7 @@ import pyarrow.parquet as pq
 
 TIMING_SUFFIXES = ("_s", "_ms", "peak_rss_bytes")
 TIME_DERIVED = ("ratio", "saved_fraction")
-WORK = ("iterations", "linear_solves", "factorizations", "inner_iterations")
+WORK = ("iterations", "linear_solves", "factorizations", "inner_iterations", "max_residual_N")
 
 
 def is_timing(name: str) -> bool:

@@ -136,8 +136,37 @@ fn write_if<T: Table, I>(
     }
 }
 
+/// Refuses an output whose inputs are not given (it would be left unwritten): an input error naming
+/// the pipeline and `stages.STAGE.outputs.NAME` (exit 2).
+pub fn check_outputs(ctx: &Job<'_, Seed003SolveInputs>) -> Result<()> {
+    let f = &ctx.inputs;
+    let table = f.quarter_table.is_some() && f.table_reference.is_some();
+    for (out, given, needs) in [
+        (
+            "table_edges",
+            table,
+            "quarter_table` and `inputs.table_reference",
+        ),
+        ("rod", f.rod.is_some(), "rod"),
+        ("rod_grid", f.rod.is_some(), "rod"),
+        ("load_displacement", f.cantilever.is_some(), "cantilever"),
+        ("cantilever_grid", f.cantilever.is_some(), "cantilever"),
+    ] {
+        if ctx.optional_output(out).is_some() && !given {
+            return Err(drapelab_core::error::InputError::new(
+                ctx.root.join(&ctx.source),
+                format!("stages.{}.outputs.{out}", ctx.stage),
+                format!("is written only with `inputs.{needs}`: add it, or drop the output"),
+            )
+            .into());
+        }
+    }
+    Ok(())
+}
+
 /// The `run` of the stage kind over this workflow.
 pub fn run(ctx: &Job<'_, Seed003SolveInputs>, p: &Seed003SolveParams) -> Result<()> {
+    check_outputs(ctx)?;
     let files = &ctx.inputs;
     let scenes: Vec<Scene> = files
         .scenes

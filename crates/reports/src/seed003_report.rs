@@ -162,11 +162,7 @@ pub fn table_10_2(edges: &[TableEdgeRow], file: &Path) -> Result<String> {
         );
     }
     for (row, e) in rows.iter().zip(edges) {
-        let f = |k: &str| {
-            row.get(k)
-                .and_then(|v| v.parse::<f64>().ok())
-                .unwrap_or(f64::NAN)
-        };
+        let f = |k: &str| crate::seed003_rod::cm_field(row, k);
         let (x0, y0) = (f("x0_cm"), f("y0_cm"));
         let pt = (e.x_m * 100.0, e.y_m * 100.0, e.drop_m * 100.0);
         let d =

@@ -31,6 +31,17 @@ const CANTILEVER: Slot = Slot::optional(
     "the cantilever of §10.3.3 (load–displacement) and Table 10.1 (grids)",
 );
 
+/// The workflow's inputs from the stage's files.
+fn inputs(ctx: &StageContext<'_>) -> Result<Seed003SolveInputs> {
+    Ok(Seed003SolveInputs {
+        scenes: ctx.files(&SCENES),
+        quarter_table: ctx.optional_file(&QUARTER_TABLE)?,
+        table_reference: ctx.optional_file(&TABLE_REFERENCE)?,
+        rod: ctx.optional_file(&ROD)?,
+        cantilever: ctx.optional_file(&CANTILEVER)?,
+    })
+}
+
 /// The `seed003-solve` stage kind.
 pub struct Seed003Solve;
 
@@ -67,14 +78,11 @@ impl StageKind for Seed003Solve {
             "cantilever_grid.parquet: Table 10.1's grids (with cantilever)",
         ),
     ];
+    /// An output whose inputs are not given is refused when the plan loads.
+    fn precheck(ctx: &StageContext<'_>, _: &Seed003SolveParams) -> Result<()> {
+        check_outputs(&crate::job(ctx, inputs(ctx)?))
+    }
     fn run(ctx: &StageContext<'_>, p: &Seed003SolveParams) -> Result<()> {
-        let inputs = Seed003SolveInputs {
-            scenes: ctx.files(&SCENES),
-            quarter_table: ctx.optional_file(&QUARTER_TABLE)?,
-            table_reference: ctx.optional_file(&TABLE_REFERENCE)?,
-            rod: ctx.optional_file(&ROD)?,
-            cantilever: ctx.optional_file(&CANTILEVER)?,
-        };
-        run(&crate::job(ctx, inputs), p)
+        run(&crate::job(ctx, inputs(ctx)?), p)
     }
 }
