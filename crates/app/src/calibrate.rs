@@ -344,7 +344,7 @@ pub fn calibrate_one_lm(
         curve_distance_pct: r.best_cost_pct,
         solves: r.solves as u64,
         steps: r.iterations as u64,
-        stop: r.stop,
+        stop: r.stop.to_string(),
     })
 }
 

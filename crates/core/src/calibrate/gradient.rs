@@ -54,7 +54,43 @@ pub struct LmReport {
     /// where JᵀJ is singular.
     pub half_width_2sigma: [Option<f64>; 2],
     /// Why the best topology's run stopped.
-    pub stop: String,
+    pub stop: LmStop,
+}
+
+/// Why a Levenberg–Marquardt run stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LmStop {
+    /// The relative step fell below √tol.
+    ConvergedStep,
+    /// The relative fall of the cost fell below tol.
+    ConvergedCost,
+    /// The solve budget was spent (the solves made).
+    Solves(usize),
+    /// The damped normal equations were singular.
+    SingularNormalEquations,
+    /// No damping found a step that lowers the residuals.
+    NoDescent,
+    /// The warm-start lattice has no node of this topology.
+    NoLatticeNode,
+    /// The drape at the start did not converge.
+    StartNotConverged,
+    /// No topology gave a converged drape with every edge.
+    NoTopology,
+}
+
+impl std::fmt::Display for LmStop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LmStop::ConvergedStep => f.write_str("converged (step)"),
+            LmStop::ConvergedCost => f.write_str("converged (cost)"),
+            LmStop::Solves(n) => write!(f, "{n} solves"),
+            LmStop::SingularNormalEquations => f.write_str("singular normal equations"),
+            LmStop::NoDescent => f.write_str("no step lowers the residuals"),
+            LmStop::NoLatticeNode => f.write_str("no lattice node"),
+            LmStop::StartNotConverged => f.write_str("the start did not converge"),
+            LmStop::NoTopology => f.write_str("no topology gave a converged drape with every edge"),
+        }
+    }
 }
 
 /// A converged drape with its residuals and their Jacobian in the unit box's (stiffness, natural
@@ -260,7 +296,7 @@ fn bounded_step(p: &Point, lambda: f64) -> Option<Vector2<f64>> {
 }
 
 /// One topology's run: (best point, accepted steps, solves, why it stopped).
-type Run = (Option<Point>, usize, usize, String);
+type Run = (Option<Point>, usize, usize, LmStop);
 
 impl Problem {
     /// Solves the warm-start lattice now (it is otherwise solved at the first evaluation that needs
@@ -274,7 +310,7 @@ impl Problem {
     /// the best topology's result.
     pub fn run_lm(&self, settings: &LmSettings) -> LmReport {
         let lattice = self.lattice();
-        let mut best: Option<(Topology, Point, String)> = None;
+        let mut best: Option<(Topology, Point, LmStop)> = None;
         let (mut solves, mut iterations) = (0, 0);
         for topology in [Topology::A, Topology::B, Topology::C] {
             let (point, its, n, stop) = self.lm_topology(lattice, topology, settings);
@@ -323,7 +359,7 @@ impl Problem {
                 iterations,
                 jtj: [[0.0; 2]; 2],
                 half_width_2sigma: [None; 2],
-                stop: "no topology gave a converged drape with every edge".into(),
+                stop: LmStop::NoTopology,
             },
         }
     }
@@ -356,24 +392,24 @@ impl Problem {
     /// Levenberg–Marquardt for one topology from its best lattice node.
     fn lm_topology(&self, lattice: &SharedLattice, topology: Topology, s: &LmSettings) -> Run {
         let Some((u0, x0)) = self.best_node(lattice, topology) else {
-            return (None, 0, 0, "no lattice node".into());
+            return (None, 0, 0, LmStop::NoLatticeNode);
         };
         let mut solves = 1;
         let Some(mut p) = self.lm_point(u0, topology, &[&x0]) else {
-            return (None, 0, solves, "the start did not converge".into());
+            return (None, 0, solves, LmStop::StartNotConverged);
         };
         let (mut lambda, mut accepted) = (s.lambda_initial, 0);
         let stop = loop {
             if solves >= s.max_solves {
-                break format!("{solves} solves");
+                break LmStop::Solves(solves);
             }
             let Some(step) = bounded_step(&p, lambda) else {
-                break "singular normal equations".into();
+                break LmStop::SingularNormalEquations;
             };
             let u = (p.u + step).map(|v| v.clamp(0.0, 1.0));
             let du = u - p.u;
             if du.norm() < s.tol_rel.sqrt() {
-                break "converged (step)".into();
+                break LmStop::ConvergedStep;
             }
             let predicted: Vec<Vector3<f64>> =
                 p.x.iter()
@@ -388,13 +424,13 @@ impl Problem {
                     accepted += 1;
                     lambda = (lambda / 3.0).max(1e-9);
                     if gain < s.tol_rel {
-                        break "converged (cost)".into();
+                        break LmStop::ConvergedCost;
                     }
                 }
                 _ => {
                     lambda *= 4.0;
                     if lambda > 1e8 {
-                        break "no step lowers the residuals".into();
+                        break LmStop::NoDescent;
                     }
                 }
             }

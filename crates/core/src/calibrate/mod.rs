@@ -7,7 +7,7 @@ mod identifiability;
 mod lattice;
 mod sample;
 
-pub use gradient::{LmReport, LmSettings};
+pub use gradient::{LmReport, LmSettings, LmStop};
 pub use identifiability::{Identifiability, Noise, identifiability, quadratic_half_widths};
 use lattice::TANGENT_KEYS;
 pub use lattice::{SharedLattice, WarmStart};
