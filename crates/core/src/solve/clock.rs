@@ -81,16 +81,16 @@ pub(super) fn grown(
 }
 
 /// The next step after one that took `iterations` Newton iterations (chord steps not counted: they
-/// factorize nothing): doubled when Newton converged within 6, kept otherwise. An accepted step is
-/// never halved for its iteration count: where the sheet touches itself the barrier, not the step,
-/// sets Newton's iterations, and halving on them collapsed a folding slack net's steps to 0.01 s
-/// for thousands of steps (stress point 70: 3,551 steps, 553 without). A step Newton cannot finish
-/// is halved and retried by the caller.
+/// factorize nothing): doubled when Newton converged within 6, kept up to 12, halved beyond.
 fn next_dt(h: f64, iterations: usize, s: StepBounds) -> f64 {
     if !s.adaptive {
         return h;
     }
-    let f = if iterations <= 6 { 2.0 } else { 1.0 };
+    let f = match iterations {
+        0..=6 => 2.0,
+        7..=12 => 1.0,
+        _ => 0.5,
+    };
     (h * f).clamp(s.min_dt_s, s.max_dt_s)
 }
 

@@ -31,8 +31,8 @@ pub struct DynamicOptions {
     /// Time step in s; implicit Euler's first step (it adapts from there). Default 1e-4.
     #[serde(default = "default_dt")]
     pub dt_s: f64,
-    /// Implicit Euler: grow the step (×2) while Newton converges within 6 iterations, keep it
-    /// otherwise, and halve and retry a step Newton cannot finish. Default true.
+    /// Implicit Euler: grow the step (×2) while Newton converges within 6 iterations, halve it beyond
+    /// 12 and retry a step Newton cannot finish. Default true.
     #[serde(default = "default_true")]
     pub adaptive_dt: bool,
     /// Implicit Euler: the largest step, s (a recording's frame interval caps it too). Default 100:
