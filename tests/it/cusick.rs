@@ -409,6 +409,7 @@ fn a_synthetic_orthotropic_fabric_photographed_gives_its_parameters_back() {
         dc_se_pct: sd / 2.0,
         nodes: 0.5 * (nodes[1] + nodes[2]),
         face_gap: None,
+        predicted_face_gap_pct: None,
     };
     let settings = FabricSettings {
         laws: vec![

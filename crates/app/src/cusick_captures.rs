@@ -27,7 +27,8 @@ pub struct CaptureRow {
     pub capture: i32,
     /// "up", "down" or "unknown".
     pub face: Face,
-    /// Predicted DC for this face, %: the mean over the face's perturbation seeds.
+    /// Predicted DC for this face, %: the mean over both faces' perturbation seeds shifted by half
+    /// the model's face gap at the fabric's predicted curl ([`FacePredictions::dc_pct`]).
     pub dc_predicted_pct: f64,
     /// Lower end of the 90 % prediction interval, %.
     pub dc_low_pct: f64,
@@ -45,6 +46,8 @@ pub struct CaptureRow {
     pub nodes_measured: i32,
     /// The face-average prediction (both faces' seeds), %.
     pub dc_face_average_pct: f64,
+    /// The mean DC of this face's own drapes, % (the face-blind drapes' where there is no curl).
+    pub dc_face_drapes_pct: f64,
     /// Baseline: the calibration specimen's mean DC over both faces, carried over, %.
     pub dc_carry_over_pct: f64,
     /// Baseline: the calibration specimen's mean DC on this face, carried over, % (None: it has no
@@ -75,6 +78,8 @@ pub struct FacePredictions {
     pub down: Option<NodeDistribution>,
     /// Every seed of both faces (or of the face-blind prediction).
     pub average: NodeDistribution,
+    /// The face gap the model gives at the prediction's curl, points (none: face-blind).
+    pub gap_pct: Option<f64>,
 }
 
 impl FacePredictions {
@@ -85,6 +90,20 @@ impl FacePredictions {
             Face::Unknown => None,
         };
         own.unwrap_or(&self.average)
+    }
+
+    /// The predicted DC of a capture on `face`: the mean of every drape (both faces: their mean is
+    /// the curl-free DC to second order in the curl) shifted by half the model's face gap, down
+    /// up and up down. The difference of the two faces' seed means would carry the seeds' spread
+    /// (SD 1–5 points over six seeds) into the gap; the gap of one perturbation turned over does not.
+    pub fn dc_pct(&self, face: Face) -> f64 {
+        let half = 0.5 * self.gap_pct.unwrap_or(0.0);
+        self.average.dc_mean_pct
+            + match face {
+                Face::Up => -half,
+                Face::Down => half,
+                Face::Unknown => 0.0,
+            }
     }
 }
 
@@ -113,7 +132,7 @@ pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> 
                 sample: r.sample,
                 capture: r.capture,
                 face,
-                dc_predicted_pct: p.dc_mean_pct,
+                dc_predicted_pct: pred.dc_pct(face),
                 dc_low_pct: f64::NAN,
                 dc_high_pct: f64::NAN,
                 nodes_predicted: p.nodes_mean,
@@ -122,6 +141,7 @@ pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> 
                 dc_measured_pct: r.dc_photo_pct,
                 nodes_measured: r.nodes_photo as i32,
                 dc_face_average_pct: pred.average.dc_mean_pct,
+                dc_face_drapes_pct: p.dc_mean_pct,
                 dc_carry_over_pct: carry,
                 dc_carry_over_face_pct: dc_where(&|o| o.sample == calib && same_face(o)),
                 dc_other_specimens_pct: dc_where(&|o| o.sample != calib && o.sample != r.sample),
@@ -196,11 +216,81 @@ mod tests {
             dc_measured_pct: measured,
             nodes_measured: 7,
             dc_face_average_pct: predicted,
+            dc_face_drapes_pct: predicted,
             dc_carry_over_pct: predicted,
             dc_carry_over_face_pct: None,
             dc_other_specimens_pct: None,
             dc_other_specimens_face_pct: None,
         }
+    }
+
+    fn distribution(dc: f64, nodes: usize) -> NodeDistribution {
+        NodeDistribution {
+            converged: 1,
+            tried: 1,
+            nodes_mean: nodes as f64,
+            nodes_mode: nodes,
+            nodes_sd: 0.0,
+            histogram: vec![(nodes, 1)],
+            dc_mean_pct: dc,
+            dc_sd_pct: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_capture_gets_the_faces_mean_shifted_by_half_the_gap_and_its_faces_nodes() {
+        // Face-up drapes at 60 % and 7 nodes, face-down at 66 % and 9, all of them at 62 % and 8;
+        // the model's gap 3 points: up 60.5, down 63.5, unknown 62, nodes each face's own.
+        let pred = FacePredictions {
+            up: Some(distribution(60.0, 7)),
+            down: Some(distribution(66.0, 9)),
+            average: distribution(62.0, 8),
+            gap_pct: Some(3.0),
+        };
+        let shadow = |sample: i32, face: Face, dc: f64| ShadowRow {
+            fabric: 4,
+            sample,
+            capture: 1,
+            face,
+            mesh_kind: String::new(),
+            mesh_rotated: false,
+            dc_photo_pct: dc,
+            nodes_photo: 8,
+            dc_mesh_pct: None,
+            nodes_mesh: None,
+            dc_matching_photo_pct: None,
+            nodes_matching_photo: None,
+            r_outline_min_m: 0.1,
+            r_outline_max_m: 0.15,
+        };
+        let rows = [
+            shadow(1, Face::Up, 58.0),
+            shadow(2, Face::Up, 61.0),
+            shadow(2, Face::Down, 64.0),
+            shadow(3, Face::Unknown, 62.5),
+        ];
+        let refs: Vec<&ShadowRow> = rows.iter().collect();
+        let caps = capture_rows(&refs, 1, &pred);
+        let got: Vec<(Face, f64, f64, f64)> = caps
+            .iter()
+            .map(|c| {
+                (
+                    c.face,
+                    c.dc_predicted_pct,
+                    c.nodes_predicted,
+                    c.dc_face_drapes_pct,
+                )
+            })
+            .collect();
+        assert_eq!(
+            got,
+            vec![
+                (Face::Up, 60.5, 7.0, 60.0),
+                (Face::Down, 63.5, 9.0, 66.0),
+                (Face::Unknown, 62.0, 8.0, 62.0)
+            ]
+        );
+        assert!(caps.iter().all(|c| c.dc_carry_over_pct == 58.0));
     }
 
     #[test]

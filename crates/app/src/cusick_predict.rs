@@ -7,6 +7,7 @@
 //! overlaying each fabric's registered meshes and simulated drapes.
 
 use crate::cusick_captures::{CaptureRow, capture_rows, fill_intervals};
+use crate::cusick_face_prior::{GapLine, gap_lines};
 use crate::cusick_measure::ShadowRow;
 use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use crate::cusick_targets::{empty_row, fill_distribution, fill_faces, fill_fit, targets};
@@ -177,12 +178,16 @@ pub fn predict_fabric(
     measured: &Measured<'_>,
     mesh: DiscMesh<'_>,
     p: &CusickPredictParams,
+    line: Option<GapLine>,
 ) -> FabricPrediction {
     let start = Instant::now();
     let tester = Tester::default();
-    let tg = targets(rows);
+    let mut tg = targets(rows);
+    if tg.specimen.face_gap.is_some() {
+        tg.specimen.predicted_face_gap_pct = line.map(|l| l.predicted_pct);
+    }
     let mut out = FabricPrediction {
-        row: empty_row(fabric, &tg),
+        row: empty_row(fabric, &tg, line),
         outlines: Vec::new(),
         profiles: Vec::new(),
         drapes: Vec::new(),
@@ -348,6 +353,7 @@ pub fn run(
         rotated: rotated_captures(&data),
     };
     ctx.started(data.fabrics.len());
+    let lines = gap_lines(&shadows);
     let rows_of = |fabric: i32| -> Vec<&ShadowRow> {
         shadows.iter().filter(|r| r.fabric == fabric).collect()
     };
@@ -369,6 +375,7 @@ pub fn run(
             &measured,
             mesh,
             &q,
+            lines.get(&f.fabric).copied(),
         );
         ctx.item_done();
         out

@@ -90,10 +90,27 @@ pub struct PredictionRow {
     pub face_gap_slope_pct_m: Option<f64>,
     /// The calibration specimen's face gap: mean DC face down less face up, points.
     pub calibration_face_gap_pct: Option<f64>,
-    /// Mean simulated DC face up (curl as fitted), %.
+    /// Predicted DC face up, %: the mean of both faces' drapes less half the predicted face gap.
     pub dc_predicted_face_up_pct: Option<f64>,
-    /// Mean simulated DC face down (curl negated), %.
+    /// Predicted DC face down, %: that mean plus half the predicted face gap.
     pub dc_predicted_face_down_pct: Option<f64>,
+    /// The face gap expected of the other specimens, points: the calibration specimen's gap on
+    /// the line fitted on the other fabrics (`gap_line_*`), or its own gap without a line.
+    pub face_gap_predicted_pct: Option<f64>,
+    /// The gap line's intercept (the other fabrics' least-squares line of their other specimens'
+    /// gap on their calibration specimen's gap), points.
+    pub gap_line_intercept_pct: Option<f64>,
+    /// The gap line's slope in [0, 1]: the share of one specimen's gap that is its fabric's.
+    pub gap_line_slope: Option<f64>,
+    /// The curl of the prediction's drapes (face up; face down its negative): the fitted curl
+    /// moved along its gap slope to the predicted gap, 1/m.
+    pub curl_predicted_per_m: Option<f64>,
+    /// The model's face gap at that curl, points (the predicted gap unless the curl hit its bound).
+    pub face_gap_model_pct: Option<f64>,
+    /// Mean DC of the face-up drapes (at the predicted curl), %.
+    pub dc_drapes_face_up_pct: Option<f64>,
+    /// Mean DC of the face-down drapes (the predicted curl negated), %.
+    pub dc_drapes_face_down_pct: Option<f64>,
     /// "ok", or why there is no prediction.
     pub status: String,
     /// Drape solves made (the calibration's and the predictions').

@@ -3,6 +3,7 @@
 //! calibration's fit, its node distribution and its per-face predictions.
 
 use crate::cusick_captures::FacePredictions;
+use crate::cusick_face_prior::{GapLine, face_gap};
 use crate::cusick_measure::ShadowRow;
 use crate::cusick_tables::PredictionRow;
 use drapelab_core::cusick::*;
@@ -22,37 +23,6 @@ pub struct Targets {
     pub(crate) nodes_histogram: String,
 }
 
-/// The face gap of one specimen's captures `own`: mean DC face down less face up, with its
-/// standard error from the SD pooled within the faces (repeated captures of one face); none
-/// without a capture on each face. With one capture per face (no repeat) the error is the gap
-/// itself: the curl is then fitted but not identifiable.
-pub fn face_gap(own: &[&&ShadowRow]) -> Option<FaceGap> {
-    let of = |face: Face| -> Vec<f64> {
-        own.iter()
-            .filter(|r| r.face == face)
-            .map(|r| r.dc_photo_pct)
-            .collect()
-    };
-    let (up, down) = (of(Face::Up), of(Face::Down));
-    if up.is_empty() || down.is_empty() {
-        return None;
-    }
-    let ((mu, _), (md, _)) = (mean_sd(&up), mean_sd(&down));
-    let gap_pct = md - mu;
-    let squares: f64 = up.iter().map(|v| (v - mu).powi(2)).sum::<f64>()
-        + down.iter().map(|v| (v - md).powi(2)).sum::<f64>();
-    let dof = up.len() + down.len() - 2;
-    let gap_se_pct = if dof == 0 {
-        gap_pct.abs()
-    } else {
-        (squares / dof as f64 * (1.0 / up.len() as f64 + 1.0 / down.len() as f64)).sqrt()
-    };
-    Some(FaceGap {
-        gap_pct,
-        gap_se_pct,
-    })
-}
-
 /// A fabric's targets from its captures: the calibration (lowest-numbered) specimen's DC, nodes
 /// and face gap, and the other specimens' statistics the predictions are scored against.
 pub fn targets(rows: &[&ShadowRow]) -> Targets {
@@ -69,6 +39,7 @@ pub fn targets(rows: &[&ShadowRow]) -> Targets {
             dc_se_pct: sd / (own.len().max(1) as f64).sqrt(),
             nodes: median(&own.iter().map(|r| r.nodes_photo as f64).collect::<Vec<_>>()),
             face_gap: face_gap(&own),
+            predicted_face_gap_pct: None,
         },
         others: others
             .iter()
@@ -94,7 +65,7 @@ pub fn targets(rows: &[&ShadowRow]) -> Targets {
 }
 
 /// A prediction row with the fabric's targets and no prediction yet (filled in by the caller).
-pub fn empty_row(fabric: i32, tg: &Targets) -> PredictionRow {
+pub fn empty_row(fabric: i32, tg: &Targets, line: Option<GapLine>) -> PredictionRow {
     PredictionRow {
         fabric,
         calibration_sample: tg.calib,
@@ -135,6 +106,13 @@ pub fn empty_row(fabric: i32, tg: &Targets) -> PredictionRow {
         calibration_face_gap_pct: tg.specimen.face_gap.map(|g| g.gap_pct),
         dc_predicted_face_up_pct: None,
         dc_predicted_face_down_pct: None,
+        face_gap_predicted_pct: tg.specimen.predicted_face_gap_pct,
+        gap_line_intercept_pct: line.map(|l| l.intercept_pct),
+        gap_line_slope: line.map(|l| l.slope),
+        curl_predicted_per_m: None,
+        face_gap_model_pct: None,
+        dc_drapes_face_up_pct: None,
+        dc_drapes_face_down_pct: None,
         status: String::new(),
         solves: 0,
         solve_time_mean_s: 0.0,
@@ -217,10 +195,25 @@ pub(crate) fn fill_faces(
             let of = |d: Vec<_>| NodeDistribution::of(&d, d.len());
             up = of(outcome.face(false));
             down = of(outcome.face(true));
-            row.dc_predicted_face_up_pct = up.as_ref().map(|f| f.dc_mean_pct);
-            row.dc_predicted_face_down_pct = down.as_ref().map(|f| f.dc_mean_pct);
+            row.dc_drapes_face_up_pct = up.as_ref().map(|f| f.dc_mean_pct);
+            row.dc_drapes_face_down_pct = down.as_ref().map(|f| f.dc_mean_pct);
+            row.curl_predicted_per_m = outcome.prediction_curl_per_m;
+            row.face_gap_model_pct = outcome.prediction_gap_pct;
         }
         Err(why) => row.status = format!("{}; face-blind: {why}", row.status),
     }
-    Some(FacePredictions { up, down, average })
+    let gap_pct = outcome
+        .prediction_gap_pct
+        .filter(|_| up.is_some() && down.is_some());
+    let faces = FacePredictions {
+        up,
+        down,
+        average,
+        gap_pct,
+    };
+    if gap_pct.is_some() {
+        row.dc_predicted_face_up_pct = Some(faces.dc_pct(Face::Up));
+        row.dc_predicted_face_down_pct = Some(faces.dc_pct(Face::Down));
+    }
+    Some(faces)
 }

@@ -15,6 +15,7 @@ pub mod benchmark;
 pub mod calibrate;
 pub mod calibration_tables;
 pub mod cusick_captures;
+pub mod cusick_face_prior;
 pub mod cusick_measure;
 pub mod cusick_predict;
 pub mod cusick_tables;

@@ -31,15 +31,19 @@ fn measured_gaps(caps: &[CaptureRow]) -> BTreeMap<i32, f64> {
 fn curl_table(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
     let others = measured_gaps(caps);
     let mut s = String::from(
-        "| fabric | calibration face gap, down − up (points) | the other specimens' face gap (points) | curl κ (1/m) | κ, 2σ interval (1/m) | side identifiable | gap slope dΔ/dκ (points·m) | DC predicted face up (%) | DC predicted face down (%) |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| fabric | calibration face gap, down − up (points) | the other specimens' face gap (points) | curl κ (1/m) | κ, 2σ interval (1/m) | side identifiable | gap slope dΔ/dκ (points·m) | gap line a + bΔ (points) | gap predicted (points) | curl predicted (1/m) | DC predicted face up (%) | DC predicted face down (%) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let interval = match (r.curl_lo_per_m, r.curl_hi_per_m) {
             (Some(a), Some(b)) => format!("[{a:.1}, {b:.1}]"),
             _ => "–".into(),
         };
+        let line = match (r.gap_line_intercept_pct, r.gap_line_slope) {
+            (Some(a), Some(b)) => format!("{a:.1} + {b:.2}Δ"),
+            _ => "–".into(),
+        };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {line} | {} | {} | {} | {} |\n",
             r.fabric,
             opt(r.calibration_face_gap_pct, 1),
             opt(others.get(&r.fabric).copied(), 1),
@@ -48,6 +52,8 @@ fn curl_table(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
             r.curl_identifiable
                 .map_or("–", |b| if b { "yes" } else { "no" }),
             opt(r.face_gap_slope_pct_m, 3),
+            opt(r.face_gap_model_pct, 1),
+            opt(r.curl_predicted_per_m, 1),
             opt(r.dc_predicted_face_up_pct, 1),
             opt(r.dc_predicted_face_down_pct, 1),
         );
@@ -71,12 +77,45 @@ fn mae(
     (mean(&errors), errors.len())
 }
 
-/// The per-capture scores: DC mean absolute error of the model and the baselines, overall and per
-/// face, the intervals' coverage, nodes within 1.
-fn score_table(caps: &[CaptureRow], rows: &[PredictionRow]) -> String {
-    type Predictor = Box<dyn Fn(&CaptureRow) -> Option<f64>>;
-    let predictors: Vec<(&str, Predictor)> = vec![
-        ("model (its face)", Box::new(|c| Some(c.dc_predicted_pct))),
+/// A prediction of a capture's DC, % (None where it gives none).
+type Predictor = Box<dyn Fn(&CaptureRow) -> Option<f64>>;
+
+/// The model's variants and the baselines scored per capture, by name.
+fn predictors(rows: &[PredictionRow]) -> Vec<(&'static str, Predictor)> {
+    let own_gap: BTreeMap<i32, f64> = rows
+        .iter()
+        .filter_map(|r| Some((r.fabric, r.calibration_face_gap_pct?)))
+        .collect();
+    let curled: BTreeMap<i32, bool> = rows
+        .iter()
+        .map(|r| (r.fabric, r.face_gap_model_pct.is_some()))
+        .collect();
+    vec![
+        (
+            "model (its face: the faces' mean ± half the predicted gap)",
+            Box::new(|c| Some(c.dc_predicted_pct)),
+        ),
+        (
+            "model, its face's own drapes (the mean of six seeds)",
+            Box::new(|c| Some(c.dc_face_drapes_pct)),
+        ),
+        (
+            "model without the gap line (± half the calibration specimen's own gap)",
+            Box::new(move |c| {
+                let half = match (curled.get(&c.fabric), own_gap.get(&c.fabric)) {
+                    (Some(true), Some(g)) => 0.5 * g,
+                    _ => 0.0,
+                };
+                Some(
+                    c.dc_face_average_pct
+                        + match c.face {
+                            Face::Up => -half,
+                            Face::Down => half,
+                            Face::Unknown => 0.0,
+                        },
+                )
+            }),
+        ),
         (
             "model, face-blind (both faces' seeds)",
             Box::new(|c| Some(c.dc_face_average_pct)),
@@ -97,7 +136,13 @@ fn score_table(caps: &[CaptureRow], rows: &[PredictionRow]) -> String {
             "the other specimens' face-matched mean",
             Box::new(|c| c.dc_other_specimens_face_pct),
         ),
-    ];
+    ]
+}
+
+/// The per-capture scores: DC mean absolute error of the model and the baselines, overall and per
+/// face, the intervals' coverage, nodes within 1.
+fn score_table(caps: &[CaptureRow], rows: &[PredictionRow]) -> String {
+    let predictors = predictors(rows);
     let mut s = String::from(
         "| prediction per capture | DC mean abs. error, all (points) | face up | face down | captures |\n|---|---|---|---|---|\n",
     );
@@ -219,7 +264,7 @@ fn face_down_from_face_up(caps: &[CaptureRow], rows: &[PredictionRow]) -> String
 /// The section.
 pub fn faces_section(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
     let mut s = String::from(
-        "\n## Both faces of every capture\n\nISO 9073-9 and BS 5058 drape every specimen face up and face down (captures 1–2 up, 3–4 down), and the faces differ with a sign that is the fabric's own. The model gives the fabric a natural curl κ (the curvature a free strip rolls up to toward the fabric's face; `physics::hinge_curl`, the linear term −Bκ∫2H dA of a spontaneous curvature), positive lifting the rim face up and lowering it face down. κ is fitted to the calibration specimen's face gap Δ = DC_down − DC_up after c (the faces' mean DC is the curl-free DC to second order in κ): the gap's slope comes from the seed-0 drape's sensitivity dx/dκ, then the faces at ±κ are solved and κ corrected by a secant until the solved gap is within 0.3 points. Its 2σ interval is the gap's standard error (pooled over repeated captures of a face) over the slope; the side is identifiable where the interval excludes zero. Each other specimen's capture is then predicted for its face (six seeds per face), with a 90 % interval made of the other fabrics' residuals only (leave one fabric out).\n\n",
+        "\n## Both faces of every capture\n\nISO 9073-9 and BS 5058 drape every specimen face up and face down (captures 1–2 up, 3–4 down), and the faces differ with a sign that is the fabric's own. The model gives the fabric a natural curl κ (the curvature a free strip rolls up to toward the fabric's face; `physics::hinge_curl`, the linear term −Bκ∫2H dA of a spontaneous curvature), positive lifting the rim face up and lowering it face down. κ is fitted to the calibration specimen's face gap Δ = DC_down − DC_up after c (the faces' mean DC is the curl-free DC to second order in κ): the gap's slope comes from the seed-0 drape's sensitivity dx/dκ, then the faces at ±κ are solved and κ corrected by a secant until the solved gap is within 0.3 points. Its 2σ interval is the gap's standard error (pooled over repeated captures of a face) over the slope; the side is identifiable where the interval excludes zero. One specimen's gap is a noisy reading of its fabric's (the calibration specimens' gaps and their siblings' correlate at about 0.4 here), so the other specimens are predicted at a shrunk gap: the least-squares line of the other specimens' gap on the calibration specimen's gap, fitted on the *other* fabrics only (leave one fabric out; slope kept in [0, 1]) — empirical Bayes, the slope the share of one specimen's gap that is its fabric's. The predicted curl moves the fitted one along its gap slope to that gap, and the prediction's drapes (six seeds per face) lie at ± it. Each capture's DC is the mean of both faces' drapes shifted by half the model's gap at that curl (the difference of the faces' seed means would add their seeds' spread to the gap); its nodes are its face's drapes'. The 90 % interval is made of the other fabrics' residuals only (leave one fabric out).\n\n",
     );
     s += &curl_table(rows, caps);
     s += "\n### Every predicted capture, per face\n\nThe baselines beside the model: the calibration specimen's mean (both faces) and its face-matched mean carried over, and — using data of the predicted fabric's other specimens, which the model never sees — their mean and face-matched mean.\n\n";

@@ -9,7 +9,7 @@
 //! curvature (cheap sharp folds) gives fewer folds at any DC. So the node count chooses the law
 //! where it tells the laws apart, and the fit says when it does not (an identifiability flag).
 
-use super::face::{CurlFit, FaceGap, fit_curl};
+use super::face::{CurlFit, FaceGap, MAX_CURL_PER_M, fit_curl};
 use super::{
     Continuation, DC_SLOPE_PRIOR_PCT, DiscMesh, DrapeParams, SecantSearch, Tester,
     calibrate_bending_length, mesh_projection, secant_bending_length, shadow_measures, solve_drape,
@@ -29,6 +29,11 @@ pub struct SpecimenTargets {
     pub nodes: f64,
     /// Its face gap, where it was photographed on both faces (none: the fit is face-blind).
     pub face_gap: Option<FaceGap>,
+    /// The face gap DC_down − DC_up expected of the fabric's *other* specimens, points: one
+    /// specimen's gap is a noisy reading of its fabric's, so the caller may shrink it toward the
+    /// population's (the app's leave-one-fabric-out gap line). The prediction's drapes lie at the
+    /// curl that gives this gap; none: at the calibration specimen's own curl.
+    pub predicted_face_gap_pct: Option<f64>,
 }
 
 /// One bending law a calibration tries: an anisotropy and a saturation.
@@ -389,6 +394,12 @@ pub struct FabricOutcome {
     pub drapes: Vec<SeededDrape>,
     /// The seeds of the face-down drapes (empty without a curl).
     pub face_down_seeds: std::ops::Range<u64>,
+    /// The curl of the prediction's drapes (face up; face down its negative), 1/m: the fitted
+    /// curl moved along the fit's gap slope to [`SpecimenTargets::predicted_face_gap_pct`].
+    pub prediction_curl_per_m: Option<f64>,
+    /// The face gap the model gives at that curl, points (the fit's solved gap carried along its
+    /// slope: the gap is linear in the curl well beyond the fitted range).
+    pub prediction_gap_pct: Option<f64>,
     /// The node and DC distribution of all of them, the face average (None when none converged).
     pub distribution: Option<NodeDistribution>,
     /// Prediction seeds tried per face.
@@ -428,23 +439,22 @@ pub fn calibrate_and_predict(
         None => Err("the calibration specimen was photographed on one face only".into()),
     };
     let first = s.calibration_seeds;
-    let (drapes, face_down_seeds, solves) = match &curl {
-        Ok(c) => {
+    let prediction = curl
+        .as_ref()
+        .ok()
+        .map(|c| prediction_curl(c, target.predicted_face_gap_pct));
+    let (drapes, face_down_seeds, solves) = match (&curl, prediction) {
+        (Ok(c), Some((kappa, _))) => {
             let at = |k: f64| DrapeParams {
                 curl_per_m: Some(k),
                 ..q.clone()
             };
             let down = first + seeds..first + 2 * seeds;
-            let mut drapes = seeded_drapes(mesh, &at(c.curl_per_m), tester, first..first + seeds);
-            drapes.extend(seeded_drapes(
-                mesh,
-                &at(-c.curl_per_m),
-                tester,
-                down.clone(),
-            ));
+            let mut drapes = seeded_drapes(mesh, &at(kappa), tester, first..first + seeds);
+            drapes.extend(seeded_drapes(mesh, &at(-kappa), tester, down.clone()));
             (drapes, down, fit.solves + c.solves + 2 * seeds as usize)
         }
-        Err(_) => {
+        _ => {
             let drapes = seeded_drapes(mesh, &q, tester, first..first + seeds);
             (drapes, 0..0, fit.solves + seeds as usize)
         }
@@ -457,8 +467,24 @@ pub fn calibrate_and_predict(
         curl,
         drapes,
         face_down_seeds,
+        prediction_curl_per_m: prediction.map(|p| p.0),
+        prediction_gap_pct: prediction.map(|p| p.1),
         seeds,
     })
+}
+
+/// The curl at which the fitted curl `c` gives the face gap `gap_pct` (none: `c` itself), moved
+/// along the fit's secant slope and kept within [`MAX_CURL_PER_M`], with the gap it gives there.
+pub fn prediction_curl(c: &CurlFit, gap_pct: Option<f64>) -> (f64, f64) {
+    let Some(gap) = gap_pct.filter(|_| c.gap_slope_pct_m != 0.0) else {
+        return (c.curl_per_m, c.gap_solved_pct);
+    };
+    let kappa = (c.curl_per_m + (gap - c.gap_solved_pct) / c.gap_slope_pct_m)
+        .clamp(-MAX_CURL_PER_M, MAX_CURL_PER_M);
+    (
+        kappa,
+        c.gap_solved_pct + c.gap_slope_pct_m * (kappa - c.curl_per_m),
+    )
 }
 
 #[cfg(test)]
@@ -473,6 +499,28 @@ mod tests {
             outline_m: Vec::new(),
             x: Vec::new(),
         }
+    }
+
+    #[test]
+    fn the_prediction_curl_moves_along_the_fits_slope_to_the_gap_asked_for() {
+        let fit = CurlFit {
+            curl_per_m: 4.0,
+            interval_per_m: [2.0, 6.0],
+            gap_slope_pct_m: -0.5,
+            gap_solved_pct: -2.1,
+            identifiable: true,
+            at_bound: false,
+            solves: 3,
+        };
+        assert_eq!(prediction_curl(&fit, None), (4.0, -2.1));
+        let (k, gap) = prediction_curl(&fit, Some(-4.1));
+        assert!(
+            (k - 8.0).abs() < 1e-12 && (gap + 4.1).abs() < 1e-12,
+            "{k} {gap}"
+        );
+        let (k, gap) = prediction_curl(&fit, Some(1e6));
+        assert_eq!(k, -MAX_CURL_PER_M);
+        assert!((gap - (-2.1 - 0.5 * (-MAX_CURL_PER_M - 4.0))).abs() < 1e-9);
     }
 
     #[test]

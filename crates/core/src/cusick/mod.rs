@@ -25,7 +25,7 @@ pub use drape::{
 pub use fabric::{
     BendingLaw, FabricFit, FabricOutcome, FabricSettings, LawCandidate, NodeDistribution,
     SeededDrape, SpecimenTargets, calibrate_and_predict, calibrate_fabric, histogram,
-    histogram_label, seeded_drapes,
+    histogram_label, prediction_curl, seeded_drapes,
 };
 pub use face::{CurlFit, Face, FaceGap, GAP_TOL_PCT, MAX_CURL_PER_M, fit_curl};
 pub use params::{SPECIMEN_KEYS, SpecimenParameters};
