@@ -247,22 +247,7 @@ mod tests {
             average: distribution(62.0, 8),
             gap_pct: Some(3.0),
         };
-        let shadow = |sample: i32, face: Face, dc: f64| ShadowRow {
-            fabric: 4,
-            sample,
-            capture: 1,
-            face,
-            mesh_kind: String::new(),
-            mesh_rotated: false,
-            dc_photo_pct: dc,
-            nodes_photo: 8,
-            dc_mesh_pct: None,
-            nodes_mesh: None,
-            dc_matching_photo_pct: None,
-            nodes_matching_photo: None,
-            r_outline_min_m: 0.1,
-            r_outline_max_m: 0.15,
-        };
+        let shadow = |sample: i32, face: Face, dc: f64| ShadowRow::photo(4, sample, 1, face, dc);
         let rows = [
             shadow(1, Face::Up, 58.0),
             shadow(2, Face::Up, 61.0),

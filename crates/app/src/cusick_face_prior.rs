@@ -8,7 +8,7 @@
 
 use crate::cusick_measure::ShadowRow;
 use drapelab_core::cusick::{Face, FaceGap};
-use drapelab_core::measure::mean_sd;
+use drapelab_core::measure::{least_squares_line, mean_sd};
 use std::collections::BTreeMap;
 
 /// Fabrics with both gaps needed, besides the predicted one, to fit a line; with fewer, a fabric
@@ -84,17 +84,8 @@ pub fn shrinkage_line(pairs: &[(f64, f64)]) -> Option<(f64, f64)> {
     if pairs.len() < MIN_FABRICS {
         return None;
     }
-    let n = pairs.len() as f64;
-    let (mx, my) = pairs
-        .iter()
-        .fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
-    let sxx: f64 = pairs.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pairs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let b = if sxx > 0.0 {
-        (sxy / sxx).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let ([mx, my], slope) = least_squares_line(pairs);
+    let b = slope.map_or(0.0, |b| b.clamp(0.0, 1.0));
     Some((my - b * mx, b))
 }
 
@@ -128,22 +119,8 @@ mod tests {
     use super::*;
 
     fn capture(fabric: i32, sample: i32, face: Face, dc: f64) -> ShadowRow {
-        ShadowRow {
-            fabric,
-            sample,
-            capture: if face == Face::Up { 1 } else { 3 },
-            face,
-            mesh_kind: String::new(),
-            mesh_rotated: false,
-            dc_photo_pct: dc,
-            nodes_photo: 8,
-            dc_mesh_pct: None,
-            nodes_mesh: None,
-            dc_matching_photo_pct: None,
-            nodes_matching_photo: None,
-            r_outline_min_m: 0.1,
-            r_outline_max_m: 0.15,
-        }
+        let number = if face == Face::Up { 1 } else { 3 };
+        ShadowRow::photo(fabric, sample, number, face, dc)
     }
 
     /// A fabric whose calibration specimen (1) shows face gap `own` and specimen 2 gap `other`.

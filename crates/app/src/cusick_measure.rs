@@ -59,6 +59,30 @@ pub struct ShadowRow {
     pub r_outline_max_m: f64,
 }
 
+#[cfg(test)]
+impl ShadowRow {
+    /// A capture of fabric `fabric`, specimen `sample` on `face` whose photo shows DC `dc_pct` and
+    /// eight nodes, with no mesh: for tests of what is made of the photos' DC.
+    pub(crate) fn photo(fabric: i32, sample: i32, capture: i32, face: Face, dc_pct: f64) -> Self {
+        ShadowRow {
+            fabric,
+            sample,
+            capture,
+            face,
+            mesh_kind: String::new(),
+            mesh_rotated: false,
+            dc_photo_pct: dc_pct,
+            nodes_photo: 8,
+            dc_mesh_pct: None,
+            nodes_mesh: None,
+            dc_matching_photo_pct: None,
+            nodes_matching_photo: None,
+            r_outline_min_m: 0.1,
+            r_outline_max_m: 0.15,
+        }
+    }
+}
+
 impl Table for ShadowRow {
     const FILE: &'static str = "shadows.parquet";
     const ROW: &'static str = "One Cusick capture: DC and nodes of its silhouette photo and of its mesh's vertical projection.";

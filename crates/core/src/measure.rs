@@ -223,6 +223,18 @@ pub fn mean_sd(v: &[f64]) -> (f64, f64) {
     (m, var.sqrt())
 }
 
+/// The least-squares line through `pts` (x, y): the means (x̄, ȳ) it passes through (0 for no
+/// point) and its slope, none where the x do not spread.
+pub fn least_squares_line(pts: &[(f64, f64)]) -> ([f64; 2], Option<f64>) {
+    let n = pts.len().max(1) as f64;
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    ([mx, my], (sxx > 0.0).then(|| sxy / sxx))
+}
+
 /// The median of the finite values of `v` (the mean of the middle two for an even count); NaN when
 /// none is finite.
 pub fn median(v: &[f64]) -> f64 {
@@ -318,6 +330,21 @@ pub fn drape_measures(scene: &crate::scene::Scene, x: &[Vector3<f64>]) -> DrapeM
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_least_squares_line_through_points_on_a_line_is_that_line() {
+        let pts: Vec<(f64, f64)> = (0..5).map(|i| (i as f64, 1.5 - 0.25 * i as f64)).collect();
+        let ([mx, my], slope) = least_squares_line(&pts);
+        assert!((mx - 2.0).abs() < 1e-15 && (my - 1.0).abs() < 1e-15);
+        assert!((slope.unwrap() + 0.25).abs() < 1e-15);
+        // Symmetric scatter about it leaves it where it is; x that do not spread give no slope.
+        let noisy = [(0.0, 1.6), (0.0, 1.4), (4.0, 0.6), (4.0, 0.4)];
+        assert!((least_squares_line(&noisy).1.unwrap() + 0.25).abs() < 1e-15);
+        assert_eq!(
+            least_squares_line(&[(1.0, 2.0), (1.0, 4.0)]),
+            ([1.0, 3.0], None)
+        );
+    }
 
     fn lobed(k: usize, amp: f64) -> Projection {
         let (nx, pixel) = (400, 0.001);

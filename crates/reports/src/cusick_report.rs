@@ -98,17 +98,8 @@ pub fn main_table(rows: &[PredictionRow]) -> String {
 /// The least-squares line through `pts` (x, y) evaluated at `x` (the mean of y where the x do not
 /// spread).
 pub fn line_at(pts: &[(f64, f64)], x: f64) -> f64 {
-    let n = pts.len().max(1) as f64;
-    let (mx, my) = pts
-        .iter()
-        .fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    if sxx > 0.0 {
-        my + sxy / sxx * (x - mx)
-    } else {
-        my
-    }
+    let ([mx, my], slope) = drapelab_core::measure::least_squares_line(pts);
+    slope.map_or(my, |b| my + b * (x - mx))
 }
 
 /// Predictions of the baselines for fabric `i`, each fitted on the other fabrics (leave one fabric

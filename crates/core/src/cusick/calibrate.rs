@@ -34,13 +34,7 @@ impl BendingCalibration {
             all.sort_by(|a, b| (a.0 - c.ln()).abs().total_cmp(&(b.0 - c.ln()).abs()));
             near = all.into_iter().take(2).collect();
         }
-        let n = near.len() as f64;
-        let (mx, my) = near
-            .iter()
-            .fold((0.0, 0.0), |a, e| (a.0 + e.0 / n, a.1 + e.1 / n));
-        let sxx: f64 = near.iter().map(|e| (e.0 - mx).powi(2)).sum();
-        let sxy: f64 = near.iter().map(|e| (e.0 - mx) * (e.1 - my)).sum();
-        let slope = sxy / sxx;
+        let slope = crate::measure::least_squares_line(&near).1?;
         (slope.is_finite() && slope > 0.0).then_some(slope)
     }
 
