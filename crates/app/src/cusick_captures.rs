@@ -97,13 +97,7 @@ impl FacePredictions {
     /// up and up down. The difference of the two faces' seed means would carry the seeds' spread
     /// (SD 1–5 points over six seeds) into the gap; the gap of one perturbation turned over does not.
     pub fn dc_pct(&self, face: Face) -> f64 {
-        let half = 0.5 * self.gap_pct.unwrap_or(0.0);
-        self.average.dc_mean_pct
-            + match face {
-                Face::Up => -half,
-                Face::Down => half,
-                Face::Unknown => 0.0,
-            }
+        self.average.dc_mean_pct + 0.5 * self.gap_pct.unwrap_or(0.0) * face.gap_sign()
     }
 }
 

@@ -102,18 +102,11 @@ fn predictors(rows: &[PredictionRow]) -> Vec<(&'static str, Predictor)> {
         (
             "model without the gap line (± half the calibration specimen's own gap)",
             Box::new(move |c| {
-                let half = match (curled.get(&c.fabric), own_gap.get(&c.fabric)) {
-                    (Some(true), Some(g)) => 0.5 * g,
+                let gap = match (curled.get(&c.fabric), own_gap.get(&c.fabric)) {
+                    (Some(true), Some(g)) => *g,
                     _ => 0.0,
                 };
-                Some(
-                    c.dc_face_average_pct
-                        + match c.face {
-                            Face::Up => -half,
-                            Face::Down => half,
-                            Face::Unknown => 0.0,
-                        },
-                )
+                Some(c.dc_face_average_pct + 0.5 * gap * c.face.gap_sign())
             }),
         ),
         (

@@ -39,6 +39,16 @@ impl Face {
             _ => Face::Unknown,
         }
     }
+
+    /// The sign with which a face gap Δ = DC_down − DC_up shifts this face's DC from the faces'
+    /// mean: −1 up, +1 down, 0 unknown (the face average).
+    pub fn gap_sign(self) -> f64 {
+        match self {
+            Face::Up => -1.0,
+            Face::Down => 1.0,
+            Face::Unknown => 0.0,
+        }
+    }
 }
 
 /// What the calibration specimen's two faces show.
