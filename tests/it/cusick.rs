@@ -299,6 +299,16 @@ for f in (5, 7):
     up = {r["dc_predicted_pct"] for r in rows if r["fabric"] == f and r["face"] == "up"}
     down = {r["dc_predicted_pct"] for r in rows if r["fabric"] == f and r["face"] == "down"}
     assert len(up) == 1 and len(down) == 1 and up != down, (f, up, down)
+# Two fabrics are too few for a node line: the other specimens get the model's face mean plus the
+# calibration specimen's whole discrepancy (its median less the model's mean), rounded as the mode.
+fab = {r["fabric"]: r for r in pq.read_table(sys.argv[1]).to_pylist()}
+for r in rows:
+    p = fab[r["fabric"]]
+    assert p["nodes_line_slope"] is None
+    d = p["nodes_calibration_median"] - p["nodes_predicted"]
+    assert abs(p["nodes_correction"] - d) < 1e-12 and abs(p["nodes_predicted_corrected"] - p["nodes_calibration_median"]) < 1e-12
+    assert abs(r["nodes_predicted"] - (r["nodes_model_mean"] + d)) < 1e-12, (r, p)
+    assert r["nodes_predicted_mode"] == int(r["nodes_predicted"] + 0.5)  # halves away from zero
 print("ok")
 "#,
         &[

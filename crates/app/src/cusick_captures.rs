@@ -34,10 +34,16 @@ pub struct CaptureRow {
     pub dc_low_pct: f64,
     /// Upper end of the 90 % prediction interval, %.
     pub dc_high_pct: f64,
-    /// Predicted node count for this face: mean over its seeds.
+    /// Predicted node count for this face: the mean over its seeds plus the fabric's node
+    /// correction ([`crate::cusick_node_prior`]).
     pub nodes_predicted: f64,
-    /// Most frequent predicted node count for this face (the smaller on a tie).
+    /// The predicted node count as a whole number: `nodes_predicted` rounded (the likeliest count;
+    /// six seeds' mean estimates it better than their mode).
     pub nodes_predicted_mode: i32,
+    /// The model's own node count for this face: the mean over its seeds, uncorrected.
+    pub nodes_model_mean: f64,
+    /// The most frequent node count of this face's seeds (the smaller on a tie), uncorrected.
+    pub nodes_model_mode: i32,
     /// How the interval was made: "leave-one-fabric-out" or "model spread".
     pub interval: String,
     /// The capture's measured DC (its photo), %.
@@ -131,6 +137,8 @@ pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> 
                 dc_high_pct: f64::NAN,
                 nodes_predicted: p.nodes_mean,
                 nodes_predicted_mode: p.nodes_mode as i32,
+                nodes_model_mean: p.nodes_mean,
+                nodes_model_mode: p.nodes_mode as i32,
                 interval: String::new(),
                 dc_measured_pct: r.dc_photo_pct,
                 nodes_measured: r.nodes_photo as i32,
@@ -192,10 +200,10 @@ pub fn fill_intervals(rows: &mut [CaptureRow], spread: impl Fn(i32) -> f64) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn row(fabric: i32, face: &str, measured: f64, predicted: f64) -> CaptureRow {
+    pub(crate) fn row(fabric: i32, face: &str, measured: f64, predicted: f64) -> CaptureRow {
         CaptureRow {
             fabric,
             sample: 2,
@@ -206,6 +214,8 @@ mod tests {
             dc_high_pct: f64::NAN,
             nodes_predicted: 7.0,
             nodes_predicted_mode: 7,
+            nodes_model_mean: 7.0,
+            nodes_model_mode: 7,
             interval: String::new(),
             dc_measured_pct: measured,
             nodes_measured: 7,

@@ -9,6 +9,7 @@
 use crate::cusick_captures::{CaptureRow, capture_rows, fill_intervals};
 use crate::cusick_face_prior::{GapLine, gap_lines};
 use crate::cusick_measure::ShadowRow;
+use crate::cusick_node_prior::correct_nodes;
 use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 use crate::cusick_targets::{empty_row, fill_distribution, fill_faces, fill_fit, targets};
 use crate::job::Job;
@@ -388,9 +389,10 @@ pub fn run(
     let mut order: Vec<usize> = (0..data.fabrics.len()).collect();
     order.sort_by(|&a, &b| cost[a].total_cmp(&cost[b]));
     let fabrics = longest_first(&order, predict);
-    let rows: Vec<PredictionRow> = fabrics.iter().map(|f| f.row.clone()).collect();
-    write_table(ctx.output("predictions")?, &rows)?;
+    let mut rows: Vec<PredictionRow> = fabrics.iter().map(|f| f.row.clone()).collect();
     let mut captures: Vec<CaptureRow> = fabrics.iter().flat_map(|f| f.captures.clone()).collect();
+    correct_nodes(&mut rows, &mut captures);
+    write_table(ctx.output("predictions")?, &rows)?;
     let spread: BTreeMap<i32, f64> = fabrics
         .iter()
         .map(|f| (f.row.fabric, f.spread_pct))

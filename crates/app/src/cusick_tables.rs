@@ -59,6 +59,18 @@ pub struct PredictionRow {
     pub prediction_seeds: i32,
     /// Median node count of the calibration specimen's photos (the calibration's target).
     pub nodes_calibration_median: f64,
+    /// The node line's intercept (the other fabrics' least-squares line of their other specimens'
+    /// mean residual, measured − model, on their calibration specimen's discrepancy, median − model
+    /// mean), nodes (None: fewer than three other fabrics).
+    pub nodes_line_intercept: Option<f64>,
+    /// The node line's slope in [0, 1]: the share of the calibration specimen's discrepancy that is
+    /// its fabric's.
+    pub nodes_line_slope: Option<f64>,
+    /// What is added to the model's node counts for the other specimens, nodes: the line at this
+    /// fabric's discrepancy, or the whole discrepancy without a line.
+    pub nodes_correction: Option<f64>,
+    /// The node count predicted for the other specimens: `nodes_predicted` + `nodes_correction`.
+    pub nodes_predicted_corrected: Option<f64>,
     /// Direction of the warp estimated from the calibration specimen's face-up photos: the maximum
     /// of their outlines' two-fold component, degrees from the photo's +x in [0, 180) (an
     /// orthotropic fabric reaches furthest along its stiffer direction). Not used by the prediction:

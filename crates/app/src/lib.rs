@@ -17,6 +17,7 @@ pub mod calibration_tables;
 pub mod cusick_captures;
 pub mod cusick_face_prior;
 pub mod cusick_measure;
+pub mod cusick_node_prior;
 pub mod cusick_predict;
 pub mod cusick_tables;
 pub mod cusick_targets;

@@ -165,19 +165,32 @@ fn score_table(caps: &[CaptureRow], rows: &[PredictionRow]) -> String {
             .collect();
         (scored.iter().filter(|b| **b).count(), scored.len())
     };
-    let (model_in, n) = within(&|c| Some(c.nodes_predicted));
-    let (mode_in, _) = within(&|c| Some(c.nodes_predicted_mode as f64));
+    let (model_in, n) = within(&|c| Some(c.nodes_model_mean));
+    let (mode_in, _) = within(&|c| Some(c.nodes_model_mode as f64));
     let (carry_in, _) = within(&|c| calib_nodes.get(&c.fabric).copied());
     let both_mode: BTreeMap<i32, f64> = rows
         .iter()
         .filter_map(|r| Some((r.fabric, r.nodes_predicted_mode? as f64)))
         .collect();
     let (both_in, _) = within(&|c| both_mode.get(&c.fabric).copied());
+    let (line_in, _) = within(&|c| Some(c.nodes_predicted_mode as f64));
+    let slopes: Vec<f64> = rows.iter().filter_map(|r| r.nodes_line_slope).collect();
+    let (lo, hi) = slopes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &b| {
+            (a.0.min(b), a.1.max(b))
+        });
     let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
     s += &format!(
-        "\nThe 90 % intervals (each from the other fabrics' residuals only) cover {covered} of {} captures ({:.0} %). Nodes within 1 of the capture's own count: the model's mean for its face {model_in} of {n} ({:.0} %), its mode {mode_in} ({:.0} %), the mode of both faces' drapes (twelve seeds; the two faces' node means differ by 0.3 on average here, within their six seeds' noise) {both_in} ({:.0} %), the calibration specimen's median carried over {carry_in} ({:.0} %).\n",
+        "\nThe 90 % intervals (each from the other fabrics' residuals only) cover {covered} of {} captures ({:.0} %).\n\nNodes within 1 of the capture's own count (`nodes_predicted_mode`, the prediction: **{line_in} of {n} ({:.0} %)**) — the model's face mean plus the node line's correction, rounded: the line (`cusick_node_prior`, fitted on the other fabrics only) gives the other specimens the share {} of the calibration specimen's discrepancy, its median count less the model's mean. Uncorrected, the model's mean for the capture's face scores {model_in} ({:.0} %), its mode {mode_in} ({:.0} %), the mode of both faces' drapes (twelve seeds; the two faces' node means differ by 0.3 on average here, within their six seeds' noise) {both_in} ({:.0} %); the calibration specimen's median carried over {carry_in} ({:.0} %). A mean within 1 of a whole count covers two counts, a whole number three: the prediction is scored as the whole number.\n",
         caps.len(),
         pct(covered),
+        pct(line_in),
+        if slopes.is_empty() {
+            "1 (too few fabrics for a line)".to_string()
+        } else {
+            format!("{lo:.2}–{hi:.2}")
+        },
         pct(model_in),
         pct(mode_in),
         pct(both_in),
@@ -263,7 +276,7 @@ fn face_down_from_face_up(caps: &[CaptureRow], rows: &[PredictionRow]) -> String
 /// The section.
 pub fn faces_section(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
     let mut s = String::from(
-        "\n## Both faces of every capture\n\nISO 9073-9 and BS 5058 drape every specimen face up and face down (captures 1–2 up, 3–4 down), and the faces differ with a sign that is the fabric's own. The model gives the fabric a natural curl κ (the curvature a free strip rolls up to toward the fabric's face; `physics::hinge_curl`, the linear term −Bκ∫2H dA of a spontaneous curvature), positive lifting the rim face up and lowering it face down. κ is fitted to the calibration specimen's face gap Δ = DC_down − DC_up after c (the faces' mean DC is the curl-free DC to second order in κ): the gap's slope comes from the seed-0 drape's sensitivity dx/dκ, then the faces at ±κ are solved and κ corrected by a secant until the solved gap is within 0.3 points. Its 2σ interval is the gap's standard error (pooled over repeated captures of a face) over the slope; the side is identifiable where the interval excludes zero. One specimen's gap is a noisy reading of its fabric's (the calibration specimens' gaps and their siblings' correlate at about 0.4 here), so the other specimens are predicted at a shrunk gap: the least-squares line of the other specimens' gap on the calibration specimen's gap, fitted on the *other* fabrics only (leave one fabric out; slope kept in [0, 1]) — empirical Bayes, the slope the share of one specimen's gap that is its fabric's. The predicted curl moves the fitted one along its gap slope to that gap, and the prediction's drapes (six seeds per face) lie at ± it. Each capture's DC is the mean of both faces' drapes shifted by half the model's gap at that curl (the difference of the faces' seed means would add their seeds' spread to the gap); its nodes are its face's drapes'. The 90 % interval is made of the other fabrics' residuals only (leave one fabric out).\n\n",
+        "\n## Both faces of every capture\n\nISO 9073-9 and BS 5058 drape every specimen face up and face down (captures 1–2 up, 3–4 down), and the faces differ with a sign that is the fabric's own. The model gives the fabric a natural curl κ (the curvature a free strip rolls up to toward the fabric's face; `physics::hinge_curl`, the linear term −Bκ∫2H dA of a spontaneous curvature), positive lifting the rim face up and lowering it face down. κ is fitted to the calibration specimen's face gap Δ = DC_down − DC_up after c (the faces' mean DC is the curl-free DC to second order in κ): the gap's slope comes from the seed-0 drape's sensitivity dx/dκ, then the faces at ±κ are solved and κ corrected by a secant until the solved gap is within 0.3 points. Its 2σ interval is the gap's standard error (pooled over repeated captures of a face) over the slope; the side is identifiable where the interval excludes zero. One specimen's gap is a noisy reading of its fabric's (the calibration specimens' gaps and their siblings' correlate at about 0.4 here), so the other specimens are predicted at a shrunk gap: the least-squares line of the other specimens' gap on the calibration specimen's gap, fitted on the *other* fabrics only (leave one fabric out; slope kept in [0, 1]) — empirical Bayes, the slope the share of one specimen's gap that is its fabric's. The predicted curl moves the fitted one along its gap slope to that gap, and the prediction's drapes (six seeds per face) lie at ± it. Each capture's DC is the mean of both faces' drapes shifted by half the model's gap at that curl (the difference of the faces' seed means would add their seeds' spread to the gap); its nodes are its face's drapes' mean plus the fabric's node correction (below). The 90 % interval is made of the other fabrics' residuals only (leave one fabric out).\n\n",
     );
     s += &curl_table(rows, caps);
     s += "\n### Every predicted capture, per face\n\nThe baselines beside the model: the calibration specimen's mean (both faces) and its face-matched mean carried over, and — using data of the predicted fabric's other specimens, which the model never sees — their mean and face-matched mean.\n\n";
