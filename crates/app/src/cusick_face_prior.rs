@@ -89,27 +89,35 @@ pub fn shrinkage_line(pairs: &[(f64, f64)]) -> Option<(f64, f64)> {
     Some((my - b * mx, b))
 }
 
+/// The [`shrinkage_line`] through the (x, y) of every fabric of `all` but `fabric` that has both
+/// (leave one fabric out), with how many fabrics it was fitted on.
+pub fn line_without(
+    all: &BTreeMap<i32, (f64, Option<f64>)>,
+    fabric: i32,
+) -> (Option<(f64, f64)>, usize) {
+    let pairs: Vec<(f64, f64)> = all
+        .iter()
+        .filter(|(f, _)| **f != fabric)
+        .filter_map(|(_, &(x, y))| Some((x, y?)))
+        .collect();
+    (shrinkage_line(&pairs), pairs.len())
+}
+
 /// Every fabric's gap line (for fabrics whose calibration specimen shows both faces and which have
 /// [`MIN_FABRICS`] others with both gaps): no fabric's own other specimens enter its line.
 pub fn gap_lines(shadows: &[ShadowRow]) -> BTreeMap<i32, GapLine> {
     let all = gaps(shadows);
     all.iter()
         .filter_map(|(&fabric, &(own, _))| {
-            let pairs: Vec<(f64, f64)> = all
-                .iter()
-                .filter(|(f, _)| **f != fabric)
-                .filter_map(|(_, &(x, y))| Some((x, y?)))
-                .collect();
-            let (a, b) = shrinkage_line(&pairs)?;
-            Some((
-                fabric,
-                GapLine {
-                    intercept_pct: a,
-                    slope: b,
-                    fabrics: pairs.len(),
-                    predicted_pct: a + b * own,
-                },
-            ))
+            let (line, fabrics) = line_without(&all, fabric);
+            let (a, b) = line?;
+            let line = GapLine {
+                intercept_pct: a,
+                slope: b,
+                fabrics,
+                predicted_pct: a + b * own,
+            };
+            Some((fabric, line))
         })
         .collect()
 }

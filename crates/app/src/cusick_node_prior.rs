@@ -9,7 +9,7 @@
 //! correction a + bD; with fewer than [`crate::cusick_face_prior::MIN_FABRICS`] other fabrics the whole of D.
 
 use crate::cusick_captures::CaptureRow;
-use crate::cusick_face_prior::shrinkage_line;
+use crate::cusick_face_prior::line_without;
 use crate::cusick_tables::PredictionRow;
 use drapelab_core::measure::mean;
 use std::collections::BTreeMap;
@@ -48,12 +48,7 @@ pub fn node_lines(rows: &[PredictionRow], caps: &[CaptureRow]) -> BTreeMap<i32, 
     let all = discrepancies(rows, caps);
     all.iter()
         .map(|(&fabric, &(d, _))| {
-            let pairs: Vec<(f64, f64)> = all
-                .iter()
-                .filter(|(f, _)| **f != fabric)
-                .filter_map(|(_, &(x, y))| Some((x, y?)))
-                .collect();
-            let line = shrinkage_line(&pairs);
+            let (line, _) = line_without(&all, fabric);
             let correction = line.map_or(d, |(a, b)| a + b * d);
             let line = NodeLine {
                 intercept: line.map(|l| l.0),
