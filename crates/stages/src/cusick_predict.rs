@@ -26,7 +26,7 @@ impl StageKind for CusickPredict {
         Slot::one("predictions", "predictions.parquet: one row per fabric"),
         Slot::one(
             "by_capture",
-            "predictions_by_capture.parquet: one row per predicted capture, its face's DC with a 90 % interval",
+            "predictions_by_capture.parquet: one row per predicted capture, its face's DC with a 90 % interval and its node count (the model's, corrected by the node line)",
         ),
         Slot::one(
             "outlines",
