@@ -183,6 +183,10 @@ pub trait EnergyTerm: Send + Sync {
     fn stiffen_barrier(&mut self, _x: &Vecs) -> bool {
         false
     }
+    /// Told by the implicit integrator that Newton now solves its time steps (`on`) or, again,
+    /// equilibria: a term whose Newton Hessian differs between the two (self-contact's pinned
+    /// pairs) switches. Default: nothing.
+    fn set_time_stepping(&mut self, _on: bool) {}
     /// The largest fraction of the step `dx` from `x` that the term allows (contact: a step that
     /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
     fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
@@ -317,6 +321,10 @@ impl Model {
         for t in &self.terms {
             t.add_exact_hessian(x, h);
         }
+    }
+    /// [`EnergyTerm::set_time_stepping`] of every term.
+    pub fn set_time_stepping(&mut self, on: bool) {
+        self.terms.iter_mut().for_each(|t| t.set_time_stepping(on));
     }
     /// [`EnergyTerm::stiffen_barrier`] of every term: true when one changed its energy.
     pub fn stiffen_barriers(&mut self, x: &Vecs) -> bool {

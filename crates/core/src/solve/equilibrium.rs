@@ -323,6 +323,37 @@ mod tests {
     }
 
     #[test]
+    fn a_neighbours_factor_hands_over_to_factorizations_once_the_line_search_shortens_its_step() {
+        // The chain at 10 g preconditions the chain at 200 g (20 times heavier, far from the
+        // start): the undamped step the neighbour's factor gives overshoots, the line search
+        // shortens it, and the damped, factorized iteration finishes — to the same drape.
+        let (mut model, mut x) = chain(0.01);
+        equilibrium(&mut model, &mut x);
+        let f = EquilibriumFactor::new(&model, &x).expect("a minimum");
+        let shared = std::sync::Arc::new(f.factor().copy());
+        let (mut plain, mut xp) = chain(0.2);
+        xp.copy_from_slice(&x);
+        equilibrium(&mut plain, &mut xp);
+        let (mut seeded, mut xs) = chain(0.2);
+        xs.copy_from_slice(&x);
+        let opts = crate::solve::StaticOptions {
+            residual_tol_rel: 1e-12,
+            neighbour_factor: Some(crate::solve::NeighbourFactor(shared)),
+            ..Default::default()
+        };
+        let r =
+            crate::solve::solve_static(&mut seeded, &mut xs, &opts, &mut crate::solve::NoObserver);
+        assert!(r.is_converged(), "{}", r.message);
+        let g = &r.globalization;
+        eprintln!("{g:?}, {} factorizations", r.factorizations);
+        assert_eq!(g.krylov_steps, 1, "{g:?}");
+        assert!(g.shortened_steps >= 1 && r.factorizations > 0, "{r:?}");
+        for p in 0..4 {
+            assert!((xs[p] - xp[p]).norm() < 1e-9, "particle {p}");
+        }
+    }
+
+    #[test]
     fn a_push_along_a_free_motion_leaves_a_residual_and_an_answerable_one_none() {
         // One free particle on a spring at its rest length, no weight: free to move sideways.
         let x = vec![Vector3::zeros(), Vector3::new(0.1, 0.0, 0.0)];

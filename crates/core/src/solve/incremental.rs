@@ -270,8 +270,27 @@ pub struct Settle {
 /// Integrates from (`x`, `v`) (updated in place) until settled, stopped or out of time: each step
 /// minimises the incremental potential ([`Inertia`] + the model). `frame_s`: land a step on every
 /// multiple of it and hand that state to `observer` (stamped with the exact frame time).
+/// Newton's Hessian is that of a time step ([`Model::set_time_stepping`]) while it integrates.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_implicit(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    v: &mut [Vector3<f64>],
+    s: &ImplicitSettings,
+    settle: &Settle,
+    budget: (f64, Option<f64>),
+    frame_s: Option<f64>,
+    observer: &mut dyn Observer,
+    report: &mut SolveReport,
+) {
+    model.set_time_stepping(true);
+    integrate(model, x, v, s, settle, budget, frame_s, observer, report);
+    model.set_time_stepping(false);
+}
+
+/// [`integrate_implicit`]'s loop.
+#[allow(clippy::too_many_arguments)]
+fn integrate(
     model: &mut Model,
     x: &mut [Vector3<f64>],
     v: &mut [Vector3<f64>],

@@ -119,7 +119,8 @@ pub(super) struct Workspace {
     /// What the globalization did so far.
     pub(super) stats: Globalization,
     /// Whether steps are solved by conjugate gradients preconditioned with a neighbour's factor
-    /// ([`StaticOptions::neighbour_factor`]); off for the rest of the run once that fails.
+    /// ([`StaticOptions::neighbour_factor`]); off for the rest of the run once that fails or the
+    /// line search shortens one of its steps.
     krylov: bool,
 }
 

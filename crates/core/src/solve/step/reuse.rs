@@ -6,7 +6,8 @@ use super::*;
 impl Workspace {
     /// The Newton step by conjugate gradients on this iteration's exact Hessian, preconditioned by
     /// the factor at hand (a neighbour's), then the line search. False (and `x` as it was) on
-    /// negative curvature, no convergence in [`KRYLOV_ITERATIONS`] or no accepted step.
+    /// negative curvature, no convergence in [`KRYLOV_ITERATIONS`] or no accepted step; a step the
+    /// line search shortens is taken and ends the Krylov steps of this solve.
     pub(super) fn krylov_step(
         &mut self,
         model: &Model,
@@ -32,6 +33,13 @@ impl Workspace {
             Some(alpha) => {
                 self.count(alpha, bound, (false, false));
                 self.stats.krylov_steps += 1;
+                // A step the line search shortened: the neighbour's factor (an undamped Newton
+                // step) no longer fits, and the damped, factorized iteration takes over. Kept on,
+                // pressed layers in the stress box took 25 shortened steps a time step, the step
+                // was rejected and halved, over and over (point 70: 18,262 steps, not settled).
+                if alpha < 1.0 {
+                    self.krylov = false;
+                }
                 true
             }
             None => false,
