@@ -288,32 +288,41 @@ mod tests {
         assert!(s[1].z < 0.0, "more mass sags lower");
     }
 
-    #[test]
-    fn a_neighbours_factor_solves_the_next_equilibrium_without_a_factorization() {
-        // The chain at 10 g, its factor; then the chain at 10.5 g and at 40 g (farther, with more
-        // sag) solved from the first drape with that factor as the preconditioner.
+    /// The chain at `m` solved from the 10 g chain's drape, with (report, drape) and without (drape)
+    /// the 10 g chain's factor as the preconditioner.
+    fn from_neighbour(
+        m: f64,
+    ) -> (
+        crate::solve::SolveReport,
+        Vec<Vector3<f64>>,
+        Vec<Vector3<f64>>,
+    ) {
         let (mut model, mut x) = chain(0.01);
         equilibrium(&mut model, &mut x);
         let f = EquilibriumFactor::new(&model, &x).expect("a minimum");
         let shared = std::sync::Arc::new(f.factor().copy());
+        let (mut plain, mut xp) = chain(m);
+        xp.copy_from_slice(&x);
+        equilibrium(&mut plain, &mut xp);
+        let (mut seeded, mut xs) = chain(m);
+        xs.copy_from_slice(&x);
+        let opts = crate::solve::StaticOptions {
+            residual_tol_rel: 1e-12,
+            neighbour_factor: Some(crate::solve::NeighbourFactor(shared)),
+            ..Default::default()
+        };
+        let r =
+            crate::solve::solve_static(&mut seeded, &mut xs, &opts, &mut crate::solve::NoObserver);
+        assert!(r.is_converged(), "{}", r.message);
+        (r, xs, xp)
+    }
+
+    #[test]
+    fn a_neighbours_factor_solves_the_next_equilibrium_without_a_factorization() {
+        // The chain at 10.5 g and at 40 g (farther, with more sag) from the 10 g chain's drape
+        // with its factor as the preconditioner.
         for m in [0.0105, 0.04] {
-            let (mut plain, mut xp) = chain(m);
-            xp.copy_from_slice(&x);
-            equilibrium(&mut plain, &mut xp);
-            let (mut seeded, mut xs) = chain(m);
-            xs.copy_from_slice(&x);
-            let opts = crate::solve::StaticOptions {
-                residual_tol_rel: 1e-12,
-                neighbour_factor: Some(crate::solve::NeighbourFactor(shared.clone())),
-                ..Default::default()
-            };
-            let r = crate::solve::solve_static(
-                &mut seeded,
-                &mut xs,
-                &opts,
-                &mut crate::solve::NoObserver,
-            );
-            assert!(r.is_converged(), "{}", r.message);
+            let (r, xs, xp) = from_neighbour(m);
             assert_eq!(r.factorizations, 0, "mass {m}: {r:?}");
             assert!(r.globalization.krylov_steps > 0);
             for p in 0..4 {
@@ -324,26 +333,10 @@ mod tests {
 
     #[test]
     fn a_neighbours_factor_hands_over_to_factorizations_once_the_line_search_shortens_its_step() {
-        // The chain at 10 g preconditions the chain at 200 g (20 times heavier, far from the
-        // start): the undamped step the neighbour's factor gives overshoots, the line search
-        // shortens it, and the damped, factorized iteration finishes — to the same drape.
-        let (mut model, mut x) = chain(0.01);
-        equilibrium(&mut model, &mut x);
-        let f = EquilibriumFactor::new(&model, &x).expect("a minimum");
-        let shared = std::sync::Arc::new(f.factor().copy());
-        let (mut plain, mut xp) = chain(0.2);
-        xp.copy_from_slice(&x);
-        equilibrium(&mut plain, &mut xp);
-        let (mut seeded, mut xs) = chain(0.2);
-        xs.copy_from_slice(&x);
-        let opts = crate::solve::StaticOptions {
-            residual_tol_rel: 1e-12,
-            neighbour_factor: Some(crate::solve::NeighbourFactor(shared)),
-            ..Default::default()
-        };
-        let r =
-            crate::solve::solve_static(&mut seeded, &mut xs, &opts, &mut crate::solve::NoObserver);
-        assert!(r.is_converged(), "{}", r.message);
+        // The chain at 200 g (20 times heavier, far from the start): the undamped step the 10 g
+        // chain's factor gives overshoots, the line search shortens it, and the damped, factorized
+        // iteration finishes — to the same drape.
+        let (r, xs, xp) = from_neighbour(0.2);
         let g = &r.globalization;
         eprintln!("{g:?}, {} factorizations", r.factorizations);
         assert_eq!(g.krylov_steps, 1, "{g:?}");
