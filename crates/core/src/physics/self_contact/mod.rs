@@ -254,6 +254,15 @@ impl SelfContact {
     }
 }
 
+/// Pushes one pair's blocks `k[a][b]` (a ≥ b) of its vertices `idx`.
+fn push_pair(h: &mut HessianBlocks, idx: &[usize; 4], k: &[[Matrix3<f64>; 4]; 4]) {
+    for a in 0..4 {
+        for b in 0..=a {
+            h.push(idx[a], idx[b], k[a][b]);
+        }
+    }
+}
+
 /// A pair pressed to within this fraction of the band beyond the thickness doubles κ: κ is built
 /// to balance one particle's weight there, so a pair pressed closer carries more than one's.
 const STIFFEN_GAP: f64 = 0.1;
@@ -300,8 +309,8 @@ impl EnergyTerm for SelfContact {
         });
     }
     /// The barrier's curvature along the line between the closest points, κ b″ n nᵀ (positive
-    /// semi-definite: the curvature of the distance itself is left out), but for pinned pairs. Only pairs
-    /// in range push blocks: pushing every candidate's (zero) blocks to keep the pattern fixed made
+    /// semi-definite: the curvature of the distance itself is left out; pinned pairs below). Only
+    /// pairs in range push blocks: pushing every candidate's (zero) blocks to keep the pattern fixed made
     /// the factor denser and the drapes slower (skirt_wool 9.8 s against 5.9 s).
     ///
     /// In implicit time steps a pair pinned within [`STIFFEN_GAP`] of the band beyond the
@@ -315,12 +324,7 @@ impl EnergyTerm for SelfContact {
         let pinned = self.thickness_m + STIFFEN_GAP * self.band_m;
         self.each_active_pair(x, |idx, d, coef, pt| {
             if self.exact_pinned && !project && d < pinned {
-                let k = self.pair_exact_blocks(pt, &idx.map(|v| x[v]), d);
-                for a in 0..4 {
-                    for b in 0..=a {
-                        h.push(idx[a], idx[b], k[a][b]);
-                    }
-                }
+                push_pair(h, &idx, &self.pair_exact_blocks(pt, &idx.map(|v| x[v]), d));
                 return;
             }
             let d2b = barrier(d - self.thickness_m, self.band_m).2;
@@ -333,27 +337,9 @@ impl EnergyTerm for SelfContact {
     /// The exact Hessian of every active pair: κ b″ ∇d∇dᵀ + κ b′ ∇²d, ∇²d the curvature of the
     /// distance with the closest points moving ([`Self::pair_exact_blocks`]).
     fn add_exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
-        let mut pairs = Vec::new();
-        {
-            let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-            self.ensure(&mut c, x, None);
-            pairs.extend(c.pairs.iter().copied());
-        }
-        for pair in pairs {
-            let idx = pair.vertices(&self.topo);
-            let pt = pair.is_point_triangle();
-            let y = idx.map(|k| x[k]);
-            let d = pair_distance(pt, &y).0;
-            if d >= self.activation_m() {
-                continue;
-            }
-            let k = self.pair_exact_blocks(pt, &y, d);
-            for a in 0..4 {
-                for b in 0..=a {
-                    h.push(idx[a], idx[b], k[a][b]);
-                }
-            }
-        }
+        self.each_active_pair(x, |idx, d, _, pt| {
+            push_pair(h, &idx, &self.pair_exact_blocks(pt, &idx.map(|v| x[v]), d));
+        });
     }
     /// Additive CCD over every candidate pair. A long step (far from equilibrium Newton may propose
     /// a vertex move of a metre) is checked in pieces of at most `piece_m` per vertex, each
