@@ -164,11 +164,17 @@ impl SelfContact {
         const SHARE: f64 = 0.1;
         c.measure_moves(x);
         let act = self.activation_m();
+        let reach: Vec<f64> = seg.iter().map(|d| d.norm()).collect();
         let mut toi = f64::INFINITY;
         for (&pair, &gap) in c.pairs.iter().zip(c.gaps.iter()) {
             let idx = pair.vertices(&self.topo);
             let lower = c.gap_left(&self.topo, pair, gap) + act - self.thickness_m;
             if lower > 0.0 {
+                // The gap shrinks by at most its vertices' whole moves: when that leaves more
+                // than the share, additive CCD never stops (cheaper than the relative motion).
+                if (1.0 - SHARE) * lower > candidates::farthest(pair, &idx, &reach) {
+                    continue;
+                }
                 let (_, l) = relative_motion(pair.is_point_triangle(), &idx.map(|k| seg[k]));
                 if (1.0 - SHARE) * lower > l {
                     continue;
@@ -437,6 +443,7 @@ impl EnergyTerm for SelfContact {
 mod tests {
     use super::*;
     use crate::physics::tests::check_gradient;
+    use crate::proximity::Pair;
 
     /// Two 3 × 3 patches, the upper one `gap` above the lower.
     fn stacked(gap: f64) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
@@ -682,6 +689,68 @@ mod tests {
         assert!(narrow.seed(&node.candidates_covering(&x, &[0.0; 18])));
         assert_eq!(narrow.energy(&y), fresh.energy(&y));
         assert_eq!(narrow.cache.lock().expect("cache").broad_phases, 1);
+    }
+
+    #[test]
+    fn a_long_steps_list_holds_the_pairs_it_brings_together_and_serves_its_line_search() {
+        // Both layers fall 3 cm (thirty margins), the upper one 5.1–5.4 mm further, into range.
+        let (x, tris) = stacked(6e-3);
+        let term = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        let dx: Vec<Vector3<f64>> = lowered(&x)
+            .iter()
+            .zip(&x)
+            .enumerate()
+            .map(|(p, (l, v))| l - v - Vector3::z() * (3e-2 + if p >= 9 { 4.5e-3 } else { 0.0 }))
+            .collect();
+        let bound = term.max_step(&x, &dx);
+        // Its bound is additive CCD's over every pair of the mesh (the list misses no pair that
+        // stops the step).
+        let topo = term.topology();
+        let all = (0..18u32)
+            .flat_map(|v| (0..8u32).map(move |t| Pair::PointTriangle(v, t)))
+            .chain(
+                (0..topo.edges.len() as u32)
+                    .flat_map(|a| (0..a).map(move |b| Pair::EdgeEdge(b, a))),
+            )
+            .filter(|pair| {
+                let idx = pair.vertices(topo);
+                let split = if pair.is_point_triangle() { 1 } else { 2 };
+                !idx[..split].iter().any(|v| idx[split..].contains(v))
+            });
+        let want = all
+            .map(|pair| {
+                let idx = pair.vertices(topo);
+                let (y, d) = (idx.map(|k| x[k]), idx.map(|k| dx[k]));
+                additive_ccd(pair.is_point_triangle(), &y, &d, 5e-4, 0.1, 1.0)
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(bound < 1.0 && bound > 0.5, "{bound}");
+        assert_eq!(bound, want);
+        {
+            // Only pairs across the layers: within a layer nothing moves relative to anything.
+            let c = term.cache.lock().expect("cache");
+            assert!(c.sweep.is_some() && !c.pairs.is_empty());
+            let across = |p: &Pair| {
+                let idx = p.vertices(topo);
+                idx.iter().any(|&v| v < 9) && idx.iter().any(|&v| v >= 9)
+            };
+            assert!(c.pairs.iter().all(across), "{}", c.pairs.len());
+        }
+        // The line search's states (and a tenth of the step behind) measure what fresh terms do,
+        // with no broad phase beyond the step's.
+        let at =
+            |a: f64| -> Vec<Vector3<f64>> { x.iter().zip(&dx).map(|(v, d)| v + d * a).collect() };
+        for a in [-0.1, 0.5, 0.9 * bound] {
+            let y = at(a);
+            let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 1e-3);
+            assert_eq!(term.energy(&y), fresh.energy(&y));
+        }
+        assert_measures_alike(
+            &term,
+            &SelfContact::new(tris, &at(bound), 5e-4, 1e-3, 1e-3),
+            &at(bound),
+        );
+        assert_eq!(term.cache.lock().expect("cache").broad_phases, 1);
     }
 
     #[test]

@@ -366,4 +366,40 @@ mod tests {
         );
         assert_eq!(a, b);
     }
+
+    #[test]
+    fn a_pattern_extended_from_the_last_one_has_the_slots_a_fresh_mapping_gives() {
+        // Particle 5 held (its blocks are not entries); the contact blocks after the chain's change,
+        // one of them diagonal, one of them the held particle's.
+        let n = 24;
+        let mut fixed = vec![false; n];
+        fixed[5] = true;
+        let dofs = DofMap::new(&fixed);
+        let with = |extra: &[(usize, usize)]| {
+            let mut h = chain(n, &[(20, 2), (17, 9)]);
+            for &(p, q) in extra {
+                h.push(p, q, Matrix3::from_diagonal_element(0.25));
+            }
+            h
+        };
+        let all = with(&[(15, 1), (22, 11), (12, 12), (18, 5)]);
+        let (first, next) = (
+            with(&[(15, 1), (12, 12)]),
+            with(&[(22, 11), (18, 5), (12, 12)]),
+        );
+        let (whole, _) = Pattern::exact(&dofs, &all).expect("a structure");
+        let last = Pattern::map(&dofs, &first, whole.structure.clone());
+        let extended = Pattern::extend(&last, &dofs, &next).expect("within the structure");
+        let fresh = Pattern::map(&dofs, &next, whole.structure.clone());
+        assert_eq!(extended.slot, fresh.slot);
+        // Each entry's slot is its own position in the structure (one search per entry).
+        let s = &whole.structure;
+        let mut want = Vec::new();
+        SparseSpd::entries(&dofs, &next, |r, c, _| want.push(s.position(r, c)));
+        want.extend((0..dofs.n).map(|d| s.position(d, d)));
+        assert_eq!(fresh.slot, want);
+        assert_eq!(extended.constant_entries, fresh.constant_entries);
+        // A block outside the structure: no extension.
+        assert!(Pattern::extend(&last, &dofs, &with(&[(23, 0)])).is_none());
+    }
 }

@@ -2,7 +2,7 @@
 //! structure's pattern (ordering, supernodes, the map from Hessian blocks into compressed values),
 //! a solve's structure grown to a superset when its contact pairs leave it.
 
-use super::{DofMap, SparseSpd};
+use super::DofMap;
 use crate::physics::HessianBlocks;
 use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -120,7 +120,40 @@ impl Structure {
         Some((s, true))
     }
 
-    /// Whether every block of `blocks` (sorted) is in the structure, over the same DOFs.
+    /// Where the entry (`r`, `c`), r ≥ c, lands in the compressed values.
+    pub(super) fn position(&self, r: usize, c: usize) -> u32 {
+        let sym = &self.sym;
+        let (start, end) = (sym.col_ptr()[c], sym.col_ptr()[c + 1]);
+        let k = sym.row_idx()[start..end].partition_point(|&i| i < r);
+        self.to_permuted[start + k]
+    }
+
+    /// The slots of the blocks at `pairs` ([`super::SparseSpd::entries`]' order: per block rows, then
+    /// columns, the lower triangle of a diagonal block), onto `out`: a block's rows lie next to one
+    /// another in each of its columns, so one search per column finds its three.
+    fn block_slots(&self, dofs: &DofMap, pairs: &[(u32, u32)], out: &mut Vec<u32>) {
+        let sym = &self.sym;
+        for &(p, q) in pairs {
+            let (Some(dp), Some(dq)) = (dofs.dof(p as usize), dofs.dof(q as usize)) else {
+                continue;
+            };
+            let diagonal = p == q;
+            let first: [usize; 3] = std::array::from_fn(|c| {
+                let (col, row) = (dq + c, if diagonal { dp + c } else { dp });
+                let (start, end) = (sym.col_ptr()[col], sym.col_ptr()[col + 1]);
+                start + sym.row_idx()[start..end].partition_point(|&i| i < row)
+            });
+            for r in 0..3 {
+                for (c, &k) in first.iter().enumerate() {
+                    if !diagonal || r >= c {
+                        out.push(self.to_permuted[k + if diagonal { r - c } else { r }]);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether every block of `blocks` is in the structure, over the same DOFs.
     pub(super) fn covers(&self, dofs: &DofMap, blocks: &[(u32, u32)]) -> bool {
         self.first == dofs.first && blocks.iter().all(|b| self.blocks.binary_search(b).is_ok())
     }
@@ -164,7 +197,7 @@ pub(super) struct Pattern {
     /// The pairs of the Hessian's constant part ([`HessianBlocks::constant`]).
     pub(super) constant_pairs: Vec<(u32, u32)>,
     pub(super) structure: Arc<Structure>,
-    /// For each entry ([`SparseSpd::entries`] order: the constant part's, then the others), then
+    /// For each entry ([`super::SparseSpd::entries`] order: the constant part's, then the others), then
     /// each diagonal shift, its position in the compressed values: a factorization adds every
     /// entry straight into its slot, in that order.
     pub(super) slot: Vec<u32>,
@@ -175,20 +208,13 @@ pub(super) struct Pattern {
 impl Pattern {
     /// The entries of `h` over `dofs` mapped into `structure` (which holds all of its blocks).
     pub(super) fn map(dofs: &DofMap, h: &HessianBlocks, structure: Arc<Structure>) -> Self {
-        let sym = &structure.sym;
-        let position = |r: usize, c: usize| -> u32 {
-            let (start, end) = (sym.col_ptr()[c], sym.col_ptr()[c + 1]);
-            let k = sym.row_idx()[start..end].partition_point(|&i| i < r);
-            structure.to_permuted[start + k]
-        };
         let mut slot = Vec::new();
-        let constant = h.constant.as_deref();
-        if let Some(c) = constant {
-            SparseSpd::entries(dofs, c, |r, c, _| slot.push(position(r, c)));
+        if let Some(c) = h.constant.as_deref() {
+            structure.block_slots(dofs, &c.pairs, &mut slot);
         }
         let constant_entries = slot.len();
-        SparseSpd::entries(dofs, h, |r, c, _| slot.push(position(r, c)));
-        slot.extend((0..dofs.n).map(|d| position(d, d)));
+        structure.block_slots(dofs, &h.pairs, &mut slot);
+        slot.extend((0..dofs.n).map(|d| structure.position(d, d)));
         Self {
             pairs: h.pairs.clone(),
             constant_pairs: h.constant_pairs().to_vec(),
@@ -196,6 +222,50 @@ impl Pattern {
             constant_entries,
             structure,
         }
+    }
+
+    /// The pattern of `h` on `last`'s structure when `h`'s blocks after those it shares with
+    /// `last` from the start (the elastic terms push first, the contact pairs that come and go
+    /// last) are all in it: `last`'s slots kept for the shared blocks, the others mapped — the
+    /// slots [`Self::map`] gives, without searching the elastic entries again at every change of
+    /// the contact set. None where a block is missing.
+    pub(super) fn extend(last: &Pattern, dofs: &DofMap, h: &HessianBlocks) -> Option<Self> {
+        let structure = &last.structure;
+        if last.constant_pairs != h.constant_pairs() || structure.first != dofs.first {
+            return None;
+        }
+        let shared = last
+            .pairs
+            .iter()
+            .zip(&h.pairs)
+            .take_while(|(a, b)| a == b)
+            .count();
+        let free =
+            |&(p, q): &(u32, u32)| dofs.dof(p as usize).is_some() && dofs.dof(q as usize).is_some();
+        let rest = &h.pairs[shared..];
+        let missing = rest
+            .iter()
+            .filter(|b| free(b))
+            .any(|b| structure.blocks.binary_search(b).is_err());
+        if missing {
+            return None;
+        }
+        let entries = |b: &(u32, u32)| match (free(b), b.0 == b.1) {
+            (false, _) => 0,
+            (true, true) => 6,
+            (true, false) => 9,
+        };
+        let kept = last.constant_entries + last.pairs[..shared].iter().map(entries).sum::<usize>();
+        let mut slot = last.slot[..kept].to_vec();
+        structure.block_slots(dofs, rest, &mut slot);
+        slot.extend_from_slice(&last.slot[last.slot.len() - dofs.n..]);
+        Some(Self {
+            pairs: h.pairs.clone(),
+            constant_pairs: last.constant_pairs.clone(),
+            slot,
+            constant_entries: last.constant_entries,
+            structure: structure.clone(),
+        })
     }
 
     /// Whether this is the pattern of `h`'s blocks over `dofs`.
@@ -245,6 +315,9 @@ impl Pattern {
         let Some(own) = last.map(|p| &p.structure).filter(|s| s.first == dofs.first) else {
             return Self::exact(dofs, h);
         };
+        if let Some(p) = last.and_then(|l| Self::extend(l, dofs, h)) {
+            return Some((Arc::new(p), false));
+        }
         let blocks = free_blocks(dofs, h);
         if own.covers(dofs, &blocks) {
             return Some((Arc::new(Self::map(dofs, h, own.clone())), false));
