@@ -56,6 +56,10 @@ pub struct HessianBlocks {
     /// computed once per model and shared by every evaluation: part of the matrix, summed before
     /// `pairs` ([`Self::all`]); a factorization keeps their assembled values between iterations.
     pub constant: Option<Arc<HessianBlocks>>,
+    /// Blocks that are not in the matrix now but may come soon (self-contact's candidate pairs
+    /// near range): a sparsity structure analysed anyway for a new block takes them in too, so
+    /// that the contact set can grow into them without another analysis. Never entries.
+    pub hints: Vec<(u32, u32)>,
 }
 
 impl HessianBlocks {
@@ -64,6 +68,7 @@ impl HessianBlocks {
         self.pairs.clear();
         self.blocks.clear();
         self.constant = None;
+        self.hints.clear();
     }
     /// Every block of the matrix: the constant part's, then this list's.
     pub fn all(&self) -> impl Iterator<Item = (&(u32, u32), &Matrix3<f64>)> {
@@ -118,6 +123,7 @@ impl HessianBlocks {
             pairs: (0..n as u32).map(|p| (p, p)).collect(),
             blocks: self.diagonal(n),
             constant: None,
+            hints: Vec::new(),
         };
         for (&(p, q), b) in self.all() {
             if p != q {

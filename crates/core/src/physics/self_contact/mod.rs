@@ -224,6 +224,24 @@ impl SelfContact {
 }
 
 impl SelfContact {
+    /// The blocks between the two primitives of every candidate pair within the margin of range
+    /// at the last measured state, as hints ([`HessianBlocks::hints`]).
+    fn hint_near(&self, h: &mut HessianBlocks) {
+        let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        for (&pair, &gap) in c.pairs.iter().zip(&c.gaps) {
+            if c.gap_left(&self.topo, pair, gap) >= self.margin_m {
+                continue;
+            }
+            let idx = pair.vertices(&self.topo);
+            let split = if pair.is_point_triangle() { 1 } else { 2 };
+            for &a in &idx[..split] {
+                for &b in &idx[split..] {
+                    h.hints.push((a.max(b) as u32, a.min(b) as u32));
+                }
+            }
+        }
+    }
+
     /// The gradient of one pair's energy κ b(d − ξ) with respect to its four vertices `y`.
     fn pair_gradient(&self, point_triangle: bool, y: &[Vector3<f64>; 4]) -> [Vector3<f64>; 4] {
         let (d, coef) = pair_distance(point_triangle, y);
@@ -339,6 +357,7 @@ impl EnergyTerm for SelfContact {
             let k: Matrix3<f64> = n * n.transpose() * (self.kappa_J * d2b);
             h.push_outer(&idx, &coef, &k);
         });
+        self.hint_near(h);
     }
     /// The exact Hessian of every active pair: κ b″ ∇d∇dᵀ + κ b′ ∇²d, ∇²d the curvature of the
     /// distance with the closest points moving ([`Self::pair_exact_blocks`]).
@@ -615,6 +634,13 @@ mod tests {
             .collect()
     }
 
+    /// [`lowered`], its upper layer `extra` (m) further down.
+    fn sunk(x: &[Vector3<f64>], extra: f64) -> Vec<Vector3<f64>> {
+        let y = lowered(x).into_iter().enumerate();
+        y.map(|(p, v)| v - Vector3::z() * if p >= 9 { extra } else { 0.0 })
+            .collect()
+    }
+
     #[test]
     fn pruned_pairs_are_the_ones_out_of_range() {
         let (x, tris) = stacked(2.2e-3);
@@ -672,11 +698,7 @@ mod tests {
         // move beyond the 1 mm margin, which a set covering the node alone would not serve.
         let (x, tris) = stacked(6e-3);
         let node = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
-        let y: Vec<Vector3<f64>> = lowered(&x)
-            .iter()
-            .enumerate()
-            .map(|(p, v)| v - Vector3::z() * if p >= 9 { 3.8e-3 } else { 0.0 })
-            .collect();
+        let y = sunk(&x, 3.8e-3);
         let spread: Vec<f64> = (0..18).map(|p| if p >= 9 { 5e-3 } else { 0.0 }).collect();
         let set = node.candidates_covering(&x, &spread);
         let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
@@ -696,11 +718,10 @@ mod tests {
         // Both layers fall 3 cm (thirty margins), the upper one 5.1–5.4 mm further, into range.
         let (x, tris) = stacked(6e-3);
         let term = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
-        let dx: Vec<Vector3<f64>> = lowered(&x)
+        let dx: Vec<Vector3<f64>> = sunk(&x, 4.5e-3)
             .iter()
             .zip(&x)
-            .enumerate()
-            .map(|(p, (l, v))| l - v - Vector3::z() * (3e-2 + if p >= 9 { 4.5e-3 } else { 0.0 }))
+            .map(|(l, v)| l - v - Vector3::z() * 3e-2)
             .collect();
         let bound = term.max_step(&x, &dx);
         // Its bound is additive CCD's over every pair of the mesh (the list misses no pair that

@@ -368,6 +368,55 @@ mod tests {
     }
 
     #[test]
+    fn a_contact_set_growing_into_its_hinted_blocks_needs_no_new_analysis() {
+        // The first contact block forces an analysis, which takes in the hinted blocks; the pairs
+        // then appear without another, and every solve equals the solve on its own structure.
+        let n = 44;
+        let dofs = DofMap::new(&vec![false; n]);
+        let mut first = chain(n, &[(30, 3)]);
+        first.hints = vec![(25, 7), (26, 8), (40, 1)];
+        let later = [
+            chain(n, &[(30, 3), (25, 7)]),
+            chain(n, &[(26, 8), (40, 1), (30, 3)]),
+        ];
+        let mut spd = SparseSpd::new();
+        solve(&mut spd, &dofs, &chain(n, &[]));
+        let before = spd.analyses;
+        let close = |y: &[f64], want: &[f64]| {
+            let err = y
+                .iter()
+                .zip(want)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-14, "{err}");
+        };
+        let y = solve(&mut spd, &dofs, &first);
+        close(&y, &solve(&mut SparseSpd::new(), &dofs, &first));
+        assert_eq!(spd.analyses, before + 1);
+        for h in &later {
+            close(
+                &solve(&mut spd, &dofs, h),
+                &solve(&mut SparseSpd::new(), &dofs, h),
+            );
+        }
+        assert_eq!(
+            spd.analyses,
+            before + 1,
+            "the hinted blocks were in the structure"
+        );
+        let holds = |spd: &SparseSpd, b| {
+            let s = &spd.pattern.as_ref().expect("a pattern").structure;
+            s.blocks.binary_search(&b).is_ok()
+        };
+        assert!(holds(&spd, (40, 1)));
+        // Without the hints the structure grows by the contact block alone.
+        let mut plain = SparseSpd::new();
+        solve(&mut plain, &dofs, &chain(n, &[]));
+        solve(&mut plain, &dofs, &chain(n, &[(30, 3)]));
+        assert!(holds(&plain, (30, 3)) && !holds(&plain, (25, 7)));
+    }
+
+    #[test]
     fn a_pattern_extended_from_the_last_one_has_the_slots_a_fresh_mapping_gives() {
         // Particle 5 held (its blocks are not entries); the contact blocks after the chain's change,
         // one of them diagonal, one of them the held particle's.

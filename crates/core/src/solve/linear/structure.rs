@@ -329,6 +329,16 @@ impl Pattern {
         if union.len() as f64 > MAX_SUPERSET * blocks.len() as f64 {
             return Self::exact(dofs, h);
         }
+        // The blocks the terms expect next, where they fit under the same bound.
+        let free =
+            |&(p, q): &(u32, u32)| dofs.dof(p as usize).is_some() && dofs.dof(q as usize).is_some();
+        let mut hinted = union.clone();
+        hinted.extend(h.hints.iter().filter(|b| free(b)));
+        hinted.sort_unstable();
+        hinted.dedup();
+        if hinted.len() as f64 <= MAX_SUPERSET * blocks.len() as f64 {
+            union = hinted;
+        }
         let (structure, analysed) = Structure::shared(dofs, union)?;
         Some((Arc::new(Self::map(dofs, h, structure)), analysed))
     }
