@@ -193,6 +193,10 @@ pub trait EnergyTerm: Send + Sync {
     /// equilibria: a term whose Newton Hessian differs between the two (self-contact's pinned
     /// pairs) switches. Default: nothing.
     fn set_time_stepping(&mut self, _on: bool) {}
+    /// Told by an equilibrium solve that has run long without converging that Newton's
+    /// (unprojected) Hessian should carry the exact curvature of every contact pair (`on`), or,
+    /// again, its usual one ([`crate::solve::StaticOptions::exact_contact_after`]). Default: nothing.
+    fn set_exact_contact(&self, _on: bool) {}
     /// The largest fraction of the step `dx` from `x` that the term allows (contact: a step that
     /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
     fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
@@ -331,6 +335,10 @@ impl Model {
     /// [`EnergyTerm::set_time_stepping`] of every term.
     pub fn set_time_stepping(&mut self, on: bool) {
         self.terms.iter_mut().for_each(|t| t.set_time_stepping(on));
+    }
+    /// [`EnergyTerm::set_exact_contact`] of every term.
+    pub fn set_exact_contact(&self, on: bool) {
+        self.terms.iter().for_each(|t| t.set_exact_contact(on));
     }
     /// [`EnergyTerm::stiffen_barrier`] of every term: true when one changed its energy.
     pub fn stiffen_barriers(&mut self, x: &Vecs) -> bool {

@@ -22,6 +22,7 @@ use candidates::Cache;
 pub use candidates::CandidateSet;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// What self-contact looks like at a state (for run reports).
@@ -52,6 +53,9 @@ pub struct SelfContact {
     /// Whether Newton's (unprojected) Hessian carries pinned pairs' exact curvature: on during
     /// implicit time steps ([`EnergyTerm::set_time_stepping`]), off for equilibrium solves.
     exact_pinned: bool,
+    /// Whether Newton's (unprojected) Hessian carries every active pair's exact curvature: an
+    /// equilibrium solve that has run long without converging ([`EnergyTerm::set_exact_contact`]).
+    exact_all: AtomicBool,
     margin_m: f64,
     /// The longest vertex move checked with one broad phase, m: four of the longest rest edge.
     piece_m: f64,
@@ -93,6 +97,7 @@ impl SelfContact {
             kappa_J,
             kappa_limit_J: KAPPA_GROWTH_LIMIT * kappa_J,
             exact_pinned: false,
+            exact_all: AtomicBool::new(false),
             margin_m,
             piece_m: (4.0 * longest).max(margin_m),
             cache: Mutex::new(Cache::default()),
@@ -301,6 +306,9 @@ impl EnergyTerm for SelfContact {
     fn set_time_stepping(&mut self, on: bool) {
         self.exact_pinned = on;
     }
+    fn set_exact_contact(&self, on: bool) {
+        self.exact_all.store(on, Ordering::Relaxed);
+    }
     /// Doubles κ when the closest active pair's gap beyond the thickness is under [`STIFFEN_GAP`]
     /// of the band, up to [`KAPPA_GROWTH_LIMIT`] times its start.
     fn stiffen_barrier(&mut self, x: &Vecs) -> bool {
@@ -343,11 +351,17 @@ impl EnergyTerm for SelfContact {
     /// kept Newton from converging in the stress box's steps (a pair pinned at the thickness,
     /// every iteration cut by the collision bound; with the Krylov hand-over 46 → 48 of 50
     /// settle). Not in equilibrium solves: there it slowed the touching drapes (l_panel_sphere
-    /// 197 → 577 iterations, ending a pair 1.5e-11 m from the thickness at 150).
+    /// 197 → 577 iterations, ending a pair 1.5e-11 m from the thickness at 150) — but every
+    /// active pair gets it once an equilibrium solve has run long without converging
+    /// ([`EnergyTerm::set_exact_contact`]: the limp table at 61 × 61 converges with it).
     fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
-        let pinned = self.thickness_m + STIFFEN_GAP * self.band_m;
+        let pinned = match self.exact_all.load(Ordering::Relaxed) {
+            true => f64::INFINITY,
+            false if self.exact_pinned => self.thickness_m + STIFFEN_GAP * self.band_m,
+            false => f64::NEG_INFINITY,
+        };
         self.each_active_pair(x, |idx, d, coef, pt| {
-            if self.exact_pinned && !project && d < pinned {
+            if !project && d < pinned {
                 push_pair(h, &idx, &self.pair_exact_blocks(pt, &idx.map(|v| x[v]), d));
                 return;
             }
@@ -493,6 +507,51 @@ mod tests {
         (x, tris)
     }
 
+    /// Two flat 3 × 3 layers `gap` apart.
+    fn pressed(gap: f64) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
+        let (mut x, tris) = stacked(gap);
+        x.iter_mut()
+            .enumerate()
+            .for_each(|(k, p)| p.z = if k < 9 { 0.0 } else { gap });
+        (x, tris)
+    }
+
+    /// How far `term`'s Newton Hessian (or its projected one) at `x` misses the change of its
+    /// gradient along a sliding, closing move of the upper layer (central differences): the
+    /// relative norm of the difference.
+    fn hessian_miss(term: &SelfContact, x: &[Vector3<f64>], project: bool) -> f64 {
+        let v: Vec<Vector3<f64>> = (0..x.len())
+            .map(|k| match k >= 9 {
+                true => Vector3::new(1.0, 0.3 * (k as f64).sin(), -0.2),
+                false => Vector3::zeros(),
+            })
+            .collect();
+        let grad = |s: f64| {
+            let y: Vec<Vector3<f64>> = x.iter().zip(&v).map(|(p, d)| p + d * s).collect();
+            let mut g = vec![Vector3::zeros(); y.len()];
+            term.add_gradient(&y, &mut g);
+            g
+        };
+        let eps = 1e-9;
+        let (gp, gm) = (grad(eps), grad(-eps));
+        let fd: Vec<Vector3<f64>> = gp
+            .iter()
+            .zip(&gm)
+            .map(|(a, b)| (a - b) / (2.0 * eps))
+            .collect();
+        let mut h = HessianBlocks::default();
+        term.add_hessian(x, &mut h, project);
+        let mut hv = vec![Vector3::zeros(); x.len()];
+        h.mul_add(&v, &mut hv);
+        let num: f64 = hv
+            .iter()
+            .zip(&fd)
+            .map(|(a, b)| (a - b).norm_squared())
+            .sum();
+        let den: f64 = fd.iter().map(|b| b.norm_squared()).sum();
+        (num / den).sqrt()
+    }
+
     /// A pair pressed within 10 % of the band beyond the thickness doubles κ (incremental potential
     /// contact's adaptive κ), one held at 20 % does not, and κ stops growing at its limit.
     #[test]
@@ -525,56 +584,48 @@ mod tests {
     #[test]
     fn a_pinned_pair_gets_its_exact_curvature_unless_projected() {
         let (xi, band) = (5e-4, 1e-3);
-        let gap = xi + 0.05 * band;
-        let (mut x, tris) = stacked(gap);
-        x.iter_mut()
-            .enumerate()
-            .for_each(|(k, p)| p.z = if k < 9 { 0.0 } else { gap });
+        let (x, tris) = pressed(xi + 0.05 * band);
         let mut term = SelfContact::new(tris, &x, xi, band, 1e-3);
-        let v: Vec<Vector3<f64>> = (0..x.len())
-            .map(|k| match k >= 9 {
-                true => Vector3::new(1.0, 0.3 * (k as f64).sin(), -0.2),
-                false => Vector3::zeros(),
-            })
-            .collect();
-        let grad = |s: f64| {
-            let y: Vec<Vector3<f64>> = x.iter().zip(&v).map(|(p, d)| p + d * s).collect();
-            let mut g = vec![Vector3::zeros(); y.len()];
-            term.add_gradient(&y, &mut g);
-            g
-        };
-        let eps = 1e-9;
-        let (gp, gm) = (grad(eps), grad(-eps));
-        let fd: Vec<Vector3<f64>> = gp
-            .iter()
-            .zip(&gm)
-            .map(|(a, b)| (a - b) / (2.0 * eps))
-            .collect();
-        let miss = |term: &SelfContact, project: bool| {
-            let mut h = HessianBlocks::default();
-            term.add_hessian(&x, &mut h, project);
-            let mut hv = vec![Vector3::zeros(); x.len()];
-            h.mul_add(&v, &mut hv);
-            let num: f64 = hv
-                .iter()
-                .zip(&fd)
-                .map(|(a, b)| (a - b).norm_squared())
-                .sum();
-            let den: f64 = fd.iter().map(|b| b.norm_squared()).sum();
-            (num / den).sqrt()
-        };
         // An equilibrium solve's Newton Hessian: the normal-only curvature, as projected.
-        let (equilibrium, projected) = (miss(&term, false), miss(&term, true));
+        let (equilibrium, projected) = (
+            hessian_miss(&term, &x, false),
+            hessian_miss(&term, &x, true),
+        );
         assert!((equilibrium - projected).abs() <= 1e-12 * projected);
         term.set_time_stepping(true);
-        let (exact, projected) = (miss(&term, false), miss(&term, true));
-        // What remains (1.6 %) is the pairs in range but not pinned, whose Hessian stays the
-        // barrier's curvature along the normal only.
+        let (exact, projected) = (
+            hessian_miss(&term, &x, false),
+            hessian_miss(&term, &x, true),
+        );
+        // What remains (1.6 %) is the finite differences' and the pair blocks' own error.
         assert!(exact < 0.05, "exact {exact:e}, projected {projected:e}");
         assert!(
             projected > 10.0 * exact,
             "exact {exact:e}, projected {projected:e}"
         );
+    }
+
+    #[test]
+    fn a_long_equilibrium_solve_gives_every_active_pair_its_exact_curvature() {
+        // Layers half the band beyond the thickness: in range, not pinned, so a time step's
+        // Hessian keeps their normal-only curvature; a solve that has run long does not.
+        let (xi, band) = (5e-4, 1e-3);
+        let (x, tris) = pressed(xi + 0.5 * band);
+        let mut term = SelfContact::new(tris, &x, xi, band, 1e-3);
+        assert!(term.energy(&x) > 0.0);
+        let usual = hessian_miss(&term, &x, false);
+        term.set_time_stepping(true);
+        assert_eq!(hessian_miss(&term, &x, false), usual);
+        term.set_time_stepping(false);
+        term.set_exact_contact(true);
+        let all = hessian_miss(&term, &x, false);
+        assert!(
+            all < 0.05 && usual > 10.0 * all,
+            "all {all:e}, usual {usual:e}"
+        );
+        assert_eq!(hessian_miss(&term, &x, true), usual, "projected as before");
+        term.set_exact_contact(false);
+        assert_eq!(hessian_miss(&term, &x, false), usual);
     }
 
     /// The active pairs are measured once per state and serve energy, gradient and Hessian there:
