@@ -70,9 +70,27 @@ pub(super) fn farthest(pair: Pair, idx: &[usize; 4], per_vertex: &[f64]) -> f64 
 pub(super) struct Sweep {
     dirs: Vec<Vec<Vector3<f64>>>,
     slack: f64,
+    /// The directions' products over the mesh's vertices, [d₁·d₁, d₁·d₂, d₂·d₂] (what of them
+    /// there is): each state's fit reads them instead of summing them again.
+    gram: [f64; 3],
 }
 
 impl Sweep {
+    /// The sweep along `dirs` (one or two) over the mesh's `vertices`.
+    fn new(dirs: Vec<Vec<Vector3<f64>>>, slack: f64, vertices: &[u32]) -> Self {
+        let dot = |a: &[Vector3<f64>], b: &[Vector3<f64>]| {
+            let each = vertices.iter().map(|&v| a[v as usize].dot(&b[v as usize]));
+            each.sum::<f64>()
+        };
+        let last = &dirs[dirs.len() - 1];
+        let gram = [
+            dot(&dirs[0], &dirs[0]),
+            dot(&dirs[0], last),
+            dot(last, last),
+        ];
+        Self { dirs, slack, gram }
+    }
+
     /// Whether the state `y` (and the step `dx` from it, if given) lies in the sweep from `anchor`
     /// over the mesh's `vertices`. The set is convex, so a step is covered when both its ends are.
     fn covers(&self, anchor: &Vecs, vertices: &[u32], y: &Vecs, dx: Option<&Vecs>) -> bool {
@@ -104,18 +122,14 @@ impl Sweep {
             })
         };
         let along = |k: usize| {
-            let dd = dot(&dir(k), &dir(k));
+            let dd = self.gram[2 * k];
             let a = if dd > 0.0 { dot(&e, &dir(k)) / dd } else { 0.0 };
             let mut w = [0.0; 2];
             w[k] = a.clamp(if k == 0 { -SWEEP_BACK } else { 0.0 }, 1.0);
             within(w)
         };
         if d.len() == 2 {
-            let (g00, g01, g11) = (
-                dot(&dir(0), &dir(0)),
-                dot(&dir(0), &dir(1)),
-                dot(&dir(1), &dir(1)),
-            );
+            let [g00, g01, g11] = self.gram;
             let det = g00 * g11 - g01 * g01;
             if det > 1e-12 * g00 * g11 {
                 let (r0, r1) = (dot(&e, &dir(0)), dot(&e, &dir(1)));
@@ -268,7 +282,7 @@ impl SelfContact {
         });
         self.anchor_list(c, x);
         c.region.clear();
-        c.sweep = Some(Sweep { dirs, slack });
+        c.sweep = Some(Sweep::new(dirs, slack, vertices));
     }
 
     /// The list's gaps at `x`, its anchor.
