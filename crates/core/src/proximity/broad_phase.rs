@@ -3,6 +3,7 @@
 //! primitives that share a cell and no vertex (ipc-toolkit's hash grid).
 
 use super::{MeshTopology, Pair, V3};
+use rayon::prelude::*;
 
 /// An axis-aligned box.
 #[derive(Debug, Clone, Copy)]
@@ -162,6 +163,23 @@ pub(super) fn for_each_cell(entries: &[(u64, u8, u32)], mut f: impl FnMut(&[(u64
     }
 }
 
+/// The entries cut into about `parts` runs of whole buckets (for workers to take one each).
+fn bucket_runs(entries: &[(u64, u8, u32)], parts: usize) -> Vec<&[(u64, u8, u32)]> {
+    let step = entries.len().div_ceil(parts.max(1)).max(1);
+    let mut runs = Vec::with_capacity(parts);
+    let mut start = 0;
+    while start < entries.len() {
+        let mut end = (start + step).min(entries.len());
+        if end < entries.len() {
+            let key = entries[end - 1].0;
+            end += entries[end..].partition_point(|e| e.0 == key);
+        }
+        runs.push(&entries[start..end]);
+        start = end;
+    }
+    runs
+}
+
 /// Every pair of primitives that share no vertex, whose boxes, each the union of its vertices'
 /// boxes `vbox` grown by `r`, overlap, and that `keep` accepts: the broad phase, a spatial hash.
 /// Sorted, without duplicates (deterministic).
@@ -169,7 +187,7 @@ pub fn candidate_pairs(
     topo: &MeshTopology,
     vbox: &[Aabb],
     r: f64,
-    keep: impl Fn(Pair) -> bool,
+    keep: impl Fn(Pair) -> bool + Sync,
 ) -> Vec<Pair> {
     let (tboxes, eboxes) = primitive_boxes(topo, vbox, r);
     let vboxes: Vec<Aabb> = topo
@@ -186,18 +204,24 @@ pub fn candidate_pairs(
         (&tboxes, &tids),
         (&eboxes, &eids),
     ]);
-    let mut pairs = Vec::new();
-    for_each_cell(&entries, |cell| {
-        let found = CellPairs {
-            topo,
-            vbox,
-            boxes: (&tboxes, &eboxes),
-            r,
-            size,
-            buckets,
-        };
-        found.collect(cell, &keep, &mut pairs)
-    });
+    let found = CellPairs {
+        topo,
+        vbox,
+        boxes: (&tboxes, &eboxes),
+        r,
+        size,
+        buckets,
+    };
+    // Buckets are independent: runs of them go to rayon's workers (the order is restored below).
+    let runs = bucket_runs(&entries, 8 * rayon::current_num_threads());
+    let mut pairs: Vec<Pair> = runs
+        .into_par_iter()
+        .flat_map_iter(|run| {
+            let mut out = Vec::new();
+            for_each_cell(run, |cell| found.collect(cell, &keep, &mut out));
+            out
+        })
+        .collect();
     pairs.sort_unstable();
     pairs.dedup();
     pairs
@@ -256,6 +280,32 @@ impl CellPairs<'_> {
                     out.push(pair);
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_of_buckets_cover_the_entries_and_never_split_a_bucket() {
+        let entries: Vec<(u64, u8, u32)> = (0..1000u32).map(|k| ((k / 7) as u64, 0, k)).collect();
+        for parts in [1, 3, 16, 5000] {
+            let runs = bucket_runs(&entries, parts);
+            assert_eq!(runs.iter().map(|r| r.len()).sum::<usize>(), entries.len());
+            for w in runs.windows(2) {
+                assert_ne!(
+                    w[0].last().unwrap().0,
+                    w[1][0].0,
+                    "bucket split ({parts} parts)"
+                );
+            }
+            assert!(
+                runs.len() <= parts.min(143),
+                "{} runs for {parts}",
+                runs.len()
+            );
         }
     }
 }

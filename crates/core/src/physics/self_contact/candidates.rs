@@ -4,7 +4,10 @@
 
 use super::SelfContact;
 use crate::physics::Vecs;
-use crate::proximity::{Aabb, MeshTopology, Pair, candidate_pairs, pair_distance, relative_motion};
+use crate::proximity::{
+    Aabb, MeshTopology, Pair, candidate_pairs, pair_distance, pair_distance_lower_bound,
+    relative_motion,
+};
 use nalgebra::Vector3;
 
 #[derive(Default, Clone)]
@@ -278,7 +281,9 @@ impl SelfContact {
                 .iter()
                 .map(|d| relative_motion(pt, &idx.map(|k| d[k])).1)
                 .fold(0.0, f64::max);
-            pair_distance(pt, &idx.map(|k| x[k])).0 - reach - 2.0 * slack < act
+            let at = idx.map(|k| x[k]);
+            pair_distance_lower_bound(pt, &at) - reach - 2.0 * slack < act
+                && pair_distance(pt, &at).0 - reach - 2.0 * slack < act
         });
         self.anchor_list(c, x);
         c.region.clear();
@@ -321,10 +326,10 @@ impl SelfContact {
         let act = self.activation_m();
         let topo = &self.topo;
         c.pairs = candidate_pairs(topo, &c.region, 0.5 * act, |pair| {
-            let idx = pair.vertices(topo);
-            pair_distance(pair.is_point_triangle(), &idx.map(|k| x[k])).0
-                - farthest(pair, &idx, &rho)
-                < act
+            let (idx, pt) = (pair.vertices(topo), pair.is_point_triangle());
+            let (at, reach) = (idx.map(|k| x[k]), farthest(pair, &idx, &rho));
+            pair_distance_lower_bound(pt, &at) - reach < act
+                && pair_distance(pt, &at).0 - reach < act
         });
         self.anchor_list(c, x);
         c.sweep = None;

@@ -208,14 +208,15 @@ impl SelfContact {
             .map(|e| (x[e[0] as usize] - x[e[1] as usize]).norm())
             .fold(0.0, f64::max);
         let boxes: Vec<Aabb> = x.iter().map(Aabb::point).collect();
-        let min_distance_m = std::cell::Cell::new(f64::INFINITY);
+        // Distances are non-negative, so their bits order as they do (an atomic minimum).
+        let least = std::sync::atomic::AtomicU64::new(f64::INFINITY.to_bits());
         candidate_pairs(&self.topo, &boxes, 0.5 * longest, |p| {
             let idx = p.vertices(&self.topo);
             let d = pair_distance(p.is_point_triangle(), &idx.map(|k| x[k])).0;
-            min_distance_m.set(min_distance_m.get().min(d));
+            least.fetch_min(d.to_bits(), std::sync::atomic::Ordering::Relaxed);
             false
         });
-        let min_distance_m = min_distance_m.get();
+        let min_distance_m = f64::from_bits(least.into_inner());
         let mut active_pairs = 0;
         self.each_active(x, |_, _, _| active_pairs += 1);
         let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
