@@ -108,6 +108,29 @@ pub fn pair_distance(point_triangle: bool, x: &[V3; 4]) -> (f64, [f64; 4]) {
     }
 }
 
+/// The mollifier of a nearly parallel edge–edge pair (IPC, Li et al. 2020, §4.3, on the squared
+/// sine of the edges' angle): with s = sin²θ / `sin2`, m = (2 − s)s below s = 1 and 1 above (C¹
+/// there); m and ∇m over the pair's four vertices (edge a's two, then b's), or None where m = 1.
+/// The distance between two segments has a kink where they turn parallel (it falls as |φ| when one
+/// turns by φ about its middle), so a barrier of it alone has a V-shaped minimum there that Newton
+/// cannot converge in; m·b(d) is smooth through it.
+pub fn edge_edge_mollifier(x: &[V3; 4], sin2: f64) -> Option<(f64, [V3; 4])> {
+    let (ea, eb) = (x[1] - x[0], x[3] - x[2]);
+    let (a, b) = (ea.norm_squared(), eb.norm_squared());
+    let u = ea.cross(&eb);
+    let k = sin2 * a * b;
+    let c = u.norm_squared();
+    if c >= k || k <= 0.0 {
+        return None;
+    }
+    let s = c / k;
+    // dm/ds = 2(1 − s); ∂s/∂eₐ = (2 e_b × u − 2c eₐ/|eₐ|²)/k, ∂s/∂e_b = (2 u × eₐ − 2c e_b/|e_b|²)/k.
+    let dm = 2.0 * (1.0 - s) / k;
+    let ga = (eb.cross(&u) - ea * (c / a)) * (2.0 * dm);
+    let gb = (u.cross(&ea) - eb * (c / b)) * (2.0 * dm);
+    Some(((2.0 - s) * s, [-ga, ga, -gb, gb]))
+}
+
 /// A lower bound on [`pair_distance`] at a few flops: the gap between the boxes of the pair's two
 /// primitives (a broad phase's first test, before the exact distance).
 pub fn pair_distance_lower_bound(point_triangle: bool, x: &[V3; 4]) -> f64 {
@@ -407,6 +430,53 @@ mod tests {
         ];
         let t = additive_ccd(false, &e, &de, 0.0, 0.1, 1.0);
         assert!(t < 0.5 && t > 0.4, "{t}");
+    }
+
+    #[test]
+    fn the_mollifier_is_its_own_gradients_integral_and_one_beyond_its_angle() {
+        let edges = |phi: f64| {
+            [
+                v(0.0, 0.0, 0.0),
+                v(0.01, 0.0, 0.0),
+                v(0.002, 0.004, 0.001),
+                v(0.002 + 0.012 * phi.cos(), 0.004 + 0.012 * phi.sin(), 0.001),
+            ]
+        };
+        let sin2 = 1e-3;
+        for phi in [1e-3, 0.01, 0.02, 0.03] {
+            let y = edges(phi);
+            let (m, g) = edge_edge_mollifier(&y, sin2).expect("within the angle");
+            assert!(m > 0.0 && m < 1.0, "{m}");
+            let h = 1e-9;
+            for k in 0..4 {
+                for c in 0..3 {
+                    let (mut yp, mut ym) = (y, y);
+                    yp[k][c] += h;
+                    ym[k][c] -= h;
+                    let at = |z: &[V3; 4]| edge_edge_mollifier(z, sin2).map_or(1.0, |m| m.0);
+                    let fd = (at(&yp) - at(&ym)) / (2.0 * h);
+                    assert!(
+                        (fd - g[k][c]).abs() < 1e-5 * (1.0 + fd.abs()),
+                        "{fd} vs {}",
+                        g[k][c]
+                    );
+                }
+            }
+        }
+        // Beyond ~1.8° the pair is left alone; near it m → 1 with a vanishing slope (C¹).
+        assert!(edge_edge_mollifier(&edges(0.05), sin2).is_none());
+        let slope = |phi: f64| {
+            let (m, g) = edge_edge_mollifier(&edges(phi), sin2).expect("inside");
+            (m, g.iter().map(|v| v.norm()).fold(0.0, f64::max))
+        };
+        let ((m, edge), (_, mid)) = (slope(0.0316), slope(0.02));
+        assert!(
+            1.0 - m < 1e-5 && edge < 1e-2 * mid,
+            "m {m}, slope {edge} against {mid}"
+        );
+        // Parallel: no energy, no force from the mollifier.
+        let (m, _) = edge_edge_mollifier(&edges(0.0), sin2).expect("parallel");
+        assert!(m.abs() < 1e-20);
     }
 
     #[test]

@@ -353,3 +353,23 @@ impl SelfContact {
         }
     }
 }
+
+impl SelfContact {
+    /// The blocks between the two primitives of every candidate pair within the margin of range
+    /// at the last measured state, as hints ([`HessianBlocks::hints`]).
+    pub(super) fn hint_near(&self, h: &mut crate::physics::HessianBlocks) {
+        let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        for (&pair, &gap) in c.pairs.iter().zip(&c.gaps) {
+            if c.gap_left(&self.topo, pair, gap) >= self.margin_m {
+                continue;
+            }
+            let idx = pair.vertices(&self.topo);
+            let split = if pair.is_point_triangle() { 1 } else { 2 };
+            for &a in &idx[..split] {
+                for &b in &idx[split..] {
+                    h.hints.push((a.max(b) as u32, a.min(b) as u32));
+                }
+            }
+        }
+    }
+}
