@@ -216,22 +216,8 @@ mod tests {
             term.add_gradient(x, &mut g);
             g
         };
-        let g = grad(&x);
-        let gscale = g.iter().map(|v| v.amax()).fold(0.0, f64::max);
         let step = 1e-6;
-        for p in [0, 7, 14, 20, 35] {
-            for c in 0..3 {
-                let (mut xp, mut xm) = (x.clone(), x.clone());
-                xp[p][c] += step;
-                xm[p][c] -= step;
-                let fd = (term.energy(&xp) - term.energy(&xm)) / (2.0 * step);
-                assert!(
-                    (fd - g[p][c]).abs() < 1e-6 * gscale,
-                    "gradient {p},{c}: {fd} vs {}",
-                    g[p][c]
-                );
-            }
-        }
+        crate::physics::tests::check_gradient_scaled(&term, &x, [0, 7, 14, 20, 35], (step, 1e-6));
         // H v against the central difference of the gradient along v.
         let v: Vec<Vector3<f64>> = (0..x.len())
             .map(|k| Vector3::new(wobble(k, 1.0), wobble(k + 2, 1.0), wobble(k + 3, 1.0)))

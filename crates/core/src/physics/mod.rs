@@ -443,6 +443,33 @@ impl Model {
 pub(crate) mod tests {
     use super::*;
 
+    /// Central differences of `term`'s energy (step `step`) at the coordinates of `particles`
+    /// against its gradient, within `tol` of the gradient's largest component anywhere.
+    pub(crate) fn check_gradient_scaled(
+        term: &dyn EnergyTerm,
+        x: &[Vector3<f64>],
+        particles: impl IntoIterator<Item = usize>,
+        (step, tol): (f64, f64),
+    ) {
+        let mut g = vec![Vector3::zeros(); x.len()];
+        term.add_gradient(x, &mut g);
+        let largest = g.iter().map(|v| v.amax()).fold(0.0, f64::max);
+        for p in particles {
+            for c in 0..3 {
+                let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+                xp[p][c] += step;
+                xm[p][c] -= step;
+                let fd = (term.energy(&xp) - term.energy(&xm)) / (2.0 * step);
+                assert!(
+                    (fd - g[p][c]).abs() < tol * largest,
+                    "{}: d/dx[{p}][{c}] fd {fd:e} vs {:e}",
+                    term.name(),
+                    g[p][c]
+                );
+            }
+        }
+    }
+
     /// Finite-difference check of every term's gradient and of the Hessian where it is exact.
     pub(crate) fn check_gradient(term: &dyn EnergyTerm, x: &[Vector3<f64>]) {
         let mut g = vec![Vector3::zeros(); x.len()];

@@ -868,23 +868,7 @@ mod tests {
         let (xi, band) = (5e-4, 1e-3);
         let (x, tris) = turned(xi + 0.3 * band, 0.01, SHIFT);
         let term = SelfContact::new(tris, &x, xi, band, 1e-3);
-        let mut g = vec![Vector3::zeros(); x.len()];
-        term.add_gradient(&x, &mut g);
-        let largest = g.iter().map(|v| v.amax()).fold(0.0, f64::max);
-        let eps = 1e-9;
-        for p in 9..x.len() {
-            for c in 0..3 {
-                let (mut xp, mut xm) = (x.clone(), x.clone());
-                xp[p][c] += eps;
-                xm[p][c] -= eps;
-                let fd = (term.energy(&xp) - term.energy(&xm)) / (2.0 * eps);
-                assert!(
-                    (fd - g[p][c]).abs() < 1e-5 * largest,
-                    "[{p}][{c}] {fd:e} vs {:e}",
-                    g[p][c]
-                );
-            }
-        }
+        crate::physics::tests::check_gradient_scaled(&term, &x, 9..x.len(), (1e-9, 1e-5));
         term.set_exact_contact(true);
         let miss = hessian_miss(&term, &x, false);
         assert!(miss < 0.05, "{miss:e}");
