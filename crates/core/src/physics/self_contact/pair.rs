@@ -1,5 +1,5 @@
-//! One self-contact pair's energy derivatives: its gradient with the edge–edge mollifier, its exact
-//! Hessian blocks (central differences of the gradient) and their projection.
+//! One self-contact pair's energy derivatives: its gradient with the edge–edge mollifier and its
+//! exact Hessian blocks (central differences of the gradient).
 
 use super::SelfContact;
 use crate::physics::HessianBlocks;
