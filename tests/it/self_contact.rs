@@ -151,6 +151,19 @@ fn check_solution(s: &Scene, sol: &Solution) -> (usize, f64) {
     self_check(sol.grid_positions(), &tris, &edges, reach)
 }
 
+/// Asserts that the drape `sol` of `s` (named `name` in the messages) passes nowhere through
+/// itself and keeps every two parts at least the thickness ξ apart; the closest distance, m.
+fn assert_uncrossed(name: &str, s: &Scene, sol: &Solution) -> f64 {
+    let (crossings, dmin) = check_solution(s, sol);
+    let xi = drapelab::build::self_thickness_m(s);
+    assert_eq!(crossings, 0, "{name} passes through itself");
+    assert!(
+        dmin >= xi,
+        "{name}: parts {dmin:.3e} m apart, closer than ξ = {xi}"
+    );
+    dmin
+}
+
 #[test]
 fn the_independent_checks_see_a_sheet_folded_through_itself() {
     // Two flat 3 × 3 patches, one through the other: crossings, and distance 0.
@@ -215,14 +228,7 @@ fn every_bundled_scene_converges_without_passing_through_itself() {
         let s = scene(name, &[]);
         let sol = solve_scene(&s, &mut NoObserver);
         assert!(sol.report.is_converged(), "{name}: {}", sol.report.message);
-        let (crossings, dmin) = check_solution(&s, &sol);
-        let xi = drapelab::build::self_thickness_m(&s);
-        assert_eq!(crossings, 0, "{name} passes through itself");
-        assert!(
-            dmin >= xi,
-            "{name}: parts {dmin:.3e} m apart, under half of 2ξ = {}",
-            2.0 * xi
-        );
+        let dmin = assert_uncrossed(name, &s, &sol);
         let active = sol
             .model
             .self_contact(&sol.x)
@@ -264,10 +270,7 @@ fn the_limp_table_at_twice_its_resolution_converges_without_passing_through_itse
         "{}: the exact curvature came in",
         sol.report.iterations
     );
-    let (crossings, dmin) = check_solution(&s, &sol);
-    let xi = drapelab::build::self_thickness_m(&s);
-    assert_eq!(crossings, 0, "passes through itself");
-    assert!(dmin >= xi, "parts {dmin:.3e} m apart, closer than ξ = {xi}");
+    assert_uncrossed("the limp table", &s, &sol);
 }
 
 /// Issue 47: a touching drape on a larger sheet converges without passing through itself — the
@@ -290,10 +293,7 @@ fn the_limp_table_on_a_larger_sheet_converges_without_passing_through_itself() {
     );
     let sol = solve_scene(&s, &mut NoObserver);
     assert!(sol.report.is_converged(), "{}", sol.report.message);
-    let (crossings, dmin) = check_solution(&s, &sol);
-    let xi = drapelab::build::self_thickness_m(&s);
-    assert_eq!(crossings, 0, "passes through itself");
-    assert!(dmin >= xi, "parts {dmin:.3e} m apart, closer than ξ = {xi}");
+    assert_uncrossed("the limp table", &s, &sol);
 }
 
 /// Without self-contact the limp drape does pass through itself, as the issue found: the check
@@ -547,10 +547,7 @@ fn a_slack_net_from_a_perturbed_flat_sheet_settles_from_the_taut_nets_drape() {
         sol.report.message
     );
     assert_eq!(sol.report.minimum, Some(true), "{}", sol.report.message);
-    let (crossings, dmin) = check_solution(&s, &sol);
-    let xi = drapelab::build::self_thickness_m(&s);
-    assert_eq!(crossings, 0);
-    assert!(dmin >= xi, "parts {dmin:.3e} m apart, ξ = {xi}");
+    assert_uncrossed("the slack net", &s, &sol);
     // The net hangs slack: its structural springs are, on average, near their natural length, far
     // from the 38.5 mm they started at.
     let g = &sol.grid;

@@ -139,6 +139,35 @@ impl SelfContact {
         c.time_s += start.elapsed().as_secs_f64();
     }
 
+    /// Σ m·value(d − ξ) over the active pairs at `x`, m each pair's mollifier (1 where the value is
+    /// infinite, within the thickness: never 0 · ∞).
+    fn sum_pairs(&self, x: &Vecs, value: impl Fn(f64) -> f64) -> f64 {
+        let mut sum = 0.0;
+        self.each_active_pair(x, |idx, d, _, pt| {
+            let v = value(d - self.thickness_m);
+            let m = match v.is_finite() {
+                true => self.mollifier(pt, &idx.map(|k| x[k])).map_or(1.0, |m| m.0),
+                false => 1.0,
+            };
+            sum += m * v;
+        });
+        sum
+    }
+
+    /// Adds every active pair's slope·m∇d + value·∇m at `x` to `g` ([`pair_force`]), (slope, value)
+    /// = `along(d − ξ)`: the energy's gradient, or its derivative along a change of coefficients.
+    fn add_pair_forces(&self, x: &Vecs, g: &mut Vecs, along: impl Fn(f64) -> (f64, f64)) {
+        self.each_active_pair(x, |idx, d, coef, pt| {
+            let y = idx.map(|k| x[k]);
+            let (slope, value) = along(d - self.thickness_m);
+            let moll = self.mollifier(pt, &y);
+            let f = pair_force(&y, d, &coef, moll.as_ref(), slope, value);
+            for k in 0..4 {
+                g[idx[k]] += f[k];
+            }
+        });
+    }
+
     /// The candidate pairs within the activation distance at `x`, into the cache's active list.
     fn measure_active(&self, c: &mut Cache, x: &Vecs) {
         self.ensure(c, x, None);
@@ -266,34 +295,12 @@ impl EnergyTerm for SelfContact {
         pressed
     }
     fn energy(&self, x: &Vecs) -> f64 {
-        let mut e = 0.0;
-        self.each_active_pair(x, |idx, d, _, pt| {
-            let b = barrier(d - self.thickness_m, self.band_m).0;
-            // Within the thickness the energy is infinite whatever the mollifier (never 0 · ∞).
-            let m = match b.is_finite() {
-                true => self.mollifier(pt, &idx.map(|k| x[k])).map_or(1.0, |m| m.0),
-                false => 1.0,
-            };
-            e += self.kappa_J * m * b;
-        });
-        e
+        self.sum_pairs(x, |gap| self.kappa_J * barrier(gap, self.band_m).0)
     }
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
-        self.each_active_pair(x, |idx, d, coef, pt| {
-            let y = idx.map(|k| x[k]);
-            let (b, db, _) = barrier(d - self.thickness_m, self.band_m);
-            let moll = self.mollifier(pt, &y);
-            let f = pair_force(
-                &y,
-                d,
-                &coef,
-                moll.as_ref(),
-                self.kappa_J * db,
-                self.kappa_J * b,
-            );
-            for k in 0..4 {
-                g[idx[k]] += f[k];
-            }
+        self.add_pair_forces(x, g, |gap| {
+            let (b, db, _) = barrier(gap, self.band_m);
+            (self.kappa_J * db, self.kappa_J * b)
         });
     }
     /// The barrier's curvature along the line between the closest points, κ b″ n nᵀ (positive
@@ -318,7 +325,6 @@ impl EnergyTerm for SelfContact {
         };
         self.each_active_pair(x, |idx, d, coef, pt| {
             let y = idx.map(|v| x[v]);
-            let moll = self.mollifier(pt, &y);
             if !project && d < pinned {
                 push_pair(h, &idx, &self.pair_exact_blocks(pt, &y, d));
                 return;
@@ -326,7 +332,7 @@ impl EnergyTerm for SelfContact {
             // A mollified pair's normal-only curvature is scaled by its mollifier (a stand-in, as
             // for the others: its exact Hessian, projected, slowed the 0.30 m limp table's
             // drape from 685 to 895 iterations).
-            let m = moll.map_or(1.0, |m| m.0);
+            let m = self.mollifier(pt, &y).map_or(1.0, |m| m.0);
             let d2b = barrier(d - self.thickness_m, self.band_m).2;
             let r: Vector3<f64> = (0..4).map(|k| x[idx[k]] * coef[k]).sum();
             let n = r / d;
@@ -392,17 +398,12 @@ impl EnergyTerm for SelfContact {
             [a, b, c] => [*a, *b, *c],
             _ => return false,
         };
-        self.each_active_pair(x, |idx, d, coef, pt| {
-            let y = idx.map(|k| x[k]);
-            let (b, db, d2b) = barrier(d - self.thickness_m, self.band_m);
-            let (db_dband, ddb) = barrier_band_derivatives(d - self.thickness_m, self.band_m);
+        self.add_pair_forces(x, g, |gap| {
+            let (b, db, d2b) = barrier(gap, self.band_m);
+            let (db_dband, ddb) = barrier_band_derivatives(gap, self.band_m);
             let slope = dkappa * db + self.kappa_J * (ddb * dband - d2b * dxi);
             let value = dkappa * b + self.kappa_J * (db_dband * dband - db * dxi);
-            let moll = self.mollifier(pt, &y);
-            let f = pair_force(&y, d, &coef, moll.as_ref(), slope, value);
-            for k in 0..4 {
-                g[idx[k]] += f[k];
-            }
+            (slope, value)
         });
         true
     }
@@ -411,17 +412,11 @@ impl EnergyTerm for SelfContact {
             [a, b, c] => [*a, *b, *c],
             _ => return None,
         };
-        let mut e = 0.0;
-        self.each_active_pair(x, |idx, d, _, pt| {
-            let (b, db, _) = barrier(d - self.thickness_m, self.band_m);
-            let db_dband = barrier_band_derivatives(d - self.thickness_m, self.band_m).0;
-            let m = match b.is_finite() {
-                true => self.mollifier(pt, &idx.map(|k| x[k])).map_or(1.0, |m| m.0),
-                false => 1.0,
-            };
-            e += m * (dkappa * b + self.kappa_J * (db_dband * dband - db * dxi));
-        });
-        Some(e)
+        Some(self.sum_pairs(x, |gap| {
+            let (b, db, _) = barrier(gap, self.band_m);
+            let db_dband = barrier_band_derivatives(gap, self.band_m).0;
+            dkappa * b + self.kappa_J * (db_dband * dband - db * dxi)
+        }))
     }
     fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {
         Some(self.state(x))
@@ -891,6 +886,53 @@ mod tests {
         let eig = dense.symmetric_eigen().eigenvalues;
         let (lowest, top) = (eig.min(), eig.max());
         assert!(lowest > -1e-9 * top, "{lowest:e} of {top:e}");
+    }
+
+    /// With mollified pairs active, the derivatives in the coefficients (ξ, d̂, κ) are the central
+    /// differences of the energy and gradient with the coefficients moved.
+    #[test]
+    fn mollified_pairs_keep_their_coefficient_derivatives() {
+        let (xi, band) = (5e-4, 1e-3);
+        let (x, tris) = turned(xi + 0.3 * band, 0.01, SHIFT);
+        let mut term = SelfContact::new(tris, &x, xi, band, 1e-3);
+        let c = term.coefficients();
+        let size = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
+        for dc in [
+            [0.1 * c[0], 0.0, 0.0],
+            [0.0, 0.1 * c[1], 0.0],
+            [0.0, 0.0, 0.1 * c[2]],
+            [0.05 * c[0], -0.1 * c[1], 0.2 * c[2]],
+        ] {
+            let mut an = vec![Vector3::zeros(); x.len()];
+            assert!(term.add_coefficient_gradient(&x, &dc, &mut an));
+            let de = term.coefficient_energy(&x, &dc).expect("∂E/∂c");
+            let eps = 1e-6;
+            let mut at = |s: f64| {
+                let moved: Vec<f64> = c.iter().zip(&dc).map(|(a, d)| a + d * s).collect();
+                term.set_coefficients(&moved);
+                let mut g = vec![Vector3::zeros(); x.len()];
+                term.add_gradient(&x, &mut g);
+                (g, term.energy(&x))
+            };
+            let ((gp, ep), (gm, em)) = (at(eps), at(-eps));
+            term.set_coefficients(&c);
+            let fd: Vec<Vector3<f64>> = gp
+                .iter()
+                .zip(&gm)
+                .map(|(a, b)| (a - b) / (2.0 * eps))
+                .collect();
+            let diff: Vec<Vector3<f64>> = fd.iter().zip(&an).map(|(a, b)| a - b).collect();
+            assert!(
+                size(&diff) < 1e-6 * size(&fd),
+                "{dc:?}: ∂g/∂c off by {:e}",
+                size(&diff) / size(&fd)
+            );
+            let fde = (ep - em) / (2.0 * eps);
+            assert!(
+                (fde - de).abs() < 1e-6 * fde.abs(),
+                "{dc:?}: ∂E/∂c {de:e} vs {fde:e}"
+            );
+        }
     }
 
     #[test]
