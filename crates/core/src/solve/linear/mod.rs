@@ -68,6 +68,9 @@ struct Base {
 pub struct SparseSpd {
     pattern: Option<Arc<Pattern>>,
     values: Vec<f64>,
+    /// The last assembled matrix before its shift (H alone), for [`Self::refactorize`]; empty
+    /// when there is none.
+    unshifted: Vec<f64>,
     /// The assembled values of the Hessian's constant part on the current pattern.
     base: Option<Base>,
     /// The factor's values, shared with the copies made of it until one factorizes on its own.
@@ -99,6 +102,7 @@ impl SparseSpd {
         Self {
             pattern: None,
             values: Vec::new(),
+            unshifted: Vec::new(),
             base: None,
             l_values: Arc::new(Vec::new()),
             mem: MemBuffer::new(StackReq::empty()),
@@ -143,26 +147,41 @@ impl SparseSpd {
         self.values = vec![0.0; nnz];
     }
 
-    /// The lower-triangle entries of `h`'s own list over the free DOFs (not its constant part).
-    fn entries(dofs: &DofMap, h: &HessianBlocks, mut visit: impl FnMut(usize, usize, f64)) {
+    /// Adds the lower-triangle entries of `h`'s own list over the free DOFs (not its constant
+    /// part) into `values` at their slots (`slot`, one per entry in this order: per block its
+    /// rows, then columns, the lower triangle of a diagonal block); the number of entries.
+    fn scatter(dofs: &DofMap, h: &HessianBlocks, slot: &[u32], values: &mut [f64]) -> usize {
+        /// (row, column) of a diagonal block's lower triangle, in the order of the slots.
+        const LOWER: [(usize, usize); 6] = [(0, 0), (1, 0), (1, 1), (2, 0), (2, 1), (2, 2)];
+        let mut e = 0;
         for (&(p, q), b) in h.pairs.iter().zip(&h.blocks) {
-            let (Some(dp), Some(dq)) = (dofs.dof(p as usize), dofs.dof(q as usize)) else {
+            if dofs.dof(p as usize).is_none() || dofs.dof(q as usize).is_none() {
                 continue;
-            };
-            for r in 0..3 {
-                for c in 0..3 {
-                    if p != q || r >= c {
-                        // Lower triangle: row ≥ column (dp ≥ dq when p > q, as DOFs follow particles).
-                        visit(dp + r, dq + c, b[(r, c)]);
+            }
+            // Lower triangle: row ≥ column (dp ≥ dq when p > q, as DOFs follow particles).
+            if p != q {
+                let s = &slot[e..e + 9];
+                for r in 0..3 {
+                    for c in 0..3 {
+                        values[s[3 * r + c] as usize] += b[(r, c)];
                     }
                 }
+                e += 9;
+            } else {
+                let s = &slot[e..e + 6];
+                for (k, &(r, c)) in LOWER.iter().enumerate() {
+                    values[s[k] as usize] += b[(r, c)];
+                }
+                e += 6;
             }
         }
+        e
     }
 
     /// Factorizes H + diag(shift) over the free DOFs. Returns false when the matrix is not
     /// positive definite (the caller raises its damping or projects the Hessian and tries again).
     pub fn factorize(&mut self, dofs: &DofMap, h: &HessianBlocks, shift: &[f64]) -> bool {
+        self.unshifted.clear();
         let Some(pattern) = self.pattern_for(dofs, h) else {
             return false;
         };
@@ -190,11 +209,7 @@ impl SparseSpd {
             (Some(b), _) if base_holds(b) => values.copy_from_slice(&b.values),
             (_, Some(c)) => {
                 values.fill(0.0);
-                let mut e = 0;
-                Self::entries(dofs, c, |_, _, v| {
-                    values[slot[e] as usize] += v;
-                    e += 1;
-                });
+                Self::scatter(dofs, c, slot, values);
                 self.base = Some(Base {
                     constant: c.clone(),
                     pattern: pattern.clone(),
@@ -203,13 +218,33 @@ impl SparseSpd {
             }
             (_, None) => values.fill(0.0),
         }
-        let mut e = pattern.constant_entries;
-        Self::entries(dofs, h, |_, _, v| {
-            values[slot[e] as usize] += v;
-            e += 1;
-        });
+        let e = pattern.constant_entries;
+        let e = e + Self::scatter(dofs, h, &slot[e..], values);
         debug_assert_eq!(e + dofs.n, slot.len());
-        for (&s, &v) in slot[e..].iter().zip(shift) {
+        self.unshifted.clone_from(values);
+        self.factorize_shifted(&pattern, shift, start)
+    }
+
+    /// Factorizes the matrix the last [`Self::factorize`] assembled with another `shift` (H itself
+    /// unchanged: a failed attempt's next damping): the same values, bit for bit, without
+    /// scattering the Hessian's entries again. Whether it is positive definite; None when no
+    /// assembled matrix is held (the last assembly failed, or none was made).
+    pub fn refactorize(&mut self, shift: &[f64]) -> Option<bool> {
+        let pattern = self.pattern.clone()?;
+        let held = self.unshifted.len() == self.values.len() && self.factor_scratch;
+        if !held || self.unshifted.is_empty() || shift.len() > pattern.slot.len() {
+            return None;
+        }
+        let start = Instant::now();
+        self.values.copy_from_slice(&self.unshifted);
+        Some(self.factorize_shifted(&pattern, shift, start))
+    }
+
+    /// Adds `shift` to the diagonal of the assembled values and factorizes them numerically.
+    fn factorize_shifted(&mut self, pattern: &Pattern, shift: &[f64], start: Instant) -> bool {
+        let values = &mut self.values;
+        let diagonal = &pattern.slot[pattern.slot.len() - shift.len()..];
+        for (&s, &v) in diagonal.iter().zip(shift) {
             values[s as usize] += v;
         }
         let structure = &pattern.structure;
@@ -416,6 +451,48 @@ mod tests {
         assert!(holds(&plain, (30, 3)) && !holds(&plain, (25, 7)));
     }
 
+    /// The (row, column) of every lower-triangle entry of `h`'s own list over the free DOFs, in
+    /// the order [`SparseSpd::scatter`] adds them.
+    fn entries(dofs: &DofMap, h: &HessianBlocks, mut visit: impl FnMut(usize, usize)) {
+        for &(p, q) in &h.pairs {
+            let (Some(dp), Some(dq)) = (dofs.dof(p as usize), dofs.dof(q as usize)) else {
+                continue;
+            };
+            for r in 0..3 {
+                for c in 0..3 {
+                    if p != q || r >= c {
+                        visit(dp + r, dq + c);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_new_shift_of_the_assembled_matrix_factorizes_as_a_fresh_assembly_does() {
+        let n = 12;
+        let dofs = DofMap::new(&vec![false; n]);
+        let h = chain(n, &[(9, 2)]);
+        let (low, high) = (vec![-50.0; dofs.n], vec![0.5; dofs.n]);
+        // A shift that makes the matrix indefinite fails; the next one, on the same values, holds.
+        let mut again = SparseSpd::new();
+        assert!(!again.factorize(&dofs, &h, &low));
+        assert_eq!(again.refactorize(&high), Some(true));
+        let mut fresh = SparseSpd::new();
+        assert!(fresh.factorize(&dofs, &h, &high));
+        let rhs: Vec<f64> = (0..dofs.n).map(|k| (k as f64 * 0.37).sin()).collect();
+        let (mut a, mut b) = (rhs.clone(), rhs);
+        again.solve_in_place(&mut a);
+        fresh.solve_in_place(&mut b);
+        assert_eq!(a, b, "bit for bit");
+        assert_eq!(again.refactorize(&low), Some(false));
+        // Nothing assembled (a pattern that could not be found, or a copy): no refactorization.
+        let mut copy = fresh.copy();
+        assert_eq!(copy.refactorize(&high), None);
+        assert!(!copy.factorize(&dofs, &h, &high[1..]));
+        assert_eq!(copy.refactorize(&high), None);
+    }
+
     #[test]
     fn a_pattern_extended_from_the_last_one_has_the_slots_a_fresh_mapping_gives() {
         // Particle 5 held (its blocks are not entries); the contact blocks after the chain's change,
@@ -444,7 +521,7 @@ mod tests {
         // Each entry's slot is its own position in the structure (one search per entry).
         let s = &whole.structure;
         let mut want = Vec::new();
-        SparseSpd::entries(&dofs, &next, |r, c, _| want.push(s.position(r, c)));
+        entries(&dofs, &next, |r, c| want.push(s.position(r, c)));
         want.extend((0..dofs.n).map(|d| s.position(d, d)));
         assert_eq!(fresh.slot, want);
         assert_eq!(extended.constant_entries, fresh.constant_entries);

@@ -54,13 +54,13 @@ impl Workspace {
             && self.top_fails(shift, scale, report)
         {
             *hessian = Hessian::Projected;
-            model.hessian(x, &mut self.h, true);
+            self.hessian(model, x, Hessian::Projected);
             shift
         } else if exact && shift * DAMPING_GROWTH <= self.parts.shift_max {
             (shift * DAMPING_GROWTH).max(MU_MIN)
         } else if exact {
             *hessian = Hessian::Projected;
-            model.hessian(x, &mut self.h, true);
+            self.hessian(model, x, Hessian::Projected);
             self.mu
         } else {
             self.mu = (shift * DAMPING_GROWTH).max(MU_MIN);
@@ -78,7 +78,19 @@ impl Workspace {
             self.shift[d + c] += crate::solve::equilibrium::HELD_SHIFT_REL * scale.max(1e-300);
         }
         report.factorizations += 1;
+        if self.assembled
+            && let Some(ok) = self.spd.refactorize(&self.shift)
+        {
+            return ok;
+        }
+        self.assembled = true;
         self.spd.factorize(&self.dofs, &self.h, &self.shift)
+    }
+
+    /// The Hessian at `x` into `h`, projected or not: a new matrix to assemble.
+    pub(super) fn hessian(&mut self, model: &Model, x: &[Vector3<f64>], kind: Hessian) {
+        model.hessian(x, &mut self.h, kind.is_projected());
+        self.assembled = false;
     }
 
     /// After the damping `shift` alone failed, where the iteration before ended on the projected
@@ -109,7 +121,7 @@ impl Workspace {
     ) -> f64 {
         if !hessian.is_projected() && self.mu >= CARRIED_DAMPING_MAX {
             *hessian = Hessian::Projected;
-            model.hessian(x, &mut self.h, true);
+            self.hessian(model, x, Hessian::Projected);
             self.mu = self.parts.mu_initial.min(self.mu);
         } else {
             self.mu = (self.mu * DAMPING_GROWTH).max(MU_MIN);

@@ -17,7 +17,7 @@ impl Workspace {
         r: f64,
         report: &mut SolveReport,
     ) -> bool {
-        model.hessian(x, &mut self.h, false);
+        self.hessian(model, x, Hessian::Exact);
         let Some(d) = self.krylov_direction(model) else {
             return false;
         };
