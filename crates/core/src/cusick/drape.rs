@@ -291,10 +291,9 @@ pub fn solve_drape_from(
     };
     let (report, x) = solve_drape_once(mesh, &without, tester, start, observer);
     let tris: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| t.map(|v| v as u32)).collect();
-    let topo = crate::proximity::MeshTopology::from_triangles(tris.clone());
+    let topo = crate::proximity::MeshTopology::shared(tris);
     let crossing = !crate::proximity::edge_triangle_crossings(&topo, &x).is_empty();
-    let probe = crate::physics::SelfContact::new(tris, &x, xi, xi, 1.0);
-    if !crossing && probe.state(&x).min_distance_m >= 2.0 * xi {
+    if !crossing && !crate::proximity::comes_within(&topo, &x, 2.0 * xi) {
         return (report, x, false);
     }
     let (mut report, x) = solve_drape_once(mesh, p, tester, start, observer);

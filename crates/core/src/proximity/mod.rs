@@ -296,6 +296,21 @@ pub fn additive_ccd(
     t
 }
 
+/// Whether two primitives of the mesh that share no vertex come closer than `d` at positions `x`
+/// (a broad phase of range `d` alone: far cheaper than the closest distance over every pair).
+pub fn comes_within(topo: &MeshTopology, x: &[V3], d: f64) -> bool {
+    let boxes: Vec<Aabb> = x.iter().map(Aabb::point).collect();
+    let found = std::sync::atomic::AtomicBool::new(false);
+    candidate_pairs(topo, &boxes, d, |p| {
+        let idx = p.vertices(topo);
+        if pair_distance(p.is_point_triangle(), &idx.map(|k| x[k])).0 < d {
+            found.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        false
+    });
+    found.into_inner()
+}
+
 /// The (edge, triangle) pairs that share no vertex and where the edge crosses the triangle at
 /// positions `x`: the sheet passing through itself (0 for a sheet that does not).
 pub fn edge_triangle_crossings(topo: &MeshTopology, x: &[V3]) -> Vec<(u32, u32)> {
@@ -503,6 +518,51 @@ mod tests {
         }
         // Not vacuous: most separated pairs are bounded within a factor of two.
         assert!(apart > 1000 && tight > apart / 2, "{tight} of {apart}");
+    }
+
+    /// Two 3 × 3 patches `gap` apart, the upper one shifted by a third of a cell: positions and
+    /// triangles.
+    fn stacked(gap: f64) -> (Vec<V3>, Vec<[u32; 3]>) {
+        let mut x = Vec::new();
+        for layer in 0..2 {
+            for j in 0..3 {
+                for i in 0..3 {
+                    let shift = layer as f64 * 0.0033;
+                    x.push(v(
+                        i as f64 * 0.01 + shift,
+                        j as f64 * 0.01,
+                        layer as f64 * gap,
+                    ));
+                }
+            }
+        }
+        let mut tris = Vec::new();
+        for layer in 0..2u32 {
+            let o = layer * 9;
+            for j in 0..2u32 {
+                for i in 0..2u32 {
+                    let p = o + j * 3 + i;
+                    tris.push([p, p + 1, p + 4]);
+                    tris.push([p, p + 4, p + 3]);
+                }
+            }
+        }
+        (x, tris)
+    }
+
+    #[test]
+    fn a_sheet_comes_within_a_distance_exactly_when_its_closest_pair_does() {
+        for gap in [2e-4, 7e-4, 3e-3] {
+            let (x, tris) = stacked(gap);
+            let topo = MeshTopology::from_triangles(tris);
+            for d in [1e-4, 5e-4, 1e-3, 5e-3] {
+                assert_eq!(comes_within(&topo, &x, d), gap < d, "gap {gap}, d {d}");
+            }
+        }
+        // One sheet on its own: neighbours share vertices, and nothing else comes near.
+        let (x, tris) = stacked(0.0);
+        let topo = MeshTopology::from_triangles(tris[..8].to_vec());
+        assert!(!comes_within(&topo, &x[..9], 5e-3));
     }
 
     #[test]
