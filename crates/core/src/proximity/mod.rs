@@ -520,14 +520,14 @@ mod tests {
         assert!(apart > 1000 && tight > apart / 2, "{tight} of {apart}");
     }
 
-    /// Two 3 × 3 patches `gap` apart, the upper one shifted by a third of a cell: positions and
-    /// triangles.
-    fn stacked(gap: f64) -> (Vec<V3>, Vec<[u32; 3]>) {
+    /// Two 3 × 3 patches of 1 cm cells `gap` apart, the upper one shifted by `shift` along x:
+    /// positions and triangles.
+    fn stacked(gap: f64, shift: f64) -> (Vec<V3>, Vec<[u32; 3]>) {
         let mut x = Vec::new();
         for layer in 0..2 {
             for j in 0..3 {
                 for i in 0..3 {
-                    let shift = layer as f64 * 0.0033;
+                    let shift = layer as f64 * shift;
                     x.push(v(
                         i as f64 * 0.01 + shift,
                         j as f64 * 0.01,
@@ -553,14 +553,15 @@ mod tests {
     #[test]
     fn a_sheet_comes_within_a_distance_exactly_when_its_closest_pair_does() {
         for gap in [2e-4, 7e-4, 3e-3] {
-            let (x, tris) = stacked(gap);
+            // The upper patch shifted by a third of a cell: its vertices over the lower's triangles.
+            let (x, tris) = stacked(gap, 0.0033);
             let topo = MeshTopology::from_triangles(tris);
             for d in [1e-4, 5e-4, 1e-3, 5e-3] {
                 assert_eq!(comes_within(&topo, &x, d), gap < d, "gap {gap}, d {d}");
             }
         }
         // One sheet on its own: neighbours share vertices, and nothing else comes near.
-        let (x, tris) = stacked(0.0);
+        let (x, tris) = stacked(0.0, 0.0);
         let topo = MeshTopology::from_triangles(tris[..8].to_vec());
         assert!(!comes_within(&topo, &x[..9], 5e-3));
     }
@@ -568,25 +569,7 @@ mod tests {
     #[test]
     fn the_broad_phase_finds_every_close_pair_of_two_stacked_sheets() {
         // Two 3 × 3 patches 1 mm apart: every vertex of one lies over a triangle of the other.
-        let mut x = Vec::new();
-        for layer in 0..2 {
-            for j in 0..3 {
-                for i in 0..3 {
-                    x.push(v(i as f64 * 0.01, j as f64 * 0.01, layer as f64 * 1e-3));
-                }
-            }
-        }
-        let mut tris = Vec::new();
-        for layer in 0..2u32 {
-            let o = layer * 9;
-            for j in 0..2u32 {
-                for i in 0..2u32 {
-                    let p = o + j * 3 + i;
-                    tris.push([p, p + 1, p + 4]);
-                    tris.push([p, p + 4, p + 3]);
-                }
-            }
-        }
+        let (x, tris) = stacked(1e-3, 0.0);
         let topo = MeshTopology::from_triangles(tris);
         let boxes: Vec<Aabb> = x.iter().map(Aabb::point).collect();
         let pairs = candidate_pairs(&topo, &boxes, 1e-3, |_| true);
