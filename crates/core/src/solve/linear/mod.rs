@@ -68,9 +68,10 @@ struct Base {
 pub struct SparseSpd {
     pattern: Option<Arc<Pattern>>,
     values: Vec<f64>,
-    /// The last assembled matrix before its shift (H alone), for [`Self::refactorize`]; empty
-    /// when there is none.
-    unshifted: Vec<f64>,
+    /// The last assembled matrix's diagonal before its shift (the rest of `values` stays as
+    /// assembled: the factorization only reads it), for [`Self::refactorize`]; empty when there
+    /// is none.
+    unshifted_diagonal: Vec<f64>,
     /// The assembled values of the Hessian's constant part on the current pattern.
     base: Option<Base>,
     /// The factor's values, shared with the copies made of it until one factorizes on its own.
@@ -102,7 +103,7 @@ impl SparseSpd {
         Self {
             pattern: None,
             values: Vec::new(),
-            unshifted: Vec::new(),
+            unshifted_diagonal: Vec::new(),
             base: None,
             l_values: Arc::new(Vec::new()),
             mem: MemBuffer::new(StackReq::empty()),
@@ -181,7 +182,7 @@ impl SparseSpd {
     /// Factorizes H + diag(shift) over the free DOFs. Returns false when the matrix is not
     /// positive definite (the caller raises its damping or projects the Hessian and tries again).
     pub fn factorize(&mut self, dofs: &DofMap, h: &HessianBlocks, shift: &[f64]) -> bool {
-        self.unshifted.clear();
+        self.unshifted_diagonal.clear();
         let Some(pattern) = self.pattern_for(dofs, h) else {
             return false;
         };
@@ -221,7 +222,8 @@ impl SparseSpd {
         let e = pattern.constant_entries;
         let e = e + Self::scatter(dofs, h, &slot[e..], values);
         debug_assert_eq!(e + dofs.n, slot.len());
-        self.unshifted.clone_from(values);
+        let diagonal = slot[slot.len() - dofs.n..].iter();
+        self.unshifted_diagonal = diagonal.map(|&s| values[s as usize]).collect();
         self.factorize_shifted(&pattern, shift, start)
     }
 
@@ -231,12 +233,15 @@ impl SparseSpd {
     /// assembled matrix is held (the last assembly failed, or none was made).
     pub fn refactorize(&mut self, shift: &[f64]) -> Option<bool> {
         let pattern = self.pattern.clone()?;
-        let held = self.unshifted.len() == self.values.len() && self.factor_scratch;
-        if !held || self.unshifted.is_empty() || shift.len() > pattern.slot.len() {
+        let held = self.factor_scratch && !self.unshifted_diagonal.is_empty();
+        if !held || shift.len() != self.unshifted_diagonal.len() {
             return None;
         }
         let start = Instant::now();
-        self.values.copy_from_slice(&self.unshifted);
+        let diagonal = &pattern.slot[pattern.slot.len() - shift.len()..];
+        for (&s, &v) in diagonal.iter().zip(&self.unshifted_diagonal) {
+            self.values[s as usize] = v;
+        }
         Some(self.factorize_shifted(&pattern, shift, start))
     }
 
