@@ -3,6 +3,7 @@
 # (issue 34's table): `drapelab simulate` each datasets/scenes/*.toml into a temporary folder and
 # print one CSV row per scene from its run.json. Run it alone (the times are wall times):
 #   bash benches/newton_iterations.sh [path/to/drapelab] > newton.csv
+# NEWTON_SET="solver.static.KEY=VALUE ..." applies the same --set overrides to every scene.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin="${1:-${CARGO_TARGET_DIR:-target}/release/drapelab}"
@@ -11,7 +12,9 @@ trap 'rm -rf "$tmp"' EXIT
 echo "scene,status,iterations,factorizations,wall_time_s,energy_J,minimum,full_steps,shortened_steps,bounded_steps,curved_steps,projected_steps,rejected_trials"
 for scene in datasets/scenes/*.toml; do
   name="$(basename "$scene" .toml)"
-  "$bin" -q simulate "$scene" --out "$tmp/$name" >/dev/null 2>&1 || true
+  sets=()
+  for kv in ${NEWTON_SET:-}; do sets+=(--set "$kv"); done
+  "$bin" -q simulate "$scene" --out "$tmp/$name" "${sets[@]}" >/dev/null 2>&1 || true
   python3 - "$tmp/$name/run.json" "$name" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))["report"]

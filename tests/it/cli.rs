@@ -463,7 +463,20 @@ fn every_solver_option_is_checked_and_a_bad_one_names_its_key() {
             "solver.static.shift_max_rel=0",
             "solver.static.shift_max_rel",
         ),
-        ("solver.static.max_iterations=0", "solver.static"),
+        (
+            "solver.static.max_iterations=0",
+            "solver.static.max_iterations",
+        ),
+        ("solver.static.load_steps=0", "solver.static.load_steps"),
+        (
+            "solver.static.residual_tol_rel=1e300",
+            "solver.static.residual_tol_rel",
+        ),
+        (
+            "solver.dynamic.residual_tol_rel=1",
+            "solver.dynamic.residual_tol_rel",
+        ),
+        ("solver.dynamic.min_dt_s=200", "solver.dynamic.min_dt_s"),
         (
             "solver.dynamic.newton_iterations=0",
             "solver.dynamic.newton_iterations",

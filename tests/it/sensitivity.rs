@@ -1,7 +1,7 @@
 //! `simulate --sensitivity KEY` and `simulate --start FILE` at the command line: the table's rows and
 //! values, run.json's word on them, bad keys and bad start files refused as bad input.
 
-use crate::support::{assert_bad_input, drapelab, root};
+use crate::support::{assert_bad_input, drapelab, root, run_python};
 use drapelab::io::{read_particles, read_sensitivities};
 use std::path::Path;
 
@@ -108,6 +108,35 @@ fn a_key_that_is_not_a_continuous_parameter_is_bad_input_and_leaves_nothing() {
     }
 }
 
+/// Friction's lagged equilibrium is not differentiated: a drape with friction asked for a
+/// sensitivity (of μ itself or of any other key) is refused before the solve, naming the flag, the
+/// key and friction, where it wrote a table of zeros (for μ) or left friction's dependence out.
+#[test]
+fn a_drape_with_friction_refuses_sensitivities_naming_the_reason() {
+    let rod = root().join("datasets/scenes/rod_polyester.toml");
+    for key in [
+        "contact.friction_coefficient",
+        "material.continuum.bending_warp_gf_cm2_per_cm",
+    ] {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("o");
+        assert_bad_input(
+            [
+                "simulate",
+                rod.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--set",
+                "contact.friction_coefficient=0.3",
+                "--sensitivity",
+                key,
+            ],
+            &["--sensitivity", key, "friction"],
+        );
+        assert!(!out.exists(), "{key}: {} left behind", out.display());
+    }
+}
+
 #[test]
 fn a_solve_that_does_not_converge_gets_no_sensitivities_and_says_why() {
     let tmp = tempfile::tempdir().unwrap();
@@ -125,6 +154,35 @@ fn a_solve_that_does_not_converge_gets_no_sensitivities_and_says_why() {
     assert_eq!(run["sensitivity"]["written"], false);
     let reason = run["sensitivity"]["reason"].as_str().unwrap();
     assert!(reason.contains("did not converge"), "{reason}");
+}
+
+/// A particles table rewritten by pyarrow with its default compression (snappy) is read as a
+/// start like drapelab's own (zstd), where it was refused as corrupt.
+#[test]
+fn a_start_written_by_pyarrow_with_snappy_is_read() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (first, second) = (tmp.path().join("a"), tmp.path().join("b"));
+    let sim = |out: &Path, extra: &[&str]| {
+        drapelab()
+            .arg("simulate")
+            .arg(hang4())
+            .args(["--out", out.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert!(sim(&first, &[]).status.success());
+    let snappy = tmp.path().join("snappy.parquet");
+    run_python(
+        "import sys, pyarrow.parquet as pq\n\
+         t = pq.read_table(sys.argv[1])\n\
+         pq.write_table(t, sys.argv[2], compression='snappy')\n\
+         assert pq.ParquetFile(sys.argv[2]).metadata.row_group(0).column(0).compression == 'SNAPPY'\n",
+        &[&first.join("particles.parquet"), &snappy],
+    );
+    let o = sim(&second, &["--start", snappy.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(run_json(&second)["start_file"], snappy.to_str().unwrap());
 }
 
 #[test]

@@ -81,6 +81,13 @@ def test_sensitivity_equals_the_command_lines_table_and_a_central_difference(tmp
         drapelab.simulate(HANG4, sensitivity=["cloth.nx"])
 
 
+def test_a_drape_with_friction_refuses_sensitivities_naming_friction():
+    rod = HANG4.parent / "rod_polyester.toml"
+    key = "contact.friction_coefficient"
+    with pytest.raises(drapelab.InputError, match=r"contact\.friction_coefficient.*friction"):
+        drapelab.simulate(rod, set={key: 0.3}, sensitivity=[key])
+
+
 def test_the_table_carries_its_run_metadata_in_the_arrow_schema(tmp_path):
     r = drapelab.simulate(HANG4)
     saved = r.save(tmp_path / "run")

@@ -303,18 +303,30 @@ fn mixed_of_term(
 fn same_structure(rebuilt: &Model, solved: &Model) -> bool {
     rebuilt.len() == solved.len()
         && rebuilt.fixed == solved.fixed[..]
-        && rebuilt.terms.len() <= solved.terms.len()
-        && rebuilt
-            .term_names()
-            .iter()
-            .zip(solved.term_names())
-            .all(|(a, c)| *a == c)
+        && rebuilt.term_names() == solved.term_names()
 }
 
 /// Checks, before a solve, that `key` is a continuous parameter of `scene` whose neighbouring values
 /// θ(1 ± 10⁻⁶) build a model with the same particles and terms. The error names `source` (the flag)
 /// and the key, and says what to do.
+///
+/// A drape with friction is refused: its equilibrium is that of lagged friction (the normal forces
+/// and anchors of the last lag held, `simulate::friction`), which the sensitivity does not
+/// differentiate; its derivative would leave friction's dependence out (for μ itself, zero).
 pub fn check_key(scene: &ValidatedScene, key: &str, source: &str) -> Result<(), InputError> {
+    let mu = scene.contact.friction_coefficient;
+    if mu > 0.0 && !scene.obstacles.is_empty() {
+        return Err(InputError::new(
+            source,
+            key,
+            format!(
+                "the drape has friction (contact.friction_coefficient = {mu}) and the sensitivity \
+                 of a lagged-friction equilibrium is not computed; set \
+                 contact.friction_coefficient=0 for a frictionless drape's sensitivities, or \
+                 difference two drapes"
+            ),
+        ));
+    }
     let params = SceneParameters {
         scene,
         source: source.to_string(),

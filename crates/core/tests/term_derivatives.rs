@@ -454,7 +454,8 @@ fn small_sheet_terms() -> (Vec<Vector3<f64>>, Vec<Labelled>) {
         rest_triangles: &tris,
         triangles: &tris,
     };
-    let patch = drapelab_core::physics::patch_bending(&sheet, [2e-5, 1e-5, 0.7e-5], 0.3);
+    let patch = drapelab_core::physics::patch_bending(&sheet, [2e-5, 1e-5, 0.7e-5], 0.3)
+        .expect("a grid has patches");
     let curl = drapelab_core::physics::hinge_curl(&sheet, 1.4e-5, -8.0);
     let cells: Vec<[usize; 4]> = (0..n - 1)
         .flat_map(|j| {

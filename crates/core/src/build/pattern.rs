@@ -76,13 +76,12 @@ pub fn pattern_builder(
 /// bending across the diagonals two to three times the plate's).
 fn bending(sewn: &SewnSheet<'_>, r: &Rigidities, warp_angle_rad: f64) -> Box<dyn EnergyTerm> {
     let b = [r.bending_warp_N_m, r.bending_weft_N_m];
-    match reads_creases(sewn) {
-        true => Box::new(patch_bending(
-            sewn,
-            [b[0], b[1], r.bending_twist_N_m],
-            warp_angle_rad,
-        )),
-        false => Box::new(sewn_hinge_bending(sewn, b, warp_angle_rad, f64::INFINITY)),
+    let patch = reads_creases(sewn)
+        .then(|| patch_bending(sewn, [b[0], b[1], r.bending_twist_N_m], warp_angle_rad))
+        .flatten();
+    match patch {
+        Some(p) => Box::new(p),
+        None => Box::new(sewn_hinge_bending(sewn, b, warp_angle_rad, f64::INFINITY)),
     }
 }
 

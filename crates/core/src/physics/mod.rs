@@ -189,6 +189,12 @@ pub trait EnergyTerm: Send + Sync {
     fn stiffen_barrier(&mut self, _x: &Vecs) -> bool {
         false
     }
+    /// The smallest gap of a barrier pair beyond its limit at `x`, as a fraction of the barrier's
+    /// band (0 at the limit, 1 at the edge of the band), or None for a term without barrier pairs
+    /// in range: what a static solve watches to adapt κ ([`crate::solve::StaticOptions::kappa_adapt_gap_rel`]).
+    fn closest_gap_rel(&self, _x: &Vecs) -> Option<f64> {
+        None
+    }
     /// Told by the implicit integrator that Newton now solves its time steps (`on`) or, again,
     /// equilibria: a term whose Newton Hessian differs between the two (self-contact's pinned
     /// pairs) switches. Default: nothing.
@@ -339,6 +345,14 @@ impl Model {
     /// [`EnergyTerm::set_exact_contact`] of every term.
     pub fn set_exact_contact(&self, on: bool) {
         self.terms.iter().for_each(|t| t.set_exact_contact(on));
+    }
+    /// The smallest [`EnergyTerm::closest_gap_rel`] of every term (infinity when none has a pair in
+    /// range).
+    pub fn closest_gap_rel(&self, x: &Vecs) -> f64 {
+        self.terms
+            .iter()
+            .filter_map(|t| t.closest_gap_rel(x))
+            .fold(f64::INFINITY, f64::min)
     }
     /// [`EnergyTerm::stiffen_barrier`] of every term: true when one changed its energy.
     pub fn stiffen_barriers(&mut self, x: &Vecs) -> bool {

@@ -20,16 +20,18 @@ const HEM_RINGS: usize = 3;
 
 /// Patch bending of a sewn sheet with rigidities [B_warp, B_weft, B_t] (N·m), the warp at
 /// `warp_angle_rad` from the pattern's +x: per triangle one stencil per curvature whose B is not
-/// zero. A seam's neighbour is unfolded beside the triangle as the hinges' is.
+/// zero. A seam's neighbour is unfolded beside the triangle as the hinges' is. None where a
+/// triangle has no six points that hold a quadratic around it (a pattern one or two triangles
+/// wide): hinges bend such a sheet.
 pub fn patch_bending(
     sheet: &SewnSheet<'_>,
     rigidity_N_m: [f64; 3],
     warp_angle_rad: f64,
-) -> super::QuadraticStencil<6> {
+) -> Option<super::QuadraticStencil<6>> {
     let (mut stencils, mut coef, mut stiff) = (Vec::new(), Vec::new(), Vec::new());
     let near = Neighbours::of(sheet);
     for t in 0..sheet.triangles.len() {
-        let points = near.patch(sheet, t);
+        let points = near.patch(sheet, t)?;
         let (area, weights) = curvature_weights(sheet, t, &points, warp_angle_rad);
         let particles = std::array::from_fn(|m| points[m].0);
         for (c, b) in rigidity_N_m.iter().enumerate() {
@@ -40,7 +42,12 @@ pub fn patch_bending(
             }
         }
     }
-    super::QuadraticStencil::from_stencils("bending/patch", stencils, coef, stiff)
+    Some(super::QuadraticStencil::from_stencils(
+        "bending/patch",
+        stencils,
+        coef,
+        stiff,
+    ))
 }
 
 /// How far a crease may be misread: the tangential and twist parts of the curvature a patch
@@ -55,11 +62,14 @@ const CREASE_FIDELITY: f64 = 0.25;
 /// a crease along an edge from the quadratics through the same values: on a grid split along one
 /// diagonal they read it exactly, but on alternating diagonals a crease along a diagonal is read
 /// as pure twist, and a twist-free plate (seed 003's KES keys have no twist rigidity) then folds
-/// there for nothing. Where this is false, hinges, which charge every crease, bend the sheet.
+/// there for nothing. Where this is false, hinges, which charge every crease, bend the sheet;
+/// false too where a triangle has no patch (a pattern one or two triangles wide).
 pub fn reads_creases(sheet: &SewnSheet<'_>) -> bool {
     let near = Neighbours::of(sheet);
     (0..sheet.triangles.len()).all(|t| {
-        let points = near.patch(sheet, t);
+        let Some(points) = near.patch(sheet, t) else {
+            return false;
+        };
         let (_, w) = curvature_weights(sheet, t, &points, 0.0);
         (0..3).all(|k| match near.across(sheet, t, k) {
             Some((_, q)) => reads_crease(sheet, t, k, q, &points, &w),
@@ -119,8 +129,8 @@ impl Neighbours {
 
     /// Six (particle, rest position) around triangle `t`: its corners, the vertices across its
     /// edges, then the nearest of its rest neighbours within [`HEM_RINGS`] rings, each taken only
-    /// where it keeps the points unisolvent for a quadratic.
-    fn patch(&self, sheet: &SewnSheet<'_>, t: usize) -> Vec<(usize, [f64; 2])> {
+    /// where it keeps the points unisolvent for a quadratic; None where fewer than six are found.
+    fn patch(&self, sheet: &SewnSheet<'_>, t: usize) -> Option<Vec<(usize, [f64; 2])>> {
         let (p, r) = (sheet.triangles[t], sheet.rest_triangles[t]);
         let corner = |k: usize| (p[k], sheet.rest[r[k]]);
         let mut candidates: Vec<(usize, [f64; 2])> = (0..3).map(corner).collect();
@@ -142,12 +152,7 @@ impl Neighbours {
                 chosen.pop();
             }
         }
-        assert_eq!(
-            chosen.len(),
-            6,
-            "a connected pattern has six points around a triangle"
-        );
-        chosen
+        (chosen.len() == 6).then_some(chosen)
     }
 
     /// The vertex across edge k of triangle t (from corner k to k + 1), in t's rest plane.
@@ -276,7 +281,7 @@ mod tests {
                     rest_triangles: &tris,
                     triangles: &tris,
                 };
-                let term = patch_bending(&sheet, b, warp);
+                let term = patch_bending(&sheet, b, warp).expect("a grid has patches");
                 let (ws, wc) = f64::sin_cos(warp);
                 let (ka, kb, kc) = (12.0, -5.0, 7.0);
                 let x: Vec<Vector3<f64>> = rest
@@ -332,5 +337,44 @@ mod tests {
             triangles: &tris,
         };
         assert!(reads_creases(&sheet), "graded");
+    }
+}
+
+#[cfg(test)]
+mod narrow {
+    use super::*;
+
+    /// Patterns one or two triangles wide (one triangle, two, a strip) have no six points that hold
+    /// a quadratic around each triangle: no patch bending and no crease reading (hinges bend
+    /// them), where a pattern three triangles wide has both.
+    #[test]
+    fn patterns_without_six_points_around_a_triangle_have_no_patch_bending() {
+        let strip = |cells: usize| {
+            let rest: Vec<[f64; 2]> = (0..=cells)
+                .flat_map(|i| [[i as f64 * 0.01, 0.0], [i as f64 * 0.01, 0.01]])
+                .collect();
+            let tris: Vec<[usize; 3]> = (0..cells)
+                .flat_map(|i| [[2 * i, 2 * i + 2, 2 * i + 3], [2 * i, 2 * i + 3, 2 * i + 1]])
+                .collect();
+            (rest, tris)
+        };
+        let one = (vec![[0.0, 0.0], [0.01, 0.0], [0.0, 0.01]], vec![[0, 1, 2]]);
+        let two = strip(1);
+        for (rest, tris) in [one, two, strip(6)] {
+            let sheet = SewnSheet {
+                rest: &rest,
+                rest_triangles: &tris,
+                triangles: &tris,
+            };
+            assert!(patch_bending(&sheet, [1e-5, 1e-5, 1e-5], 0.0).is_none());
+            assert!(!reads_creases(&sheet));
+        }
+        let (rest, tris) = crate::physics::testing::grid(4, 0.01, false);
+        let sheet = SewnSheet {
+            rest: &rest,
+            rest_triangles: &tris,
+            triangles: &tris,
+        };
+        assert!(patch_bending(&sheet, [1e-5, 1e-5, 1e-5], 0.0).is_some());
     }
 }

@@ -95,6 +95,12 @@ pub struct SelfContactSummary {
     /// Smallest distance between two parts of the sheet that share no vertex, m (null when none is
     /// within the longest edge of another); null when not modelled.
     pub min_distance_m: Option<f64>,
+    /// The barrier's stiffness κ at the end, J; null when not modelled.
+    pub kappa_J: Option<f64>,
+    /// κ at the end over κ as built: above 1 where a solve stiffened the barrier because layers
+    /// pressed pairs to within a small fraction of the band (IPC's adaptive κ); null when not
+    /// modelled.
+    pub kappa_growth: Option<f64>,
     /// Pairs within the activation distance at the end.
     pub active_pairs: usize,
     /// Broad phases the solve ran.
@@ -160,6 +166,8 @@ pub fn self_contact_summary(
         activation_distance_m: xi.map(|t| 2.0 * t),
         min_distance_m: state
             .and_then(|s| s.min_distance_m.is_finite().then_some(s.min_distance_m)),
+        kappa_J: state.map(|s| s.kappa_J),
+        kappa_growth: state.map(|s| s.kappa_growth),
         active_pairs: state.map_or(0, |s| s.active_pairs),
         broad_phases: state.map_or(0, |s| s.broad_phases),
         time_s: state.map_or(0.0, |s| s.time_s),

@@ -117,6 +117,16 @@ impl DynamicOptions {
         if let Some(w) = self.max_wall_time_s {
             KeyError::positive("max_wall_time_s", w)?;
         }
+        tolerance_below_one_weight(self.residual_tol_rel)?;
+        if self.min_dt_s > self.max_dt_s {
+            return Err(KeyError::new(
+                "min_dt_s",
+                format!(
+                    "must not exceed max_dt_s ({} s), got {} s",
+                    self.max_dt_s, self.min_dt_s
+                ),
+            ));
+        }
         KeyError::non_negative("rayleigh_mass_per_s", self.rayleigh_mass_per_s)?;
         KeyError::non_negative("rayleigh_stiffness_s", self.rayleigh_stiffness_s)?;
         if self.newton_iterations == 0 {
@@ -206,4 +216,19 @@ impl Default for DynamicOptions {
             max_wall_time_s: None,
         }
     }
+}
+
+/// Ok when a residual tolerance relative to the lightest particle's weight is below 1: a residual
+/// force as large as a particle's weight is no equilibrium, and any start would "converge".
+pub(crate) fn tolerance_below_one_weight(tol: f64) -> Result<(), crate::error::KeyError> {
+    if tol >= 1.0 {
+        return Err(crate::error::KeyError::new(
+            "residual_tol_rel",
+            format!(
+                "must be below 1 (a fraction of the lightest particle's weight; 1e-8 is the \
+                 default), got {tol}"
+            ),
+        ));
+    }
+    Ok(())
 }

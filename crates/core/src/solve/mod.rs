@@ -15,6 +15,7 @@ mod newton;
 mod report;
 mod sag;
 mod stability;
+mod static_options;
 mod step;
 mod strategy;
 mod time_step;

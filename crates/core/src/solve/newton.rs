@@ -12,169 +12,12 @@
 //! spring's length: the step follows the curve x + α dx + ½ α² a, a the geodesic acceleration
 //! (Transtrum & Sethna 2012), which bends it along the arcs the springs allow.
 
+pub use super::static_options::{NeighbourFactor, StaticOptions};
 use super::step::Workspace;
-use super::strategy::{Direction, FactorReuse, Regularization, Start};
 use super::{DivergenceReason, Observer, SolveReport, Stage, StateEvent, Status, StopReason};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
-use serde::{Deserialize, Serialize};
 use std::time::Instant;
-
-/// Options of the static solver.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct StaticOptions {
-    /// Convergence when the largest residual force on a free particle is below this fraction of the
-    /// lightest free particle's weight. Default 1e-8.
-    #[serde(default = "default_tol")]
-    pub residual_tol_rel: f64,
-    /// Newton iterations allowed over all load steps. Default 500.
-    #[serde(default = "default_max_iter")]
-    pub max_iterations: usize,
-    /// Number of equal load increments (1 = full load at once). Default 1.
-    #[serde(default = "default_steps")]
-    pub load_steps: usize,
-    /// Initial Levenberg–Marquardt damping relative to the mean Hessian diagonal. Default 1e-3.
-    #[serde(default = "default_lm")]
-    pub lm_damping_initial: f64,
-    /// A strain (relative elongation) beyond which the solve is reported as diverged. Default 10.
-    #[serde(default = "default_strain")]
-    pub strain_bound: f64,
-    /// Where a solve of a scene starts: from a coarser grid's solution, a shaped sheet or the flat
-    /// one ([`Start`]). Default `"nested"`. The old booleans `coarse_start` and `sag_start` are
-    /// read as this key.
-    #[serde(default)]
-    pub start: Start,
-    /// The path a step follows: `"curved"` (along the geodesic acceleration, where it is at most
-    /// twice the step and the Hessian is exact) or `"straight"` ([`Direction`]). Default `"curved"`;
-    /// `"straight"` next to the answer (a warm start). The old boolean `curvilinear` is read as this.
-    #[serde(default)]
-    pub direction: Direction,
-    /// The largest shift of an indefinite exact Hessian, relative to its mean diagonal, tried
-    /// (tenfold from 1e-8) before the projected Hessian is used. Default 1e-5.
-    #[serde(default = "default_shift_max")]
-    pub shift_max_rel: f64,
-    /// How an indefinite exact Hessian is made positive definite: `"shift-ladder"` (shifts for the
-    /// iteration only, then the projected Hessian) or `"carried-damping"` (the shift carried on as
-    /// damping: the Cusick drape's validated path) ([`Regularization`]). Default `"shift-ladder"`.
-    /// The old boolean `carried_damping` is read as this key.
-    #[serde(default)]
-    pub regularization: Regularization,
-    /// Whether a factorization serves more than one step: `"fresh"` or `"chord"` (Shamanskii's
-    /// modified Newton while the residual halves per step) ([`FactorReuse`]). Default `"fresh"`
-    /// (the calibration's warm-started solves and each step of implicit Euler use `"chord"`). The
-    /// old boolean `reuse_factorization` is read as this key.
-    #[serde(default)]
-    pub factor_reuse: FactorReuse,
-    /// Whether a converged solve checks that its equilibrium is a minimum: one more factorization,
-    /// of the exact Hessian ([`is_minimum`]; the report's `minimum`, absent when not checked).
-    /// Default true. Off only where the status alone is read and the start is a stable
-    /// neighbour's drape: the calibration's warm-started evaluations, where the check was a third
-    /// of the factorizations.
-    #[serde(default = "default_check_minimum")]
-    pub check_minimum: bool,
-    /// Newton iterations after which self-contact's active pairs carry their exact curvature in
-    /// Newton's Hessian, the distance's own κ b′∇²d with the barrier's κ b″∇d∇dᵀ
-    /// ([`crate::physics::EnergyTerm::set_exact_contact`]): where folds press many pairs
-    /// together, the normal-only curvature leaves Newton's steps across them too short and the
-    /// solve crawls (the limp table on a 61 × 61 grid: 3,000 iterations, 1.7e-3 of a particle's
-    /// weight off; 1,186 iterations and converged with it after 500). Default 500: the bundled
-    /// touching drapes converge within 330 iterations without it, and from the first iteration
-    /// it slowed one (l_panel_sphere: 197 → 577). Lower it for a touching drape that stops at its
-    /// iteration budget; 0 from the start.
-    #[serde(default = "default_exact_contact_after")]
-    pub exact_contact_after: usize,
-    /// The factor of a neighbouring equilibrium's Hessian (set in code, never read from a file):
-    /// each Newton step is then solved by conjugate gradients preconditioned with it, with no
-    /// factorization of its own while that converges ([`NeighbourFactor`]). The calibration sets it
-    /// to its lattice node's.
-    #[serde(skip)]
-    pub neighbour_factor: Option<NeighbourFactor>,
-}
-
-impl StaticOptions {
-    /// Checks every option (keys relative to `[solver.static]`).
-    pub fn check(&self) -> Result<(), crate::error::KeyError> {
-        use crate::error::KeyError;
-        KeyError::positive("residual_tol_rel", self.residual_tol_rel)?;
-        KeyError::positive("lm_damping_initial", self.lm_damping_initial)?;
-        KeyError::positive("strain_bound", self.strain_bound)?;
-        KeyError::positive("shift_max_rel", self.shift_max_rel)?;
-        if self.max_iterations == 0 || self.load_steps == 0 {
-            return Err(KeyError::new(
-                "",
-                "max_iterations and load_steps must be ≥ 1",
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// A neighbouring equilibrium's factor, shared. As a preconditioner of conjugate gradients it
-/// needs no scale: a model whose energy is a multiple of the neighbour's takes the same steps.
-#[derive(Clone)]
-pub struct NeighbourFactor(pub std::sync::Arc<super::SparseSpd>);
-
-impl std::fmt::Debug for NeighbourFactor {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "NeighbourFactor")
-    }
-}
-
-/// Two options are equal whatever neighbour factor they carry (it is a start, not a setting).
-impl PartialEq for NeighbourFactor {
-    fn eq(&self, _: &Self) -> bool {
-        true
-    }
-}
-
-fn default_check_minimum() -> bool {
-    true
-}
-
-fn default_exact_contact_after() -> usize {
-    500
-}
-
-fn default_shift_max() -> f64 {
-    1e-5
-}
-
-fn default_tol() -> f64 {
-    1e-8
-}
-fn default_max_iter() -> usize {
-    500
-}
-fn default_steps() -> usize {
-    1
-}
-fn default_lm() -> f64 {
-    1e-3
-}
-fn default_strain() -> f64 {
-    10.0
-}
-
-impl Default for StaticOptions {
-    fn default() -> Self {
-        Self {
-            residual_tol_rel: default_tol(),
-            max_iterations: default_max_iter(),
-            load_steps: default_steps(),
-            lm_damping_initial: default_lm(),
-            strain_bound: default_strain(),
-            start: Start::default(),
-            direction: Direction::default(),
-            shift_max_rel: default_shift_max(),
-            regularization: Regularization::default(),
-            factor_reuse: FactorReuse::default(),
-            check_minimum: default_check_minimum(),
-            exact_contact_after: default_exact_contact_after(),
-            neighbour_factor: None,
-        }
-    }
-}
 
 /// Solves for the static equilibrium starting from `x` (updated in place), the external loads raised
 /// in `opts.load_steps` equal steps.
@@ -278,6 +121,8 @@ pub(super) struct NewtonRun {
     start: Instant,
     /// The load of the last stage.
     load: f64,
+    /// The closest barrier pair's gap after the last accepted step, relative to its band.
+    last_gap_rel: f64,
 }
 
 impl NewtonRun {
@@ -303,6 +148,7 @@ impl NewtonRun {
             floor: false,
             start: Instant::now(),
             load: 1.0,
+            last_gap_rel: f64::INFINITY,
         })
     }
 
@@ -310,7 +156,7 @@ impl NewtonRun {
     /// run stopped (its report says why).
     pub(super) fn stage(
         &mut self,
-        model: &Model,
+        model: &mut Model,
         x: &mut [Vector3<f64>],
         opts: &StaticOptions,
         (load, goal): (f64, Goal),
@@ -376,6 +222,9 @@ impl NewtonRun {
                 );
                 return false;
             }
+            if adapt_kappa(model, x, opts, &mut self.last_gap_rel) {
+                e = model.energy(x, load);
+            }
             let strain = model.max_strain(x);
             if strain > opts.strain_bound {
                 let bound = opts.strain_bound;
@@ -393,6 +242,24 @@ impl NewtonRun {
         finish_report(model, x, self.load, &mut self.ws, timing, &mut self.report);
         self.report
     }
+}
+
+/// Doubles the barriers' κ after an accepted step that left the closest barrier pair within
+/// [`StaticOptions::kappa_adapt_gap_rel`] of its band and closer than the step before did
+/// (`last_gap_rel`, updated; IPC's adaptive κ): true when the energy changed.
+fn adapt_kappa(
+    model: &mut Model,
+    x: &[Vector3<f64>],
+    opts: &StaticOptions,
+    last_gap_rel: &mut f64,
+) -> bool {
+    if opts.kappa_adapt_gap_rel <= 0.0 {
+        return false;
+    }
+    let gap = model.closest_gap_rel(x);
+    let closing = gap < opts.kappa_adapt_gap_rel && gap < *last_gap_rel;
+    *last_gap_rel = gap;
+    closing && model.stiffen_barriers(x)
 }
 
 /// Hands Newton iterate `iter` (residual `r` N, energy `e` J) to `observer` when it wants it.
