@@ -129,10 +129,14 @@ fn read_start(
                 ),
             ));
         }
-        if !v.iter().all(|c| c.is_finite()) {
+        // A drape's coordinates are finite and within a kilometre of the origin.
+        if let Some(c) = (0..3).find(|&c| !v[c].is_finite() || v[c].abs() > 1e3) {
             return Err(bad(
-                "x_m",
-                format!("row {p}: a position that is not finite"),
+                ["x_m", "y_m", "z_m"][c],
+                format!(
+                    "row {p}: {} is not a position within a kilometre of the origin",
+                    v[c]
+                ),
             ));
         }
         x.push(v);

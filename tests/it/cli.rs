@@ -499,3 +499,17 @@ fn every_solver_option_is_checked_and_a_bad_one_names_its_key() {
         assert_bad(Some(&hang4()), &["--set", set], key);
     }
 }
+
+/// A grid sheet without `cloth.nx` is refused naming the key and saying it is missing (it said
+/// "got 0"), one line, exit 2, nothing written.
+#[test]
+fn a_missing_grid_count_is_named_as_missing() {
+    let text: String = hang4()
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("nx"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_bad(Some(&text), &[], "cloth.nx");
+    let (_, err, _, _) = simulate_text(Some(&text), &[]);
+    assert!(err.contains("missing") && !err.contains("got 0"), "{err}");
+}

@@ -183,6 +183,12 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
         );
     let bowtie = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 2 1 0\nv 2 2 0\nf 1 2 3\nf 3 4 5\n";
     std::fs::write(dir.path().join("bowtie.obj"), bowtie).unwrap();
+    let huge = "v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::fs::write(dir.path().join("huge.obj"), huge).unwrap();
+    let panel = root()
+        .join("datasets/patterns/l_panel.obj")
+        .display()
+        .to_string();
     let cases: Vec<(String, &str, &str)> = vec![
         (
             base.replace("l_panel.obj", "missing.obj"),
@@ -200,6 +206,8 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
             "vertex",
             "bowtie.obj",
         ),
+        // A coordinate that would overflow the areas: its line, not "a face without area".
+        (base.replace(&panel, "huge.obj"), "line 2", "huge.obj"),
         (
             base.replace("[cloth]", "[cloth]\nnx = 11"),
             "cloth.nx",

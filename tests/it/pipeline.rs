@@ -307,6 +307,17 @@ outputs.markdown = "reports/y.md"
 params = { title = "y", x = "a" }
 "#;
     assert_bad_pipeline(cycle, "stages.x", "cycle");
+    // A stage that reads its own output: a cycle of one, refused at load naming its input slot.
+    let own = r#"
+name = "t"
+[stages.x]
+kind = "report"
+inputs.tables = ["{run}/x.parquet"]
+outputs.plot = "{run}/x.parquet"
+outputs.markdown = "reports/x.md"
+params = { title = "x", x = "iterations" }
+"#;
+    assert_bad_pipeline(own, "stages.x.inputs.tables", "own output");
     assert_bad_pipeline(
         &PIPELINE.replace("kind = \"sweep\"", "kind = \"swep\""),
         "stages.sweep2.kind",

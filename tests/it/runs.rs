@@ -403,3 +403,40 @@ params = { title = "t", x = "cloth.nx", y = "centre_height_m" }
     );
     assert!(line.len() < 2000, "{line}");
 }
+
+/// Two `simulate` runs into one `--out`, the second started while the first solves: both finish
+/// with their status (the later no longer removes the earlier's staging folder, which left the
+/// earlier with exit 1 and no status), the folder holds one whole result and no staging.
+#[test]
+fn two_simulate_runs_into_one_folder_both_finish() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let scene = crate::support::root().join("datasets/scenes/sphere_wool.toml");
+    let start = || {
+        crate::support::drapelab()
+            .arg("-q")
+            .arg("simulate")
+            .arg(&scene)
+            .arg("--out")
+            .arg(&out)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let first = start();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let second = start();
+    for (k, child) in [first, second].into_iter().enumerate() {
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "run {k}: {err}");
+    }
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(run["report"]["status"], "converged");
+    assert!(out.join("particles.parquet").exists());
+    for e in std::fs::read_dir(&out).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        assert!(!name.ends_with(".partial"), "{name} left behind");
+    }
+}

@@ -84,6 +84,23 @@ fn sensitivity_parquet_holds_one_row_per_particle_and_key_in_particles_order() {
     );
 }
 
+/// `simulate SCENE --out DIR [extra] --sensitivity KEY` is refused as bad input in one line naming
+/// `names`, and leaves no DIR behind.
+fn assert_sensitivity_refused(scene: &Path, extra: &[&str], key: &str, names: &[&str]) {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let mut args = vec![
+        "simulate",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    args.extend(["--sensitivity", key]);
+    assert_bad_input(args, names);
+    assert!(!out.exists(), "{key}: {} left behind", out.display());
+}
+
 #[test]
 fn a_key_that_is_not_a_continuous_parameter_is_bad_input_and_leaves_nothing() {
     for key in [
@@ -91,20 +108,7 @@ fn a_key_that_is_not_a_continuous_parameter_is_bad_input_and_leaves_nothing() {
         "material.mass_spring.nope",
         "solver.static.residual_tol_rel",
     ] {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("o");
-        assert_bad_input(
-            [
-                "simulate",
-                hang4().to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-                "--sensitivity",
-                key,
-            ],
-            &["--sensitivity", key],
-        );
-        assert!(!out.exists(), "{key}: {} left behind", out.display());
+        assert_sensitivity_refused(&hang4(), &[], key, &["--sensitivity", key]);
     }
 }
 
@@ -118,22 +122,8 @@ fn a_drape_with_friction_refuses_sensitivities_naming_the_reason() {
         "contact.friction_coefficient",
         "material.continuum.bending_warp_gf_cm2_per_cm",
     ] {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("o");
-        assert_bad_input(
-            [
-                "simulate",
-                rod.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-                "--set",
-                "contact.friction_coefficient=0.3",
-                "--sensitivity",
-                key,
-            ],
-            &["--sensitivity", key, "friction"],
-        );
-        assert!(!out.exists(), "{key}: {} left behind", out.display());
+        let friction = ["--set", "contact.friction_coefficient=0.3"];
+        assert_sensitivity_refused(&rod, &friction, key, &["--sensitivity", key, "friction"]);
     }
 }
 
@@ -183,6 +173,48 @@ fn a_start_written_by_pyarrow_with_snappy_is_read() {
     let o = sim(&second, &["--start", snappy.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(run_json(&second)["start_file"], snappy.to_str().unwrap());
+}
+
+/// A start whose particle has a non-finite or far-off coordinate is refused naming the column that
+/// holds it (it named x_m for a NaN in z_m), and nothing is written.
+#[test]
+fn a_start_with_a_bad_coordinate_names_its_column() {
+    let tmp = tempfile::tempdir().unwrap();
+    let first = tmp.path().join("a");
+    let o = drapelab()
+        .arg("simulate")
+        .arg(hang4())
+        .args(["--out", first.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    for (column, value) in [("z_m", "float('nan')"), ("y_m", "1e300")] {
+        let bad = tmp.path().join(format!("{column}.parquet"));
+        run_python(
+            &format!(
+                "import sys, pyarrow as pa, pyarrow.parquet as pq\n\
+                 t = pq.read_table(sys.argv[1])\n\
+                 c = t.column('{column}').to_pylist()\n\
+                 c[3] = {value}\n\
+                 t = t.set_column(t.schema.get_field_index('{column}'), '{column}', pa.array(c))\n\
+                 pq.write_table(t, sys.argv[2])\n"
+            ),
+            &[&first.join("particles.parquet"), &bad],
+        );
+        let out = tmp.path().join(format!("{column}-out"));
+        assert_bad_input(
+            [
+                "simulate",
+                hang4().to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--start",
+                bad.to_str().unwrap(),
+            ],
+            &["--start", column, "row 3"],
+        );
+        assert!(!out.exists(), "{column}: {} left behind", out.display());
+    }
 }
 
 #[test]

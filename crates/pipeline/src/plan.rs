@@ -348,10 +348,20 @@ fn link_inputs(
             let mut produced = false;
             for (out, w) in writer {
                 if out == Path::new(pat) || glob.matches_path(out) {
-                    produced = true;
-                    if w != &s.name {
-                        s.deps.insert(w.clone());
+                    if w == &s.name {
+                        return Err(InputError::new(
+                            file,
+                            &key,
+                            format!(
+                                "`{pat}` is this stage's own output `{}`: a stage cannot read what \
+                                 it writes (a dependency cycle of one stage); read a file or \
+                                 another stage's output",
+                                out.display()
+                            ),
+                        ));
                     }
+                    produced = true;
+                    s.deps.insert(w.clone());
                 }
             }
             if !produced {

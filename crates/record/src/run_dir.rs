@@ -151,7 +151,7 @@ pub fn simulate_to_dir_with(
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     remove_stale_staging(out);
     let staging = tempfile::Builder::new()
-        .prefix(".simulate.")
+        .prefix(&format!(".simulate.{}.", std::process::id()))
         .suffix(".partial")
         .tempdir_in(out)
         .with_context(|| format!("cannot write into {}", out.display()))?;
@@ -160,14 +160,28 @@ pub fn simulate_to_dir_with(
     Ok(simulated)
 }
 
-/// Removes staging folders that a killed run left in `out`.
+/// Removes staging folders that a killed run left in `out`: those whose process (the pid in the
+/// name, `.simulate.PID.XXXX.partial`) is gone. A run still writing into the same folder keeps its
+/// own: two runs into one `--out` both finish, the later's files last.
 fn remove_stale_staging(out: &Path) {
     for e in std::fs::read_dir(out).into_iter().flatten().flatten() {
         let name = e.file_name().to_string_lossy().to_string();
-        if name.starts_with(".simulate.") && name.ends_with(".partial") {
+        let Some(middle) = name
+            .strip_prefix(".simulate.")
+            .and_then(|n| n.strip_suffix(".partial"))
+        else {
+            continue;
+        };
+        let owner = middle.split('.').next().and_then(|p| p.parse::<u32>().ok());
+        if !owner.is_some_and(process_alive) {
             std::fs::remove_dir_all(e.path()).ok();
         }
     }
+}
+
+/// Whether process `pid` is running (Linux's /proc; elsewhere assumed, so nothing live is removed).
+fn process_alive(pid: u32) -> bool {
+    !cfg!(target_os = "linux") || Path::new("/proc").join(pid.to_string()).exists()
 }
 
 /// Moves the files `written` from `staging` into `out`, `run.json` last, after removing the

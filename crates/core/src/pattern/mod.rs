@@ -172,6 +172,10 @@ fn resolve(
     Ok(resolved as usize)
 }
 
+/// The largest vertex coordinate a pattern file may hold, in its unit (a kilometre in
+/// millimetres): beyond it areas overflow long before a sheet could be that size.
+const MAX_COORDINATE: f64 = 1e6;
+
 fn parse(text: &str) -> Result<Raw, Defect> {
     let mut raw = Raw::default();
     let mut current: Vec<String> = Vec::new();
@@ -184,7 +188,18 @@ fn parse(text: &str) -> Result<Raw, Defect> {
             "v" => {
                 let c: Vec<f64> = rest.iter().take(3).filter_map(|t| t.parse().ok()).collect();
                 match c[..] {
-                    [x, y, z] if c.iter().all(|v| v.is_finite()) => raw.v.push([x, y, z]),
+                    [x, y, z] if c.iter().all(|v| v.abs() <= MAX_COORDINATE) => {
+                        raw.v.push([x, y, z])
+                    }
+                    [_, _, _] if c.iter().all(|v| v.is_finite()) => {
+                        return Err(defect(
+                            format!("line {n}"),
+                            format!(
+                                "a vertex coordinate beyond ±{MAX_COORDINATE:e} (in the file's unit): \
+                                 not a pattern piece's size"
+                            ),
+                        ));
+                    }
                     _ => {
                         return Err(defect(
                             format!("line {n}"),
