@@ -30,6 +30,9 @@ fn sensitivity_parquet_holds_one_row_per_particle_and_key_in_particles_order() {
             K,
             "--sensitivity",
             RHO,
+            // Asked twice: computed and written once.
+            "--sensitivity",
+            K,
         ])
         .output()
         .unwrap();
@@ -38,6 +41,10 @@ fn sensitivity_parquet_holds_one_row_per_particle_and_key_in_particles_order() {
     let rows = read_sensitivities(&out.join("sensitivity.parquet")).unwrap();
     let n = particles.len();
     assert_eq!(rows.len(), 2 * n);
+    assert_eq!(
+        run_json(&out)["sensitivity"]["keys"],
+        serde_json::json!([K, RHO])
+    );
     for (k, key) in [K, RHO].iter().enumerate() {
         for (p, (i, j, _)) in particles.iter().enumerate() {
             let r = &rows[k * n + p];

@@ -423,11 +423,16 @@ fn sensitivities(
         return Ok((None, Vec::new()));
     }
     let start = std::time::Instant::now();
+    // A key asked for twice is computed and written once, in the order first asked.
+    let mut keys: Vec<String> = Vec::new();
+    for k in &extras.sensitivity_keys {
+        if !keys.contains(k) {
+            keys.push(k.clone());
+        }
+    }
     let result =
         Equilibrium::new(&loaded.scene, model, x, report, "--sensitivity").and_then(|mut eq| {
-            extras
-                .sensitivity_keys
-                .iter()
+            keys.iter()
                 .map(|k| eq.sensitivity(k))
                 .collect::<Result<Vec<_>, _>>()
         });
@@ -448,7 +453,7 @@ fn sensitivities(
         Err(e) => (false, Some(e.to_string()), Vec::new(), Vec::new()),
     };
     let record = SensitivityRecord {
-        keys: extras.sensitivity_keys.clone(),
+        keys,
         written,
         reason,
         d_energy_J_per_unit: d_energy,

@@ -78,17 +78,8 @@ in the key's unit (SI)",
         if !c.initial_perturbation_m.is_finite() {
             return ck.err("cloth.initial_perturbation_m", "must be finite".into());
         }
-        for (key, n) in [("cloth.nx", c.nx), ("cloth.ny", c.ny)] {
-            // Absent reads as 0 (a mesh sheet has none): say so rather than "got 0".
-            let got = match n {
-                0 => {
-                    "it is missing (a grid sheet needs nx and ny; a mesh sheet gives `mesh`)".into()
-                }
-                n => format!("got {n}"),
-            };
-            if !(2..=2049).contains(&n) {
-                return ck.err(key, format!("must be in 2..=2049, {got}"));
-            }
+        if let Some((key, message)) = self.grid_count_error() {
+            return ck.err(key, message);
         }
         if !(0.0..1.0).contains(&c.grading) {
             return ck.err(

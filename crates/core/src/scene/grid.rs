@@ -5,6 +5,20 @@ use super::Scene;
 use crate::cloth::Spacing;
 
 impl Scene {
+    /// The grid count out of 2..=2049 (`cloth.nx` first) and what is wrong with it; absent reads as
+    /// 0 (a mesh sheet has none), which is said as missing rather than "got 0".
+    pub(super) fn grid_count_error(&self) -> Option<(&'static str, String)> {
+        let c = &self.cloth;
+        let (key, n) = [("cloth.nx", c.nx), ("cloth.ny", c.ny)]
+            .into_iter()
+            .find(|(_, n)| !(2..=2049).contains(n))?;
+        let got = match n {
+            0 => "it is missing (a grid sheet needs nx and ny; a mesh sheet gives `mesh`)".into(),
+            n => format!("got {n}"),
+        };
+        Some((key, format!("must be in 2..=2049, {got}")))
+    }
+
     /// The grid of the scene (uniform or graded, refined towards `cloth.refine_x_m`/`refine_y_m`);
     /// of a mesh sheet, its vertices as one row ([`Grid::vertex_row`](crate::cloth::Grid::vertex_row)).
     pub fn grid(&self) -> crate::cloth::Grid {
