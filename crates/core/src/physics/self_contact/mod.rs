@@ -921,7 +921,21 @@ mod tests {
     fn mollified_pairs_keep_their_coefficient_derivatives() {
         let (xi, band) = (5e-4, 1e-3);
         let (x, tris) = turned(xi + 0.3 * band, 0.01, SHIFT);
-        let mut term = SelfContact::new(tris, &x, xi, band, 1e-3);
+        let term = SelfContact::new(tris, &x, xi, band, 1e-3);
+        let built = term.coefficients();
+        // As built, and with κ grown 4× where layers pressed: the coefficient is κ₀ (as built),
+        // the growth held as it moves, so ∂/∂κ₀ carries the growth.
+        for growth in [1.0, 4.0] {
+            let mut term = SelfContact::new(term.topo.triangles.clone(), &x, xi, band, 1e-3);
+            term.kappa_J *= growth;
+            assert_eq!(term.coefficients(), built);
+            assert_eq!(term.kappa_growth(), growth);
+            check_coefficient_derivatives(&mut term, &x);
+        }
+    }
+
+    /// ∂g/∂c and ∂E/∂c of `term` at `x` against central differences through `set_coefficients`.
+    fn check_coefficient_derivatives(term: &mut SelfContact, x: &[Vector3<f64>]) {
         let c = term.coefficients();
         let size = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
         for dc in [
