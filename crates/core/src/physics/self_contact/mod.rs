@@ -945,15 +945,15 @@ mod tests {
             [0.05 * c[0], -0.1 * c[1], 0.2 * c[2]],
         ] {
             let mut an = vec![Vector3::zeros(); x.len()];
-            assert!(term.add_coefficient_gradient(&x, &dc, &mut an));
-            let de = term.coefficient_energy(&x, &dc).expect("∂E/∂c");
+            assert!(term.add_coefficient_gradient(x, &dc, &mut an));
+            let de = term.coefficient_energy(x, &dc).expect("∂E/∂c");
             let eps = 1e-6;
             let mut at = |s: f64| {
                 let moved: Vec<f64> = c.iter().zip(&dc).map(|(a, d)| a + d * s).collect();
                 term.set_coefficients(&moved);
                 let mut g = vec![Vector3::zeros(); x.len()];
-                term.add_gradient(&x, &mut g);
-                (g, term.energy(&x))
+                term.add_gradient(x, &mut g);
+                (g, term.energy(x))
             };
             let ((gp, ep), (gm, em)) = (at(eps), at(-eps));
             term.set_coefficients(&c);
