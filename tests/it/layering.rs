@@ -80,7 +80,7 @@ const CORE_RANKS: [(&str, u8); 28] = [
     ("table", 0),
     ("material", 1),
     ("obstacle", 1),
-    ("proximity", 1),
+    ("proximity", 0),
     ("optim", 1),
     ("surface", 3),
     ("raster", 1),

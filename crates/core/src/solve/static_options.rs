@@ -82,6 +82,21 @@ pub struct StaticOptions {
     /// residual stalls; lower it where the drape's layers should rest closer.
     #[serde(default = "default_kappa_adapt_gap")]
     pub kappa_adapt_gap_rel: f64,
+    /// In a run of Newton iterations whose exact Hessian stayed indefinite (each stepped on the
+    /// projected Hessian), the exact one is tried again only every this many iterations; in between
+    /// the iteration factorizes the projected Hessian at once (`"shift-ladder"` regularization
+    /// only). Each iteration in such a run otherwise factorizes twice in vain (the damping, then
+    /// the ladder's top) before the projected Hessian: where folds keep a drape's Hessian
+    /// indefinite for hundreds of iterations (the skirt on 121 × 121: 905 of 1,042) that was two
+    /// thirds of the factorizations. 8 (chosen by leave-one-out over the bundled scenes, criterion
+    /// factorizations; `docs/src/benchmarks.md`) converged the skirt on 121 × 121 in 655 iterations
+    /// and 95 s against 1,042 and 261 s, at the cost of up to 7 projected steps where an exact one
+    /// would have served; the path changes, and a drape with many nearby minima (a sphere's folds)
+    /// may settle in another. Default 1 (the exact Hessian at every iteration): the path that the
+    /// bundled pipelines' fold counts and tables were measured on; the skirt scene sets 8. Set 8
+    /// for a large drape that folds (a garment) whose run.json shows most steps projected.
+    #[serde(default = "default_exact_retry_every")]
+    pub exact_retry_every: usize,
     /// The factor of a neighbouring equilibrium's Hessian (set in code, never read from a file):
     /// each Newton step is then solved by conjugate gradients preconditioned with it, with no
     /// factorization of its own while that converges ([`NeighbourFactor`]). The calibration sets it
@@ -144,6 +159,10 @@ fn default_exact_contact_after() -> usize {
     500
 }
 
+fn default_exact_retry_every() -> usize {
+    1
+}
+
 fn default_kappa_adapt_gap() -> f64 {
     0.1
 }
@@ -184,6 +203,7 @@ impl Default for StaticOptions {
             check_minimum: default_check_minimum(),
             exact_contact_after: default_exact_contact_after(),
             kappa_adapt_gap_rel: default_kappa_adapt_gap(),
+            exact_retry_every: default_exact_retry_every(),
             neighbour_factor: None,
         }
     }

@@ -1033,4 +1033,50 @@ mod tests {
         }
         assert!(passed > 10 && cut > 10, "{passed} free steps, {cut} cut");
     }
+    /// The contact set against a brute-force one: along a random walk of the upper layer (steps
+    /// cut to 90 % of the term's own step bound, as a line search takes them), the pairs the term
+    /// measures active at each state, with their distances, are exactly those of a check of every
+    /// vertex–triangle and edge–edge pair, and no pair ever comes within the thickness.
+    #[test]
+    fn the_active_set_along_a_random_walk_is_the_brute_force_one() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let (mut x, tris) = stacked(4e-3);
+        let term = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
+        let mut seen_active = 0;
+        for step in 0..60 {
+            let drift = Vector3::new(
+                rng.random_range(-2e-3..2e-3),
+                rng.random_range(-2e-3..2e-3),
+                rng.random_range(-1.5e-3..1e-3),
+            );
+            let dx: Vec<Vector3<f64>> = (0..x.len())
+                .map(|k| match k >= 9 {
+                    true => drift + Vector3::from_fn(|_, _| rng.random_range(-5e-4..5e-4)),
+                    false => Vector3::from_fn(|_, _| rng.random_range(-2e-4..2e-4)),
+                })
+                .collect();
+            let alpha = (0.9 * term.max_step(&x, &dx)).min(1.0);
+            x.iter_mut().zip(&dx).for_each(|(p, d)| *p += d * alpha);
+            let mut active = Vec::new();
+            term.each_active(&x, |idx, d, _| active.push((idx, d)));
+            active.sort_by_key(|a| a.0);
+            let topo = term.topology();
+            let mut brute: Vec<([usize; 4], f64)> =
+                crate::proximity::brute_force_pairs(topo, &x, term.activation_m())
+                    .into_iter()
+                    .map(|(p, d)| (p.vertices(topo), d))
+                    .collect();
+            brute.sort_by_key(|a| a.0);
+            assert_eq!(active, brute, "step {step}");
+            let closest = crate::proximity::brute_force_pairs(topo, &x, f64::INFINITY);
+            let least = closest.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+            assert!(least > term.thickness_m, "step {step}: {least}");
+            seen_active += usize::from(!active.is_empty());
+        }
+        assert!(
+            seen_active > 20,
+            "the walk pressed the layers ({seen_active} states)"
+        );
+    }
 }

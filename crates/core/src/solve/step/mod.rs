@@ -92,6 +92,8 @@ struct Parts {
     shift_max: f64,
     /// The damping's initial value (where a carried damping returns when the Hessian is projected).
     mu_initial: f64,
+    /// [`StaticOptions::exact_retry_every`].
+    exact_retry_every: usize,
     search: Backtracking<Armijo>,
 }
 
@@ -126,6 +128,8 @@ pub(super) struct Workspace {
     parts: Parts,
     /// The Hessian of the last factorization (see [`Workspace::top_fails`]).
     last_hessian: Hessian,
+    /// Iterations in a row that stepped on the projected Hessian ([`Workspace::skips_exact`]).
+    projected_run: usize,
     /// The largest residual force at the start of the previous iteration, N.
     r_prev: f64,
     /// How the previous iteration's step was taken.
@@ -230,9 +234,11 @@ impl Workspace {
                 factor_reuse: opts.factor_reuse,
                 shift_max: opts.shift_max_rel,
                 mu_initial: opts.lm_damping_initial,
+                exact_retry_every: opts.exact_retry_every,
                 search: SEARCH,
             },
             last_hessian: Hessian::Exact,
+            projected_run: 0,
             r_prev: f64::INFINITY,
             last_step: Taken::Partial,
             stats: Globalization::default(),
@@ -400,9 +406,12 @@ impl Workspace {
             return true;
         }
         self.last_step = Taken::Partial;
-        let mut hessian = Hessian::Exact;
+        let mut hessian = match self.skips_exact() {
+            true => Hessian::Projected,
+            false => Hessian::Exact,
+        };
         self.hessian(model, x, hessian);
-        // The damping's scale: the mean diagonal of this iteration's exact Hessian.
+        // The damping's scale: the mean diagonal of this iteration's Hessian.
         let scale = self.damping_scale();
         for _ in 0..DAMPED_ROUNDS {
             if !self.factorize(model, x, &mut hessian, scale, report) {
@@ -426,6 +435,10 @@ impl Workspace {
             match self.line_search(model, x, load, (e, r), (bound.min(1.0), slope)) {
                 Some(alpha) => {
                     self.count(alpha, bound, (curved, hessian.is_projected()));
+                    self.projected_run = match hessian.is_projected() {
+                        true => self.projected_run + 1,
+                        false => 0,
+                    };
                     if alpha == 1.0 && bound >= 1.0 {
                         self.last_step = Taken::Whole;
                         self.mu = if self.mu < 1e-12 {
@@ -442,6 +455,19 @@ impl Workspace {
             }
         }
         false
+    }
+
+    /// Whether this iteration goes straight to the projected Hessian: on the ladder of shifts,
+    /// after two iterations in a row stepped on it, except every
+    /// [`StaticOptions::exact_retry_every`]th. Where
+    /// folds keep the exact Hessian indefinite, each such iteration otherwise factorizes it twice
+    /// (the damping, the ladder's top: [`Workspace::top_fails`]) before the projected one.
+    fn skips_exact(&self) -> bool {
+        let every = self.parts.exact_retry_every;
+        self.parts.regularization == Regularization::ShiftLadder
+            && every > 1
+            && self.projected_run >= 2
+            && !self.projected_run.is_multiple_of(every)
     }
 
     /// Counts an accepted step of length `alpha` under the terms' `bound`.

@@ -3,6 +3,10 @@
 //! profile. Each gives a signed distance (positive outside, m) with its outward normal, and the height
 //! of its upper surface above a point (for the vertical-gap method of §10.7.1).
 
+mod mesh;
+
+pub use mesh::{BodyDefect, TriangleBody};
+
 use crate::error::KeyError;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};

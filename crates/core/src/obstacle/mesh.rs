@@ -1,0 +1,504 @@
+//! A rigid body given as a triangle mesh (issue 77's mesh obstacles: a dress form, a mannequin, a
+//! table scanned or modelled): its signed distance, sign from the angle-weighted pseudo-normal of the
+//! closest feature (Bærentzen and Aanæs, "Signed distance computation using the angle weighted
+//! pseudonormal", IEEE TVCG 11(3), 2005), found through a bounding-volume hierarchy built once over
+//! the static body, and the height of its upper surface on a vertical line.
+//!
+//! Triangles face outward when counter-clockwise seen from outside. The sign is right for a closed,
+//! consistently oriented mesh; near an open mesh's border it is that of the nearest face's side.
+
+use crate::proximity::{Aabb, point_triangle_distance};
+use nalgebra::Vector3;
+use std::collections::HashMap;
+
+type V3 = Vector3<f64>;
+
+/// Triangles a leaf of the hierarchy holds at most.
+const LEAF_SIZE: usize = 4;
+
+/// A node of the hierarchy: its box and either two children or a run of triangles.
+#[derive(Debug, Clone)]
+struct Node {
+    bounds: Aabb,
+    /// Inner node: the children's indices; leaf: the run `order[first..first + count]`.
+    first: u32,
+    count: u32,
+    right: u32,
+}
+
+/// A static triangle mesh with what its distance queries need, built once.
+#[derive(Debug, Clone)]
+pub struct TriangleBody {
+    vertices: Vec<V3>,
+    triangles: Vec<[u32; 3]>,
+    face_normals: Vec<V3>,
+    /// Angle-weighted pseudo-normal of every vertex.
+    vertex_normals: Vec<V3>,
+    /// Pseudo-normal of every edge (the sum of its faces' normals), by its sorted ends.
+    edge_normals: HashMap<(u32, u32), V3>,
+    nodes: Vec<Node>,
+    /// Triangle indices in the leaves' order.
+    order: Vec<u32>,
+}
+
+/// What is wrong with a body mesh, for an error naming the file.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BodyDefect {
+    /// No triangle at all.
+    NoTriangles,
+    /// A vertex with a coordinate that is not finite.
+    NotFinite(usize),
+    /// A triangle naming a vertex the mesh does not have.
+    MissingVertex(usize),
+    /// A triangle without area (its corners on a line, or two the same).
+    Degenerate(usize),
+}
+
+impl std::fmt::Display for BodyDefect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BodyDefect::NoTriangles => write!(f, "the mesh has no triangles"),
+            BodyDefect::NotFinite(v) => {
+                write!(f, "vertex {} has a coordinate that is not finite", v + 1)
+            }
+            BodyDefect::MissingVertex(t) => {
+                write!(f, "face {} names a vertex the file does not have", t + 1)
+            }
+            BodyDefect::Degenerate(t) => {
+                write!(f, "face {} has no area (its corners on a line)", t + 1)
+            }
+        }
+    }
+}
+
+impl TriangleBody {
+    /// The body of `triangles` over `vertices` (m), checked: every coordinate finite, every index
+    /// present, every triangle with an area above 10⁻¹² of the mesh's box's squared size.
+    pub fn new(vertices: Vec<V3>, triangles: Vec<[u32; 3]>) -> Result<Self, BodyDefect> {
+        if triangles.is_empty() {
+            return Err(BodyDefect::NoTriangles);
+        }
+        if let Some(v) = vertices
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(BodyDefect::NotFinite(v));
+        }
+        if let Some(t) = triangles
+            .iter()
+            .position(|t| t.iter().any(|&v| v as usize >= vertices.len()))
+        {
+            return Err(BodyDefect::MissingVertex(t));
+        }
+        let bounds = vertices
+            .iter()
+            .fold(Aabb::point(&vertices[0]), |b, p| b.union(&Aabb::point(p)));
+        let size2 = (bounds.hi - bounds.lo).norm_squared();
+        let corner = |t: &[u32; 3], k: usize| vertices[t[k] as usize];
+        let mut face_normals = Vec::with_capacity(triangles.len());
+        for (i, t) in triangles.iter().enumerate() {
+            let n = (corner(t, 1) - corner(t, 0)).cross(&(corner(t, 2) - corner(t, 0)));
+            if 0.5 * n.norm() <= 1e-12 * size2 {
+                return Err(BodyDefect::Degenerate(i));
+            }
+            face_normals.push(n.normalize());
+        }
+        let (vertex_normals, edge_normals) = pseudo_normals(&vertices, &triangles, &face_normals);
+        let mut body = Self {
+            vertices,
+            triangles,
+            face_normals,
+            vertex_normals,
+            edge_normals,
+            nodes: Vec::new(),
+            order: Vec::new(),
+        };
+        body.build_hierarchy();
+        Ok(body)
+    }
+
+    /// The number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The mesh's bounding box, m.
+    pub fn bounds(&self) -> Aabb {
+        self.nodes[0].bounds
+    }
+
+    fn triangle_box(&self, t: u32) -> Aabb {
+        let tri = self.triangles[t as usize];
+        let p = |k: usize| Aabb::point(&self.vertices[tri[k] as usize]);
+        p(0).union(&p(1)).union(&p(2))
+    }
+
+    /// Builds the hierarchy: boxes split at the median centroid along their longest side.
+    fn build_hierarchy(&mut self) {
+        self.order = (0..self.triangles.len() as u32).collect();
+        self.nodes.clear();
+        let n = self.order.len();
+        self.build_node(0, n);
+    }
+
+    fn build_node(&mut self, first: usize, count: usize) -> u32 {
+        let run = &self.order[first..first + count];
+        let bounds = run
+            .iter()
+            .map(|&t| self.triangle_box(t))
+            .reduce(|a, b| a.union(&b))
+            .expect("a node holds a triangle");
+        let at = self.nodes.len() as u32;
+        self.nodes.push(Node {
+            bounds,
+            first: first as u32,
+            count: count as u32,
+            right: 0,
+        });
+        if count <= LEAF_SIZE {
+            return at;
+        }
+        let axis = (bounds.hi - bounds.lo).imax();
+        let centre = |t: u32| {
+            let tri = self.triangles[t as usize];
+            tri.iter()
+                .map(|&v| self.vertices[v as usize][axis])
+                .sum::<f64>()
+        };
+        let half = count / 2;
+        let mut run = self.order[first..first + count].to_vec();
+        run.select_nth_unstable_by(half, |a, b| centre(*a).total_cmp(&centre(*b)));
+        self.order[first..first + count].copy_from_slice(&run);
+        self.build_node(first, half);
+        let right = self.build_node(first + half, count - half);
+        let node = &mut self.nodes[at as usize];
+        node.count = 0;
+        node.right = right;
+        at
+    }
+
+    /// The closest point of the surface to `p`: (distance, triangle, barycentric weights).
+    fn closest(&self, p: &V3) -> (f64, u32, [f64; 3]) {
+        let mut best = (f64::INFINITY, 0, [1.0, 0.0, 0.0]);
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if box_distance(&node.bounds, p) >= best.0 {
+                continue;
+            }
+            if node.count == 0 {
+                // Visit the nearer child first: it tightens the bound for the other.
+                let (l, r) = (i + 1, node.right);
+                let (dl, dr) = (
+                    box_distance(&self.nodes[l as usize].bounds, p),
+                    box_distance(&self.nodes[r as usize].bounds, p),
+                );
+                let (near, far) = if dl <= dr { (l, r) } else { (r, l) };
+                stack.push(far);
+                stack.push(near);
+                continue;
+            }
+            for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                let tri = self.triangles[t as usize];
+                let c = |k: usize| &self.vertices[tri[k] as usize];
+                let (d, w) = point_triangle_distance(p, c(0), c(1), c(2));
+                if d < best.0 {
+                    best = (d, t, w);
+                }
+            }
+        }
+        best
+    }
+
+    /// The pseudo-normal of the feature of triangle `t` that the weights `w` name: the face's own
+    /// normal inside it, an edge's where one weight is zero, a vertex's where two are.
+    fn feature_normal(&self, t: u32, w: &[f64; 3]) -> V3 {
+        let tri = self.triangles[t as usize];
+        let on: Vec<usize> = (0..3).filter(|&k| w[k] != 0.0).collect();
+        match on.as_slice() {
+            [k] => self.vertex_normals[tri[*k] as usize],
+            [a, b] => {
+                let (u, v) = (tri[*a], tri[*b]);
+                self.edge_normals[&(u.min(v), u.max(v))]
+            }
+            _ => self.face_normals[t as usize],
+        }
+    }
+
+    /// Signed distance from `p` to the surface (m, positive outside) and the outward unit normal of
+    /// the distance there: along p − c from the closest point c, its sign from the closest
+    /// feature's pseudo-normal; the pseudo-normal itself on the surface.
+    pub fn signed_distance(&self, p: &V3) -> (f64, V3) {
+        let (d, t, w) = self.closest(p);
+        let tri = self.triangles[t as usize];
+        let c: V3 = (0..3).map(|k| self.vertices[tri[k] as usize] * w[k]).sum();
+        let pn = self.feature_normal(t, &w);
+        let r = p - c;
+        let sign = if r.dot(&pn) < 0.0 { -1.0 } else { 1.0 };
+        match r.try_normalize(1e-300) {
+            Some(u) if d > 1e-12 * self.bounds_size() => (sign * d, u * sign),
+            _ => (sign * d, pn),
+        }
+    }
+
+    fn bounds_size(&self) -> f64 {
+        let b = self.bounds();
+        (b.hi - b.lo).norm()
+    }
+
+    /// The height of the highest point of the surface on the vertical through (x, y), if the
+    /// vertical meets it.
+    pub fn top_at(&self, x: f64, y: f64) -> Option<f64> {
+        let mut top: Option<f64> = None;
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            let b = &node.bounds;
+            if x < b.lo.x
+                || x > b.hi.x
+                || y < b.lo.y
+                || y > b.hi.y
+                || top.is_some_and(|z| b.hi.z <= z)
+            {
+                continue;
+            }
+            if node.count == 0 {
+                stack.push(i + 1);
+                stack.push(node.right);
+                continue;
+            }
+            for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                if let Some(z) = self.vertical_hit(t, x, y) {
+                    top = Some(top.map_or(z, |h| h.max(z)));
+                }
+            }
+        }
+        top
+    }
+
+    /// Where the vertical through (x, y) meets triangle `t` (its height), if it does.
+    fn vertical_hit(&self, t: u32, x: f64, y: f64) -> Option<f64> {
+        let tri = self.triangles[t as usize];
+        let [a, b, c] = tri.map(|v| self.vertices[v as usize]);
+        let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+        if det.abs() < 1e-300 {
+            return None;
+        }
+        let u = ((x - a.x) * (c.y - a.y) - (c.x - a.x) * (y - a.y)) / det;
+        let v = ((b.x - a.x) * (y - a.y) - (x - a.x) * (b.y - a.y)) / det;
+        let inside = u >= -1e-12 && v >= -1e-12 && u + v <= 1.0 + 1e-12;
+        inside.then(|| a.z + u * (b.z - a.z) + v * (c.z - a.z))
+    }
+}
+
+/// The distance from `p` to the box (0 inside).
+fn box_distance(b: &Aabb, p: &V3) -> f64 {
+    (b.lo - p).sup(&(p - b.hi)).sup(&V3::zeros()).norm()
+}
+
+/// Every vertex's angle-weighted pseudo-normal (its faces' normals weighted by their angles at it)
+/// and every edge's (the sum of its faces' normals), normalised.
+fn pseudo_normals(
+    vertices: &[V3],
+    triangles: &[[u32; 3]],
+    face_normals: &[V3],
+) -> (Vec<V3>, HashMap<(u32, u32), V3>) {
+    let mut vn = vec![V3::zeros(); vertices.len()];
+    let mut en: HashMap<(u32, u32), V3> = HashMap::new();
+    for (t, n) in triangles.iter().zip(face_normals) {
+        for k in 0..3 {
+            let (v, a, b) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let (e1, e2) = (
+                vertices[a as usize] - vertices[v as usize],
+                vertices[b as usize] - vertices[v as usize],
+            );
+            let angle = e1.angle(&e2);
+            vn[v as usize] += n * angle;
+            let key = (v.min(a), v.max(a));
+            *en.entry(key).or_insert_with(V3::zeros) += n;
+        }
+    }
+    let unit = |v: V3| v.try_normalize(1e-300).unwrap_or(V3::z());
+    (
+        vn.into_iter().map(unit).collect(),
+        en.into_iter().map(|(k, v)| (k, unit(v))).collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sphere of radius `r` centred at the origin: an icosahedron subdivided `levels` times, its
+    /// vertices on the sphere, triangles counter-clockwise seen from outside.
+    pub(crate) fn icosphere(r: f64, levels: usize) -> (Vec<V3>, Vec<[u32; 3]>) {
+        let g = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut v: Vec<V3> = [
+            [-1.0, g, 0.0],
+            [1.0, g, 0.0],
+            [-1.0, -g, 0.0],
+            [1.0, -g, 0.0],
+            [0.0, -1.0, g],
+            [0.0, 1.0, g],
+            [0.0, -1.0, -g],
+            [0.0, 1.0, -g],
+            [g, 0.0, -1.0],
+            [g, 0.0, 1.0],
+            [-g, 0.0, -1.0],
+            [-g, 0.0, 1.0],
+        ]
+        .iter()
+        .map(|p| V3::new(p[0], p[1], p[2]).normalize())
+        .collect();
+        let mut t: Vec<[u32; 3]> = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..levels {
+            let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+            let mut split = |a: u32, b: u32, v: &mut Vec<V3>| {
+                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    v.push(((v[a as usize] + v[b as usize]) * 0.5).normalize());
+                    (v.len() - 1) as u32
+                })
+            };
+            let mut next = Vec::new();
+            for [a, b, c] in t {
+                let (ab, bc, ca) = (
+                    split(a, b, &mut v),
+                    split(b, c, &mut v),
+                    split(c, a, &mut v),
+                );
+                next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+            }
+            t = next;
+        }
+        (v.into_iter().map(|p| p * r).collect(), t)
+    }
+
+    #[test]
+    fn a_meshed_sphere_has_the_spheres_signed_distance_within_its_sagitta() {
+        let r = 0.1;
+        let mut previous = f64::INFINITY;
+        for levels in [2, 3, 4] {
+            let (v, t) = icosphere(r, levels);
+            let body = TriangleBody::new(v.clone(), t.clone()).expect("a valid mesh");
+            // A face's corners lie on the sphere, so it lies inside it by at most the depth of a
+            // cap over its circumcircle (radius at most the longest edge / √3).
+            let vs = &v;
+            let edge = t
+                .iter()
+                .flat_map(|f| {
+                    (0..3).map(move |k| (vs[f[k] as usize] - vs[f[(k + 1) % 3] as usize]).norm())
+                })
+                .fold(0.0, f64::max);
+            let sagitta = r - (r * r - edge * edge / 3.0).sqrt();
+            let mut worst: f64 = 0.0;
+            for k in 0..400 {
+                let (a, b) = (
+                    k as f64 * 2.399963,
+                    (1.0 - 2.0 * (k as f64 + 0.5) / 400.0).acos(),
+                );
+                let dir = V3::new(b.sin() * a.cos(), b.sin() * a.sin(), b.cos());
+                for s in [0.5, 0.95, 1.02, 1.3] {
+                    let p = dir * (r * s);
+                    let (d, n) = body.signed_distance(&p);
+                    let exact = r * s - r;
+                    // Inside or out, the faces' points are nearer the centre than the sphere's.
+                    assert!(
+                        d >= exact - 1e-12 && d <= exact + sagitta + 1e-12,
+                        "{levels}: {d} vs {exact}"
+                    );
+                    assert!(n.dot(&dir) > 0.9, "{levels}: normal {n} at {dir}");
+                    worst = worst.max((d - exact).abs());
+                }
+            }
+            assert!(
+                worst < previous,
+                "{levels}: the gap shrinks as the mesh is refined"
+            );
+            previous = worst;
+        }
+    }
+
+    #[test]
+    fn the_hierarchy_finds_the_brute_force_closest_triangle() {
+        let (v, t) = icosphere(0.2, 3);
+        let body = TriangleBody::new(v.clone(), t.clone()).expect("a valid mesh");
+        for k in 0..200 {
+            let f = k as f64;
+            let p = V3::new((f * 0.37).sin(), (f * 0.71).cos(), (f * 1.3).sin()) * 0.4;
+            let brute = t
+                .iter()
+                .map(|tri| {
+                    point_triangle_distance(
+                        &p,
+                        &v[tri[0] as usize],
+                        &v[tri[1] as usize],
+                        &v[tri[2] as usize],
+                    )
+                    .0
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(body.signed_distance(&p).0.abs(), brute, "{p}");
+        }
+    }
+
+    #[test]
+    fn the_top_of_a_meshed_sphere_lies_on_its_surface() {
+        let (v, t) = icosphere(0.1, 4);
+        let body = TriangleBody::new(v, t).expect("a valid mesh");
+        for (x, y) in [(0.0, 0.0), (0.03, -0.05), (0.07, 0.02)] {
+            let z = body.top_at(x, y).expect("over the sphere");
+            let exact = (0.01f64 - x * x - y * y).sqrt();
+            assert!(z <= exact && z > exact - 2e-3, "{z} vs {exact}");
+            assert!(body.signed_distance(&V3::new(x, y, z)).0.abs() < 1e-12);
+        }
+        assert_eq!(body.top_at(0.2, 0.0), None);
+    }
+
+    #[test]
+    fn bad_meshes_are_refused_with_their_defect() {
+        let (v, t) = icosphere(0.1, 0);
+        assert_eq!(
+            TriangleBody::new(v.clone(), vec![]).err(),
+            Some(BodyDefect::NoTriangles)
+        );
+        let mut nan = v.clone();
+        nan[3].y = f64::NAN;
+        assert_eq!(
+            TriangleBody::new(nan, t.clone()).err(),
+            Some(BodyDefect::NotFinite(3))
+        );
+        let mut missing = t.clone();
+        missing[5][1] = 99;
+        assert_eq!(
+            TriangleBody::new(v.clone(), missing).err(),
+            Some(BodyDefect::MissingVertex(5))
+        );
+        let mut flat = t.clone();
+        flat[7] = [1, 1, 2];
+        assert_eq!(
+            TriangleBody::new(v, flat).err(),
+            Some(BodyDefect::Degenerate(7))
+        );
+    }
+}
