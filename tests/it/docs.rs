@@ -38,7 +38,7 @@ fn the_reference_pages_match_the_code() {
     generated("tables.md", &drapelab::app::tables_markdown().unwrap());
     generated("kinds.md", &drapelab::cli::kinds_text());
     generated("cli.md", &drapelab::cli::cli_reference());
-    let mut scenes: Vec<PathBuf> = ["scenes", "patterns"]
+    let mut scenes: Vec<PathBuf> = ["scenes", "patterns", "bodies"]
         .iter()
         .flat_map(|d| {
             glob::glob(

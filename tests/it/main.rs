@@ -1,6 +1,7 @@
 //! drapelab's integration tests: physics (force balance, exact solutions, symmetry, agreement of
 //! solvers, stability), the command line (bad input), and real clients reading the recordings.
 
+mod bodies;
 mod calibrate;
 mod cli;
 mod contact;

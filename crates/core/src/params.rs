@@ -30,14 +30,17 @@ pub trait Parameterized {
 const NOT_PHYSICS: [&str; 4] = ["solver", "record", "name", "description"];
 
 /// Keys that lay out the mesh (where the grid lines fall), not the fabric: changing one relabels
-/// material points, so a particle's derivative in it means nothing physical.
+/// material points, so a particle's derivative in it means nothing physical. A mesh obstacle's
+/// file unit (`obstacles.N.mesh_unit_m`) is read as one too: the body moves by `offset_m`.
 const MESH_LAYOUT: [&str; 3] = ["cloth.grading", "cloth.refine_x_m", "cloth.refine_y_m"];
 
 /// Whether `key` is (or lies under) a mesh-layout key.
 fn is_mesh_layout(key: &str) -> bool {
-    MESH_LAYOUT
-        .iter()
-        .any(|m| key == *m || key.starts_with(&format!("{m}.")))
+    let body_unit = key.starts_with("obstacles.") && key.ends_with(".mesh_unit_m");
+    body_unit
+        || MESH_LAYOUT
+            .iter()
+            .any(|m| key == *m || key.starts_with(&format!("{m}.")))
 }
 
 /// Every continuous parameter of `scene`: the dotted keys of its real-valued entries (integers,
@@ -112,7 +115,7 @@ pub fn value(scene: &Scene, key: &str, source: &str) -> Result<f64, InputError> 
         toml::Value::Float(_) if is_mesh_layout(key) => Err(InputError::new(
             source,
             key,
-            "lays out the mesh (where grid lines fall), not the fabric: no physical derivative",
+            "lays out a mesh (where grid lines fall, or a mesh file's unit), not the fabric: no physical derivative",
         )),
         toml::Value::Float(f) if NOT_PHYSICS.iter().all(|s| !key.starts_with(s)) => Ok(*f),
         toml::Value::Float(_) => Err(InputError::new(
@@ -145,6 +148,7 @@ pub fn with_value(
         .map_err(|m| InputError::new(source, key, m))?;
     let mut changed: Scene = crate::config::from_table(std::path::Path::new(source), "", t)?;
     changed.cloth.carry_pattern(&scene.cloth);
+    crate::scene::carry_bodies(&mut changed.obstacles, &scene.obstacles);
     changed.validate(std::path::Path::new(source))?;
     changed
         .validated()

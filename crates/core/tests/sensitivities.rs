@@ -264,6 +264,26 @@ fn table_contact_sensitivities_match_central_differences_for_every_key() {
     }
 }
 
+/// The table as a mesh body (issue 77): its offset is a parameter like the analytic table's
+/// corners, and the drape's derivative in it matches differences of drapes.
+#[test]
+fn a_mesh_body_offset_has_the_sensitivity_of_differences_of_drapes() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../datasets/bodies/table_wool_mesh.toml");
+    let o = [
+        ("cloth.nx", toml::Value::Integer(21)),
+        ("cloth.ny", toml::Value::Integer(21)),
+        ("solver.static.residual_tol_rel", toml::Value::Float(1e-12)),
+    ];
+    let o: Vec<(String, toml::Value)> = o.iter().map(|(k, v)| (k.to_string(), v.clone())).collect();
+    let scene = Scene::load(&path, &o).unwrap().scene;
+    let keys = check_every_key(&scene);
+    assert!(
+        keys.iter().any(|c| c == "obstacles.0.offset_m.2"),
+        "{keys:?}"
+    );
+}
+
 #[test]
 fn the_adjoint_gradient_equals_the_sensitivity_contracted_with_dj_dx() {
     let scene = load_tol("cantilever_wool_warp", &[], 1e-11);

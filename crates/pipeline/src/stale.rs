@@ -64,18 +64,18 @@ fn current_inputs(plan: &Plan, s: &PlannedStage) -> BTreeMap<String, Option<Stri
 }
 
 /// The files of every slot with their content hashes (None when missing), and the files they
-/// name: a scene's mesh file (`cloth.mesh`) is read with it, so it is an input too.
+/// name: a scene's mesh files (`cloth.mesh`, mesh obstacles) are read with it, so they are inputs too.
 pub(crate) fn hashed(
     plan: &Plan,
     slots: &BTreeMap<String, BTreeSet<String>>,
 ) -> BTreeMap<String, Option<String>> {
-    let named = slots.values().flatten().filter_map(|p| {
+    let named = slots.values().flatten().flat_map(|p| {
         let path = plan.root.join(p);
-        let mesh = path
-            .extension()
-            .is_some_and(|e| e == "toml")
-            .then(|| drapelab_core::scene::mesh_file_of(&path))??;
-        Some(rel(&plan.root, &mesh))
+        let meshes = match path.extension().is_some_and(|e| e == "toml") {
+            true => drapelab_core::scene::mesh_files_of(&path),
+            false => Vec::new(),
+        };
+        meshes.into_iter().map(|m| rel(&plan.root, &m))
     });
     let files: BTreeSet<String> = slots.values().flatten().cloned().chain(named).collect();
     files

@@ -259,8 +259,8 @@ fn holds(scene: &Scene, grid: &Grid, held: &mut Vec<[bool; 3]>) {
 }
 
 /// Contact with the scene's obstacles (only when it has some): with `contact.fix_supported`, the
-/// particles that start above the top face of a table or pedestal, or above the flat top of a body
-/// form (a skirt's waist), are fixed (seed 003 §10.5, §10.7.2.3); with
+/// particles that start above the top face of a table or pedestal, above the flat top of a body
+/// form (a skirt's waist) or above a horizontal top face of a mesh body, are fixed (seed 003 §10.5, §10.7.2.3); with
 /// the barrier method every other particle gets the barrier term (the vertical-gap method works in the
 /// solver instead, [`crate::simulate`]).
 pub(crate) fn contact_terms(scene: &Scene, x0: &[Vector3<f64>], b: &mut ModelBuilder) {
@@ -273,6 +273,8 @@ pub(crate) fn contact_terms(scene: &Scene, x0: &[Vector3<f64>], b: &mut ModelBui
         for (p, x) in x0.iter().enumerate().take(b.fixed.len()) {
             let on_top = scene.obstacles.iter().any(|o| match o {
                 Obstacle::Box { .. } | Obstacle::Pedestal { .. } => o.top_at(x.x, x.y).is_some(),
+                // A mesh body: over a horizontal top face, starting above it.
+                Obstacle::Mesh { .. } => o.flat_top_at(x.x, x.y).is_some_and(|z| x.z >= z),
                 // A body form: the part over its flat top (the waist of a skirt).
                 Obstacle::Revolution { axis_m, profile_m } => {
                     let top = profile_m[profile_m.len() - 1];

@@ -13,11 +13,14 @@ use std::collections::HashMap;
 
 type V3 = Vector3<f64>;
 
+/// How far outside a face a vertical still meets it (m): as the analytic table's edge slack.
+const EDGE_SLACK_M: f64 = 1e-9;
+
 /// Triangles a leaf of the hierarchy holds at most.
 const LEAF_SIZE: usize = 4;
 
 /// A node of the hierarchy: its box and either two children or a run of triangles.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 struct Node {
     bounds: Aabb,
     /// Inner node: the children's indices; leaf: the run `order[first..first + count]`.
@@ -27,7 +30,7 @@ struct Node {
 }
 
 /// A static triangle mesh with what its distance queries need, built once.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct TriangleBody {
     vertices: Vec<V3>,
     triangles: Vec<[u32; 3]>,
@@ -249,16 +252,29 @@ impl TriangleBody {
     /// The height of the highest point of the surface on the vertical through (x, y), if the
     /// vertical meets it.
     pub fn top_at(&self, x: f64, y: f64) -> Option<f64> {
-        let mut top: Option<f64> = None;
+        self.highest_hit(x, y).map(|h| h.0)
+    }
+
+    /// [`Self::top_at`] where the surface there is horizontal (its face's normal within 10⁻⁴ rad
+    /// of up: a table's top, a form's flat shoulder), for the supports rule.
+    pub fn flat_top_at(&self, x: f64, y: f64) -> Option<f64> {
+        let (z, t) = self.highest_hit(x, y)?;
+        (self.face_normals[t as usize].z >= 1.0 - 5e-9).then_some(z)
+    }
+
+    /// The height and triangle of the highest point of the surface on the vertical through (x, y).
+    fn highest_hit(&self, x: f64, y: f64) -> Option<(f64, u32)> {
+        let mut top: Option<(f64, u32)> = None;
         let mut stack = vec![0u32];
         while let Some(i) = stack.pop() {
             let node = &self.nodes[i as usize];
             let b = &node.bounds;
-            if x < b.lo.x
-                || x > b.hi.x
-                || y < b.lo.y
-                || y > b.hi.y
-                || top.is_some_and(|z| b.hi.z <= z)
+            let e = EDGE_SLACK_M;
+            if x < b.lo.x - e
+                || x > b.hi.x + e
+                || y < b.lo.y - e
+                || y > b.hi.y + e
+                || top.is_some_and(|(z, _)| b.hi.z <= z)
             {
                 continue;
             }
@@ -268,8 +284,10 @@ impl TriangleBody {
                 continue;
             }
             for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                if let Some(z) = self.vertical_hit(t, x, y) {
-                    top = Some(top.map_or(z, |h| h.max(z)));
+                if let Some(z) = self.vertical_hit(t, x, y)
+                    && top.is_none_or(|(h, _)| z > h)
+                {
+                    top = Some((z, t));
                 }
             }
         }
@@ -286,7 +304,10 @@ impl TriangleBody {
         }
         let u = ((x - a.x) * (c.y - a.y) - (c.x - a.x) * (y - a.y)) / det;
         let v = ((b.x - a.x) * (y - a.y) - (x - a.x) * (b.y - a.y)) / det;
-        let inside = u >= -1e-12 && v >= -1e-12 && u + v <= 1.0 + 1e-12;
+        // A point on an edge counts (grid lines laid on a table's edge by construction): a slack
+        // of 1 nm, as the analytic table's.
+        let tol = EDGE_SLACK_M / det.abs().sqrt();
+        let inside = u >= -tol && v >= -tol && u + v <= 1.0 + tol;
         inside.then(|| a.z + u * (b.z - a.z) + v * (c.z - a.z))
     }
 }

@@ -63,6 +63,30 @@ pub enum Obstacle {
         /// Meridional profile: (z, r) pairs in m, z strictly increasing, r ≥ 0.
         profile_m: Vec<[f64; 2]>,
     },
+    /// A rigid body given as a triangle mesh (a dress form, a mannequin, a scanned table): a
+    /// Wavefront OBJ file whose faces (polygons split into fans) face outward, counter-clockwise
+    /// seen from outside. Cloth vertices are kept out of it by the barrier on their signed distance
+    /// to its surface ([`TriangleBody`]); the surface's edges and corners are not sharper than the
+    /// cloth's spacing for that to keep the cloth's edges out too.
+    Mesh {
+        /// The OBJ file, relative to the scene file's folder.
+        mesh: std::path::PathBuf,
+        /// The file's length unit in m: 1 for metres (default), 0.01 for centimetres, 0.001 for
+        /// millimetres.
+        #[serde(default = "unit_metre")]
+        mesh_unit_m: f64,
+        /// Where the file's origin lies in the scene, m: the body is translated by it. Default
+        /// [0, 0, 0]. A continuous key (`--sensitivity obstacles.0.offset_m.2`).
+        #[serde(default)]
+        offset_m: [f64; 3],
+        /// The body read from `mesh` (set when the scene is loaded; never written).
+        #[serde(skip)]
+        body: Option<std::sync::Arc<TriangleBody>>,
+    },
+}
+
+fn unit_metre() -> f64 {
+    1.0
 }
 
 /// How far outside a table's or pedestal's top face a point still counts as above it (m): grid lines
@@ -118,7 +142,7 @@ fn revolution_sdf(profile: &[[f64; 2]], r: f64, z: f64) -> (f64, f64, f64) {
 impl Obstacle {
     /// Whether the solid is convex (every kind but a solid of revolution, whose profile may narrow).
     pub fn is_convex(&self) -> bool {
-        !matches!(self, Obstacle::Revolution { .. })
+        !matches!(self, Obstacle::Revolution { .. } | Obstacle::Mesh { .. })
     }
 
     /// The obstacle's real-valued shape parameters (its points, directions, radii, heights and
@@ -155,6 +179,7 @@ impl Obstacle {
                 .iter_mut()
                 .chain(profile_m.iter_mut().flatten())
                 .collect(),
+            Obstacle::Mesh { offset_m, .. } => offset_m.iter_mut().collect(),
         }
     }
 
@@ -216,6 +241,11 @@ impl Obstacle {
                 let (d, nr, nz) = revolution_sdf(profile_m, rr, p.z);
                 (d, (radial * nr + Vector3::z() * nz).normalize())
             }
+            Obstacle::Mesh { offset_m, body, .. } => match body {
+                Some(b) => b.signed_distance(&(p - v(*offset_m))),
+                // Not read (a scene built in code without loading): nothing to touch.
+                None => (f64::INFINITY, Vector3::z()),
+            },
         }
     }
 
@@ -277,6 +307,24 @@ impl Obstacle {
                 }
                 top
             }
+            Obstacle::Mesh { offset_m, body, .. } => body
+                .as_ref()?
+                .top_at(x - offset_m[0], y - offset_m[1])
+                .map(|z| z + offset_m[2]),
+        }
+    }
+
+    /// The height of a horizontal upper face on the vertical through (x, y): a table's or
+    /// pedestal's top where the vertical meets it, a mesh body's where its highest face there is
+    /// horizontal; None for other shapes (the supports rule, `contact.fix_supported`).
+    pub fn flat_top_at(&self, x: f64, y: f64) -> Option<f64> {
+        match self {
+            Obstacle::Box { .. } | Obstacle::Pedestal { .. } => self.top_at(x, y),
+            Obstacle::Mesh { offset_m, body, .. } => body
+                .as_ref()?
+                .flat_top_at(x - offset_m[0], y - offset_m[1])
+                .map(|z| z + offset_m[2]),
+            _ => None,
         }
     }
 
@@ -322,6 +370,22 @@ impl Obstacle {
             Obstacle::Revolution { axis_m, profile_m } => {
                 finite("axis_m", axis_m)?;
                 check_profile(profile_m)
+            }
+            Obstacle::Mesh {
+                offset_m,
+                mesh_unit_m,
+                body,
+                ..
+            } => {
+                finite("offset_m", offset_m)?;
+                positive("mesh_unit_m", *mesh_unit_m)?;
+                match body {
+                    Some(_) => Ok(()),
+                    None => Err(KeyError::new(
+                        "mesh",
+                        "was not read (load the scene from its file)",
+                    )),
+                }
             }
         }
     }

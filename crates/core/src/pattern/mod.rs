@@ -66,6 +66,16 @@ struct Raw {
     groups: BTreeMap<String, Vec<usize>>,
 }
 
+/// The vertices (in the file's unit) and the triangles (polygons split into fans, each with its
+/// line) of OBJ text, without a pattern's checks: a rigid body's mesh ([`crate::obstacle::TriangleBody`]).
+pub fn parse_obj_triangles(text: &str) -> Result<ObjTriangles, Defect> {
+    let raw = parse(text)?;
+    Ok((raw.v, raw.faces))
+}
+
+/// Vertices, and triangles with the line each came from.
+pub type ObjTriangles = (Vec<[f64; 3]>, Vec<([usize; 3], usize)>);
+
 /// Reads a pattern from OBJ text; `unit_m` is the file's unit in metres (1 for m, 0.01 for cm).
 pub fn parse_obj(text: &str, unit_m: f64) -> Result<Pattern, Defect> {
     let raw = parse(text)?;
@@ -196,7 +206,7 @@ fn parse(text: &str) -> Result<Raw, Defect> {
                             format!("line {n}"),
                             format!(
                                 "a vertex coordinate beyond ±{MAX_COORDINATE:e} (in the file's unit): \
-                                 not a pattern piece's size"
+                                 not a pattern piece's or a body's size"
                             ),
                         ));
                     }

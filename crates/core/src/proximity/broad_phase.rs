@@ -6,7 +6,7 @@ use super::{MeshTopology, Pair, V3};
 use rayon::prelude::*;
 
 /// An axis-aligned box.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Aabb {
     /// Lower corner.
     pub lo: V3,

@@ -35,6 +35,7 @@ impl Scene {
             read_renamed_keys(&mut table).map_err(|e| InputError::new(path, e.key, e.message))?;
             let mut scene: Scene = from_table(path, "", table)?;
             scene.cloth.read_mesh(path)?;
+            super::body::read_bodies(&mut scene.obstacles, path)?;
             Ok(scene)
         };
         let mut scene = with(&|_| true)?;

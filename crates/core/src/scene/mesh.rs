@@ -10,18 +10,35 @@ use crate::pattern::Pattern;
 use nalgebra::{Rotation3, Vector3};
 use std::path::Path;
 
-/// The mesh file a scene file names (`cloth.mesh`, relative to the scene file's folder), read from
-/// its TOML without loading the scene: a pipeline hashes it with the scene, so that a changed OBJ
-/// makes the stages that read the scene stale. None for a grid scene or a file that is not a scene.
-pub fn mesh_file_of(scene_path: &Path) -> Option<std::path::PathBuf> {
-    let text = std::fs::read_to_string(scene_path).ok()?;
-    let table: toml::Table = text.parse().ok()?;
-    let mesh = table.get("cloth")?.get("mesh")?.as_str()?;
-    let file = Path::new(mesh);
-    Some(match scene_path.parent() {
-        Some(dir) if file.is_relative() => dir.join(file),
-        _ => file.to_path_buf(),
-    })
+/// The mesh files a scene file names (`cloth.mesh` and every `obstacles.N.mesh`, relative to the
+/// scene file's folder), read from its TOML without loading the scene: a pipeline hashes them with
+/// the scene, so that a changed OBJ makes the stages that read the scene stale. Empty for a grid
+/// scene without mesh obstacles or a file that is not a scene.
+pub fn mesh_files_of(scene_path: &Path) -> Vec<std::path::PathBuf> {
+    let Some(table) = std::fs::read_to_string(scene_path)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+    else {
+        return Vec::new();
+    };
+    let cloth = table.get("cloth").and_then(|c| c.get("mesh"));
+    let obstacles = table.get("obstacles").and_then(|o| o.as_array());
+    let bodies = obstacles
+        .into_iter()
+        .flatten()
+        .filter_map(|o| o.get("mesh"));
+    cloth
+        .into_iter()
+        .chain(bodies)
+        .filter_map(|m| m.as_str())
+        .map(|mesh| {
+            let file = Path::new(mesh);
+            match scene_path.parent() {
+                Some(dir) if file.is_relative() => dir.join(file),
+                _ => file.to_path_buf(),
+            }
+        })
+        .collect()
 }
 
 impl ClothSpec {

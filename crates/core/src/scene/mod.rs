@@ -10,13 +10,15 @@ use crate::solve::{DynamicOptions, StaticOptions};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
+mod body;
 mod check;
 mod grid;
 mod load;
 mod mesh;
 
+pub use body::{carry_bodies, read_body};
 pub use check::{GRAVITY_M_PER_S2, MAGNITUDES, SHEET_SIDE_M, ValidatedScene};
-pub use mesh::mesh_file_of;
+pub use mesh::mesh_files_of;
 
 /// The sheet: size, resolution, spacing and areal density.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
