@@ -8,7 +8,12 @@ obstacles of the bundled scenes, faces counter-clockwise seen from outside, cent
 
 - sphere_5cm_L{2,3,4}.obj: a sphere of radius 0.05 m, an icosahedron subdivided 2, 3 and 4 times
   (320, 1,280 and 5,120 triangles), its vertices on the sphere;
-- table_10cm.obj: the box of table_wool.toml (10 cm square top at z = 0, 30 cm deep), 12 triangles.
+- table_10cm.obj: the box of table_wool.toml (10 cm square top at z = 0, 30 cm deep), 12 triangles;
+- dress_form.obj: a dress form (torso, shoulders, neck stump; hips at the bottom, no arms or legs),
+  72 cm tall from the cut below the hips (z = 0) to the flat top of the neck, about a European
+  size 38 (girths: bust 86, waist 70, hips 96 cm), facing −y: 91 rings of 56 points (superelliptic
+  sections whose half-widths, front and back depths and exponent follow the table DRESS_FORM in z,
+  interpolated monotonically), capped flat at both ends, 10,192 triangles.
 Standard library only; the same files on every run.
 """
 import math
@@ -43,6 +48,67 @@ def icosphere(r, levels):
     return [tuple(r * c for c in p) for p in v], f
 
 
+# z (m), half-width a (m), front depth (toward -y), back depth, superellipse exponent.
+DRESS_FORM = [
+    (0.000, 0.160, 0.110, 0.115, 2.5),
+    (0.060, 0.172, 0.118, 0.125, 2.5),
+    (0.140, 0.160, 0.105, 0.112, 2.5),
+    (0.240, 0.128, 0.085, 0.090, 2.4),
+    (0.320, 0.132, 0.095, 0.092, 2.4),
+    (0.400, 0.145, 0.120, 0.100, 2.4),
+    (0.470, 0.150, 0.128, 0.100, 2.4),
+    (0.530, 0.160, 0.110, 0.098, 2.4),
+    (0.580, 0.185, 0.090, 0.090, 2.6),
+    (0.615, 0.150, 0.075, 0.075, 2.4),
+    (0.640, 0.060, 0.058, 0.058, 2.0),
+    (0.720, 0.055, 0.055, 0.055, 2.0),
+]
+
+
+def pchip(xs, ys, x):
+    """Monotone cubic interpolation (Fritsch and Carlson): no overshoot between the table's rows."""
+    n = len(xs)
+    h = [xs[i + 1] - xs[i] for i in range(n - 1)]
+    d = [(ys[i + 1] - ys[i]) / h[i] for i in range(n - 1)]
+    m = [d[0]] + [0.0] * (n - 2) + [d[-1]]
+    for i in range(1, n - 1):
+        if d[i - 1] * d[i] > 0:
+            w1, w2 = 2 * h[i] + h[i - 1], h[i] + 2 * h[i - 1]
+            m[i] = (w1 + w2) / (w1 / d[i - 1] + w2 / d[i])
+    k = max(i for i in range(n - 1) if xs[i] <= x) if x < xs[-1] else n - 2
+    t = (x - xs[k]) / h[k]
+    h00, h10 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t
+    h01, h11 = -2 * t**3 + 3 * t**2, t**3 - t**2
+    return h00 * ys[k] + h10 * h[k] * m[k] + h01 * ys[k + 1] + h11 * h[k] * m[k + 1]
+
+
+def dress_form(rings=91, points=56):
+    zs = [row[0] for row in DRESS_FORM]
+    col = lambda c: [row[c] for row in DRESS_FORM]
+    top = zs[-1]
+    v, f = [], []
+    for k in range(rings):
+        z = top * k / (rings - 1)
+        a, bf, bb, p = (pchip(zs, col(c), z) for c in (1, 2, 3, 4))
+        for j in range(points):
+            th = 2 * math.pi * j / points
+            c, s_ = math.cos(th), math.sin(th)
+            x = a * math.copysign(abs(c) ** (2 / p), c)
+            y = (bf if s_ < 0 else bb) * math.copysign(abs(s_) ** (2 / p), s_)
+            v.append((x, y, z))
+    at = lambda k, j: k * points + j % points
+    for k in range(rings - 1):
+        for j in range(points):
+            f += [(at(k, j), at(k, j + 1), at(k + 1, j + 1)), (at(k, j), at(k + 1, j + 1), at(k + 1, j))]
+    v.append((0.0, 0.0, 0.0))
+    v.append((0.0, 0.0, top))
+    bottom, lid = len(v) - 2, len(v) - 1
+    for j in range(points):
+        f.append((bottom, at(0, j + 1), at(0, j)))
+        f.append((lid, at(rings - 1, j), at(rings - 1, j + 1)))
+    return v, f
+
+
 def box(lo, hi):
     v = [(x, y, z) for z in (lo[2], hi[2]) for y in (lo[1], hi[1]) for x in (lo[0], hi[0])]
     # Corners: index = x + 2y + 4z (0/1 per axis); two triangles per face, outward.
@@ -69,6 +135,9 @@ def main():
         v, f = icosphere(0.05, levels)
         write(os.path.join(out, f"sphere_5cm_L{levels}.obj"), v, f,
               f"sphere of radius 0.05 m, icosahedron subdivided {levels} times, {len(f)} triangles")
+    v, f = dress_form()
+    write(os.path.join(out, "dress_form.obj"), v, f,
+          f"dress form, 72 cm from the cut below the hips to the neck's top, facing -y, {len(f)} triangles")
     v, f = box((-0.05, -0.05, -0.30), (0.05, 0.05, 0.0))
     write(os.path.join(out, "table_10cm.obj"), v, f, "box 10 cm x 10 cm x 30 cm, top at z = 0, 12 triangles")
 

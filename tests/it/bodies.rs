@@ -198,3 +198,85 @@ fn a_scene_names_its_body_mesh_as_an_input_file() {
     assert_eq!(files, vec![root().join("datasets/bodies/table_10cm.obj")]);
     assert!(drapelab::scene::mesh_files_of(&root().join("datasets/scenes/hang4.toml")).is_empty());
 }
+
+/// Whether `p` lies inside the closed triangle mesh (`v`, `f`): the parity of a ray's crossings
+/// along +x, slightly tilted so that it meets no edge (written here, not the solver's geometry).
+fn inside(p: &nalgebra::Vector3<f64>, v: &[nalgebra::Vector3<f64>], f: &[[usize; 3]]) -> bool {
+    let dir = nalgebra::Vector3::new(1.0, 1e-3, 2e-3).normalize();
+    let mut crossings = 0;
+    for t in f {
+        let (a, b, c) = (v[t[0]], v[t[1]], v[t[2]]);
+        let (e1, e2) = (b - a, c - a);
+        let h = dir.cross(&e2);
+        let det = e1.dot(&h);
+        if det.abs() < 1e-18 {
+            continue;
+        }
+        let s = p - a;
+        let u = s.dot(&h) / det;
+        let q = s.cross(&e1);
+        let w = dir.dot(&q) / det;
+        let along = e2.dot(&q) / det;
+        crossings += usize::from(u >= 0.0 && w >= 0.0 && u + w <= 1.0 && along > 0.0);
+    }
+    crossings % 2 == 1
+}
+
+fn read_obj(path: &Path) -> (Vec<nalgebra::Vector3<f64>>, Vec<[usize; 3]>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let nums = |l: &str| -> Vec<f64> { l.split_whitespace().map(|t| t.parse().unwrap()).collect() };
+    let v = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let c = nums(l);
+            nalgebra::Vector3::new(c[0], c[1], c[2])
+        })
+        .collect();
+    let f = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("f "))
+        .map(|l| {
+            let c = nums(l);
+            [c[0] as usize - 1, c[1] as usize - 1, c[2] as usize - 1]
+        })
+        .collect();
+    (v, f)
+}
+
+/// The bundled dress form is a closed body facing outward: its signed distance is negative inside
+/// and positive outside (checked against a ray-parity test), its top is the neck's flat top; the
+/// cape scene drapes on it converged, no particle inside the form, the sheet uncrossed.
+#[test]
+fn a_cape_drapes_on_the_dress_form_without_entering_it_or_itself() {
+    let bodies = root().join("datasets/bodies");
+    let (v, f) = read_obj(&bodies.join("dress_form.obj"));
+    assert!(f.len() > 10_000, "{} triangles", f.len());
+    let body = drapelab::scene::read_body(&bodies.join("dress_form.obj"), 1.0).expect("valid");
+    for k in 0..300 {
+        let t = k as f64;
+        let p = nalgebra::Vector3::new(
+            0.25 * (t * 0.7).sin(),
+            0.2 * (t * 1.3).cos(),
+            0.37 + 0.36 * (t * 0.3).sin(),
+        );
+        let d = body.signed_distance(&p).0;
+        assert_eq!(d < 0.0, inside(&p, &v, &f), "{p}: {d}");
+    }
+    assert!((body.top_at(0.0, 0.0).unwrap() - 0.72).abs() < 1e-12);
+    let path = bodies.join("cape_form.toml");
+    let sets = ["cloth.nx=21", "cloth.ny=21"];
+    let scene = load(&path, &sets);
+    let sol = solved(&path, &sets);
+    assert_eq!(sol.report.minimum, Some(true));
+    let entered: Vec<usize> = (0..sol.x.len())
+        .filter(|&p| inside(&sol.x[p], &v, &f))
+        .collect();
+    assert!(entered.is_empty(), "particles inside the form: {entered:?}");
+    let lowest = sol.x.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    assert!(
+        lowest < 0.5,
+        "the cape hangs below the shoulders ({lowest} m)"
+    );
+    crate::self_contact::assert_uncrossed("the cape", &scene, &sol);
+}

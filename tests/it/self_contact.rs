@@ -153,7 +153,7 @@ fn check_solution(s: &Scene, sol: &Solution) -> (usize, f64) {
 
 /// Asserts that the drape `sol` of `s` (named `name` in the messages) passes nowhere through
 /// itself and keeps every two parts at least the thickness ξ apart; the closest distance, m.
-fn assert_uncrossed(name: &str, s: &Scene, sol: &Solution) -> f64 {
+pub(crate) fn assert_uncrossed(name: &str, s: &Scene, sol: &Solution) -> f64 {
     let (crossings, dmin) = check_solution(s, sol);
     let xi = drapelab::build::self_thickness_m(s);
     assert_eq!(crossings, 0, "{name} passes through itself");
