@@ -79,7 +79,7 @@ fn nan_is_refused() {
 #[test]
 fn pin_outside_the_grid_is_refused() {
     let t = hang4().replace("[boundary]", "[boundary]\npin_particles = [[3, 11]]");
-    assert_bad(Some(&t), &[], "boundary.pin_particles[0]");
+    assert_bad(Some(&t), &[], "boundary.pin_particles.0");
 }
 
 #[test]
@@ -400,27 +400,19 @@ fn every_physical_number_out_of_range_is_refused_naming_its_key() {
     }
 }
 
-/// A dotted `--set` key as scene errors name it: a list of tables' entry in brackets
-/// (`loads.0.magnitude_N` → `loads[0].magnitude_N`), a list of numbers as a whole
-/// (`cloth.origin_m.1` → `cloth.origin_m`).
+/// A dotted `--set` key as scene errors name it: the same spelling (`loads.0.magnitude_N`), a list
+/// of numbers as a whole (`cloth.origin_m.1` → `cloth.origin_m`).
 fn named(key: &str) -> String {
     let parts: Vec<&str> = key.split('.').collect();
     let numeric = |p: &str| p.parse::<usize>().is_ok();
-    let mut out = String::new();
+    let mut out: Vec<&str> = Vec::new();
     for (k, p) in parts.iter().enumerate() {
-        if numeric(p) {
-            if parts.get(k + 1).is_some_and(|n| !numeric(n)) {
-                out.push_str(&format!("[{p}]"));
-                continue;
-            }
+        if numeric(p) && parts.get(k + 1).is_none_or(|n| numeric(n)) {
             break;
         }
-        if !out.is_empty() {
-            out.push('.');
-        }
-        out.push_str(p);
+        out.push(p);
     }
-    out
+    out.join(".")
 }
 
 #[test]

@@ -217,12 +217,12 @@ fn bad_obstacles_exit_2_naming_the_key() {
             (
                 "radius_m = 0.05",
                 "radius_m = -0.05",
-                "obstacles[0].radius_m",
+                "obstacles.0.radius_m",
             ),
             (
                 "centre_m = [0.0, 0.0, -0.0505]",
                 "centre_m = [0.0, 0.0, -0.02]",
-                "obstacles[0]",
+                "obstacles.0",
             ),
             ("kind = \"sphere\"", "kind = \"cone\"", "obstacles"),
             (

@@ -176,27 +176,27 @@ fn bad_loads_and_holds_exit_2_naming_the_key() {
             (
                 "particle = [30, 0]",
                 "particle = [31, 0]",
-                "loads[0].particle",
+                "loads.0.particle",
             ),
             (
                 "magnitude_N = 0.4903325",
                 "magnitude_N = -1.0",
-                "loads[0].magnitude_N",
+                "loads.0.magnitude_N",
             ),
             (
                 "direction = [1.0, -1.0, 0.0]",
                 "direction = [0.0, 0.0, 0.0]",
-                "loads[0].direction",
+                "loads.0.direction",
             ),
             (
                 "particle = [30, 0]",
                 "particle = [30, 0]\nat_m = [0.1, 0.1]",
-                "loads[0].particle",
+                "loads.0.particle",
             ),
             (
                 "components = [\"z\"]",
                 "components = []",
-                "boundary.holds[0].components",
+                "boundary.holds.0.components",
             ),
             (
                 "components = [\"z\"]",
@@ -206,7 +206,7 @@ fn bad_loads_and_holds_exit_2_naming_the_key() {
             (
                 "particles = [[0, 30], [30, 30]]",
                 "particles = [[0, 31]]",
-                "boundary.holds[1].particles",
+                "boundary.holds.1.particles",
             ),
             (
                 "kind = \"static\"",
@@ -216,7 +216,7 @@ fn bad_loads_and_holds_exit_2_naming_the_key() {
             (
                 "magnitude_N = 0.4903325",
                 "magnitude_N = nan",
-                "loads[0].magnitude_N",
+                "loads.0.magnitude_N",
             ),
         ],
     );

@@ -218,7 +218,7 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
                 "[[obstacles]]",
                 "[boundary]\npin_groups = [\"waist\"]\n[[obstacles]]",
             ),
-            "boundary.pin_groups[0]",
+            "boundary.pin_groups.0",
             "scene.toml",
         ),
         (

@@ -234,22 +234,22 @@ fn invalid_wrinkle_inputs_exit_2_naming_the_key() {
             (
                 "length_m = 1.40\nheight_m = 0.90",
                 "length_m = 0.0\nheight_m = 0.90",
-                "cases[0].length_m",
+                "cases.0.length_m",
             ),
             (
                 "thickness_m = 0.25e-3",
                 "thickness_m = -1e-3",
-                "cases[0].thickness_m",
+                "cases.0.thickness_m",
             ),
             (
                 "poisson_ratio = 0.3",
                 "poisson_ratio = 0.5",
-                "cases[0].poisson_ratio",
+                "cases.0.poisson_ratio",
             ),
             (
                 "support_displacement_m = 0.10",
                 "support_displacement_m = 0.80",
-                "cases[0].support_displacement_m",
+                "cases.0.support_displacement_m",
             ),
             (
                 "tolerance_rel = 0.05",

@@ -94,6 +94,20 @@ pub fn read_toml_table(path: &Path) -> Result<toml::Table, InputError> {
     })
 }
 
+/// A key path as `--set` takes it: a list's entry as `.N`, not `[N]` (`loads[0].magnitude_N` →
+/// `loads.0.magnitude_N`), so that errors and flags spell every key alike.
+pub fn dotted(key: &str) -> String {
+    let mut out = String::with_capacity(key.len());
+    for c in key.chars() {
+        match c {
+            '[' => out.push('.'),
+            ']' => {}
+            c => out.push(c),
+        }
+    }
+    out
+}
+
 /// Deserializes a table into `T`, naming the dotted key of the first error.
 pub fn from_table<T: serde::de::DeserializeOwned>(
     path: &Path,
@@ -101,7 +115,7 @@ pub fn from_table<T: serde::de::DeserializeOwned>(
     table: toml::Table,
 ) -> Result<T, InputError> {
     serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
-        let key = e.path().to_string();
+        let key = dotted(&e.path().to_string());
         let key = if key == "." {
             prefix.trim_end_matches('.').to_string()
         } else {

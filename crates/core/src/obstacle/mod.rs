@@ -470,13 +470,13 @@ fn check_profile(profile_m: &[[f64; 2]]) -> Result<(), KeyError> {
     for (k, p) in profile_m.iter().enumerate() {
         if !(p[0].is_finite() && p[1].is_finite() && p[1] >= 0.0) {
             return Err(KeyError::new(
-                format!("profile_m[{k}]"),
+                format!("profile_m.{k}"),
                 "needs finite z and r ≥ 0",
             ));
         }
         if k > 0 && p[0] <= profile_m[k - 1][0] {
             return Err(KeyError::new(
-                format!("profile_m[{k}]"),
+                format!("profile_m.{k}"),
                 "heights must increase strictly",
             ));
         }

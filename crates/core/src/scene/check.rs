@@ -20,7 +20,7 @@ impl Scene {
 
     /// Every physical number of the scene (its solver and recording options aside) is finite and
     /// zero or of a size drapelab computes in ([`MAGNITUDES`]); the error names the key as the other
-    /// checks do (`loads[0].magnitude_N`, `obstacles[1].centre_m`).
+    /// checks do and `--set` takes it (`loads.0.magnitude_N`, `obstacles.1.centre_m`).
     fn check_magnitudes(&self, ck: &Check<'_>) -> Result<(), InputError> {
         // The key is spelled only for an error: a scene is checked once per solve, and a
         // calibration solves tens of thousands.
@@ -51,7 +51,7 @@ in the key's unit (SI)",
                 // A list of tables names its entry as the other checks do (`loads[0].magnitude_N`);
                 // a list of numbers (a point, a profile) is named as a whole.
                 toml::Value::Array(a) => a.iter().enumerate().try_for_each(|(i, v)| match v {
-                    toml::Value::Table(_) => walk(ck, &|| format!("{}[{i}]", key()), v),
+                    toml::Value::Table(_) => walk(ck, &|| format!("{}.{i}", key()), v),
                     _ => walk(ck, key, v),
                 }),
                 _ => Ok(()),
@@ -206,7 +206,7 @@ in the key's unit (SI)",
         for (n, p) in self.boundary.pin_particles.iter().enumerate() {
             if p[0] >= c.nx || p[1] >= c.ny {
                 return ck.err(
-                    &format!("boundary.pin_particles[{n}]"),
+                    &format!("boundary.pin_particles.{n}"),
                     format!(
                         "[{}, {}] lies outside the {}×{} grid (i < nx, j < ny)",
                         p[0], p[1], c.nx, c.ny
@@ -231,13 +231,13 @@ in the key's unit (SI)",
         for (h, hold) in self.boundary.holds.iter().enumerate() {
             if hold.components.is_empty() {
                 return ck.err(
-                    &format!("boundary.holds[{h}].components"),
+                    &format!("boundary.holds.{h}.components"),
                     "name at least one of \"x\", \"y\", \"z\"".into(),
                 );
             }
             if let Some(p) = hold.particles.iter().find(|p| p[0] >= c.nx || p[1] >= c.ny) {
                 return ck.err(
-                    &format!("boundary.holds[{h}].particles"),
+                    &format!("boundary.holds.{h}.particles"),
                     format!(
                         "[{}, {}] lies outside the {}×{} grid",
                         p[0], p[1], c.nx, c.ny
@@ -275,7 +275,7 @@ in the key's unit (SI)",
     fn check_loads(&self, ck: &Check<'_>) -> Result<(), InputError> {
         let c = &self.cloth;
         for (k, l) in self.loads.iter().enumerate() {
-            let key = |f: &str| format!("loads[{k}].{f}");
+            let key = |f: &str| format!("loads.{k}.{f}");
             match (l.particle, l.at_m) {
                 (Some(p), None) if p[0] >= c.nx || p[1] >= c.ny => {
                     return ck.err(
@@ -348,7 +348,7 @@ would already touch itself; use a coarser grid or a thinner sheet"
         let flat = self.initial_positions();
         for (k, o) in self.obstacles.iter().enumerate() {
             o.check().map_err(|e| {
-                InputError::new(ck.path, format!("obstacles[{k}].{}", e.key), e.message)
+                InputError::new(ck.path, format!("obstacles.{k}.{}", e.key), e.message)
             })?;
             if let Some((p, d)) = flat
                 .iter()
@@ -358,7 +358,7 @@ would already touch itself; use a coarser grid or a thinner sheet"
                 .filter(|(_, d)| *d <= 0.0)
             {
                 return ck.err(
-                    &format!("obstacles[{k}]"),
+                    &format!("obstacles.{k}"),
                     format!(
                         "the sheet starts inside this obstacle (particle {} is {:.3e} m deep): \
                          move the obstacle down or the sheet up (cloth.origin_m)",

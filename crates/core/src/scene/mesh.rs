@@ -259,7 +259,7 @@ its triangles)"
         }
         if let Some(k) = self.loads.iter().position(|l| l.particle.is_some()) {
             return ck.err(
-                &format!("loads[{k}].particle"),
+                &format!("loads.{k}.particle"),
                 "is a grid index; on a mesh sheet give the load's position (at_m)".into(),
             );
         }
@@ -272,7 +272,7 @@ its triangles)"
         {
             let known: Vec<&str> = groups.keys().map(String::as_str).collect();
             return ck.err(
-                &format!("boundary.pin_groups[{k}]"),
+                &format!("boundary.pin_groups.{k}"),
                 format!(
                     "the mesh has no group `{g}` (its groups: {})",
                     if known.is_empty() {

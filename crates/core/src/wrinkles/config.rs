@@ -258,7 +258,7 @@ pub fn load_config(path: &Path) -> Result<WrinkleConfig, InputError> {
         let Some(base) = cfg.cases.iter().find(|c| c.case == s.base) else {
             return Err(InputError::new(
                 path,
-                format!("sweeps[{k}].base"),
+                format!("sweeps.{k}.base"),
                 format!("no case named `{}`", s.base),
             ));
         };
@@ -267,7 +267,7 @@ pub fn load_config(path: &Path) -> Result<WrinkleConfig, InputError> {
             if !c.set(&s.key, v) {
                 return Err(InputError::new(
                     path,
-                    format!("sweeps[{k}].key"),
+                    format!("sweeps.{k}.key"),
                     format!("`{}` is not a numeric key of a case", s.key),
                 ));
             }
@@ -283,7 +283,7 @@ pub fn load_config(path: &Path) -> Result<WrinkleConfig, InputError> {
     for (list, cases) in [("cases", &cfg.cases), ("photographs", &cfg.photographs)] {
         for (k, c) in cases.iter().enumerate() {
             c.check(&cfg.defaults)
-                .map_err(|e| InputError::new(path, format!("{list}[{k}].{}", e.key), e.message))?;
+                .map_err(|e| InputError::new(path, format!("{list}.{k}.{}", e.key), e.message))?;
         }
     }
     Ok(cfg)
