@@ -63,9 +63,7 @@ fn simulate(
     }
     let extras = crate::io::SimulateExtras {
         sensitivity_keys: sensitivity.to_vec(),
-        start: start
-            .map(|f| read_start(f, &loaded.scene.grid()))
-            .transpose()?,
+        start: start.map(|f| read_start(f, &loaded.scene)).transpose()?,
         obj,
     };
     let _out = args::out_dir(out)?;
@@ -99,11 +97,14 @@ fn simulate(
 }
 
 /// The grid particles' positions of a saved drape (`--start FILE`), checked against the scene's
-/// grid: the same particles (i, j) in the same order, finite positions.
+/// grid (the same particles (i, j) in the same order, finite positions) and the scene itself
+/// ([`crate::build::check_start`]: fixed particles in place, none inside an obstacle, no two
+/// neighbours at one point).
 fn read_start(
     file: &Path,
-    grid: &crate::cloth::Grid,
+    scene: &crate::scene::ValidatedScene,
 ) -> Result<(Vec<nalgebra::Vector3<f64>>, String), InputError> {
+    let grid = &scene.grid();
     let bad = |key: &str, m: String| InputError::new(format!("--start {}", file.display()), key, m);
     let rows = crate::io::read_particles(file).map_err(|e| bad("", format!("{e:#}")))?;
     if rows.len() != grid.len() {
@@ -141,5 +142,7 @@ fn read_start(
         }
         x.push(v);
     }
+    let built = crate::build::build_scene(scene);
+    crate::build::check_start(scene, &built, &x).map_err(|d| bad(d.column, d.message))?;
     Ok((x, file.display().to_string()))
 }

@@ -276,3 +276,73 @@ fn a_restart_from_a_saved_drape_lands_on_it_at_once() {
     );
     assert!(!out.exists());
 }
+
+/// Issue 78: a start that moves the scene's fixed particles, puts a particle inside an obstacle or
+/// two neighbours at one point is refused naming `--start`, the particle and what is wrong, and
+/// nothing is written (they ran before: "diverged" with an empty message, or "converged in 0
+/// iterations" with the pins moved).
+#[test]
+fn a_start_that_the_scene_cannot_have_is_refused_naming_the_particle() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sphere = root().join("datasets/scenes/sphere_wool.toml");
+    let edit = |scene: &Path, name: &str, code: &str| {
+        let saved = tmp.path().join(format!("{name}-saved"));
+        let o = drapelab()
+            .arg("simulate")
+            .arg(scene)
+            .args(["--out", saved.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(o.status.success());
+        let bad = tmp.path().join(format!("{name}.parquet"));
+        run_python(
+            &format!(
+                "import sys, pyarrow as pa, pyarrow.parquet as pq\n\
+                 t = pq.read_table(sys.argv[1])\n\
+                 x, y, z = (t.column(c).to_pylist() for c in ('x_m', 'y_m', 'z_m'))\n\
+                 {code}\n\
+                 for c, v in (('x_m', x), ('y_m', y), ('z_m', z)):\n\
+                 \x20   t = t.set_column(t.schema.get_field_index(c), c, pa.array(v))\n\
+                 pq.write_table(t, sys.argv[2])\n"
+            ),
+            &[&saved.join("particles.parquet"), &bad],
+        );
+        bad
+    };
+    let cases = [
+        (
+            hang4(),
+            "moved",
+            "z = [v + 0.1 for v in z]",
+            &["--start", "fixed", "x_m"][..],
+        ),
+        (
+            sphere.clone(),
+            "inside",
+            "k = 15 * 31 + 16\nz[k] = -0.03",
+            &["--start", "obstacles.0", "z_m", "[16, 15]"][..],
+        ),
+        (
+            hang4(),
+            "coincident",
+            "x[5], y[5], z[5] = x[6], y[6], z[6]",
+            &["--start", "one point"][..],
+        ),
+    ];
+    for (scene, name, code, names) in cases {
+        let bad = edit(&scene, name, code);
+        let out = tmp.path().join(format!("{name}-out"));
+        assert_bad_input(
+            [
+                "simulate",
+                scene.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--start",
+                bad.to_str().unwrap(),
+            ],
+            names,
+        );
+        assert!(!out.exists(), "{name}: {} left behind", out.display());
+    }
+}

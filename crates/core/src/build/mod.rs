@@ -3,8 +3,10 @@
 
 mod continuum;
 mod pattern;
+mod start;
 use continuum::{continuum_terms, symmetry_planes};
 pub use pattern::{PatternSheet, pattern_builder};
+pub use start::{StartDefect, check_start};
 
 use crate::cloth::Grid;
 use crate::physics::{EnergyTerm, Model, ModelBuilder, SpringFamily, Springs};
