@@ -62,6 +62,14 @@ fn negative_stiffness_is_refused() {
     assert_bad(Some(&t), &[], "material.mass_spring.stiffness_N_per_m");
 }
 
+/// Issue 78: a mass-spring scene without its stiffness was run with 1000 N/m; it is refused naming
+/// the key (no stiffness is a fabric's by default).
+#[test]
+fn a_missing_stiffness_is_refused_naming_the_key() {
+    let t = hang4().replace("stiffness_N_per_m = 1000.0", "");
+    assert_bad(Some(&t), &[], "stiffness_N_per_m");
+}
+
 #[test]
 fn nan_is_refused() {
     let t = hang4().replace(

@@ -44,8 +44,8 @@ impl Topology {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MassSpring {
-    /// Stiffness of every spring in N/m, the seed's single `K` (Table 3: 500..1200). Default 1000.
-    #[serde(default = "default_stiffness")]
+    /// Stiffness of every spring in N/m, the seed's single `K` (Table 3: 500..1200). Required in a
+    /// scene file: no value is a fabric's by default (a calibration finds it).
     pub stiffness_N_per_m: f64,
     /// Stiffness of the structural springs in N/m, overriding `stiffness_N_per_m` when set.
     #[serde(default)]
