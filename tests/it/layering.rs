@@ -395,59 +395,61 @@ fn a_stage_file_is_an_adapter() {
     }
 }
 
-/// Lengths of the functions of a Rust file outside `#[cfg(test)]` modules, by brace matching
-/// (string literals with braces are rare enough here; raw strings are skipped).
+/// Lengths of the functions of a Rust file (free, in impls, in traits with a body) outside
+/// `#[cfg(test)]` items, from the line of `fn` to the line of the body's closing brace, found by
+/// parsing the file as Rust (syn): braces in strings, chars and comments count for nothing.
 fn long_functions(text: &str, limit: usize) -> Vec<(String, usize)> {
-    let lines: Vec<&str> = text.lines().collect();
-    let test_start = lines
-        .iter()
-        .position(|l| l.trim_start().starts_with("#[cfg(test)]"))
-        .unwrap_or(lines.len());
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < test_start {
-        let t = lines[i].trim_start();
-        let is_fn = [
-            "fn ",
-            "pub fn ",
-            "pub(crate) fn ",
-            "const fn ",
-            "pub const fn ",
-        ]
-        .iter()
-        .any(|p| t.starts_with(p));
-        if !is_fn {
-            i += 1;
-            continue;
-        }
-        // Find the opening brace of the body, then its match.
-        let mut depth = 0i64;
-        let mut opened = false;
-        let mut j = i;
-        'scan: while j < lines.len() {
-            for c in lines[j].chars() {
-                match c {
-                    '{' => {
-                        depth += 1;
-                        opened = true;
-                    }
-                    '}' => depth -= 1,
-                    ';' if !opened => break 'scan,
-                    _ => {}
-                }
-                if opened && depth == 0 {
-                    break 'scan;
-                }
-            }
-            j += 1;
-        }
-        let len = j.saturating_sub(i) + 1;
-        if opened && len > limit {
-            out.push((t.chars().take(60).collect(), len));
-        }
-        i = if opened { j + 1 } else { i + 1 };
+    use syn::visit::Visit;
+    struct Lengths {
+        limit: usize,
+        out: Vec<(String, usize)>,
     }
-    out
+    impl Lengths {
+        fn check(&mut self, sig: &syn::Signature, body: &syn::Block) {
+            let start = sig.fn_token.span.start().line;
+            let end = body.brace_token.span.close().end().line;
+            let len = end + 1 - start;
+            if len > self.limit {
+                self.out.push((format!("fn {}", sig.ident), len));
+            }
+        }
+    }
+    fn is_test(attrs: &[syn::Attribute]) -> bool {
+        attrs.iter().any(|a| {
+            a.path().is_ident("cfg")
+                && matches!(&a.meta, syn::Meta::List(l) if l.tokens.to_string().contains("test"))
+        })
+    }
+    impl<'ast> Visit<'ast> for Lengths {
+        fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+            if !is_test(&m.attrs) {
+                syn::visit::visit_item_mod(self, m);
+            }
+        }
+        fn visit_item_fn(&mut self, f: &'ast syn::ItemFn) {
+            if !is_test(&f.attrs) {
+                self.check(&f.sig, &f.block);
+                syn::visit::visit_item_fn(self, f);
+            }
+        }
+        fn visit_impl_item_fn(&mut self, f: &'ast syn::ImplItemFn) {
+            self.check(&f.sig, &f.block);
+            syn::visit::visit_impl_item_fn(self, f);
+        }
+        fn visit_trait_item_fn(&mut self, f: &'ast syn::TraitItemFn) {
+            if let Some(body) = &f.default {
+                self.check(&f.sig, body);
+            }
+            syn::visit::visit_trait_item_fn(self, f);
+        }
+    }
+    let file = syn::parse_file(text).unwrap_or_else(|e| panic!("not Rust: {e}"));
+    let mut v = Lengths {
+        limit,
+        out: Vec::new(),
+    };
+    v.visit_file(&file);
+    v.out
 }
 
 /// The library and binary sources: every `.rs` under `crates/` and `src/` outside a `tests/` folder.
@@ -519,4 +521,17 @@ fn the_function_length_check_sees_a_long_function() {
     let found = long_functions(&text, 150);
     assert_eq!(found.len(), 1);
     assert_eq!(found[0].1, 162);
+    // An 81-line method whose strings hold closing braces (a brace counter stops at the first), and
+    // a short one whose strings hold opening braces (a brace counter runs on past its end).
+    let braces = "        let s = \"}} }} {{\";\n".repeat(79);
+    let text = format!(
+        "impl A {{\n    fn planted(&self) {{\n{braces}    }}\n    fn short(&self) {{\n        let t = \"{{{{\";\n    }}\n}}\n"
+    );
+    assert_eq!(
+        long_functions(&text, 80),
+        vec![("fn planted".to_string(), 81)]
+    );
+    // Functions under #[cfg(test)] are not counted.
+    let tested = format!("#[cfg(test)]\nmod tests {{\n    fn long() {{\n{body}    }}\n}}\n");
+    assert!(long_functions(&tested, 80).is_empty());
 }

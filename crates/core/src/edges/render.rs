@@ -85,6 +85,55 @@ pub fn render_drape(
     opts: &RenderOptions,
 ) -> RenderedPhoto {
     let s = opts.px_per_cm * 100.0; // px per m in the plane y = 0
+    let (pts, (w, h), (umin, vmin)) = projected(grid, x, opts);
+    let m = opts.margin_px as f64;
+    let mut img = rasterize(&pts, x, crate::cloth::grid_triangles(grid), w, h);
+    // The rasterizer's pixel (u, v) spans [u, u + 1) × [v, v + 1); the photo's coordinates put pixel
+    // centres at integers (as fit_image, OpenCV and imageproc do), half a pixel less.
+    let corner_px = |(i, j): (usize, usize)| {
+        let p = pts[grid.index(i, j)];
+        (p.0 - 0.5, p.1 - 0.5)
+    };
+    let mut corners_px = [corner_px(corners[0]), corner_px(corners[1])];
+    // The camera's axis meets every plane y = const at x = z = 0.
+    let mut axis_px = (m - umin - 0.5, m - vmin - 0.5);
+    draw_markers(&mut img, &corners_px, opts.marker_radius_px);
+    if opts.rotation_deg != 0.0 {
+        img = rotated(img, opts.rotation_deg, &mut corners_px, &mut axis_px);
+    }
+    if opts.blur_sigma_px > 0.0 {
+        img = imageproc::filter::gaussian_blur_f32(&img, opts.blur_sigma_px as f32);
+    }
+    add_noise(&mut img, opts.noise_sigma, opts.seed);
+    // A pinhole at y = −d has focal length s·d px; the corners' plane is d + y_c from it.
+    let plane_y = 0.5
+        * (x[grid.index(corners[0].0, corners[0].1)].y
+            + x[grid.index(corners[1].0, corners[1].1)].y);
+    let (px_per_cm, pinhole) = match opts.camera {
+        Camera::Orthographic => (opts.px_per_cm, None),
+        Camera::Pinhole { distance_m } => {
+            let p = super::Pinhole {
+                focal_length_px: s * distance_m,
+                distance_m: distance_m + plane_y,
+                principal_point_px: Some(axis_px),
+            };
+            (p.focal_length_px / (100.0 * p.distance_m), Some(p))
+        }
+    };
+    RenderedPhoto {
+        image: img,
+        corners_px,
+        px_per_cm,
+        pinhole,
+    }
+}
+
+/// The grid particles projected by the camera to (u, v, depth) in pixels, shifted so that the
+/// image holds them with the margin; the image's size and the shift's (u, v) minimum.
+type Projected = (Vec<(f64, f64, f64)>, (u32, u32), (f64, f64));
+
+fn projected(grid: &Grid, x: &[Vector3<f64>], opts: &RenderOptions) -> Projected {
+    let s = opts.px_per_cm * 100.0;
     let project = |p: &Vector3<f64>| -> (f64, f64, f64) {
         match opts.camera {
             Camera::Orthographic => (p.x * s, -p.z * s, p.y),
@@ -110,82 +159,64 @@ pub fn render_drape(
         (vmax - vmin + 2.0 * m).ceil() as u32,
     );
     let shift = |p: (f64, f64, f64)| (p.0 - umin + m, p.1 - vmin + m, p.2);
-    let pts: Vec<(f64, f64, f64)> = pts.into_iter().map(shift).collect();
-    let mut img = rasterize(&pts, x, crate::cloth::grid_triangles(grid), w, h);
-    // The rasterizer's pixel (u, v) spans [u, u + 1) × [v, v + 1); the photo's coordinates put pixel
-    // centres at integers (as fit_image, OpenCV and imageproc do), half a pixel less.
-    let corner_px = |(i, j): (usize, usize)| {
-        let p = pts[grid.index(i, j)];
-        (p.0 - 0.5, p.1 - 0.5)
-    };
-    let mut corners_px = [corner_px(corners[0]), corner_px(corners[1])];
-    // The camera's axis meets every plane y = const at x = z = 0.
-    let mut axis_px = (m - umin - 0.5, m - vmin - 0.5);
-    if opts.marker_radius_px > 0.0 {
-        let r = opts.marker_radius_px;
-        for &(cu, cv) in &corners_px {
-            for v in (cv - r - 1.0).floor().max(0.0) as u32..((cv + r + 1.0).ceil() as u32).min(h) {
-                for u in
-                    (cu - r - 1.0).floor().max(0.0) as u32..((cu + r + 1.0).ceil() as u32).min(w)
-                {
-                    if ((u as f64 - cu).powi(2) + (v as f64 - cv).powi(2)).sqrt() <= r {
-                        img.put_pixel(u, v, Rgb([220, 30, 30]));
-                    }
+    (pts.into_iter().map(shift).collect(), (w, h), (umin, vmin))
+}
+
+/// Red discs of radius `r` px at the corners (none for r = 0): the markers a photo's corners carry.
+fn draw_markers(img: &mut RgbImage, corners_px: &[(f64, f64); 2], r: f64) {
+    if r <= 0.0 {
+        return;
+    }
+    let (w, h) = img.dimensions();
+    for &(cu, cv) in corners_px {
+        for v in (cv - r - 1.0).floor().max(0.0) as u32..((cv + r + 1.0).ceil() as u32).min(h) {
+            for u in (cu - r - 1.0).floor().max(0.0) as u32..((cu + r + 1.0).ceil() as u32).min(w) {
+                if ((u as f64 - cu).powi(2) + (v as f64 - cv).powi(2)).sqrt() <= r {
+                    img.put_pixel(u, v, Rgb([220, 30, 30]));
                 }
             }
         }
     }
-    if opts.rotation_deg != 0.0 {
-        let theta = opts.rotation_deg.to_radians();
-        img = imageproc::geometric_transformations::rotate_about_center(
-            &img,
-            theta as f32,
-            imageproc::geometric_transformations::Interpolation::Bilinear,
-            imageproc::geometric_transformations::Border::Constant(Rgb([BACKGROUND as u8; 3])),
-        );
-        // imageproc maps p to c + R(θ)(p − c) with c = (w/2, h/2) in pixel-index coordinates (pixel
-        // centres at integers), the photo's coordinates.
-        let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
-        let (sn, cs) = theta.sin_cos();
-        for c in corners_px.iter_mut().chain(std::iter::once(&mut axis_px)) {
-            let (du, dv) = (c.0 - cx, c.1 - cy);
-            *c = (cx + cs * du - sn * dv, cy + sn * du + cs * dv);
-        }
+}
+
+/// The image turned by `deg` about its centre, the corners and the camera axis turned with it.
+fn rotated(
+    img: RgbImage,
+    deg: f64,
+    corners_px: &mut [(f64, f64); 2],
+    axis_px: &mut (f64, f64),
+) -> RgbImage {
+    let (w, h) = img.dimensions();
+    let theta = deg.to_radians();
+    let img = imageproc::geometric_transformations::rotate_about_center(
+        &img,
+        theta as f32,
+        imageproc::geometric_transformations::Interpolation::Bilinear,
+        imageproc::geometric_transformations::Border::Constant(Rgb([BACKGROUND as u8; 3])),
+    );
+    // imageproc maps p to c + R(θ)(p − c) with c = (w/2, h/2) in pixel-index coordinates (pixel
+    // centres at integers), the photo's coordinates.
+    let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
+    let (sn, cs) = theta.sin_cos();
+    for c in corners_px.iter_mut().chain(std::iter::once(axis_px)) {
+        let (du, dv) = (c.0 - cx, c.1 - cy);
+        *c = (cx + cs * du - sn * dv, cy + sn * du + cs * dv);
     }
-    if opts.blur_sigma_px > 0.0 {
-        img = imageproc::filter::gaussian_blur_f32(&img, opts.blur_sigma_px as f32);
+    img
+}
+
+/// Gaussian noise of standard deviation `sigma` (grey levels) on every channel, seeded (Box–Muller).
+fn add_noise(img: &mut RgbImage, sigma: f64, seed: u64) {
+    if sigma <= 0.0 {
+        return;
     }
-    if opts.noise_sigma > 0.0 {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
-        for p in img.pixels_mut() {
-            // Box–Muller.
-            let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
-            let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos() * opts.noise_sigma;
-            for ch in p.0.iter_mut() {
-                *ch = (*ch as f64 + z).round().clamp(0.0, 255.0) as u8;
-            }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    for p in img.pixels_mut() {
+        let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+        let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos() * sigma;
+        for ch in p.0.iter_mut() {
+            *ch = (*ch as f64 + z).round().clamp(0.0, 255.0) as u8;
         }
-    }
-    // A pinhole at y = −d has focal length s·d px; the corners' plane is d + y_c from it.
-    let plane_y = 0.5
-        * (x[grid.index(corners[0].0, corners[0].1)].y
-            + x[grid.index(corners[1].0, corners[1].1)].y);
-    let (px_per_cm, pinhole) = match opts.camera {
-        Camera::Orthographic => (opts.px_per_cm, None),
-        Camera::Pinhole { distance_m } => {
-            let p = super::Pinhole {
-                focal_length_px: s * distance_m,
-                distance_m: distance_m + plane_y,
-                principal_point_px: Some(axis_px),
-            };
-            (p.focal_length_px / (100.0 * p.distance_m), Some(p))
-        }
-    };
-    RenderedPhoto {
-        image: img,
-        corners_px,
-        px_per_cm,
-        pinhole,
     }
 }
 
