@@ -48,6 +48,22 @@ fn merged(total: Option<SolveReport>, run: SolveReport) -> SolveReport {
     }
 }
 
+/// A message that counts the last stage's iterations ("converged in 10 iterations …") restated
+/// with the whole run's `total`, the last stage's count kept in brackets: a run of many stages
+/// must not read as converged in its last stage's few.
+fn whole_count(message: &str, total: usize) -> String {
+    let counted = message
+        .strip_prefix("converged in ")
+        .and_then(|rest| rest.split_once(" iterations"))
+        .and_then(|(n, rest)| n.parse::<usize>().ok().map(|n| (n, rest)));
+    match counted {
+        Some((last, rest)) if last != total => {
+            format!("converged in {total} iterations ({last} in the last stage){rest}")
+        }
+        _ => message.to_string(),
+    }
+}
+
 /// Runs `continuation` on `model` from `x` (updated in place) with Newton under `opts`: the
 /// observer sees the first run's iterations; a stage that does not reach its goal ends it with that
 /// run's status. The work of every run adds up in the report.
@@ -67,11 +83,15 @@ pub fn execute(
                 Stage::Solve(load) => (load, Goal::Tolerance),
                 Stage::Increment(load) => (load, Goal::Increment),
                 Stage::Done(note) => {
+                    let staged = total.is_some();
                     let mut t = match run.take() {
                         Some(r) => merged(total, r.finish(model, x)),
                         None => total
                             .unwrap_or_else(|| SolveReport::unsolved(super::SolverKind::Static)),
                     };
+                    if staged {
+                        t.message = whole_count(&t.message, t.iterations);
+                    }
                     t.message += &note;
                     return t;
                 }
@@ -136,6 +156,9 @@ mod tests {
         let r = execute(&mut model, &mut x, &opts, &mut Ramp(0), &mut NoObserver);
         assert!(r.is_converged(), "{}", r.message);
         assert!(r.message.ends_with(" (ramped)"));
+        // The message counts every stage's iterations, as the report does.
+        let counted = format!("converged in {} iterations", r.iterations);
+        assert!(r.message.starts_with(&counted), "{}", r.message);
         assert!((x[1].z + 0.1 + 0.1 * 9.81 / k).abs() < 1e-9, "{}", x[1].z);
         // Four stages' work: at least one iteration each.
         assert!(r.iterations >= 4, "{}", r.iterations);
