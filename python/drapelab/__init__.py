@@ -118,6 +118,14 @@ class Result:
         self.nx = nx
         self.ny = ny
 
+    @property
+    def neutral_modes(self) -> List[Dict[str, Any]]:
+        """The rigid motions the converged drape is free to make (``run.json``'s
+        ``neutral_modes``): each a dict with ``kind`` ("slide" or "turn"), ``axis``, a point
+        ``through_m`` of a turn's axis and ``curvature_rel``. Empty when there are none (and for a
+        state that is no converged static drape). A sensitivity is the one orthogonal to them."""
+        return list(self.run.get("neutral_modes") or [])
+
     def sensitivity(self, key: str) -> np.ndarray:
         """How each particle of the converged drape moves per unit of the scene key ``key``
         (``simulate(..., sensitivity=[key])``): an ``(n, 3)`` float64 array dx*/dθ, m per unit of

@@ -346,3 +346,33 @@ fn a_start_that_the_scene_cannot_have_is_refused_naming_the_particle() {
         assert!(!out.exists(), "{name}: {} left behind", out.display());
     }
 }
+
+/// Issue 78: run.json says which rigid motions a converged equilibrium is free to make. The wool
+/// sheet held at its centre on a frictionless sphere may turn about the vertical through the pin
+/// (its sensitivities are the ones orthogonal to that turn); the hanging net held at four corners
+/// has none.
+#[test]
+fn run_json_lists_the_neutral_modes_of_the_equilibrium() {
+    let tmp = tempfile::tempdir().unwrap();
+    let modes = |scene: &Path, name: &str| {
+        let out = tmp.path().join(name);
+        let o = drapelab()
+            .arg("simulate")
+            .arg(scene)
+            .args(["--out", out.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        run_json(&out)["neutral_modes"].clone()
+    };
+    let sphere = modes(&root().join("datasets/scenes/sphere_wool.toml"), "sphere");
+    let list = sphere.as_array().expect("a list");
+    assert_eq!(list.len(), 1, "{sphere}");
+    assert_eq!(list[0]["kind"], "turn");
+    let axis: Vec<f64> = serde_json::from_value(list[0]["axis"].clone()).unwrap();
+    assert_eq!(axis, vec![0.0, 0.0, 1.0]);
+    let through: Vec<f64> = serde_json::from_value(list[0]["through_m"].clone()).unwrap();
+    assert!(through[0].abs() < 1e-12 && through[1].abs() < 1e-12, "{through:?}");
+    let hang = modes(&hang4(), "hang4");
+    assert_eq!(hang.as_array().map(Vec::len), Some(0), "{hang}");
+}

@@ -81,6 +81,14 @@ def test_sensitivity_equals_the_command_lines_table_and_a_central_difference(tmp
         drapelab.simulate(HANG4, sensitivity=["cloth.nx"])
 
 
+def test_a_drape_free_to_turn_lists_its_neutral_mode():
+    r = drapelab.simulate(ROOT / "datasets/scenes/sphere_wool.toml", set={"cloth.nx": 21, "cloth.ny": 21})
+    assert r.converged
+    (mode,) = r.neutral_modes
+    assert mode["kind"] == "turn" and mode["axis"] == [0.0, 0.0, 1.0]
+    assert drapelab.simulate(HANG4).neutral_modes == []
+
+
 def test_a_drape_with_friction_refuses_sensitivities_naming_friction():
     rod = HANG4.parent / "rod_polyester.toml"
     key = "contact.friction_coefficient"

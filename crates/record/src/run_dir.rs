@@ -35,6 +35,11 @@ struct RunRecord<'a> {
     /// The sensitivities asked for (`--sensitivity`): written, or why not.
     #[serde(skip_serializing_if = "Option::is_none")]
     sensitivity: Option<SensitivityRecord>,
+    /// The rigid motions the converged equilibrium is free to make (a turn about a held point on
+    /// a frictionless sphere), empty when none; absent for a run that is no converged static
+    /// equilibrium. A sensitivity is the one orthogonal to them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    neutral_modes: Option<Vec<drapelab_core::solve::NeutralMode>>,
     /// The saved state the solve started from (`--start`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     start_file: Option<String>,
@@ -299,6 +304,8 @@ fn simulate_into(
             .then(|| drapelab_core::measure::drape_measures(scene, &x)),
         self_contact: drapelab_core::simulate::self_contact_summary(scene, &model, &x),
         sensitivity,
+        neutral_modes: (report.is_converged() && scene.solver.kind.integrator().is_none())
+            .then(|| drapelab_core::solve::neutral_modes(&model, &x)),
         start_file: extras.start.as_ref().map(|s| s.1.clone()),
         scene,
     };

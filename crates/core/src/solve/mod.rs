@@ -11,6 +11,7 @@ mod equilibrium;
 mod incremental;
 mod kind;
 mod linear;
+mod neutral;
 mod newton;
 mod report;
 mod sag;
@@ -28,6 +29,7 @@ pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use kind::{SolverKind, by_report_name};
 pub use linear::{DofMap, SparseSpd};
+pub use neutral::{NEUTRAL_REL, NeutralMode, neutral_modes};
 pub use newton::{NeighbourFactor, StaticOptions, is_minimum, solve_static, solve_static_loads};
 pub use report::{
     Divergence, DivergenceReason, Globalization, Part, SolveReport, Status, StopReason,
