@@ -187,6 +187,42 @@ pub fn load_scene(path: &Path, sets: &[String]) -> Result<LoadedScene, InputErro
     })
 }
 
+/// [`load_scene`] with the scene's material replaced by the fabric file `fabric` (`--fabric`,
+/// relative to the working folder).
+pub fn load_scene_in_fabric(
+    path: &Path,
+    sets: &[String],
+    fabric: &Path,
+) -> Result<LoadedScene, InputError> {
+    let flag = format!("--fabric {}", fabric.display());
+    if !fabric.is_file() {
+        return Err(InputError::new(flag, "", "not a file"));
+    }
+    let absolute =
+        std::path::absolute(fabric).map_err(|e| InputError::new(&flag, "", e.to_string()))?;
+    let mut overrides = sets
+        .iter()
+        .map(|s| parse_override(s))
+        .collect::<Result<Vec<_>, InputError>>()?;
+    let given = overrides.len();
+    let mut material = toml::Table::new();
+    material.insert(
+        "fabric".into(),
+        toml::Value::String(absolute.display().to_string()),
+    );
+    overrides.push(("material".into(), toml::Value::Table(material)));
+    Scene::load(path, &overrides).map_err(|e| {
+        match crate::config::override_culprit(&e.key, &overrides[..given]) {
+            Some(i) => InputError::new(
+                format!("--set {} (over {})", sets[i], path.display()),
+                e.key,
+                e.message,
+            ),
+            None => e,
+        }
+    })
+}
+
 /// Runs the parsed command line; returns the exit code.
 pub fn run(cli: Cli) -> Result<i32> {
     let quiet = cli.quiet;

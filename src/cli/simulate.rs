@@ -30,6 +30,11 @@ pub struct SimulateArgs {
     /// scene and grid) instead of the scene's own start: a restart.
     #[arg(long, value_name = "FILE")]
     pub start: Option<PathBuf>,
+    /// Drape the scene in this fabric: its material (and its areal density, where the file gives
+    /// one) from a fabric file as a calibration writes it, in place of the scene's [material].
+    /// The same as `[material] fabric = "FILE"` in the scene.
+    #[arg(long, value_name = "FILE")]
+    pub fabric: Option<PathBuf>,
     /// Also write the converged drape as drape.obj (Wavefront OBJ, metres; every particle a
     /// vertex in particles.parquet's order) for Blender, MeshLab or a CAD tool.
     /// triangles.parquet (the same faces as row indices) is written beside every state.
@@ -42,7 +47,7 @@ pub fn run(a: SimulateArgs, quiet: bool) -> Result<i32> {
     simulate(
         &a.scene,
         &a.out,
-        &a.set,
+        (&a.set, a.fabric.as_deref()),
         (&a.sensitivity, a.start.as_deref(), a.obj),
         quiet,
     )
@@ -52,11 +57,14 @@ pub fn run(a: SimulateArgs, quiet: bool) -> Result<i32> {
 fn simulate(
     scene: &Path,
     out: &Path,
-    set: &[String],
+    (set, fabric): (&[String], Option<&Path>),
     (sensitivity, start, obj): (&[String], Option<&Path>, bool),
     quiet: bool,
 ) -> Result<i32> {
-    let loaded = load_scene(scene, set)?;
+    let loaded = match fabric {
+        Some(f) => super::load_scene_in_fabric(scene, set, f)?,
+        None => load_scene(scene, set)?,
+    };
     crate::build::check_something_free(&loaded)?;
     for key in sensitivity {
         crate::sensitivity::check_key(&loaded.scene, key, "--sensitivity")?;

@@ -11,6 +11,7 @@ mod dynamics;
 mod edges;
 mod engine;
 mod equilibria;
+mod fabrics;
 mod layering;
 mod loads;
 mod patterns;

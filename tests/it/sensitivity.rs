@@ -372,7 +372,10 @@ fn run_json_lists_the_neutral_modes_of_the_equilibrium() {
     let axis: Vec<f64> = serde_json::from_value(list[0]["axis"].clone()).unwrap();
     assert_eq!(axis, vec![0.0, 0.0, 1.0]);
     let through: Vec<f64> = serde_json::from_value(list[0]["through_m"].clone()).unwrap();
-    assert!(through[0].abs() < 1e-12 && through[1].abs() < 1e-12, "{through:?}");
+    assert!(
+        through[0].abs() < 1e-12 && through[1].abs() < 1e-12,
+        "{through:?}"
+    );
     let hang = modes(&hang4(), "hang4");
     assert_eq!(hang.as_array().map(Vec::len), Some(0), "{hang}");
 }

@@ -136,7 +136,7 @@ pub struct Rigidities {
 }
 
 /// Continuum material as given in a scene: KES units of seed 003 Table 10.3 or SI, never both.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Continuum {
     /// Tensile rigidity, warp (x), in gf/cm (Table 10.3 unit).
@@ -271,6 +271,10 @@ pub struct Material {
     pub mass_spring: Option<MassSpring>,
     /// Continuum rigidities (seed 003).
     pub continuum: Option<Continuum>,
+    /// A fabric file (relative to the scene file) whose material model the scene takes instead of
+    /// giving one here ([`crate::scene::Fabric`]): what a calibration writes. Default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fabric: Option<std::path::PathBuf>,
 }
 
 #[cfg(test)]

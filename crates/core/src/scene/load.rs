@@ -36,6 +36,7 @@ impl Scene {
             let mut scene: Scene = from_table(path, "", table)?;
             scene.cloth.read_mesh(path)?;
             super::body::read_bodies(&mut scene.obstacles, path)?;
+            super::fabric::apply_fabric(&mut scene, path)?;
             Ok(scene)
         };
         let mut scene = with(&|_| true)?;

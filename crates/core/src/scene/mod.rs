@@ -12,12 +12,14 @@ use std::path::PathBuf;
 
 mod body;
 mod check;
+mod fabric;
 mod grid;
 mod load;
 mod mesh;
 
 pub use body::{carry_bodies, read_body};
 pub use check::{GRAVITY_M_PER_S2, MAGNITUDES, SHEET_SIDE_M, ValidatedScene};
+pub use fabric::{Fabric, FabricFile};
 pub use mesh::mesh_files_of;
 
 /// The sheet: size, resolution, spacing and areal density.
@@ -72,7 +74,9 @@ pub struct ClothSpec {
     /// For graded spacing: y coordinates in m of interior lines y = const, as `refine_x_m`.
     #[serde(default)]
     pub refine_y_m: Vec<f64>,
-    /// Areal density (mass per area) in kg/m² (45 g/m² = 0.045).
+    /// Areal density (mass per area) in kg/m² (45 g/m² = 0.045). Required unless the scene's
+    /// fabric file (`material.fabric`) gives it.
+    #[serde(default)]
     pub areal_density_kg_per_m2: f64,
     /// "square" (default) or "disc": the circle inscribed in the sheet, the grid particles outside it
     /// left out (a drape-tester specimen).
