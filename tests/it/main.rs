@@ -12,6 +12,7 @@ mod edges;
 mod engine;
 mod equilibria;
 mod fabrics;
+mod fuzz;
 mod layering;
 mod loads;
 mod patterns;

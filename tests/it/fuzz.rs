@@ -1,0 +1,193 @@
+//! Issue 78: a property test over mutated inputs. Bundled scenes (a grid net, a continuum sheet
+//! over a sphere, a sheet on a mesh body) with one value replaced by an extreme one (0, a negative,
+//! 1e300, NaN, a huge or wrong-typed value), a key deleted or an unknown key added, each run
+//! through `drapelab simulate` with a small iteration budget: no run panics, a refused input exits
+//! 2 with one line and leaves nothing, and a run that exits 0 or 1 writes a run.json whose status
+//! is one of the statuses.
+
+use crate::support::{drapelab, root};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// The values a mutation puts in place of a number, as TOML.
+const EXTREMES: [&str; 9] = [
+    "0", "0.0", "-1.0", "1e300", "nan", "inf", "-0.0", "\"text\"", "[1, 2]",
+];
+
+/// Every `key = value` line of a scene's text whose value starts like a number or a list.
+fn numeric_lines(text: &str) -> Vec<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            let v = l.split_once(" = ").map(|(_, v)| v.trim_start());
+            v.is_some_and(|v| v.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '['))
+        })
+        .map(|(k, _)| k)
+        .collect()
+}
+
+/// `text` with one mutation drawn by `rng`.
+fn mutated(text: &str, rng: &mut ChaCha8Rng) -> String {
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let numeric = numeric_lines(text);
+    let k = numeric[rng.random_range(0..numeric.len())];
+    match rng.random_range(0..4) {
+        0 => lines[k].clear(),
+        1 => lines.insert(k + 1, "unknown_key_m = 1.0".into()),
+        _ => {
+            let key = lines[k]
+                .split_once(" = ")
+                .map(|(k, _)| k.to_string())
+                .unwrap_or_default();
+            lines[k] = format!("{key} = {}", EXTREMES[rng.random_range(0..EXTREMES.len())]);
+        }
+    }
+    lines.join("\n") + "\n"
+}
+
+#[test]
+fn mutated_scenes_never_panic_and_every_exit_is_a_result_or_a_refusal() {
+    let scenes = [
+        root().join("datasets/scenes/hang4.toml"),
+        root().join("datasets/scenes/sphere_wool.toml"),
+        root().join("datasets/bodies/table_wool_mesh.toml"),
+    ];
+    let mut rng = ChaCha8Rng::seed_from_u64(78);
+    let dir = tempfile::tempdir().unwrap();
+    let mut outcomes = [0usize; 3];
+    for case in 0..60 {
+        let source = &scenes[case % scenes.len()];
+        // Relative mesh and fabric paths made absolute: the scene is written elsewhere.
+        let folder = source.parent().unwrap().display().to_string();
+        let original = std::fs::read_to_string(source)
+            .unwrap()
+            .replace("mesh = \"", &format!("mesh = \"{folder}/"))
+            .replace("fabric = \"", &format!("fabric = \"{folder}/"));
+        let text = mutated(&original, &mut rng);
+        let scene = dir.path().join(format!("case{case}.toml"));
+        std::fs::write(&scene, &text).unwrap();
+        let out = dir.path().join(format!("out{case}"));
+        let o = drapelab()
+            .args(["-q", "simulate"])
+            .arg(&scene)
+            .arg("--out")
+            .arg(&out)
+            .args([
+                "--set",
+                "solver.static.max_iterations=40",
+                "--set",
+                "cloth.nx=11",
+                "--set",
+                "cloth.ny=11",
+            ])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).to_string();
+        let code = o.status.code();
+        assert!(
+            matches!(code, Some(0..=2)),
+            "case {case}: exit {code:?}: {err}\n{text}"
+        );
+        if code == Some(2) {
+            assert_eq!(err.trim().lines().count(), 1, "case {case}: {err}");
+            assert!(
+                !out.exists(),
+                "case {case}: a refusal left {}",
+                out.display()
+            );
+            outcomes[2] += 1;
+            continue;
+        }
+        let run: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        let status = run["status"].as_str().unwrap_or_default();
+        let statuses = ["converged", "max-iterations", "diverged", "invalid"];
+        assert!(statuses.contains(&status), "case {case}: status {status:?}");
+        assert_eq!(
+            code == Some(0),
+            status == "converged",
+            "case {case}: exit {code:?}, {status}"
+        );
+        let message = run["report"]["message"].as_str().unwrap_or_default();
+        assert!(
+            !message.is_empty(),
+            "case {case}: {status} without a message\n{text}"
+        );
+        outcomes[code.unwrap() as usize] += 1;
+    }
+    eprintln!("exits 0 / 1 / 2: {outcomes:?}");
+    assert!(outcomes[2] > 10 && outcomes[0] > 5, "{outcomes:?}");
+}
+
+/// `obj` with one line mutated by `rng`: a vertex's coordinate made extreme, a face's index moved
+/// out of range or onto its neighbour's, a line deleted or doubled.
+fn mutated_obj(obj: &str, rng: &mut ChaCha8Rng) -> String {
+    let mut lines: Vec<String> = obj.lines().map(String::from).collect();
+    let k = rng.random_range(2..lines.len());
+    let words: Vec<String> = lines[k].split_whitespace().map(String::from).collect();
+    match (words.first().map(String::as_str), rng.random_range(0..4)) {
+        (Some("v"), 0) => lines[k] = format!("v {} {} nan", words[1], words[2]),
+        (Some("v"), 1) => lines[k] = format!("v 1e300 {} {}", words[2], words[3]),
+        (Some("f"), 0) => lines[k] = format!("f {} {} 99999", words[1], words[2]),
+        (Some("f"), 1) => lines[k] = format!("f {} {} {}", words[1], words[1], words[2]),
+        (_, 2) => lines[k].clear(),
+        _ => {
+            let copy = lines[k].clone();
+            lines.insert(k, copy);
+        }
+    }
+    lines.join("\n") + "\n"
+}
+
+/// The same property over mutated pattern meshes (the L-shaped panel on the sphere): a file that
+/// is no valid pattern is refused naming it (exit 2, one line, nothing written); one that still is
+/// drapes with a status.
+#[test]
+fn mutated_pattern_meshes_never_panic_and_every_exit_is_a_result_or_a_refusal() {
+    let folder = root().join("datasets/patterns");
+    let scene_text = std::fs::read_to_string(folder.join("l_panel_sphere.toml")).unwrap();
+    let obj = std::fs::read_to_string(folder.join("l_panel.obj")).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(49);
+    let dir = tempfile::tempdir().unwrap();
+    let mut outcomes = [0usize; 3];
+    for case in 0..30 {
+        std::fs::write(dir.path().join("l_panel.obj"), mutated_obj(&obj, &mut rng)).unwrap();
+        let scene = dir.path().join("scene.toml");
+        std::fs::write(&scene, &scene_text).unwrap();
+        let out = dir.path().join(format!("out{case}"));
+        let o = drapelab()
+            .args(["-q", "simulate"])
+            .arg(&scene)
+            .arg("--out")
+            .arg(&out)
+            .args(["--set", "solver.static.max_iterations=30"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).to_string();
+        let code = o.status.code();
+        assert!(
+            matches!(code, Some(0..=2)),
+            "case {case}: exit {code:?}: {err}"
+        );
+        if code == Some(2) {
+            assert_eq!(err.trim().lines().count(), 1, "case {case}: {err}");
+            assert!(
+                err.contains("l_panel.obj") || err.contains("scene.toml"),
+                "{err}"
+            );
+            assert!(
+                !out.exists(),
+                "case {case}: a refusal left {}",
+                out.display()
+            );
+        } else {
+            assert!(out.join("run.json").is_file(), "case {case}: no run.json");
+        }
+        outcomes[code.unwrap() as usize] += 1;
+    }
+    eprintln!("exits 0 / 1 / 2: {outcomes:?}");
+    assert!(
+        outcomes[2] > 5 && outcomes[1] + outcomes[0] > 5,
+        "{outcomes:?}"
+    );
+}
