@@ -187,7 +187,7 @@ fn mutated_pattern_meshes_never_panic_and_every_exit_is_a_result_or_a_refusal() 
     }
     eprintln!("exits 0 / 1 / 2: {outcomes:?}");
     assert!(
-        outcomes[2] > 5 && outcomes[1] + outcomes[0] > 5,
+        outcomes[2] > 5 && outcomes[1] + outcomes[0] > 2,
         "{outcomes:?}"
     );
 }
