@@ -246,7 +246,8 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
              sensitivity: Sequence[str] = (),
              frames: int = 0,
              progress: Optional[Callable[[int, Optional[float], float, float], Any]] = None,
-             *, set: Optional[Mapping[str, Any]] = None) -> Result:
+             *, set: Optional[Mapping[str, Any]] = None,
+             fabric: Optional[PathLike] = None) -> Result:
     """Solves a scene as ``drapelab simulate`` does.
 
     Args:
@@ -261,6 +262,8 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
         progress: called as ``progress(index, time_s, max_residual_N, energy_J)`` at most every
             50 ms during the solve (``time_s`` None for a static solve); an exception it raises
             stops the solve and is raised again.
+        fabric: a fabric file (as a calibration writes it) whose material, and areal density where
+            it gives one, replace the scene's, as ``drapelab simulate --fabric FILE`` does.
 
     Returns:
         The :class:`Result`, converged or not (see its ``status``).
@@ -271,7 +274,12 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
     """
     if set is not None and overrides is not None:
         raise InputError("set: give overrides= (its new name) or set=, not both")
-    overrides_json = _json(dict(overrides if overrides is not None else (set or {})))
+    given = dict(overrides if overrides is not None else (set or {}))
+    if fabric is not None:
+        if not os.path.isfile(fabric):
+            raise InputError(f"fabric: {os.fspath(fabric)} is not a file")
+        given["material"] = {"fabric": os.path.abspath(fabric)}
+    overrides_json = _json(given)
     if isinstance(scene, Mapping):
         path, table = None, _json(dict(scene))
     else:

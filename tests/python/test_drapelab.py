@@ -89,6 +89,16 @@ def test_a_drape_free_to_turn_lists_its_neutral_mode():
     assert drapelab.simulate(HANG4).neutral_modes == []
 
 
+def test_a_scene_draped_in_a_fabric_file_equals_its_material_inline():
+    sphere = ROOT / "datasets/scenes/sphere_wool.toml"
+    wool = ROOT / "datasets/fabrics/wool_seed003.toml"
+    inline = drapelab.simulate(sphere, set={"cloth.nx": 21, "cloth.ny": 21})
+    in_fabric = drapelab.simulate(sphere, set={"cloth.nx": 21, "cloth.ny": 21}, fabric=wool)
+    assert inline.converged and np.array_equal(inline.positions, in_fabric.positions)
+    with pytest.raises(drapelab.InputError, match="fabric"):
+        drapelab.simulate(sphere, fabric=ROOT / "datasets/fabrics/nowhere.toml")
+
+
 def test_a_drape_with_friction_refuses_sensitivities_naming_friction():
     rod = HANG4.parent / "rod_polyester.toml"
     key = "contact.friction_coefficient"
