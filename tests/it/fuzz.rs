@@ -8,6 +8,7 @@
 use crate::support::{drapelab, root};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::path::Path;
 
 /// The values a mutation puts in place of a number, as TOML.
 const EXTREMES: [&str; 9] = [
@@ -45,6 +46,44 @@ fn mutated(text: &str, rng: &mut ChaCha8Rng) -> String {
     lines.join("\n") + "\n"
 }
 
+/// Runs `drapelab -q simulate SCENE --out OUT` with `sets` and checks the property: exit 0, 1 or
+/// 2; a refusal (2) is one line on stderr naming one of `names` and leaves nothing; a run (0 or 1)
+/// writes a run.json whose status is a status, with a message, and exits 0 exactly when it
+/// converged. Returns the exit code.
+fn checked_run(scene: &Path, out: &Path, sets: &[&str], names: &[&str], what: &str) -> usize {
+    let mut cmd = drapelab();
+    cmd.args(["-q", "simulate"])
+        .arg(scene)
+        .arg("--out")
+        .arg(out);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    let o = cmd.output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    let code = o.status.code();
+    assert!(matches!(code, Some(0..=2)), "{what}: exit {code:?}: {err}");
+    if code == Some(2) {
+        assert_eq!(err.trim().lines().count(), 1, "{what}: {err}");
+        assert!(names.iter().any(|n| err.contains(n)), "{what}: {err}");
+        assert!(!out.exists(), "{what}: a refusal left {}", out.display());
+        return 2;
+    }
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let status = run["status"].as_str().unwrap_or_default();
+    let statuses = ["converged", "max-iterations", "diverged", "invalid"];
+    assert!(statuses.contains(&status), "{what}: status {status:?}");
+    assert_eq!(
+        code == Some(0),
+        status == "converged",
+        "{what}: exit {code:?}, {status}"
+    );
+    let message = run["report"]["message"].as_str().unwrap_or_default();
+    assert!(!message.is_empty(), "{what}: {status} without a message");
+    code.unwrap() as usize
+}
+
 #[test]
 fn mutated_scenes_never_panic_and_every_exit_is_a_result_or_a_refusal() {
     let scenes = [
@@ -67,53 +106,13 @@ fn mutated_scenes_never_panic_and_every_exit_is_a_result_or_a_refusal() {
         let scene = dir.path().join(format!("case{case}.toml"));
         std::fs::write(&scene, &text).unwrap();
         let out = dir.path().join(format!("out{case}"));
-        let o = drapelab()
-            .args(["-q", "simulate"])
-            .arg(&scene)
-            .arg("--out")
-            .arg(&out)
-            .args([
-                "--set",
-                "solver.static.max_iterations=40",
-                "--set",
-                "cloth.nx=11",
-                "--set",
-                "cloth.ny=11",
-            ])
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr).to_string();
-        let code = o.status.code();
-        assert!(
-            matches!(code, Some(0..=2)),
-            "case {case}: exit {code:?}: {err}\n{text}"
-        );
-        if code == Some(2) {
-            assert_eq!(err.trim().lines().count(), 1, "case {case}: {err}");
-            assert!(
-                !out.exists(),
-                "case {case}: a refusal left {}",
-                out.display()
-            );
-            outcomes[2] += 1;
-            continue;
-        }
-        let run: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
-        let status = run["status"].as_str().unwrap_or_default();
-        let statuses = ["converged", "max-iterations", "diverged", "invalid"];
-        assert!(statuses.contains(&status), "case {case}: status {status:?}");
-        assert_eq!(
-            code == Some(0),
-            status == "converged",
-            "case {case}: exit {code:?}, {status}"
-        );
-        let message = run["report"]["message"].as_str().unwrap_or_default();
-        assert!(
-            !message.is_empty(),
-            "case {case}: {status} without a message\n{text}"
-        );
-        outcomes[code.unwrap() as usize] += 1;
+        let sets = [
+            "solver.static.max_iterations=40",
+            "cloth.nx=11",
+            "cloth.ny=11",
+        ];
+        let what = format!("case {case}\n{text}");
+        outcomes[checked_run(&scene, &out, &sets, &["case", ".toml"], &what)] += 1;
     }
     eprintln!("exits 0 / 1 / 2: {outcomes:?}");
     assert!(outcomes[2] > 10 && outcomes[0] > 5, "{outcomes:?}");
@@ -155,35 +154,9 @@ fn mutated_pattern_meshes_never_panic_and_every_exit_is_a_result_or_a_refusal() 
         let scene = dir.path().join("scene.toml");
         std::fs::write(&scene, &scene_text).unwrap();
         let out = dir.path().join(format!("out{case}"));
-        let o = drapelab()
-            .args(["-q", "simulate"])
-            .arg(&scene)
-            .arg("--out")
-            .arg(&out)
-            .args(["--set", "solver.static.max_iterations=30"])
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr).to_string();
-        let code = o.status.code();
-        assert!(
-            matches!(code, Some(0..=2)),
-            "case {case}: exit {code:?}: {err}"
-        );
-        if code == Some(2) {
-            assert_eq!(err.trim().lines().count(), 1, "case {case}: {err}");
-            assert!(
-                err.contains("l_panel.obj") || err.contains("scene.toml"),
-                "{err}"
-            );
-            assert!(
-                !out.exists(),
-                "case {case}: a refusal left {}",
-                out.display()
-            );
-        } else {
-            assert!(out.join("run.json").is_file(), "case {case}: no run.json");
-        }
-        outcomes[code.unwrap() as usize] += 1;
+        let sets = ["solver.static.max_iterations=30"];
+        let names = ["l_panel.obj", "scene.toml"];
+        outcomes[checked_run(&scene, &out, &sets, &names, &format!("case {case}"))] += 1;
     }
     eprintln!("exits 0 / 1 / 2: {outcomes:?}");
     assert!(

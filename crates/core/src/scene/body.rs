@@ -26,17 +26,7 @@ pub(super) fn read_bodies(obstacles: &mut [Obstacle], scene_path: &Path) -> Resu
                 );
                 return Err(InputError::new(scene_path, key("mesh_unit_m"), m));
             }
-            let path = match scene_path.parent() {
-                Some(dir) if mesh.is_relative() => dir.join(&*mesh),
-                _ => mesh.clone(),
-            };
-            if !path.is_file() {
-                let m = format!(
-                    "{} is not a file (a relative path is read from the scene file's folder)",
-                    path.display()
-                );
-                return Err(InputError::new(scene_path, key("mesh"), m));
-            }
+            let path = super::load::named_file(scene_path, mesh, &key("mesh"))?;
             *body = Some(Arc::new(read_body(&path, *mesh_unit_m)?));
         }
     }

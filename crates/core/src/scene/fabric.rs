@@ -148,17 +148,7 @@ pub(super) fn apply_fabric(scene: &mut super::Scene, scene_path: &Path) -> Resul
             "give either a fabric file or [material.continuum] / [material.mass_spring], not both",
         ));
     }
-    let path = match scene_path.parent() {
-        Some(dir) if file.is_relative() => dir.join(&file),
-        _ => file.clone(),
-    };
-    if !path.is_file() {
-        let m = format!(
-            "{} is not a file (a relative path is read from the scene file's folder)",
-            path.display()
-        );
-        return Err(InputError::new(scene_path, "material.fabric", m));
-    }
+    let path = super::load::named_file(scene_path, &file, "material.fabric")?;
     let fabric = Fabric::read(&path)?;
     let mut material = fabric.material();
     material.fabric = Some(file);

@@ -64,20 +64,7 @@ impl ClothSpec {
                 ),
             ));
         }
-        let path = match scene_path.parent() {
-            Some(dir) if file.is_relative() => dir.join(file),
-            _ => file.clone(),
-        };
-        if !path.is_file() {
-            return Err(InputError::new(
-                scene_path,
-                "cloth.mesh",
-                format!(
-                    "{} is not a file (a relative path is read from the scene file's folder)",
-                    path.display()
-                ),
-            ));
-        }
+        let path = super::load::named_file(scene_path, file, "cloth.mesh")?;
         let pattern = crate::pattern::read_obj(&path, self.mesh_unit_m)?;
         self.pattern = Some(std::sync::Arc::new(pattern));
         Ok(())
