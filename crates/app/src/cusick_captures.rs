@@ -6,7 +6,8 @@
 //! The interval holds the specimen-to-specimen variation the model cannot know: it is the
 //! prediction plus the 5 % and 95 % quantiles of the residuals (measured − predicted) of every
 //! *other* fabric's captures of the same kind (known face, or face average) — leave one fabric
-//! out, never this fabric's own data. With fewer than [`MIN_POOL`] such residuals (a dataset of
+//! out, never this fabric's own data — widened to hold the prediction itself where those residuals
+//! lie all on one side (issue 78: a point is never outside its own interval). With fewer than [`MIN_POOL`] such residuals (a dataset of
 //! one or two fabrics) it falls back to ±1.645 of the model's own spread (its seeds' DC SD and the
 //! calibration specimen's), and says so.
 
@@ -184,9 +185,11 @@ pub fn fill_intervals(rows: &mut [CaptureRow], spread: impl Fn(i32) -> f64) {
             .collect();
         pool.sort_by(f64::total_cmp);
         let (lo, hi, how) = if pool.len() >= MIN_POOL {
+            // Widened to hold the point itself where the others' residuals lie all on one side
+            // (a model biased on them): a prediction is never outside its own interval.
             (
-                quantile(&pool, 0.05),
-                quantile(&pool, 0.95),
+                quantile(&pool, 0.05).min(0.0),
+                quantile(&pool, 0.95).max(0.0),
                 "leave-one-fabric-out",
             )
         } else {
@@ -305,6 +308,22 @@ pub(crate) mod tests {
         fill_intervals(&mut mixed, |_| 1.0);
         let u = mixed.last().unwrap();
         assert!(u.dc_high_pct >= 50.0 + 49.0, "{u:?}");
+        // The others' residuals all positive (a model that predicts too low on them): the
+        // interval reaches down to the point itself, never above it.
+        let mut biased: Vec<CaptureRow> = (0..21)
+            .map(|k| row(2 + k % 3, "up", 55.0 + k as f64 * 0.5, 50.0))
+            .collect();
+        biased.push(row(1, "up", 60.0, 50.0));
+        fill_intervals(&mut biased, |_| 1.0);
+        for r in &biased {
+            assert!(
+                r.dc_low_pct <= r.dc_predicted_pct && r.dc_predicted_pct <= r.dc_high_pct,
+                "{r:?}"
+            );
+        }
+        let own = biased.last().unwrap();
+        assert_eq!(own.dc_low_pct, 50.0);
+        assert!(own.dc_high_pct > 60.0, "{own:?}");
         // One fabric alone: the model's own spread.
         let mut lone = vec![row(5, "up", 52.0, 50.0), row(5, "down", 49.0, 50.0)];
         fill_intervals(&mut lone, |_| 2.0);
