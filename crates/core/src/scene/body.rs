@@ -26,7 +26,7 @@ pub(super) fn read_bodies(obstacles: &mut [Obstacle], scene_path: &Path) -> Resu
                 );
                 return Err(InputError::new(scene_path, key("mesh_unit_m"), m));
             }
-            let path = super::load::named_file(scene_path, mesh, &key("mesh"))?;
+            let path = super::files::named_file(scene_path, mesh, &key("mesh"))?;
             *body = Some(Arc::new(read_body(&path, *mesh_unit_m)?));
         }
     }

@@ -148,7 +148,7 @@ pub(super) fn apply_fabric(scene: &mut super::Scene, scene_path: &Path) -> Resul
             "give either a fabric file or [material.continuum] / [material.mass_spring], not both",
         ));
     }
-    let path = super::load::named_file(scene_path, &file, "material.fabric")?;
+    let path = super::files::named_file(scene_path, &file, "material.fabric")?;
     let fabric = Fabric::read(&path)?;
     let mut material = fabric.material();
     material.fabric = Some(file);

@@ -166,25 +166,3 @@ fn rename_into(
     t.insert(new.into(), toml::Value::String(value.into()));
     Ok(())
 }
-
-/// The file a scene names under `key` (`cloth.mesh`, `obstacles.N.mesh`, `material.fabric`): read
-/// from the scene file's folder when relative. An error naming the scene file and the key when it
-/// is not a file.
-pub(super) fn named_file(
-    scene_path: &Path,
-    file: &Path,
-    key: &str,
-) -> Result<std::path::PathBuf, InputError> {
-    let path = match scene_path.parent() {
-        Some(dir) if file.is_relative() => dir.join(file),
-        _ => file.to_path_buf(),
-    };
-    if !path.is_file() {
-        let m = format!(
-            "{} is not a file (a relative path is read from the scene file's folder)",
-            path.display()
-        );
-        return Err(InputError::new(scene_path, key, m));
-    }
-    Ok(path)
-}

@@ -64,7 +64,7 @@ impl ClothSpec {
                 ),
             ));
         }
-        let path = super::load::named_file(scene_path, file, "cloth.mesh")?;
+        let path = super::files::named_file(scene_path, file, "cloth.mesh")?;
         let pattern = crate::pattern::read_obj(&path, self.mesh_unit_m)?;
         self.pattern = Some(std::sync::Arc::new(pattern));
         Ok(())

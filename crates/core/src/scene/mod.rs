@@ -13,6 +13,7 @@ use std::path::PathBuf;
 mod body;
 mod check;
 mod fabric;
+mod files;
 mod grid;
 mod load;
 mod mesh;
