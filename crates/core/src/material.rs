@@ -169,6 +169,18 @@ pub struct Continuum {
     pub bending_twist_N_m: Option<f64>,
     /// Thickness in m (informational; the model is a shell of zero thickness). Default none.
     pub thickness_m: Option<f64>,
+    /// Bending saturation, 1/m: the curvature κ₀ about which the bending moment levels off
+    /// (M = B κ / √(1 + (κ/κ₀)²), at most B κ₀), as inter-fibre friction makes it in fabric; the
+    /// Cusick calibration fits it as a multiple of 1/c. Default none (linear bending). Bends a mesh sheet (`cloth.mesh`) by hinges
+    /// ([`crate::physics::sewn_hinge_bending`]); a grid sheet refuses it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_saturation_per_m: Option<f64>,
+    /// Natural curl, 1/m: the curvature a free strip of the fabric rolls up to, positive toward
+    /// the pattern's +z side ([`crate::physics::hinge_curl`]); the Cusick calibration fits it from
+    /// the gap between face-up and face-down drapes. Default none (no curl). A mesh sheet's; a
+    /// grid sheet refuses it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curl_per_m: Option<f64>,
 }
 
 /// Converts gf/cm to N/m.

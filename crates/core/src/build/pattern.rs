@@ -7,8 +7,8 @@
 use crate::material::Rigidities;
 use crate::pattern::Pattern;
 use crate::physics::{
-    EnergyTerm, Membrane, MembraneError, ModelBuilder, SewnSheet, patch_bending, reads_creases,
-    sewn_hinge_bending,
+    EnergyTerm, Membrane, MembraneError, ModelBuilder, SewnSheet, hinge_curl, patch_bending,
+    reads_creases, sewn_hinge_bending,
 };
 
 /// A pattern and its fabric.
@@ -19,6 +19,10 @@ pub struct PatternSheet<'a> {
     pub rigidities: &'a Rigidities,
     /// The warp's angle from the pattern's +x, rad.
     pub warp_angle_rad: f64,
+    /// The curvature beyond which the bending moment levels off, 1/m (∞: linear bending).
+    pub bending_saturation_per_m: f64,
+    /// The natural curl, 1/m ([`crate::physics::hinge_curl`]); none: no curl term.
+    pub curl_per_m: Option<f64>,
     /// Areal density, kg/m².
     pub areal_density_kg_per_m2: f64,
 }
@@ -63,7 +67,11 @@ pub fn pattern_builder(
     };
     b.term(Box::new(Membrane::sewn(&sewn, sheet.warp_angle_rad, y)?));
     if r.bending_warp_N_m > 0.0 || r.bending_weft_N_m > 0.0 {
-        b.term(bending(&sewn, r, sheet.warp_angle_rad));
+        b.term(bending(&sewn, sheet));
+    }
+    if let Some(curl) = sheet.curl_per_m {
+        let mean = (r.bending_warp_N_m * r.bending_weft_N_m).sqrt();
+        b.term(Box::new(hinge_curl(&sewn, mean, curl)));
     }
     b.gravity();
     Ok(b)
@@ -73,15 +81,18 @@ pub fn pattern_builder(
 /// ([`patch_bending`], exact on quadratics, the grid's twist rigidity included) where the patches
 /// read every crease as curvature across it ([`reads_creases`]: a grid split along one diagonal),
 /// else orthotropic hinges ([`sewn_hinge_bending`], which charge every crease but read twist and
-/// bending across the diagonals two to three times the plate's).
-fn bending(sewn: &SewnSheet<'_>, r: &Rigidities, warp_angle_rad: f64) -> Box<dyn EnergyTerm> {
+/// bending across the diagonals two to three times the plate's). A saturating law bends by hinges
+/// (seed 000's Cusick model: [`sewn_hinge_bending`] with its κ₀).
+fn bending(sewn: &SewnSheet<'_>, sheet: &PatternSheet<'_>) -> Box<dyn EnergyTerm> {
+    let (r, warp_angle_rad) = (sheet.rigidities, sheet.warp_angle_rad);
     let b = [r.bending_warp_N_m, r.bending_weft_N_m];
-    let patch = reads_creases(sewn)
+    let kappa0 = sheet.bending_saturation_per_m;
+    let patch = (reads_creases(sewn) && kappa0 == f64::INFINITY)
         .then(|| patch_bending(sewn, [b[0], b[1], r.bending_twist_N_m], warp_angle_rad))
         .flatten();
     match patch {
         Some(p) => Box::new(p),
-        None => Box::new(sewn_hinge_bending(sewn, b, warp_angle_rad, f64::INFINITY)),
+        None => Box::new(sewn_hinge_bending(sewn, b, warp_angle_rad, kappa0)),
     }
 }
 
@@ -92,16 +103,18 @@ pub(super) fn build_mesh_scene(
     scene: &crate::scene::ValidatedScene,
     pattern: &Pattern,
 ) -> super::BuiltScene {
-    let r = scene
+    let c = scene
         .material
         .continuum
         .as_ref()
-        .and_then(|c| c.rigidities().ok())
         .expect("validated mesh scene: continuum material");
+    let r = c.rigidities().expect("validated rigidities");
     let sheet = PatternSheet {
         pattern,
         rigidities: &r,
         warp_angle_rad: scene.cloth.warp_angle_deg.to_radians(),
+        bending_saturation_per_m: c.bending_saturation_per_m.unwrap_or(f64::INFINITY),
+        curl_per_m: c.curl_per_m,
         areal_density_kg_per_m2: scene.cloth.areal_density_kg_per_m2,
     };
     let pinned = scene.pinned_group_vertices();
@@ -186,6 +199,8 @@ mod tests {
                 pattern: &pattern,
                 rigidities: &r,
                 warp_angle_rad: angle,
+                bending_saturation_per_m: f64::INFINITY,
+                curl_per_m: None,
                 areal_density_kg_per_m2: rho,
             };
             let mut model = pattern_builder(&sheet, g, &pattern.groups["top"])
@@ -254,6 +269,8 @@ mod tests {
             pattern: &pattern,
             rigidities: &r,
             warp_angle_rad: 0.0,
+            bending_saturation_per_m: f64::INFINITY,
+            curl_per_m: None,
             areal_density_kg_per_m2: 0.19,
         };
         // The corner vertex (5, 5) sits on the sphere's top.

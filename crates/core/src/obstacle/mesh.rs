@@ -180,11 +180,17 @@ impl TriangleBody {
         at
     }
 
-    /// The closest point of the surface to `p`: (distance, triangle, barycentric weights).
-    fn closest(&self, p: &V3) -> (f64, u32, [f64; 3]) {
-        let mut best = (f64::INFINITY, 0, [1.0, 0.0, 0.0]);
-        let mut stack = vec![0u32];
-        while let Some(i) = stack.pop() {
+    /// The closest point of the surface to `p` nearer than `reach`: (distance, triangle,
+    /// barycentric weights); none where no triangle lies within `reach` (boxes farther are pruned
+    /// at once, so a short reach answers far points from the root).
+    fn closest_within(&self, p: &V3, reach: f64) -> Option<(f64, u32, [f64; 3])> {
+        let mut best = (reach, u32::MAX, [1.0, 0.0, 0.0]);
+        // A median split halves every run: the depth stays below 64 for any mesh that fits in memory.
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let i = stack[top];
             let node = &self.nodes[i as usize];
             if box_distance(&node.bounds, p) >= best.0 {
                 continue;
@@ -197,8 +203,9 @@ impl TriangleBody {
                     box_distance(&self.nodes[r as usize].bounds, p),
                 );
                 let (near, far) = if dl <= dr { (l, r) } else { (r, l) };
-                stack.push(far);
-                stack.push(near);
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
                 continue;
             }
             for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
@@ -210,7 +217,7 @@ impl TriangleBody {
                 }
             }
         }
-        best
+        (best.1 != u32::MAX).then_some(best)
     }
 
     /// The pseudo-normal of the feature of triangle `t` that the weights `w` name: the face's own
@@ -232,16 +239,24 @@ impl TriangleBody {
     /// the distance there: along p − c from the closest point c, its sign from the closest
     /// feature's pseudo-normal; the pseudo-normal itself on the surface.
     pub fn signed_distance(&self, p: &V3) -> (f64, V3) {
-        let (d, t, w) = self.closest(p);
+        self.signed_distance_within(p, f64::INFINITY)
+            .expect("a body has triangles")
+    }
+
+    /// [`TriangleBody::signed_distance`] where the surface lies nearer than `reach` (m); none where
+    /// it does not (then the point is farther than `reach` outside, or deeper than `reach` inside:
+    /// a barrier of band `reach` needs no more).
+    pub fn signed_distance_within(&self, p: &V3, reach: f64) -> Option<(f64, V3)> {
+        let (d, t, w) = self.closest_within(p, reach)?;
         let tri = self.triangles[t as usize];
         let c: V3 = (0..3).map(|k| self.vertices[tri[k] as usize] * w[k]).sum();
         let pn = self.feature_normal(t, &w);
         let r = p - c;
         let sign = if r.dot(&pn) < 0.0 { -1.0 } else { 1.0 };
-        match r.try_normalize(1e-300) {
+        Some(match r.try_normalize(1e-300) {
             Some(u) if d > 1e-12 * self.bounds_size() => (sign * d, u * sign),
             _ => (sign * d, pn),
-        }
+        })
     }
 
     fn bounds_size(&self) -> f64 {
@@ -481,6 +496,31 @@ mod tests {
                 .fold(f64::INFINITY, f64::min);
             assert_eq!(body.signed_distance(&p).0.abs(), brute, "{p}");
         }
+    }
+
+    /// The query with a reach answers exactly as the full one where the surface lies within the
+    /// reach (inside or outside) and none where it does not.
+    #[test]
+    fn a_query_within_a_reach_is_the_full_query_or_none_beyond_it() {
+        let (v, t) = icosphere(0.1, 3);
+        let body = TriangleBody::new(v, t).expect("a valid mesh");
+        let (mut near, mut far) = (0, 0);
+        for k in 0..400 {
+            let s = k as f64;
+            let p = V3::new((s * 0.71).sin(), (s * 1.37).cos(), (s * 0.29).sin()) * 0.13;
+            let full = body.signed_distance(&p);
+            match body.signed_distance_within(&p, 0.01) {
+                Some(within) => {
+                    assert_eq!(within, full, "{p}");
+                    near += 1;
+                }
+                None => {
+                    assert!(full.0.abs() >= 0.01, "{p}: {}", full.0);
+                    far += 1;
+                }
+            }
+        }
+        assert!(near > 20 && far > 20, "{near} near, {far} far");
     }
 
     #[test]

@@ -249,6 +249,19 @@ impl Obstacle {
         }
     }
 
+    /// [`Obstacle::signed_distance`] where the surface lies nearer than `reach` (m), else none: a
+    /// mesh body answers far points from its hierarchy's root ([`TriangleBody::signed_distance_within`]).
+    pub fn signed_distance_within(&self, p: &Vector3<f64>, r: f64) -> Option<(f64, Vector3<f64>)> {
+        match self {
+            Obstacle::Mesh {
+                offset_m,
+                body: Some(b),
+                ..
+            } => b.signed_distance_within(&(p - v(*offset_m)), r),
+            _ => Some(self.signed_distance(p)).filter(|(d, _)| *d < r),
+        }
+    }
+
     /// Height of the obstacle's upper surface on the vertical through (x, y), if the vertical meets it
     /// (the vertical-gap method of §10.7.1 pulls a node that went inside back up to it).
     pub fn top_at(&self, x: f64, y: f64) -> Option<f64> {

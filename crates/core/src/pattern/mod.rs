@@ -12,6 +12,7 @@
 //! and `l` polylines) that pins and clamps can address.
 
 mod checks;
+mod refine;
 
 use checks::{connected, manifold, off_plane, oriented, rest_layout, unused_vertex};
 use std::collections::BTreeMap;

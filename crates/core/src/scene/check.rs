@@ -192,6 +192,7 @@ in the key's unit (SI)",
                 }
                 ck.nonneg("material.continuum.shear", r.shear_N_per_m)?;
                 ck.nonneg("material.continuum.bending_twist", r.bending_twist_N_m)?;
+                self.check_hinge_keys(ck, cont)?;
             }
         }
         Ok(())

@@ -41,6 +41,10 @@ pub fn mesh_files_of(scene_path: &Path) -> Vec<std::path::PathBuf> {
         .collect()
 }
 
+/// The most uniform refinements a scene may ask of its mesh (`cloth.mesh_refine`): 4⁴ = 256 times
+/// the file's triangles.
+const MAX_MESH_REFINE: usize = 4;
+
 impl ClothSpec {
     /// Whether the sheet is a mesh (`cloth.mesh`) rather than the grid.
     pub fn is_mesh(&self) -> bool {
@@ -64,8 +68,21 @@ impl ClothSpec {
                 ),
             ));
         }
+        if self.mesh_refine > MAX_MESH_REFINE {
+            return Err(InputError::new(
+                scene_path,
+                "cloth.mesh_refine",
+                format!(
+                    "must be at most {MAX_MESH_REFINE} (each level multiplies the particles by about 4), got {}",
+                    self.mesh_refine
+                ),
+            ));
+        }
         let path = super::files::named_file(scene_path, file, "cloth.mesh")?;
-        let pattern = crate::pattern::read_obj(&path, self.mesh_unit_m)?;
+        let mut pattern = crate::pattern::read_obj(&path, self.mesh_unit_m)?;
+        for _ in 0..self.mesh_refine {
+            pattern = pattern.refined();
+        }
         self.pattern = Some(std::sync::Arc::new(pattern));
         Ok(())
     }
@@ -73,9 +90,10 @@ impl ClothSpec {
 
 impl ClothSpec {
     /// Takes `from`'s pattern over to this copy of its cloth (a scene rebuilt from its table, where
-    /// the pattern is not serialized): the same file, rescaled when `mesh_unit_m` changed.
+    /// the pattern is not serialized): the same file and refinement, rescaled when `mesh_unit_m`
+    /// changed.
     pub fn carry_pattern(&mut self, from: &ClothSpec) {
-        if self.mesh != from.mesh {
+        if self.mesh != from.mesh || self.mesh_refine != from.mesh_refine {
             return;
         }
         self.pattern = from.pattern.as_ref().map(|p| {
@@ -202,6 +220,7 @@ from the file: leave it out"
         }
         let mesh_keys = [
             ("cloth.mesh_unit_m", c.mesh_unit_m != 1.0),
+            ("cloth.mesh_refine", c.mesh_refine != 0),
             ("cloth.warp_angle_deg", c.warp_angle_deg != 0.0),
             (
                 "cloth.rotation_deg",
@@ -214,6 +233,36 @@ from the file: leave it out"
                 key,
                 "is a mesh sheet's key (with cloth.mesh); the grid's warp runs along x".into(),
             );
+        }
+        Ok(())
+    }
+
+    /// The keys only hinges bend by (saturation, curl): finite, the saturation > 0, and a mesh
+    /// sheet to bend (a grid's bending is linear along its lines).
+    pub(super) fn check_hinge_keys(
+        &self,
+        ck: &Check<'_>,
+        cont: &crate::material::Continuum,
+    ) -> Result<(), InputError> {
+        let keys = [
+            ("bending_saturation_per_m", cont.bending_saturation_per_m),
+            ("curl_per_m", cont.curl_per_m),
+        ];
+        for (k, v) in keys.iter().filter_map(|(k, v)| v.map(|v| (*k, v))) {
+            let key = format!("material.continuum.{k}");
+            if !self.cloth.is_mesh() {
+                return ck.err(
+                    &key,
+                    "bends a mesh sheet's hinges (cloth.mesh); a grid sheet's bending is linear along its lines: drape a pattern, or leave it out".into(),
+                );
+            }
+            match k {
+                "curl_per_m" if !v.is_finite() => {
+                    ck.err(&key, format!("must be finite, got {v}"))?
+                }
+                "bending_saturation_per_m" => ck.pos(&key, v)?,
+                _ => {}
+            }
         }
         Ok(())
     }

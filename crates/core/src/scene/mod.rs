@@ -49,6 +49,12 @@ pub struct ClothSpec {
     /// millimetres.
     #[serde(default = "default_unit", skip_serializing_if = "is_one")]
     pub mesh_unit_m: f64,
+    /// Uniform refinements of the mesh: each splits every triangle into four at its edges'
+    /// midpoints (particles about ×4, seams and groups kept; [`crate::pattern::Pattern::refined`]).
+    /// Default 0 (the file as it is); at most 4. Raise it to run a bundled pattern finer, lower it
+    /// with `--set` for a quick look.
+    #[serde(default, skip_serializing_if = "is_zero_count")]
+    pub mesh_refine: usize,
     /// The warp's direction in the mesh's plane, degrees from its +x towards +y (default 0: warp
     /// along x, as on the grid). Change it for a panel cut on the bias (45) or across the roll (90).
     #[serde(default, skip_serializing_if = "is_zero")]
