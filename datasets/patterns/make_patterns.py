@@ -167,6 +167,7 @@ def three_gore_skirt():
     outside the form down to its hips; 55 cm long (the hem 30 cm below the form's cut). A cone
     through a point is developable: each quad between two generators is planar, so the flat gores
     (vt, each gore's centre generator along -y, its grain) are the placed ones with no stretch.
+    Groups: the gores' faces (`front`, `back_left`, `back_right`), `waist` and `hem` (vertices).
     20 rows and 22 columns a gore (1,386 vertices); scenes refine it (cloth.mesh_refine)."""
     apex, z_w, z_hem = 0.75, 0.25, -0.30
     half_w, front, back = 0.140, 0.100, 0.105
@@ -191,7 +192,7 @@ def three_gore_skirt():
 
     offset = cols // 2
     t_of_row = lambda i: (apex - (z_w + (z_hem - z_w) * i / rows)) / (apex - z_w)
-    verts, vts, faces, waist, ids, tex = [], [], {}, [], {}, {}
+    verts, vts, faces, waist, hem, ids, tex = [], [], {}, [], [], {}, {}
 
     def vertex(i, k):
         key = (i, k % gens)
@@ -202,6 +203,8 @@ def three_gore_skirt():
             verts.append((t * x, t * y, apex + t * (z - apex)))
             if i == 0:
                 waist.append(ids[key])
+            if i == rows:
+                hem.append(ids[key])
         return ids[key]
 
     def texture(g, i, k):
@@ -241,6 +244,8 @@ def three_gore_skirt():
         lines += ["f " + f for f in fs]
     lines.append("g waist")
     lines.append("l " + " ".join(str(v + 1) for v in sorted(set(waist))))
+    lines.append("g hem")
+    lines.append("l " + " ".join(str(v + 1) for v in sorted(set(hem))))
     (HERE / "three_gore_skirt.obj").write_text("\n".join(lines) + "\n")
 
 

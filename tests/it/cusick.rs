@@ -191,7 +191,7 @@ fn a_missing_or_unreadable_photo_and_an_empty_fabric_exit_2_naming_the_file() {
 }
 
 /// Keeps only `fabrics` in a copied dataset's fabrics.csv and captures_index.csv.
-fn keep_fabrics(dataset: &std::path::Path, fabrics: &[&str]) {
+pub(crate) fn keep_fabrics(dataset: &std::path::Path, fabrics: &[&str]) {
     for name in ["fabrics.csv", "captures_index.csv"] {
         let path = dataset.join(name);
         let text = std::fs::read_to_string(&path).unwrap();

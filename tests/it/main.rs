@@ -13,6 +13,7 @@ mod engine;
 mod equilibria;
 mod fabrics;
 mod fuzz;
+mod garment;
 mod layering;
 mod loads;
 mod patterns;

@@ -45,6 +45,10 @@ pub struct CusickPredictParams {
     pub calibration: FabricSettings,
     /// The drape model (its bending length and anisotropy are what is calibrated).
     pub drape: DrapeParams,
+    /// The fabrics to calibrate and predict, by number; empty (the default) for every fabric of
+    /// the dataset. A pipeline that needs two fabrics' files names them here.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fabrics: Vec<i32>,
 }
 
 impl Default for CusickPredictParams {
@@ -56,6 +60,7 @@ impl Default for CusickPredictParams {
             subdivisions: 0,
             calibration: FabricSettings::default(),
             drape: DrapeParams::default(),
+            fabrics: Vec::new(),
         }
     }
 }
@@ -341,7 +346,17 @@ pub fn run(
     p: &CusickPredictParams,
 ) -> Result<Vec<PredictionRow>> {
     let files = &ctx.inputs;
-    let data = CusickDataset::open(files.index.parent().unwrap_or(std::path::Path::new(".")))?;
+    let mut data = CusickDataset::open(files.index.parent().unwrap_or(std::path::Path::new(".")))?;
+    if let Some(f) = p
+        .fabrics
+        .iter()
+        .find(|f| !data.fabrics.iter().any(|d| d.fabric == **f))
+    {
+        let m = format!("no fabric {f} in the dataset's fabrics.csv");
+        return Err(ctx.param_error("fabrics", m).into());
+    }
+    data.fabrics
+        .retain(|f| p.fabrics.is_empty() || p.fabrics.contains(&f.fabric));
     let shadows = read_table::<ShadowRow>(&files.shadows)?;
     let photo_outlines = outlines_by_capture(read_table::<OutlineRow>(&files.photo_outlines)?);
     let template = data.template()?;

@@ -15,6 +15,7 @@ pub mod benchmark;
 pub mod calibrate;
 pub mod calibration_tables;
 pub mod cusick_captures;
+pub mod cusick_fabric;
 pub mod cusick_face_prior;
 pub mod cusick_measure;
 pub mod cusick_node_prior;
@@ -23,6 +24,7 @@ pub mod cusick_tables;
 pub mod cusick_targets;
 pub mod defaults;
 pub mod fit_edges;
+pub mod garment;
 pub mod peers;
 pub mod scene_keys;
 pub mod score;
@@ -79,6 +81,7 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<crate::peers::PeerRow>()?,
         md::<crate::cusick_measure::ShadowRow>()?,
         md::<crate::cusick_tables::PredictionRow>()?,
+        md::<crate::garment::GarmentRow>()?,
         md::<crate::cusick_captures::CaptureRow>()?,
         md::<crate::cusick_tables::OutlineRow>()?,
         md::<crate::cusick_tables::ProfileRow>()?,

@@ -10,6 +10,7 @@ pub mod cusick_faces;
 pub mod cusick_plots;
 pub mod cusick_report;
 pub mod format;
+pub mod garment_report;
 pub mod montage;
 pub mod report;
 pub mod seed003_drawings;

@@ -9,10 +9,13 @@ mod benchmark;
 mod benchmark_report;
 mod calibrate;
 mod calibration_report;
+mod cusick_fabric;
 mod cusick_measure;
 mod cusick_predict;
 mod cusick_report;
 mod fit_edges;
+mod garment;
+mod garment_report;
 mod peers;
 pub mod report;
 mod score;
@@ -31,11 +34,14 @@ pub use benchmark::{Benchmark, BenchmarkParams};
 pub use benchmark_report::{BenchmarkReport, BenchmarkReportParams};
 pub use calibrate::{Calibrate, CalibrateParams};
 pub use calibration_report::{CalibrationReport, CalibrationReportParams};
+pub use cusick_fabric::{CusickFabric, CusickFabricParams};
 pub use cusick_measure::{CusickMeasure, CusickMeasureParams, ShadowRow, measure_dataset};
 pub use cusick_predict::{CusickPredict, CusickPredictParams};
 pub use cusick_report::{CusickReport, CusickReportParams, dc_within, nodes_within};
 pub use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 pub use fit_edges::{FitEdges, FitEdgesParams};
+pub use garment::{Garment, GarmentParams};
+pub use garment_report::{GarmentReport, GarmentReportParams};
 pub use peers::{Peers, PeersParams};
 pub use report::{Report, ReportParams};
 pub use score::{Score, ScoreParams};
@@ -138,6 +144,9 @@ pub fn registry() -> Registry {
         .with::<Skips>()
         .with::<CusickMeasure>()
         .with::<CusickPredict>()
+        .with::<CusickFabric>()
+        .with::<Garment>()
+        .with::<GarmentReport>()
         .with::<CusickReport>()
         .with::<Surface>()
 }

@@ -362,7 +362,7 @@ fn pseudo_normals(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A sphere of radius `r` centred at the origin: an icosahedron subdivided `levels` times, its

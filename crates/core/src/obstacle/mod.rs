@@ -3,7 +3,7 @@
 //! profile. Each gives a signed distance (positive outside, m) with its outward normal, and the height
 //! of its upper surface above a point (for the vertical-gap method of §10.7.1).
 
-mod mesh;
+pub(crate) mod mesh;
 
 pub use mesh::{BodyDefect, TriangleBody};
 
