@@ -244,25 +244,24 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
             "scene.toml",
         ),
     ];
-    // A mesh scene's run folder does not hold its pattern: `surface RUN` says so in one line.
+    // A mesh scene's run folder is dressed with the pattern beside the scene file it names; where
+    // that file is gone, `surface RUN` says so in one line, naming it.
+    let copied = dir.path().join("copied");
+    std::fs::create_dir_all(&copied).unwrap();
+    for f in ["l_panel_table.toml", "l_panel.obj"] {
+        std::fs::copy(root().join("datasets/patterns").join(f), copied.join(f)).unwrap();
+    }
     let run = dir.path().join("run");
-    assert!(
-        simulate_recorded(
-            &root().join("datasets/patterns/l_panel_table.toml"),
-            &run,
-            &[]
-        )
-        .status
-        .success()
-    );
+    let scene = copied.join("l_panel_table.toml");
+    assert!(simulate_recorded(&scene, &run, &[]).status.success());
+    let surface = |out: &Path| drapelab().arg("surface").arg(&run).arg("--out").arg(out).output();
+    let dressed = dir.path().join("dressed");
+    let o = surface(&dressed).unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dressed.join("drape.glb").is_file());
+    std::fs::remove_file(&scene).unwrap();
     let out = dir.path().join("surface");
-    let o = drapelab()
-        .arg("surface")
-        .arg(&run)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = surface(&out).unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert_eq!(
@@ -270,7 +269,7 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
         1,
         "{err}"
     );
-    assert!(err.contains("cloth.mesh") && !out.exists(), "{err}");
+    assert!(err.contains("scene_file") && !out.exists(), "{err}");
     for (text, key, file) in cases {
         let scene = dir.path().join("scene.toml");
         std::fs::write(&scene, &text).unwrap();

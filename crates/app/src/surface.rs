@@ -33,9 +33,29 @@ fn mesh_sheet(file: &Path, key: &str) -> InputError {
     InputError::new(
         file,
         key,
-        "a mesh sheet's run does not hold its pattern (the OBJ file beside the scene): dress the \
-scene file itself (`drapelab surface SCENE.toml`), which solves it",
+        "a mesh sheet's run reads its pattern beside the scene file it names, which is not there: \
+dress the scene file itself (`drapelab surface SCENE.toml`), which solves it",
     )
+}
+
+/// The scene of a mesh sheet's run: the recorded scene (its material as solved, the fabric file's
+/// name dropped) loaded again beside the scene file the run names, whose folder its mesh paths
+/// are relative to; an error naming run.json where that file is gone.
+fn mesh_run_scene(
+    json: &Path,
+    v: &serde_json::Value,
+    mut scene: Scene,
+) -> Result<drapelab_core::scene::ValidatedScene, InputError> {
+    let file = PathBuf::from(v["scene_file"].as_str().unwrap_or(""));
+    if !file.is_file() {
+        return Err(mesh_sheet(json, "scene_file"));
+    }
+    scene.material.fabric = None;
+    let table = match toml::Value::try_from(&scene) {
+        Ok(toml::Value::Table(t)) => t,
+        _ => return Err(InputError::new(json, "scene", "cannot be written as TOML")),
+    };
+    Scene::load_table(&file, table, &[]).map(|l| l.scene)
 }
 
 /// The drape of a run folder (or its `run.json`): the scene recorded in `run.json` and the
@@ -60,12 +80,12 @@ pub fn load_run(path: &Path) -> Result<Drape> {
     }
     let scene: Scene = serde_json::from_value(v["scene"].clone())
         .map_err(|e| InputError::new(&json, "scene", e.to_string()))?;
-    if scene.cloth.is_mesh() {
-        return Err(mesh_sheet(&json, "scene.cloth.mesh").into());
-    }
-    let scene = scene
-        .validated()
-        .map_err(|e| InputError::new(&json, format!("scene.{}", e.key), e.message))?;
+    let scene = match scene.cloth.is_mesh() {
+        true => mesh_run_scene(&json, &v, scene)?,
+        false => scene
+            .validated()
+            .map_err(|e| InputError::new(&json, format!("scene.{}", e.key), e.message))?,
+    };
     let grid = scene.grid();
     let mut x = vec![Vector3::zeros(); grid.len()];
     let particles = dir.join("particles.parquet");
