@@ -160,9 +160,38 @@ outputs.comparison = "{run}/calibrate/comparison.parquet"
 runs = 1
 baseline_cmaes = true
 ica = { decades = 3, countries = 6, imperialists = 2, beta = 2.0, gamma = 0.3, revolution_rate = 0.2, xi = 0.1, seed = 2 }
+[stages.fabric]
+kind = "knitted-fabric"
+inputs.results = "{run}/calibrate/results.parquet"
+inputs.samples = "datasets/knitted/knitted_samples.csv"
+params.sample = 8
+outputs.fabric = "{run}/fabrics/sample_08.toml"
 "#,
     );
     crate::support::run_plan(&file);
+    // The calibrated sample as a fabric file: its mass-spring parameters and Table 2's density;
+    // hang4 draped in it converges.
+    let fabric_file = tmp.path().join("runs/c/fabrics/sample_08.toml");
+    let fabric = drapelab::scene::Fabric::read(&fabric_file).unwrap();
+    let results: Vec<drapelab::app::calibration_tables::ResultRow> =
+        drapelab::io::read_table(&tmp.path().join("runs/c/calibrate/results.parquet")).unwrap();
+    let ms = fabric.mass_spring.as_ref().unwrap();
+    assert_eq!(ms.stiffness_N_per_m, results[0].stiffness_N_per_m);
+    assert_eq!(ms.topology, results[0].topology);
+    let density = fabric.areal_density_kg_per_m2.unwrap();
+    assert!(density > 0.02 && density < 0.2, "{density}");
+    assert!(!fabric.calibrated.contains(&"damping_Ns_per_m".to_string()));
+    let out = tmp.path().join("hang");
+    let o = crate::support::drapelab()
+        .args(["-q", "simulate"])
+        .arg(root().join("datasets/scenes/hang4.toml"))
+        .args(["--set", "cloth.nx=11", "--set", "cloth.ny=11", "--fabric"])
+        .arg(&fabric_file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let code = r#"
 import sys, polars as pl
 from rerun.experimental import RrdReader

@@ -254,7 +254,14 @@ fn a_bad_mesh_scene_is_refused_in_one_line_naming_file_and_key() {
     let run = dir.path().join("run");
     let scene = copied.join("l_panel_table.toml");
     assert!(simulate_recorded(&scene, &run, &[]).status.success());
-    let surface = |out: &Path| drapelab().arg("surface").arg(&run).arg("--out").arg(out).output();
+    let surface = |out: &Path| {
+        drapelab()
+            .arg("surface")
+            .arg(&run)
+            .arg("--out")
+            .arg(out)
+            .output()
+    };
     let dressed = dir.path().join("dressed");
     let o = surface(&dressed).unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -346,17 +346,7 @@ pub fn run(
     p: &CusickPredictParams,
 ) -> Result<Vec<PredictionRow>> {
     let files = &ctx.inputs;
-    let mut data = CusickDataset::open(files.index.parent().unwrap_or(std::path::Path::new(".")))?;
-    if let Some(f) = p
-        .fabrics
-        .iter()
-        .find(|f| !data.fabrics.iter().any(|d| d.fabric == **f))
-    {
-        let m = format!("no fabric {f} in the dataset's fabrics.csv");
-        return Err(ctx.param_error("fabrics", m).into());
-    }
-    data.fabrics
-        .retain(|f| p.fabrics.is_empty() || p.fabrics.contains(&f.fabric));
+    let data = dataset(ctx, p)?;
     let shadows = read_table::<ShadowRow>(&files.shadows)?;
     let photo_outlines = outlines_by_capture(read_table::<OutlineRow>(&files.photo_outlines)?);
     let template = data.template()?;
@@ -430,6 +420,24 @@ pub fn run(
         &overlay,
     )?;
     Ok(rows)
+}
+
+/// The dataset of the index's folder, its fabrics those of `p.fabrics` (all when empty); a fabric
+/// it lacks is an error naming the parameter.
+fn dataset(ctx: &Job<'_, CusickPredictInputs>, p: &CusickPredictParams) -> Result<CusickDataset> {
+    let index = &ctx.inputs.index;
+    let mut data = CusickDataset::open(index.parent().unwrap_or(std::path::Path::new(".")))?;
+    if let Some(f) = p
+        .fabrics
+        .iter()
+        .find(|f| !data.fabrics.iter().any(|d| d.fabric == **f))
+    {
+        let m = format!("no fabric {f} in the dataset's fabrics.csv");
+        return Err(ctx.param_error("fabrics", m).into());
+    }
+    data.fabrics
+        .retain(|f| p.fabrics.is_empty() || p.fabrics.contains(&f.fabric));
+    Ok(data)
 }
 
 /// The captures whose meshes the dataset rotated.

@@ -25,6 +25,7 @@ pub mod cusick_targets;
 pub mod defaults;
 pub mod fit_edges;
 pub mod garment;
+pub mod knitted_fabric;
 pub mod peers;
 pub mod scene_keys;
 pub mod score;

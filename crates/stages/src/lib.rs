@@ -16,6 +16,7 @@ mod cusick_report;
 mod fit_edges;
 mod garment;
 mod garment_report;
+mod knitted_fabric;
 mod peers;
 pub mod report;
 mod score;
@@ -42,6 +43,7 @@ pub use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
 pub use fit_edges::{FitEdges, FitEdgesParams};
 pub use garment::{Garment, GarmentParams};
 pub use garment_report::{GarmentReport, GarmentReportParams};
+pub use knitted_fabric::{KnittedFabric, KnittedFabricParams};
 pub use peers::{Peers, PeersParams};
 pub use report::{Report, ReportParams};
 pub use score::{Score, ScoreParams};
@@ -147,6 +149,7 @@ pub fn registry() -> Registry {
         .with::<CusickFabric>()
         .with::<Garment>()
         .with::<GarmentReport>()
+        .with::<KnittedFabric>()
         .with::<CusickReport>()
         .with::<Surface>()
 }

@@ -56,7 +56,8 @@ pub struct Fabric {
     /// The material keys a calibration fitted; the others are stated defaults.
     #[serde(default)]
     pub calibrated: Vec<String>,
-    /// 2σ intervals [low, high] of the calibrated keys, in the keys' units.
+    /// Intervals [low, high] of the calibrated keys, in the keys' units: a Cusick calibration's
+    /// 2σ (`cusick-fabric`), a knitted calibration's range its photos allow (`knitted-fabric`).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub intervals: BTreeMap<String, [f64; 2]>,
 }
