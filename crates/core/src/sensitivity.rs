@@ -136,6 +136,11 @@ impl<'a> Equilibrium<'a> {
         &self.factor
     }
 
+    /// The factor, for solves with it (a Newton correction of the equilibrium).
+    pub fn factor_mut(&mut self) -> &mut EquilibriumFactor {
+        &mut self.factor
+    }
+
     /// The factor of the solved scene's `model` at `x`; none unless the report says converged.
     /// `source` names where the keys come from in errors (a flag, a file).
     pub fn new(
