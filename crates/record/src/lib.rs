@@ -18,6 +18,7 @@ mod photo;
 mod rerun;
 mod rrd;
 mod run_dir;
+mod run_sensitivity;
 mod sampled;
 mod sensitivity_table;
 mod surface_out;
