@@ -347,6 +347,8 @@ pub fn report_markdown(
         .iter()
         .fold((f64::INFINITY, 0.0f64), |a, &w| (a.0.min(w), a.1.max(w)));
     let mut s = String::from(INTRO);
+    s += &crate::cusick_headline::headline(rows, captures);
+    s += "\n## Every fabric\n\n";
     s += &main_table(rows);
     s += &format!(
         "\nDC within the measured mean ± max(2 SD, 4 points): {} of {} fabrics. Nodes within 1 of the measured median: {} of {} (the model's mean), {} of {} with the node line's correction (`nodes_predicted_corrected`, below).\n",

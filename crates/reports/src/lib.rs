@@ -7,6 +7,7 @@
 pub mod benchmark_report;
 pub mod calibration_report;
 pub mod cusick_faces;
+pub mod cusick_headline;
 pub mod cusick_plots;
 pub mod cusick_report;
 pub mod format;
