@@ -2,7 +2,6 @@
 //! calibration specimen's own measurement carried over to the fabric's other specimens — by every
 //! criterion the report scores, and where that baseline does as well, said first.
 
-use crate::cusick_report::{dc_within, nodes_near, nodes_within};
 use drapelab_app::cusick_captures::CaptureRow;
 use drapelab_app::cusick_tables::PredictionRow;
 use std::collections::BTreeMap;
@@ -123,4 +122,21 @@ pub fn headline(rows: &[PredictionRow], caps: &[CaptureRow]) -> String {
         ),
     };
     s
+}
+
+/// Whether the predicted DC lies within the measured mean ± max(2 SD, 4 points).
+pub fn dc_within(r: &PredictionRow) -> Option<bool> {
+    let band = (2.0 * r.dc_measured_sd_pct).max(4.0);
+    r.dc_predicted_pct
+        .map(|p| (p - r.dc_measured_mean_pct).abs() <= band)
+}
+
+/// Whether a node count `n` lies within 1 of the fabric's measured median.
+pub fn nodes_near(r: &PredictionRow, n: f64) -> bool {
+    (n - r.nodes_measured_median).abs() <= 1.0
+}
+
+/// Whether the predicted mean node count lies within 1 of the measured median.
+pub fn nodes_within(r: &PredictionRow) -> Option<bool> {
+    r.nodes_predicted.map(|n| nodes_near(r, n))
 }

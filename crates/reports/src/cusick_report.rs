@@ -20,22 +20,7 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 pub struct CusickReportParams {}
 
-/// Whether the predicted DC lies within the measured mean ± max(2 SD, 4 points).
-pub fn dc_within(r: &PredictionRow) -> Option<bool> {
-    let band = (2.0 * r.dc_measured_sd_pct).max(4.0);
-    r.dc_predicted_pct
-        .map(|p| (p - r.dc_measured_mean_pct).abs() <= band)
-}
-
-/// Whether a node count `n` lies within 1 of the fabric's measured median.
-pub fn nodes_near(r: &PredictionRow, n: f64) -> bool {
-    (n - r.nodes_measured_median).abs() <= 1.0
-}
-
-/// Whether the predicted mean node count lies within 1 of the measured median.
-pub fn nodes_within(r: &PredictionRow) -> Option<bool> {
-    r.nodes_predicted.map(|n| nodes_near(r, n))
-}
+pub use crate::cusick_headline::{dc_within, nodes_near, nodes_within};
 
 /// "yes", "no" or "–".
 pub fn yes(b: Option<bool>) -> &'static str {

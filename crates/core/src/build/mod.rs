@@ -292,6 +292,17 @@ pub(crate) fn contact_terms(scene: &Scene, x0: &[Vector3<f64>], b: &mut ModelBui
     if scene.contact.method == ContactMethod::Barrier {
         let (obstacles, d_hat) = (scene.obstacles.clone(), scene.contact.distance_m);
         b.obstacles(obstacles, d_hat, kappa_gravity(scene));
+        if scene.contact.body_edges {
+            let edges = crate::physics::BodyEdgeBarrier::new(
+                &scene.obstacles,
+                &scene_triangles(scene),
+                &b.masses,
+                &b.fixed,
+                (d_hat, kappa_gravity(scene)),
+            );
+            b.terms
+                .extend(edges.map(|t| Box::new(t) as Box<dyn crate::physics::EnergyTerm>));
+        }
     }
 }
 

@@ -39,6 +39,8 @@ pub struct TriangleBody {
     vertex_normals: Vec<V3>,
     /// Pseudo-normal of every edge (the sum of its faces' normals), by its sorted ends.
     edge_normals: HashMap<(u32, u32), V3>,
+    /// The edges whose two faces are coplanar (a flat face's inner diagonals), by sorted ends.
+    flat_edges: std::collections::HashSet<(u32, u32)>,
     nodes: Vec<Node>,
     /// Triangle indices in the leaves' order.
     order: Vec<u32>,
@@ -107,12 +109,14 @@ impl TriangleBody {
             face_normals.push(n.normalize());
         }
         let (vertex_normals, edge_normals) = pseudo_normals(&vertices, &triangles, &face_normals);
+        let flat_edges = flat_edges(&triangles, &face_normals);
         let mut body = Self {
             vertices,
             triangles,
             face_normals,
             vertex_normals,
             edge_normals,
+            flat_edges,
             nodes: Vec::new(),
             order: Vec::new(),
         };
@@ -218,6 +222,39 @@ impl TriangleBody {
             }
         }
         (best.1 != u32::MAX).then_some(best)
+    }
+
+    /// The feature edges (their end points, each once) of the triangles whose boxes overlap
+    /// `bounds`: those whose two faces are not coplanar (a flat face's inner diagonal is no edge a
+    /// sheet can hang on). The candidates of a segment's closest body edge within that box.
+    pub fn edges_near(&self, bounds: &Aabb) -> Vec<(V3, V3)> {
+        let mut keys: Vec<(u32, u32)> = Vec::new();
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if !node.bounds.overlaps(bounds) {
+                continue;
+            }
+            if node.count == 0 {
+                stack.extend([i + 1, node.right]);
+                continue;
+            }
+            for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                let tri = self.triangles[t as usize];
+                if self.triangle_box(t).overlaps(bounds) {
+                    keys.extend((0..3).map(|k| {
+                        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                        (a.min(b), a.max(b))
+                    }));
+                }
+            }
+        }
+        keys.sort_unstable();
+        keys.dedup();
+        keys.iter()
+            .filter(|k| !self.flat_edges.contains(k))
+            .map(|&(a, b)| (self.vertices[a as usize], self.vertices[b as usize]))
+            .collect()
     }
 
     /// The pseudo-normal of the feature of triangle `t` that the weights `w` name: the face's own
@@ -334,6 +371,31 @@ fn box_distance(b: &Aabb, p: &V3) -> f64 {
 
 /// Every vertex's angle-weighted pseudo-normal (its faces' normals weighted by their angles at it)
 /// and every edge's (the sum of its faces' normals), normalised.
+/// The edges whose two faces are coplanar (their unit normals within 10⁻⁹ of each other).
+fn flat_edges(
+    triangles: &[[u32; 3]],
+    face_normals: &[V3],
+) -> std::collections::HashSet<(u32, u32)> {
+    let mut first: HashMap<(u32, u32), V3> = HashMap::new();
+    let mut flat = std::collections::HashSet::new();
+    for (t, n) in triangles.iter().zip(face_normals) {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let key = (a.min(b), a.max(b));
+            match first.get(&key) {
+                Some(m) if (m - n).norm() < 1e-9 => {
+                    flat.insert(key);
+                }
+                Some(_) => {}
+                None => {
+                    first.insert(key, *n);
+                }
+            }
+        }
+    }
+    flat
+}
+
 fn pseudo_normals(
     vertices: &[V3],
     triangles: &[[u32; 3]],

@@ -5,6 +5,7 @@
 mod assembly;
 mod barrier;
 mod bending;
+mod body_edges;
 mod curl;
 mod friction;
 mod kernel;
@@ -23,6 +24,7 @@ pub use assembly::ModelBuilder;
 pub use bending::{
     CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,
 };
+pub use body_edges::BodyEdgeBarrier;
 pub use curl::{Curl, CurlKernel, hinge_curl};
 pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
 pub use kernel::{Kernel, Local, Potential};

@@ -96,3 +96,22 @@ pub fn carry_bodies(obstacles: &mut [Obstacle], from: &[Obstacle]) {
         }
     }
 }
+
+impl super::Scene {
+    /// `contact.body_edges` needs a mesh body and the barrier method.
+    pub(super) fn check_body_edges(&self, ck: &super::check::Check<'_>) -> Result<(), InputError> {
+        let meshed = self
+            .obstacles
+            .iter()
+            .any(|o| matches!(o, crate::obstacle::Obstacle::Mesh { .. }));
+        if self.contact.body_edges
+            && !(meshed && self.contact.method == super::ContactMethod::Barrier)
+        {
+            return ck.err(
+                "contact.body_edges",
+                "keeps the sheet's edges off a mesh body's edges: it needs an obstacle of kind \"mesh\" and contact.method = \"barrier\"".into(),
+            );
+        }
+        Ok(())
+    }
+}

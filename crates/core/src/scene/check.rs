@@ -327,6 +327,7 @@ would already touch itself; use a coarser grid or a thinner sheet"
                 );
             }
         }
+        self.check_body_edges(ck)?;
         if self.contact.self_contact == SelfContactMode::On
             && !self.solver.kind.supports_self_contact()
         {

@@ -377,6 +377,12 @@ pub struct ContactSpec {
     /// else 1 mm, at most a fifth of the grid's shortest spacing.
     #[serde(default)]
     pub self_thickness_m: Option<f64>,
+    /// Keep the sheet's edges off a mesh body's feature edges too, not only its vertices off the
+    /// body ([`crate::physics::BodyEdgeBarrier`]). Default false: enough for bodies smoother than
+    /// the sheet (a dress form); turn it on for sharp ones (a table's rim) whose edges a coarse
+    /// sheet's edges would cut.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub body_edges: bool,
 }
 
 /// Whether the sheet's self-contact is modelled ([`ContactSpec::self_contact`]).
@@ -405,6 +411,7 @@ impl Default for ContactSpec {
             friction_coefficient: 0.0,
             self_contact: SelfContactMode::Auto,
             self_thickness_m: None,
+            body_edges: false,
         }
     }
 }
