@@ -320,6 +320,17 @@ print("ok")
     assert_eq!(out.trim(), "ok");
     let md = std::fs::read_to_string(tmp.path().join("reports/cusick.md")).unwrap();
     assert!(md.contains("![shadows](cusick_shadows.svg)"), "{md}");
+    // The report opens with the model against the simplest baseline, and says where it does as well.
+    let first = md.find("\n## ").unwrap();
+    assert!(
+        md[first..].starts_with("\n## The model against the simplest baseline"),
+        "{md}"
+    );
+    assert!(
+        md.contains("calibration specimen carried over")
+            && md.contains("The baseline does as well")
+            || md.contains("The model beats the baseline")
+    );
     assert!(
         md.contains("## Both faces of every capture") && md.contains("face down from face up only")
     );
