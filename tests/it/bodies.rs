@@ -409,13 +409,9 @@ fn a_coarse_sheet_keeps_its_edges_off_a_sharp_body_rim_with_body_edges_on() {
     );
     assert_eq!(cut(true), 0);
     let sphere = root().join("datasets/scenes/sphere_wool.toml");
-    let args = [
-        "simulate",
-        sphere.to_str().unwrap(),
-        "--out",
-        "/tmp/x",
-        "--set",
+    crate::support::assert_bad_set(
+        &sphere,
         "contact.body_edges=true",
-    ];
-    assert_bad_input(args, &["contact.body_edges", "mesh"]);
+        &["contact.body_edges", "mesh"],
+    );
 }

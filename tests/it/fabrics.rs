@@ -201,14 +201,7 @@ fn a_mesh_strip_rolls_to_its_curl_and_droops_further_when_its_bending_saturates(
     let sphere = root().join("datasets/scenes/sphere_wool.toml");
     for key in ["curl_per_m", "bending_saturation_per_m"] {
         let set = format!("material.continuum.{key}=3.0");
-        let args = [
-            "simulate",
-            sphere.to_str().unwrap(),
-            "--out",
-            "/tmp/x",
-            "--set",
-            &set,
-        ];
-        assert_bad_input(args, &[&format!("material.continuum.{key}"), "mesh"]);
+        let names = [format!("material.continuum.{key}"), "mesh".into()];
+        crate::support::assert_bad_set(&sphere, &set, &names.each_ref().map(|n| n.as_str()));
     }
 }

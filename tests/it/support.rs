@@ -162,6 +162,21 @@ where
     err
 }
 
+/// `drapelab simulate SCENE --set SET` is refused as bad input in one line naming `names`.
+pub fn assert_bad_set(scene: &Path, set: &str, names: &[&str]) -> String {
+    let out = tempfile::tempdir().unwrap();
+    let out = out.path().join("o");
+    let args = [Path::new("simulate"), scene, Path::new("--out"), &out];
+    let err = assert_bad_input(
+        args.iter()
+            .map(|p| p.as_os_str())
+            .chain([std::ffi::OsStr::new("--set"), std::ffi::OsStr::new(set)]),
+        names,
+    );
+    assert!(!out.exists(), "{set}: {} left behind", out.display());
+    err
+}
+
 /// For each `(from, to, key)`: the bundled file `path` (relative to the repository) with its first
 /// `from` replaced by `to`, given to `drapelab COMMAND FILE --out DIR`, is refused as bad input
 /// naming `key` and the file, and leaves nothing in DIR.
