@@ -318,6 +318,55 @@ print("ok")
         ],
     );
     assert_eq!(out.trim(), "ok");
+    // Every fabric as a fabric file: fabric 5's density is known (rigidities, N·m), fabric 7's is
+    // not (bending lengths, m, which a scene turns into rigidities with its own density).
+    let fabrics = run.join("fabrics");
+    let index = std::fs::read_to_string(fabrics.join("index.toml")).unwrap();
+    assert!(
+        index.contains("fabric_05.toml") && index.contains("fabric_07.toml"),
+        "{index}"
+    );
+    let f5 = drapelab::scene::Fabric::read(&fabrics.join("fabric_05.toml")).unwrap();
+    let f7 = drapelab::scene::Fabric::read(&fabrics.join("fabric_07.toml")).unwrap();
+    let r7 = rows.iter().find(|r| r.fabric == 7).unwrap();
+    assert!(f5.continuum.as_ref().unwrap().bending_warp_N_m.is_some());
+    assert_eq!(f7.areal_density_kg_per_m2, None);
+    assert_eq!(f7.bending_length_warp_m, r7.bending_length_warp_m);
+    let [lo, hi] = f7.intervals["bending_length_warp_m"];
+    assert!(lo < f7.bending_length_warp_m.unwrap() && f7.bending_length_warp_m.unwrap() < hi);
+    let disc = root().join("datasets/patterns/cusick_disc_pedestal.toml");
+    let f7_path = fabrics.join("fabric_07.toml");
+    let f7_arg = f7_path.to_str().unwrap();
+    let args = [
+        disc.to_str().unwrap(),
+        "--out",
+        "/tmp/x",
+        "--fabric",
+        f7_arg,
+    ];
+    let unset = ["--set", "cloth.areal_density_kg_per_m2=0"];
+    let simulate = std::iter::once("simulate").chain(args).chain(unset);
+    crate::support::assert_bad_input(simulate, &["cloth.areal_density_kg_per_m2"]);
+    let mut material = toml::Table::new();
+    material.insert("fabric".into(), f7_arg.into());
+    let scene = drapelab::scene::Scene::load(
+        &disc,
+        &[
+            ("material".into(), toml::Value::Table(material)),
+            ("cloth.areal_density_kg_per_m2".into(), 0.2.into()),
+        ],
+    )
+    .unwrap()
+    .scene;
+    let c = r7.bending_length_warp_m.unwrap();
+    let b = scene
+        .material
+        .continuum
+        .as_ref()
+        .unwrap()
+        .bending_warp_N_m
+        .unwrap();
+    assert!((b / (0.2 * scene.gravity.g_m_per_s2 * c.powi(3)) - 1.0).abs() < 1e-12);
     let md = std::fs::read_to_string(tmp.path().join("reports/cusick.md")).unwrap();
     assert!(md.contains("![shadows](cusick_shadows.svg)"), "{md}");
     // The report opens with the model against the simplest baseline, and says where it does as well.

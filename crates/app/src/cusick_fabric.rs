@@ -12,7 +12,9 @@
 //! - tensile and shear rigidity, which the tester does not measure: stated defaults, not in
 //!   `calibrated` (those of the drape model's stretching springs).
 //!
-//! A fabric whose areal density the dataset does not give is refused: its rigidity needs its weight.
+//! A fabric whose areal density the dataset does not give is written with its bending lengths
+//! (`bending_length_warp_m`, `bending_length_weft_m`) in place of rigidities and no density: a
+//! scene draping it gives the density, and the rigidity B = w g c³ follows.
 
 use crate::cusick_tables::PredictionRow;
 use crate::job::Job;
@@ -29,8 +31,10 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CusickFabricParams {
-    /// The fabric's number in the dataset (`fabrics.csv`). Required.
-    pub fabric: i32,
+    /// The fabric's number in the dataset (`fabrics.csv`), written to `outputs.fabric`; none (the
+    /// default) writes every fabric of the predictions beside `outputs.fabrics` (an index).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fabric: Option<i32>,
     /// Tensile rigidity written (warp and weft alike), N/m: not measured by the tester, so a stated
     /// default, that of the drape model's stretching springs. Default 500.
     #[serde(default = "default_tensile")]
@@ -60,8 +64,15 @@ pub struct CusickFabricInputs {
 const G: f64 = 9.81;
 
 /// The fabric file of one calibrated fabric: `row` of predictions.parquet, `name` and areal density
-/// `w` from the dataset, `source` the provenance line.
-pub fn fabric_of(row: &PredictionRow, name: &str, w: f64, source: String) -> Result<Fabric> {
+/// `w` from the dataset (where known), `source` the provenance line. With `w` the bending is
+/// written as rigidities (N·m); without, as bending lengths, which a scene turns into rigidities
+/// with its own areal density.
+pub fn fabric_of(
+    row: &PredictionRow,
+    name: &str,
+    w: Option<f64>,
+    source: String,
+) -> Result<Fabric> {
     let (Some(cw), Some(cf), Some(c)) = (
         row.bending_length_warp_m,
         row.bending_length_weft_m,
@@ -73,19 +84,20 @@ pub fn fabric_of(row: &PredictionRow, name: &str, w: f64, source: String) -> Res
             row.status
         );
     };
-    let rigidity = |len: f64| w * G * len.powi(3);
+    // What is written per direction: B = w g c³ (N·m) where the weight is known, else c (m); both
+    // move with c at a fixed anisotropy.
+    let (keys, power, unit) = match w {
+        Some(w) => (["bending_warp_N_m", "bending_weft_N_m"], 3, w * G),
+        None => (["bending_length_warp_m", "bending_length_weft_m"], 1, 1.0),
+    };
+    let value = |len: f64| unit * len.powi(power);
     let mut intervals = BTreeMap::new();
     if let (Some(lo), Some(hi)) = (row.bending_length_lo_m, row.bending_length_hi_m) {
-        // B ∝ c³ at a fixed anisotropy: both rigidities move with c.
-        let scale = |x: f64| (x / c).powi(3);
-        for (key, b) in [
-            ("bending_warp_N_m", rigidity(cw)),
-            ("bending_weft_N_m", rigidity(cf)),
-        ] {
-            intervals.insert(key.to_string(), [b * scale(lo), b * scale(hi)]);
+        for (key, len) in keys.iter().zip([cw, cf]) {
+            intervals.insert(key.to_string(), [value(len * lo / c), value(len * hi / c)]);
         }
     }
-    let mut calibrated = vec!["bending_warp_N_m".to_string(), "bending_weft_N_m".into()];
+    let mut calibrated: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
     let saturation = row
         .bending_saturation_curvature_per_m
         .filter(|v| v.is_finite());
@@ -99,14 +111,17 @@ pub fn fabric_of(row: &PredictionRow, name: &str, w: f64, source: String) -> Res
             intervals.insert("curl_per_m".into(), [lo, hi]);
         }
     }
+    let known = w.is_some();
     Ok(Fabric {
         name: name.to_string(),
         source: Some(source),
         build_id: Some(drapelab_core::provenance::build_id().to_string()),
-        areal_density_kg_per_m2: Some(w),
+        areal_density_kg_per_m2: w,
+        bending_length_warp_m: (!known).then_some(cw),
+        bending_length_weft_m: (!known).then_some(cf),
         continuum: Some(Continuum {
-            bending_warp_N_m: Some(rigidity(cw)),
-            bending_weft_N_m: Some(rigidity(cf)),
+            bending_warp_N_m: known.then(|| value(cw)),
+            bending_weft_N_m: known.then(|| value(cf)),
             bending_saturation_per_m: saturation,
             curl_per_m: curl,
             ..Continuum::default()
@@ -117,57 +132,95 @@ pub fn fabric_of(row: &PredictionRow, name: &str, w: f64, source: String) -> Res
     })
 }
 
-/// The `run` of the stage kind over this workflow: the fabric's file, written atomically.
-pub fn run(ctx: &Job<'_, CusickFabricInputs>, p: &CusickFabricParams) -> Result<Fabric> {
+/// The `run` of the stage kind over this workflow: one fabric's file (`params.fabric`,
+/// `outputs.fabric`), or every fabric's beside an index (`outputs.fabrics`), written atomically.
+pub fn run(ctx: &Job<'_, CusickFabricInputs>, p: &CusickFabricParams) -> Result<Vec<Fabric>> {
     let files = &ctx.inputs;
     let data = CusickDataset::open(files.index.parent().unwrap_or(std::path::Path::new(".")))?;
-    let Some(info) = data.fabrics.iter().find(|f| f.fabric == p.fabric) else {
-        let known: Vec<String> = data.fabrics.iter().map(|f| f.fabric.to_string()).collect();
+    let rows = read_table::<PredictionRow>(&files.predictions)?;
+    let Some(number) = p.fabric else {
+        return write_all(ctx, p, &data, &rows);
+    };
+    let Some(row) = rows.iter().find(|r| r.fabric == number) else {
+        let known: Vec<String> = rows.iter().map(|r| r.fabric.to_string()).collect();
         let m = format!(
-            "no fabric {} in the dataset (it has {})",
-            p.fabric,
+            "no fabric {number} in the predictions (they have {})",
             known.join(", ")
         );
         return Err(ctx.param_error("fabric", m).into());
     };
-    let Some(w) = info.areal_density_kg_per_m2 else {
-        let m = format!(
-            "fabric {} has no areal density in fabrics.csv: its bending rigidity B = w g c³ needs its weight; add it there",
-            p.fabric
+    let fabric = fabric_file(ctx, p, &data, row)?;
+    write(ctx.output("fabric")?, &fabric)?;
+    Ok(vec![fabric])
+}
+
+/// Every fabric of `rows` as `fabric_NN.toml` beside the index `outputs.fabrics`, which lists them.
+fn write_all(
+    ctx: &Job<'_, CusickFabricInputs>,
+    p: &CusickFabricParams,
+    data: &CusickDataset,
+    rows: &[PredictionRow],
+) -> Result<Vec<Fabric>> {
+    let index = ctx.output("fabrics")?;
+    let dir = index.parent().unwrap_or(std::path::Path::new("."));
+    let mut text = String::from(
+        "# The fabric files of a Cusick calibration, one per fabric (drapelab's cusick-fabric stage).\n",
+    );
+    let mut out = Vec::new();
+    for row in rows.iter().filter(|r| r.bending_length_mean_m.is_some()) {
+        let fabric = fabric_file(ctx, p, data, row)?;
+        let file = format!("fabric_{:02}.toml", row.fabric);
+        write(&dir.join(&file), &fabric)?;
+        text += &format!(
+            "\n[[fabrics]]\nfabric = {}\nname = {:?}\nfile = {file:?}\nareal_density_known = {}\n",
+            row.fabric,
+            fabric.name,
+            fabric.areal_density_kg_per_m2.is_some()
         );
-        return Err(ctx.param_error("fabric", m).into());
-    };
-    let rows = read_table::<PredictionRow>(&files.predictions)?;
-    let Some(row) = rows.iter().find(|r| r.fabric == p.fabric) else {
-        bail!(
-            "{}: no row for fabric {}",
-            files.predictions.display(),
-            p.fabric
-        );
-    };
-    let name = match info.name.as_str() {
-        "" => format!("Cusick fabric {}", p.fabric),
-        n => n.to_string(),
+        out.push(fabric);
+    }
+    drapelab_core::atomic::write_text(index, &text)?;
+    Ok(out)
+}
+
+/// The fabric file of prediction `row`, its name and density from the dataset, the stated tensile
+/// and shear rigidities of `p`.
+fn fabric_file(
+    ctx: &Job<'_, CusickFabricInputs>,
+    p: &CusickFabricParams,
+    data: &CusickDataset,
+    row: &PredictionRow,
+) -> Result<Fabric> {
+    let info = data.fabrics.iter().find(|f| f.fabric == row.fabric);
+    let name = match info.map(|f| f.name.as_str()) {
+        Some(n) if !n.is_empty() => n.to_string(),
+        _ => format!("Cusick fabric {}", row.fabric),
     };
     let source = format!(
         "Cusick drape tester: fabric {} calibrated on specimen {} ({}), stage `{}` of {}",
-        p.fabric,
+        row.fabric,
         row.calibration_sample,
-        ctx.relative(&files.predictions).display(),
+        ctx.relative(&ctx.inputs.predictions).display(),
         ctx.stage,
         ctx.source.display()
     );
+    let w = info.and_then(|f| f.areal_density_kg_per_m2);
     let mut fabric = fabric_of(row, &name, w, source)?;
     if let Some(c) = fabric.continuum.as_mut() {
         c.tensile_warp_N_per_m = Some(p.tensile_N_per_m);
         c.tensile_weft_N_per_m = Some(p.tensile_N_per_m);
         c.shear_N_per_m = Some(p.shear_N_per_m);
     }
+    Ok(fabric)
+}
+
+/// Writes `fabric` to `path` with its header.
+fn write(path: &std::path::Path, fabric: &Fabric) -> Result<()> {
     let text = format!(
         "# A fabric file written by drapelab's cusick-fabric stage (crates/app/src/cusick_fabric.rs):\n\
          # bending calibrated on the Cusick drape tester; tensile and shear are stated defaults.\n{}",
         fabric.to_toml()
     );
-    drapelab_core::atomic::write_text(ctx.output("fabric")?, &text)?;
-    Ok(fabric)
+    drapelab_core::atomic::write_text(path, &text)?;
+    Ok(())
 }

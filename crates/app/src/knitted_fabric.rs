@@ -79,6 +79,8 @@ pub fn fabric_of(row: &ResultRow, w: f64, source: String) -> Fabric {
         source: Some(source),
         build_id: Some(drapelab_core::provenance::build_id().to_string()),
         areal_density_kg_per_m2: Some(w),
+        bending_length_warp_m: None,
+        bending_length_weft_m: None,
         continuum: None,
         mass_spring: Some(MassSpring {
             stiffness_N_per_m: row.stiffness_N_per_m,

@@ -47,6 +47,14 @@ pub struct Fabric {
     /// `cloth.areal_density_kg_per_m2`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub areal_density_kg_per_m2: Option<f64>,
+    /// Peirce's bending length along the warp, c_warp (BS 3356), m: the continuum's bending
+    /// rigidity B_warp = w g c_warp³ from the areal density w the fabric or the scene gives, in
+    /// place of `bending_warp_N_m` for a fabric whose weight is unknown (a drape tester measures c).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_length_warp_m: Option<f64>,
+    /// Peirce's bending length along the weft, m (as `bending_length_warp_m`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_length_weft_m: Option<f64>,
     /// The continuum rigidities (the keys of `[material.continuum]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub continuum: Option<Continuum>,
@@ -71,7 +79,19 @@ impl Fabric {
         let f = file.fabric;
         let bad = |key: String, m: String| Err(InputError::new(path, key, m));
         let given = match (&f.continuum, &f.mass_spring) {
-            (Some(c), None) => table_keys(c),
+            (Some(c), None) => {
+                let mut keys = table_keys(c);
+                for (k, v) in f.bending_lengths() {
+                    if !(v.is_finite() && v > 0.0) {
+                        return bad(
+                            format!("fabric.{k}"),
+                            format!("must be a finite length > 0, got {v}"),
+                        );
+                    }
+                    keys.push(k.to_string());
+                }
+                keys
+            }
             (None, Some(m)) => table_keys(m),
             (Some(_), Some(_)) => {
                 return bad(
@@ -106,6 +126,43 @@ impl Fabric {
             }
         }
         Ok(f)
+    }
+
+    /// The bending lengths the fabric gives, by key.
+    fn bending_lengths(&self) -> Vec<(&'static str, f64)> {
+        [
+            ("bending_length_warp_m", self.bending_length_warp_m),
+            ("bending_length_weft_m", self.bending_length_weft_m),
+        ]
+        .into_iter()
+        .filter_map(|(k, v)| v.map(|v| (k, v)))
+        .collect()
+    }
+
+    /// The continuum's bending rigidities from the bending lengths (B = w g c³ at areal density
+    /// `w` and gravity `g`); an error message where the continuum gives that rigidity too.
+    fn resolve_bending_lengths(
+        &self,
+        material: &mut Material,
+        w: f64,
+        g: f64,
+    ) -> Result<(), String> {
+        let Some(c) = material.continuum.as_mut() else {
+            return Ok(());
+        };
+        for (k, len) in self.bending_lengths() {
+            let (si, kes) = match k {
+                "bending_length_warp_m" => (&mut c.bending_warp_N_m, c.bending_warp_gf_cm2_per_cm),
+                _ => (&mut c.bending_weft_N_m, c.bending_weft_gf_cm2_per_cm),
+            };
+            if si.is_some() || kes.is_some() {
+                return Err(format!(
+                    "`{k}` and the continuum's rigidity in that direction are both given: keep one"
+                ));
+            }
+            *si = Some(w * g * len.powi(3));
+        }
+        Ok(())
     }
 
     /// The scene's material from this fabric.
@@ -153,7 +210,6 @@ pub(super) fn apply_fabric(scene: &mut super::Scene, scene_path: &Path) -> Resul
     let fabric = Fabric::read(&path)?;
     let mut material = fabric.material();
     material.fabric = Some(file);
-    scene.material = material;
     match fabric.areal_density_kg_per_m2 {
         Some(d) => scene.cloth.areal_density_kg_per_m2 = d,
         None if scene.cloth.areal_density_kg_per_m2 == 0.0 => {
@@ -168,6 +224,11 @@ pub(super) fn apply_fabric(scene: &mut super::Scene, scene_path: &Path) -> Resul
         }
         None => {}
     }
+    let w = scene.cloth.areal_density_kg_per_m2;
+    fabric
+        .resolve_bending_lengths(&mut material, w, scene.gravity.g_m_per_s2)
+        .map_err(|m| InputError::new(&path, "fabric", m))?;
+    scene.material = material;
     Ok(())
 }
 
@@ -183,6 +244,8 @@ mod tests {
             source: Some("a calibration".into()),
             build_id: Some("0123456789abcdef".into()),
             areal_density_kg_per_m2: Some(0.12),
+            bending_length_warp_m: None,
+            bending_length_weft_m: None,
             continuum: Some(Continuum {
                 bending_warp_N_m: Some(2.5e-6),
                 bending_weft_N_m: Some(1.5e-6),
