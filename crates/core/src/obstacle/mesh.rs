@@ -41,6 +41,8 @@ pub struct TriangleBody {
     edge_normals: HashMap<(u32, u32), V3>,
     /// The edges whose two faces are coplanar (a flat face's inner diagonals), by sorted ends.
     flat_edges: std::collections::HashSet<(u32, u32)>,
+    /// Per vertex, whether it lies on a feature edge (a corner a sheet can press on).
+    corner_flags: Vec<bool>,
     nodes: Vec<Node>,
     /// Triangle indices in the leaves' order.
     order: Vec<u32>,
@@ -110,6 +112,16 @@ impl TriangleBody {
         }
         let (vertex_normals, edge_normals) = pseudo_normals(&vertices, &triangles, &face_normals);
         let flat_edges = flat_edges(&triangles, &face_normals);
+        let mut corner_flags = vec![false; vertices.len()];
+        for t in &triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if !flat_edges.contains(&(a.min(b), a.max(b))) {
+                    corner_flags[a as usize] = true;
+                    corner_flags[b as usize] = true;
+                }
+            }
+        }
         let mut body = Self {
             vertices,
             triangles,
@@ -117,6 +129,7 @@ impl TriangleBody {
             vertex_normals,
             edge_normals,
             flat_edges,
+            corner_flags,
             nodes: Vec::new(),
             order: Vec::new(),
         };
@@ -255,6 +268,38 @@ impl TriangleBody {
             .filter(|k| !self.flat_edges.contains(k))
             .map(|&(a, b)| (self.vertices[a as usize], self.vertices[b as usize]))
             .collect()
+    }
+
+    /// The corners (vertices on a feature edge: not inside a flat region) of the triangles whose
+    /// boxes overlap `bounds`, each once.
+    pub fn corners_near(&self, bounds: &Aabb) -> Vec<V3> {
+        let mut found: Vec<u32> = Vec::new();
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if !node.bounds.overlaps(bounds) {
+                continue;
+            }
+            if node.count == 0 {
+                stack.extend([i + 1, node.right]);
+                continue;
+            }
+            for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                let tri = self.triangles[t as usize];
+                found.extend(tri.iter().filter(|&&v| {
+                    let p = &self.vertices[v as usize];
+                    bounds.overlaps(&Aabb::point(p)) && self.is_corner(v)
+                }));
+            }
+        }
+        found.sort_unstable();
+        found.dedup();
+        found.iter().map(|&v| self.vertices[v as usize]).collect()
+    }
+
+    /// Whether vertex `v` lies on a feature edge (an edge whose faces are not coplanar).
+    fn is_corner(&self, v: u32) -> bool {
+        self.corner_flags.get(v as usize).copied().unwrap_or(false)
     }
 
     /// The pseudo-normal of the feature of triangle `t` that the weights `w` name: the face's own
