@@ -537,3 +537,68 @@ fn the_equilibrium_energys_derivative_is_the_envelope_theorems() {
         assert!(checked >= 4, "{}: only {checked} keys", scene.name);
     }
 }
+
+/// Every bundled scene (datasets/scenes, patterns and bodies; grids at 11 × 11 or their own size
+/// if smaller, the garment at its file's resolution, static solves), every continuous key: the
+/// sensitivity against central differences of drapes solved to 10⁻¹² (neutral turns removed), or
+/// the key reported as a structural change. Run by `cargo test --release -p drapelab-core --test
+/// sensitivities -- --ignored --nocapture` (about four minutes on 2 cores); the named scenes above
+/// run always. It does not pass today (2026-12-02), and is kept out of the suite until it does:
+/// 20 of 26 scenes pass every key; diagonal_tension_wool's 11 × 11 drape at 10⁻¹² is a saddle
+/// (`minimum` false), rod_polyester's does not reach 10⁻¹² in 3,000 iterations (the references);
+/// l_panel_sphere's `cloth.areal_density_kg_per_m2` misses by 20 % (a neutral turn removed: to be
+/// found), cape_form's `cloth.origin_m.0` by 3.6·10⁻⁴, and the garments refuse
+/// `cloth.initial_perturbation_m` (a flat pattern's key listed as a parameter of a placed garment).
+#[test]
+#[ignore]
+fn every_bundled_scenes_sensitivities_match_central_differences() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets");
+    let (mut checked, mut failed) = (0, Vec::new());
+    for dir in ["scenes", "patterns", "bodies"] {
+        let mut files: Vec<_> = std::fs::read_dir(root.join(dir))
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        files.sort();
+        for path in files {
+            let Ok(plain) = Scene::load(&path, &[]) else {
+                continue;
+            };
+            let s = &plain.scene;
+            if s.solver.kind != drapelab_core::scene::SolverKind::Static {
+                continue;
+            }
+            let mut o: Vec<(String, toml::Value)> = vec![(
+                "solver.static.residual_tol_rel".into(),
+                toml::Value::Float(1e-12),
+            )];
+            if !s.cloth.is_mesh() {
+                for k in ["cloth.nx", "cloth.ny"] {
+                    let n = if k == "cloth.nx" {
+                        s.cloth.nx
+                    } else {
+                        s.cloth.ny
+                    };
+                    o.push((k.into(), toml::Value::Integer(n.min(11) as i64)));
+                }
+            } else if s.cloth.mesh_refine > 0 {
+                o.push(("cloth.mesh_refine".into(), toml::Value::Integer(0)));
+            }
+            let scene = Scene::load(&path, &o).unwrap().scene;
+            let start = std::time::Instant::now();
+            match std::panic::catch_unwind(|| check_every_key(&scene)) {
+                Ok(keys) => eprintln!(
+                    "SUMMARY {}: {} keys within 1e-4 in {:.1} s",
+                    scene.name,
+                    keys.len(),
+                    start.elapsed().as_secs_f64()
+                ),
+                Err(_) => failed.push(scene.name.clone()),
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "{checked} scenes");
+    assert!(failed.is_empty(), "scenes with a key off: {failed:?}");
+}
