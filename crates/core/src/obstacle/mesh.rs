@@ -237,11 +237,9 @@ impl TriangleBody {
         (best.1 != u32::MAX).then_some(best)
     }
 
-    /// The feature edges (their end points, each once) of the triangles whose boxes overlap
-    /// `bounds`: those whose two faces are not coplanar (a flat face's inner diagonal is no edge a
-    /// sheet can hang on). The candidates of a segment's closest body edge within that box.
-    pub fn edges_near(&self, bounds: &Aabb) -> Vec<(V3, V3)> {
-        let mut keys: Vec<(u32, u32)> = Vec::new();
+    /// The triangles whose boxes overlap `bounds`, found through the hierarchy.
+    fn triangles_overlapping(&self, bounds: &Aabb) -> Vec<[u32; 3]> {
+        let mut found = Vec::new();
         let mut stack = vec![0u32];
         while let Some(i) = stack.pop() {
             let node = &self.nodes[i as usize];
@@ -252,46 +250,46 @@ impl TriangleBody {
                 stack.extend([i + 1, node.right]);
                 continue;
             }
-            for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                let tri = self.triangles[t as usize];
-                if self.triangle_box(t).overlaps(bounds) {
-                    keys.extend((0..3).map(|k| {
-                        let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                        (a.min(b), a.max(b))
-                    }));
-                }
-            }
+            let run = &self.order[node.first as usize..(node.first + node.count) as usize];
+            found.extend(
+                run.iter()
+                    .filter(|&&t| self.triangle_box(t).overlaps(bounds))
+                    .map(|&t| self.triangles[t as usize]),
+            );
         }
+        found
+    }
+
+    /// The feature edges (their end points, each once) of the triangles whose boxes overlap
+    /// `bounds`: those whose two faces are not coplanar (a flat face's inner diagonal is no edge a
+    /// sheet can hang on). The candidates of a segment's closest body edge within that box.
+    pub fn edges_near(&self, bounds: &Aabb) -> Vec<(V3, V3)> {
+        let mut keys: Vec<(u32, u32)> = self
+            .triangles_overlapping(bounds)
+            .iter()
+            .flat_map(|tri| (0..3).map(move |k| (tri[k], tri[(k + 1) % 3])))
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .filter(|k| !self.flat_edges.contains(k))
+            .collect();
         keys.sort_unstable();
         keys.dedup();
         keys.iter()
-            .filter(|k| !self.flat_edges.contains(k))
             .map(|&(a, b)| (self.vertices[a as usize], self.vertices[b as usize]))
             .collect()
     }
 
     /// The corners (vertices on a feature edge: not inside a flat region) of the triangles whose
-    /// boxes overlap `bounds`, each once.
+    /// boxes overlap `bounds` and within them, each once.
     pub fn corners_near(&self, bounds: &Aabb) -> Vec<V3> {
-        let mut found: Vec<u32> = Vec::new();
-        let mut stack = vec![0u32];
-        while let Some(i) = stack.pop() {
-            let node = &self.nodes[i as usize];
-            if !node.bounds.overlaps(bounds) {
-                continue;
-            }
-            if node.count == 0 {
-                stack.extend([i + 1, node.right]);
-                continue;
-            }
-            for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                let tri = self.triangles[t as usize];
-                found.extend(tri.iter().filter(|&&v| {
-                    let p = &self.vertices[v as usize];
-                    bounds.overlaps(&Aabb::point(p)) && self.is_corner(v)
-                }));
-            }
-        }
+        let mut found: Vec<u32> = self
+            .triangles_overlapping(bounds)
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&v| {
+                bounds.overlaps(&Aabb::point(&self.vertices[v as usize])) && self.is_corner(v)
+            })
+            .collect();
         found.sort_unstable();
         found.dedup();
         found.iter().map(|&v| self.vertices[v as usize]).collect()
