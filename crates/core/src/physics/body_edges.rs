@@ -40,7 +40,6 @@ pub struct BodyEdgeBarrier {
     /// Cloth particles of each stencil: an edge's two (the third unused) or a triangle's three.
     stencils: Vec<([usize; 3], usize)>,
     kappa_J: Vec<f64>,
-    fixed: Vec<bool>,
     d_hat_m: f64,
 }
 
@@ -119,7 +118,6 @@ impl BodyEdgeBarrier {
             bodies,
             stencils,
             kappa_J,
-            fixed: fixed.to_vec(),
             d_hat_m,
         })
     }
@@ -236,11 +234,10 @@ impl EnergyTerm for BodyEdgeBarrier {
             let curv = (!project).then(|| self.curvature(&p, x));
             let (ends, n) = self.stencils[p.stencil];
             // The lower triangle of the blocks: a block at (i, j) stands for its transpose too.
+            // Fixed vertices' blocks too: their coupling carries a held vertex's motion into the
+            // drape (sensitivities in a key that moves it).
             for i in 0..n {
                 for j in 0..=i {
-                    if self.fixed[ends[i]] || self.fixed[ends[j]] {
-                        continue;
-                    }
                     let mut m = grad[i] * grad[j].transpose() * (k * d2b);
                     if let Some(c) = &curv {
                         m += c[i][j] * (k * db);
