@@ -59,6 +59,22 @@ pub fn continuous_keys(scene: &Scene) -> Vec<String> {
     keys
 }
 
+/// The continuous keys of a validated scene that it lets move from their value: [`continuous_keys`]
+/// less those its checks refuse to change (a flat pattern's `cloth.initial_perturbation_m` on a
+/// garment placed in 3D, which must stay 0). Each key is nudged by 10⁻⁹ of its value (10⁻⁹ where
+/// it is 0) and the changed scene validated.
+pub fn free_keys(scene: &ValidatedScene) -> Vec<String> {
+    continuous_keys(scene)
+        .into_iter()
+        .filter(|k| {
+            value(scene, k, "").is_ok_and(|v| {
+                let nudged = if v == 0.0 { 1e-9 } else { v * (1.0 + 1e-9) };
+                with_value(scene, k, nudged, "").is_ok()
+            })
+        })
+        .collect()
+}
+
 fn collect_floats(prefix: &str, v: &toml::Value, out: &mut Vec<String>) {
     match v {
         toml::Value::Float(_) if !is_mesh_layout(prefix) => out.push(prefix.to_string()),

@@ -12,6 +12,9 @@
 //! gives no coefficients would contribute the central difference of its rebuilt gradients at x*. The fixed particles' motion (a pin moved by
 //! `cloth.size_x_m`) enters through the coupling blocks of the exact Hessian, H dx_fixed/dθ. No
 //! solve is needed, and the coefficients' difference is exact for coefficients linear in θ.
+//!
+//! The barriers' κ is held where the solve left it (a static solve may have doubled it where layers
+//! press): the sensitivity is that of the solved model's equilibrium, κ being the solver's choice.
 
 use crate::build::build_scene;
 use crate::error::InputError;
@@ -95,7 +98,7 @@ neutral mode; residual {r:.1e}): the drape does not move smoothly with it"
     }
 }
 
-/// A grid scene's continuous keys as parameters ([`params::continuous_keys`]); `source` names
+/// A scene's continuous keys that it lets change as parameters ([`params::free_keys`]); `source` names
 /// where the keys come from in errors (a flag, a file).
 pub struct SceneParameters<'a> {
     /// The scene.
@@ -106,7 +109,7 @@ pub struct SceneParameters<'a> {
 
 impl Parameterized for SceneParameters<'_> {
     fn keys(&self) -> Vec<String> {
-        params::continuous_keys(self.scene)
+        params::free_keys(self.scene)
     }
     fn value(&self, key: &str) -> Result<f64, InputError> {
         params::value(self.scene, key, &self.source)
