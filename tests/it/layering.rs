@@ -1,7 +1,7 @@
 //! The layering written down in the module map (docs/src/reference/modules.md), checked: crates
 //! depend only on crates below them, the core crate pulls in no I/O stack (not even transitively)
-//! and the application layer no report stack, no module of the core imports a module above it, no
-//! crate's modules import each other in a cycle, a stage file is an adapter (at most 100 lines of
+//! and the application layer no report stack, no module of the core imports a module above it (no circle
+//! at any depth: `module_graph.rs`), a stage file is an adapter (at most 100 lines of
 //! code), no function outside tests runs over 80 lines and no source file over 500 before its tests.
 
 use crate::support::root;
@@ -276,95 +276,6 @@ fn no_core_module_imports_one_above_it() {
         }
     }
     assert_eq!(seen.len(), CORE_RANKS.len(), "modules: {seen:?}");
-}
-
-/// The modules of the crate whose sources lie in `src` and the modules each imports (`crate::X`).
-fn module_graph(src: &Path) -> BTreeMap<String, std::collections::BTreeSet<String>> {
-    let mut files = Vec::new();
-    rust_files(src, &mut files);
-    let mut graph: BTreeMap<String, std::collections::BTreeSet<String>> = BTreeMap::new();
-    for f in &files {
-        let rel = f.strip_prefix(src).unwrap();
-        let m = module_of(rel);
-        let deps = graph.entry(m.clone()).or_default();
-        let text = std::fs::read_to_string(f).unwrap();
-        let mut refs = crate_refs(&text);
-        // In a file at the crate's root, `super::` is the crate (before its tests, where it is
-        // the file's own module).
-        if rel.components().count() == 1 {
-            let code = &text[..text.find("#[cfg(test)]").unwrap_or(text.len())];
-            refs.extend(refs_after(code, "super::"));
-        }
-        for d in refs {
-            if d != m {
-                deps.insert(d);
-            }
-        }
-    }
-    graph
-}
-
-/// A cycle among the modules of `graph`, if any (depth-first search).
-fn find_cycle(graph: &BTreeMap<String, std::collections::BTreeSet<String>>) -> Option<Vec<String>> {
-    fn visit(
-        g: &BTreeMap<String, std::collections::BTreeSet<String>>,
-        m: &str,
-        path: &mut Vec<String>,
-        done: &mut std::collections::BTreeSet<String>,
-    ) -> Option<Vec<String>> {
-        if let Some(i) = path.iter().position(|p| p == m) {
-            return Some(path[i..].to_vec());
-        }
-        if done.contains(m) {
-            return None;
-        }
-        path.push(m.to_string());
-        for d in g.get(m).into_iter().flatten() {
-            if let Some(c) = visit(g, d, path, done) {
-                return Some(c);
-            }
-        }
-        path.pop();
-        done.insert(m.to_string());
-        None
-    }
-    let mut done = std::collections::BTreeSet::new();
-    graph
-        .keys()
-        .find_map(|m| visit(graph, m, &mut Vec::new(), &mut done))
-}
-
-#[test]
-fn no_crate_has_an_import_cycle_among_its_modules() {
-    let mut srcs = vec![root().join("src")];
-    for e in std::fs::read_dir(root().join("crates")).unwrap() {
-        srcs.push(e.unwrap().path().join("src"));
-    }
-    for src in srcs {
-        let graph = module_graph(&src);
-        assert!(graph.len() > 1, "{}: no modules found", src.display());
-        if let Some(cycle) = find_cycle(&graph) {
-            panic!(
-                "{}: modules import each other: {}",
-                src.display(),
-                cycle.join(" → ")
-            );
-        }
-    }
-}
-
-#[test]
-fn the_cycle_check_sees_a_cycle() {
-    let g: BTreeMap<String, std::collections::BTreeSet<String>> = [
-        ("a", &["b"][..]),
-        ("b", &["c"][..]),
-        ("c", &["a"][..]),
-        ("d", &[][..]),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v.iter().map(|s| s.to_string()).collect()))
-    .collect();
-    assert_eq!(find_cycle(&g).map(|c| c.len()), Some(3));
 }
 
 /// Lines of code of a Rust text outside `#[cfg(test)]`: not blank, not a comment.

@@ -16,6 +16,7 @@ mod fuzz;
 mod garment;
 mod layering;
 mod loads;
+mod module_graph;
 mod patterns;
 mod pipeline;
 mod recordings;

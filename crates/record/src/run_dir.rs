@@ -267,7 +267,8 @@ fn simulate_into(
     finish_recorders(&report, &x, (timeline, rrd), &mut outputs)?;
     let state = (&grid, absent.as_slice(), x.as_slice());
     state_files(scene, state, &report, extras.obj, out, &mut outputs)?;
-    let (sensitivity, sens_data) = sensitivities(loaded, &grid, &model, &x, &report, extras, out)?;
+    let asked = &extras.sensitivity_keys;
+    let (sensitivity, sens_data) = sensitivities(loaded, &grid, &model, &x, &report, asked, out)?;
     if sensitivity.as_ref().is_some_and(|s| s.written) {
         outputs.push("sensitivity.parquet");
     }

@@ -1,7 +1,6 @@
 //! The sensitivities a simulate run writes (`--sensitivity KEY`): dx*/dθ per key at the converged
 //! drape, made as accurate as the derivative needs, and what run.json says of them.
 
-use crate::SimulateExtras;
 use anyhow::Result;
 use drapelab_core::scene::LoadedScene;
 use drapelab_core::solve::SolveReport;
@@ -83,7 +82,7 @@ fn accurate_sensitivities(
     Ok((second, accuracy))
 }
 
-/// The sensitivities `extras` asks for, written into `out/sensitivity.parquet` when the state is a
+/// The sensitivities of `asked` (`simulate --sensitivity KEY`, in the order asked), written into `out/sensitivity.parquet` when the state is a
 /// converged minimum; what run.json says of them (None when none were asked for).
 pub(crate) fn sensitivities(
     loaded: &LoadedScene,
@@ -91,16 +90,16 @@ pub(crate) fn sensitivities(
     model: &drapelab_core::physics::Model,
     x: &[nalgebra::Vector3<f64>],
     report: &SolveReport,
-    extras: &SimulateExtras,
+    asked: &[String],
     out: &Path,
 ) -> Result<(Option<SensitivityRecord>, KeyedSensitivities)> {
-    if extras.sensitivity_keys.is_empty() {
+    if asked.is_empty() {
         return Ok((None, Vec::new()));
     }
     let start = std::time::Instant::now();
     // A key asked for twice is computed and written once, in the order first asked.
     let mut keys: Vec<String> = Vec::new();
-    for k in &extras.sensitivity_keys {
+    for k in asked {
         if !keys.contains(k) {
             keys.push(k.clone());
         }

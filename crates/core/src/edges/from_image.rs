@@ -37,7 +37,7 @@ pub struct FitImageOptions {
     pub calibration: Calibration,
     /// The pinhole camera that took the photo, if known (its projection rides on every edge fit);
     /// None: orthographic.
-    pub pinhole: Option<super::Pinhole>,
+    pub pinhole: Option<super::projection::Pinhole>,
 }
 
 /// The result of fitting a photo.

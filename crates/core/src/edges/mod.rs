@@ -10,6 +10,7 @@ mod from_image;
 mod from_particles;
 mod photo;
 mod poly;
+mod projection;
 mod render;
 mod segment;
 mod systematic;
@@ -18,10 +19,9 @@ pub use from_image::{Calibration, FitImageOptions, ImageFit, fit_image, read_gra
 pub use from_particles::{
     EdgeSource, ReferenceLine, edges_from_particles, edges_from_silhouette, simulated_edges,
 };
-pub use photo::{
-    CameraFile, Pinhole, Projection, ScoreRow, read_camera, render_options, scene_view, score_edges,
-};
+pub use photo::{CameraFile, ScoreRow, read_camera, render_options, scene_view, score_edges};
 pub use poly::{Polynomial, fit_polynomial};
+pub use projection::{Pinhole, Projection};
 pub use render::{Camera, RenderOptions, RenderedPhoto, render_drape, render_view};
 pub use systematic::{PERTURBATIONS, edge_perturbations, systematic_pct, with_systematics};
 

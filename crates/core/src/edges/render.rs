@@ -70,7 +70,7 @@ pub struct RenderedPhoto {
     pub px_per_cm: f64,
     /// The pinhole camera as a camera file describes it (focal length, distance to the corners'
     /// plane, principal point); None for the orthographic camera.
-    pub pinhole: Option<super::Pinhole>,
+    pub pinhole: Option<super::projection::Pinhole>,
 }
 
 /// Background and fabric grey levels.
@@ -112,7 +112,7 @@ pub fn render_drape(
     let (px_per_cm, pinhole) = match opts.camera {
         Camera::Orthographic => (opts.px_per_cm, None),
         Camera::Pinhole { distance_m } => {
-            let p = super::Pinhole {
+            let p = super::projection::Pinhole {
                 focal_length_px: s * distance_m,
                 distance_m: distance_m + plane_y,
                 principal_point_px: Some(axis_px),

@@ -1,6 +1,6 @@
 //! The one executor of static continuations (argmin's habit: the executor owns the loop). A
 //! continuation is a sequence of Newton stages of one model whose set-up changes between them: the
-//! external loads raised in increments (seed 003 §10.3.3, [`super::newton::LoadRamp`]), obstacles'
+//! external loads raised in increments (seed 003 §10.3.3, [`super::LoadRamp`]), obstacles'
 //! contact sets refreshed (§10.7.1's vertical gap), friction anchors lagged one solve behind. The
 //! [`Continuation`] says what the next stage is; [`execute`] runs the Newton runs, hands the
 //! observer the first run, stops at the first stage that does not reach its goal, and merges the

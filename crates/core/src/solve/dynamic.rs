@@ -13,8 +13,9 @@
 //! The explicit integrators stop with [`StopReason::ContactTooStiff`] the first time a step would
 //! carry a particle into an obstacle: their step cannot resolve the barrier there.
 
-use super::dynamic_options::{DynamicOptions, Integrator};
+use super::dynamic_options::DynamicOptions;
 use super::incremental::{ImplicitSettings, Settle, integrate_implicit, observe_start};
+use super::kind::Integrator;
 use super::stability::{kinetic_energy, stability_limit_dt};
 use super::time_step::Stepper;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};

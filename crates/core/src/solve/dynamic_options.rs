@@ -1,28 +1,7 @@
 //! The dynamic solvers' options (`[solver.dynamic]`): each key's meaning, unit and default, and
-//! their checks; and [`Integrator`], which time integrator a dynamic solve uses.
+//! their checks.
 
 use serde::{Deserialize, Serialize};
-
-/// A time integrator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Hash)]
-#[serde(rename_all = "kebab-case")]
-pub enum Integrator {
-    /// Forward Euler with Provot's correction (seed 000).
-    ExplicitEuler,
-    /// Semi-implicit (symplectic) Euler.
-    SymplecticEuler,
-    /// Implicit Euler as an optimisation of the incremental potential (Newton, adaptive steps).
-    ImplicitEuler,
-    /// Implicit Euler linearised once per step (Baraff–Witkin, conjugate gradients, fixed steps).
-    BaraffWitkin,
-}
-
-impl Integrator {
-    /// The name written into outputs: its [`super::SolverKind`]'s.
-    pub fn as_str(self) -> &'static str {
-        super::SolverKind::from(self).name()
-    }
-}
 
 /// Options of the dynamic solvers.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -12,7 +12,7 @@
 
 use super::FactorReuse;
 use super::clock::{Clock, StepBounds, grown};
-use super::newton::StaticOptions;
+use super::static_options::StaticOptions;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
 use crate::physics::{EnergyTerm, HessianBlocks, Model, Vecs};
 use nalgebra::{Matrix3, Vector3};

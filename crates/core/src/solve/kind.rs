@@ -1,7 +1,27 @@
 //! Which solver runs a scene: its names in scenes and in reports, and the integrator it is.
 
-use super::Integrator;
 use serde::{Deserialize, Serialize};
+
+/// A time integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Hash)]
+#[serde(rename_all = "kebab-case")]
+pub enum Integrator {
+    /// Forward Euler with Provot's correction (seed 000).
+    ExplicitEuler,
+    /// Semi-implicit (symplectic) Euler.
+    SymplecticEuler,
+    /// Implicit Euler as an optimisation of the incremental potential (Newton, adaptive steps).
+    ImplicitEuler,
+    /// Implicit Euler linearised once per step (Baraff–Witkin, conjugate gradients, fixed steps).
+    BaraffWitkin,
+}
+
+impl Integrator {
+    /// The name written into outputs: its [`SolverKind`]'s.
+    pub fn as_str(self) -> &'static str {
+        SolverKind::from(self).name()
+    }
+}
 
 /// Which solver runs the scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]

@@ -11,6 +11,7 @@ mod equilibrium;
 mod incremental;
 mod kind;
 mod linear;
+mod load_ramp;
 mod neutral;
 mod newton;
 mod report;
@@ -24,18 +25,20 @@ mod vertical_gap;
 
 pub use continuation::{Continuation, Stage, execute};
 pub use dynamic::solve_dynamic;
-pub use dynamic_options::{DynamicOptions, Integrator};
+pub use dynamic_options::DynamicOptions;
 pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
-pub use kind::{SolverKind, by_report_name};
+pub use kind::{Integrator, SolverKind, by_report_name};
 pub use linear::{DofMap, SparseSpd};
+pub use load_ramp::{LoadRamp, solve_static, solve_static_loads};
 pub use neutral::{NEUTRAL_REL, NeutralMode, neutral_modes};
-pub use newton::{NeighbourFactor, StaticOptions, is_minimum, solve_static, solve_static_loads};
+pub use newton::is_minimum;
 pub use report::{
     Divergence, DivergenceReason, Globalization, Part, SolveReport, Status, StopReason,
 };
 pub use sag::{folded_start, sagged_start};
 pub use stability::{highest_mode, kinetic_energy, stability_limit_dt};
+pub use static_options::{NeighbourFactor, StaticOptions};
 pub use strategy::{
     Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Start, Verdict,
 };

@@ -12,40 +12,14 @@
 //! spring's length: the step follows the curve x + α dx + ½ α² a, a the geodesic acceleration
 //! (Transtrum & Sethna 2012), which bends it along the arcs the springs allow.
 
-pub use super::static_options::{NeighbourFactor, StaticOptions};
+use super::static_options::{NeighbourFactor, StaticOptions};
 use super::step::Workspace;
-use super::{DivergenceReason, Observer, SolveReport, Stage, StateEvent, Status, StopReason};
+use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
 use std::time::Instant;
 
-/// Solves for the static equilibrium starting from `x` (updated in place), the external loads raised
-/// in `opts.load_steps` equal steps.
-pub fn solve_static(
-    model: &mut Model,
-    x: &mut [Vector3<f64>],
-    opts: &StaticOptions,
-    observer: &mut dyn Observer,
-) -> SolveReport {
-    let steps = opts.load_steps.max(1);
-    let loads: Vec<f64> = (1..=steps).map(|s| s as f64 / steps as f64).collect();
-    solve_static_loads(model, x, opts, &loads, observer)
-}
-
-/// [`solve_static`] through the given load factors (increasing; the last one is solved to the
-/// tolerance and reported, the others only roughly), one Newton run through the executor
-/// ([`super::execute`] of a [`LoadRamp`]).
-pub fn solve_static_loads(
-    model: &mut Model,
-    x: &mut [Vector3<f64>],
-    opts: &StaticOptions,
-    loads: &[f64],
-    observer: &mut dyn Observer,
-) -> SolveReport {
-    super::execute(model, x, opts, &mut LoadRamp::new(loads), observer)
-}
-
-/// [`solve_static_loads`] at full load that also hands back the run's last factor when it
+/// [`super::solve_static_loads`] at full load that also hands back the run's last factor when it
 /// converged: the preconditioner of the next solve of a nearby model ([`NeighbourFactor`]), as the
 /// next step of implicit Euler is.
 pub fn solve_static_keeping_factor(
@@ -67,37 +41,6 @@ pub fn solve_static_keeping_factor(
     let factor = (reached && run.ws.spd.has_factor())
         .then(|| NeighbourFactor(std::sync::Arc::new(run.ws.spd.copy())));
     (run.finish(model, x), factor)
-}
-
-/// Incremental loading (seed 003 §10.3.3) as a continuation: the external loads raised through the
-/// given factors within one Newton run, the last solved to the tolerance.
-pub struct LoadRamp {
-    loads: Vec<f64>,
-    next: usize,
-}
-
-impl LoadRamp {
-    /// The ramp through `loads` (full load at once when empty).
-    pub fn new(loads: &[f64]) -> Self {
-        let loads = if loads.is_empty() {
-            vec![1.0]
-        } else {
-            loads.to_vec()
-        };
-        Self { loads, next: 0 }
-    }
-}
-
-impl super::Continuation for LoadRamp {
-    fn next(&mut self, _model: &mut Model, _x: &mut [Vector3<f64>], _solved: bool) -> Stage {
-        let k = self.next;
-        self.next += 1;
-        match self.loads.get(k) {
-            Some(&load) if k + 1 == self.loads.len() => Stage::Solve(load),
-            Some(&load) => Stage::Increment(load),
-            None => Stage::Done(String::new()),
-        }
-    }
 }
 
 /// How far a stage of a Newton run solves.

@@ -1,7 +1,7 @@
 //! The stability of an explicit step: the highest natural frequency of the linearised sheet (power
 //! iteration), the largest stable step of each explicit integrator, and the kinetic energy.
 
-use super::dynamic_options::Integrator;
+use super::kind::Integrator;
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
 

@@ -3,7 +3,7 @@
 //! gradients with a block-Jacobi preconditioner), each cut short where it would enter an obstacle.
 
 use super::SolveReport;
-use super::dynamic_options::Integrator;
+use super::kind::Integrator;
 use super::linear::DofMap;
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::{Matrix3, Vector3};

@@ -9,7 +9,7 @@ mod factor;
 mod reuse;
 
 use super::linear::{DofMap, SparseSpd};
-use super::newton::StaticOptions;
+use super::static_options::StaticOptions;
 use super::strategy::{
     Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Verdict,
 };
