@@ -74,13 +74,17 @@ fn neighbour(scene: &ValidatedScene, sol: &Solution) -> Option<Vec<Vector3<f64>>
     let mut x: Vec<Vector3<f64>> = (0..sol.x.len())
         .map(|p| if b.model.fixed[p] { b.x0[p] } else { sol.x[p] })
         .collect();
-    let mut held: Scene = (**scene).clone();
-    held.solver.static_.kappa_adapt_gap_rel = 0.0;
+    let held = drapelab_core::solve::StaticOptions {
+        kappa_adapt_gap_rel: 0.0,
+        ..scene.solver.static_.clone()
+    };
     let r = drapelab_core::simulate::solve_model_warm(
+        scene,
         &held,
         &b.grid,
         &mut b.model,
         &mut x,
+        Default::default(),
         &mut NoObserver,
     );
     r.is_converged().then_some(x)

@@ -320,7 +320,8 @@ fn observed_solve(
     obs: &mut Observers<'_>,
 ) -> SolveReport {
     let mut r = if warm {
-        solve_model_warm(scene, grid, model, x, obs)
+        let (opts, cold) = (&scene.solver.static_, Default::default());
+        solve_model_warm(scene, opts, grid, model, x, cold, obs)
     } else {
         solve_model(scene, grid, model, x, obs)
     };

@@ -172,11 +172,19 @@ impl Problem {
         starts: &[&[Vector3<f64>]],
     ) -> Option<Point> {
         let scene = self.scene_for(&self.lm_params(&u, topology));
-        let mut straight = scene.clone();
-        straight.solver.static_.direction = crate::solve::Direction::Straight;
-        straight.solver.static_.factor_reuse = crate::solve::FactorReuse::Chord;
-        let sol =
-            crate::simulate::solve_scene_from_lowest(&straight, starts, None, &mut NoObserver);
+        let opts = crate::solve::StaticOptions {
+            direction: crate::solve::Direction::Straight,
+            factor_reuse: crate::solve::FactorReuse::Chord,
+            ..scene.solver.static_.clone()
+        };
+        let cold = crate::solve::WarmData::default();
+        let sol = crate::simulate::solve_scene_from_lowest(
+            &scene,
+            Some(&opts),
+            starts,
+            cold,
+            &mut NoObserver,
+        );
         if !sol.report.is_converged() {
             return None;
         }

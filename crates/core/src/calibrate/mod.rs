@@ -262,29 +262,32 @@ impl Problem {
             // calibrated parameters (issue 34, one run each on one machine); reusing the factorization
             // (chord steps) took it from 280 s to 247 s (reports/newton_iterations.md).
             false => {
-                let mut straight = scene.clone();
-                straight.solver.static_.direction = crate::solve::Direction::Straight;
-                straight.solver.static_.factor_reuse = crate::solve::FactorReuse::Chord;
-                // The cost reads the status only, and the start is a stable lattice drape (or its
-                // tangent prediction): the minimum check was a third of an evaluation's
-                // factorizations.
-                straight.solver.static_.check_minimum = false;
+                let opts = crate::solve::StaticOptions {
+                    direction: crate::solve::Direction::Straight,
+                    factor_reuse: crate::solve::FactorReuse::Chord,
+                    // The cost reads the status only, and the start is a stable lattice drape (or
+                    // its tangent prediction): the minimum check was a third of an evaluation's
+                    // factorizations.
+                    check_minimum: false,
+                    residual_tol_rel: scene
+                        .solver
+                        .static_
+                        .residual_tol_rel
+                        .max(EVALUATION_TOL_REL),
+                    ..scene.solver.static_.clone()
+                };
                 // Its Newton steps by CG with the node's factor: no factorization while that
                 // converges (the slack population's median went from 1 factorization and 7
                 // iterations to 0 and 4, its slowest solve from 0.3 s to 27 ms).
-                straight.solver.static_.neighbour_factor = warm.factor.clone();
-                let tol = &mut straight.solver.static_.residual_tol_rel;
-                *tol = tol.max(EVALUATION_TOL_REL);
+                let neighbour = crate::solve::WarmData {
+                    factor: warm.factor.as_ref(),
+                    candidates: warm.candidates.as_ref(),
+                };
                 let solve = match warm.ordered {
                     true => crate::simulate::solve_scene_from_first,
                     false => crate::simulate::solve_scene_from_lowest,
                 };
-                solve(
-                    &straight,
-                    &starts,
-                    warm.candidates.as_ref(),
-                    &mut NoObserver,
-                )
+                solve(&scene, Some(&opts), &starts, neighbour, &mut NoObserver)
             }
             true => solve_scene(&scene, &mut NoObserver),
         };

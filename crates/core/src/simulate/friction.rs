@@ -13,6 +13,7 @@ pub(super) fn solve_with_friction(
     model: &mut crate::physics::Model,
     x: &mut [Vector3<f64>],
     opts: &crate::solve::StaticOptions,
+    warm: crate::solve::WarmData<'_>,
     observer: &mut dyn Observer,
 ) -> SolveReport {
     let steps = if opts.load_steps > 1 {
@@ -36,7 +37,7 @@ pub(super) fn solve_with_friction(
         stage: 0,
         before: Vec::new(),
     };
-    crate::solve::execute(model, x, opts, &mut lag, observer)
+    crate::solve::execute(model, x, opts, warm, &mut lag, observer)
 }
 
 /// Refreshes of the friction anchors at full load after the load increments.

@@ -8,7 +8,9 @@ mod start;
 use crate::build::{BuiltScene, build_scene};
 use crate::cloth::Grid;
 use crate::scene::Scene;
-use crate::solve::{Observer, SolveReport, solve_dynamic, solve_static};
+use crate::solve::{
+    Observer, SolveReport, StaticOptions, WarmData, solve_dynamic, solve_static_warm,
+};
 use friction::solve_with_friction;
 use nalgebra::Vector3;
 use start::{coarse_start, taut_start};
@@ -179,7 +181,8 @@ pub fn self_contact_summary(
 /// checked first ([`Scene::validated`]): an invalid one gives a solution with status invalid, the
 /// bad key in its message, and no particles.
 pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
-    solve_built(scene, &[], None, Choice::Lowest, observer)
+    let cold = WarmData::default();
+    solve_built(scene, None, &[], cold, Choice::Lowest, observer)
 }
 
 /// Solves a validated scene statically or dynamically from the given positions of all particles
@@ -190,21 +193,24 @@ pub fn solve_scene_from(
     x0: &[Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, &[x0], None, Choice::Lowest, observer)
+    let cold = WarmData::default();
+    solve_built(scene, None, &[x0], cold, Choice::Lowest, observer)
 }
 
 /// [`solve_scene_from`] the candidate start with the lowest energy in the scene's model (e.g. a
 /// neighbouring drape and its tangent prediction): the model is built once for the choice and the
 /// solve. Candidates that do not match the model's particle count are passed over; with none left,
-/// the scene's own start. `candidates`, a self-contact candidate set from the neighbour's solve
-/// ([`crate::physics::Model::candidates`]), seeds the model's broad phase where it fits.
+/// the scene's own start. `opts`, where given, replaces the scene's static solver options (a
+/// calibration's cheaper steps, with no copy of the scene); `warm` is the neighbour's data (its
+/// factor, its self-contact candidates, which seed the model's broad phase where they fit).
 pub fn solve_scene_from_lowest(
     scene: &Scene,
+    opts: Option<&StaticOptions>,
     starts: &[&[Vector3<f64>]],
-    candidates: Option<&crate::physics::CandidateSet>,
+    warm: WarmData<'_>,
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, starts, candidates, Choice::Lowest, observer)
+    solve_built(scene, opts, starts, warm, Choice::Lowest, observer)
 }
 
 /// [`solve_scene_from_lowest`], but from the first candidate whose energy is finite: the starts come
@@ -212,11 +218,12 @@ pub fn solve_scene_from_lowest(
 /// Hermite start), and the energies of the others are not taken (each is a pass over the model).
 pub fn solve_scene_from_first(
     scene: &Scene,
+    opts: Option<&StaticOptions>,
     starts: &[&[Vector3<f64>]],
-    candidates: Option<&crate::physics::CandidateSet>,
+    warm: WarmData<'_>,
     observer: &mut dyn Observer,
 ) -> Solution {
-    solve_built(scene, starts, candidates, Choice::FirstFinite, observer)
+    solve_built(scene, opts, starts, warm, Choice::FirstFinite, observer)
 }
 
 /// How a solve picks among its candidate starts.
@@ -230,8 +237,9 @@ enum Choice {
 
 fn solve_built(
     scene: &Scene,
+    opts: Option<&StaticOptions>,
     starts: &[&[Vector3<f64>]],
-    candidates: Option<&crate::physics::CandidateSet>,
+    warm: WarmData<'_>,
     choice: Choice,
     observer: &mut dyn Observer,
 ) -> Solution {
@@ -246,9 +254,10 @@ fn solve_built(
         mut model,
         x0: mut x,
     } = build_scene(scene);
-    if let Some(set) = candidates {
+    if let Some(set) = warm.candidates {
         model.seed_candidates(set);
     }
+    let opts = opts.unwrap_or(&scene.solver.static_);
     let mut scored = starts
         .iter()
         .filter(|s| s.len() == x.len())
@@ -263,9 +272,9 @@ fn solve_built(
     let report = match start {
         Some(x0) => {
             x.copy_from_slice(x0);
-            solve_model_warm(scene, &grid, &mut model, &mut x, observer)
+            solve_model_warm(scene, opts, &grid, &mut model, &mut x, warm, observer)
         }
-        _ => solve_model(scene, &grid, &mut model, &mut x, observer),
+        _ => solve_model_with(scene, opts, &grid, &mut model, &mut x, observer),
     };
     let mut report = report;
     check_crossings(scene, &grid, &model, &x, &mut report);
@@ -279,20 +288,24 @@ fn solve_built(
 }
 
 /// Solves a built scene from `x` as it is, a warm start near the equilibrium (a saved drape, a
-/// neighbouring parameter's solution): no coarse, sagged or folded start, and Newton starts far less
-/// damped ([`WARM_LM_DAMPING`]).
+/// neighbouring parameter's solution) with the static options `opts` (the scene's, or a caller's
+/// in their place) and the neighbour's data `warm`: no coarse, sagged or folded start, and Newton
+/// starts far less damped ([`WARM_LM_DAMPING`]).
 pub fn solve_model_warm(
     scene: &Scene,
+    opts: &StaticOptions,
     grid: &Grid,
     model: &mut crate::physics::Model,
     x: &mut [Vector3<f64>],
+    warm: WarmData<'_>,
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let mut warm = scene.clone();
-    let lm = &mut warm.solver.static_.lm_damping_initial;
-    *lm = lm.min(WARM_LM_DAMPING);
-    let mut report = static_or_dynamic(&warm, grid, model, x, observer);
-    check_minimum(scene.solver.static_.check_minimum, model, x, &mut report);
+    let damped = StaticOptions {
+        lm_damping_initial: opts.lm_damping_initial.min(WARM_LM_DAMPING),
+        ..opts.clone()
+    };
+    let mut report = static_or_dynamic(scene, &damped, grid, model, x, warm, observer);
+    check_minimum(opts.check_minimum, model, x, &mut report);
     report
 }
 
@@ -303,13 +316,15 @@ pub const WARM_LM_DAMPING: f64 = 1e-5;
 /// The scene's solver from `x` as it is: the static solve, or the dynamic integrator.
 fn static_or_dynamic(
     scene: &Scene,
+    opts: &StaticOptions,
     grid: &Grid,
     model: &mut crate::physics::Model,
     x: &mut [Vector3<f64>],
+    warm: WarmData<'_>,
     observer: &mut dyn Observer,
 ) -> SolveReport {
     match scene.solver.kind.integrator() {
-        None => static_solve(scene, grid, model, x, observer),
+        None => static_solve(scene, opts, grid, model, x, warm, observer),
         Some(integ) => {
             let mut v = vec![Vector3::zeros(); x.len()];
             let mut report =
@@ -347,13 +362,27 @@ pub fn solve_model(
     x: &mut [Vector3<f64>],
     observer: &mut dyn Observer,
 ) -> SolveReport {
+    solve_model_with(scene, &scene.solver.static_, grid, model, x, observer)
+}
+
+/// [`solve_model`] with the static options `opts` in place of the scene's (its coarse and taut
+/// starts solve with the scene's own).
+fn solve_model_with(
+    scene: &Scene,
+    opts: &StaticOptions,
+    grid: &Grid,
+    model: &mut crate::physics::Model,
+    x: &mut [Vector3<f64>],
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let cold = WarmData::default();
     if scene.solver.kind.integrator().is_some() {
-        return static_or_dynamic(scene, grid, model, x, observer);
+        return static_or_dynamic(scene, opts, grid, model, x, cold, observer);
     }
     // Nested iteration: start Newton from the interpolated solution of the scene on the grid with
     // every other line, when that grid exists; far fewer fine iterations are needed. Otherwise,
     // without obstacles, from the sagged sheet.
-    let taut = match scene.solver.static_.start.is_shaped() {
+    let taut = match opts.start.is_shaped() {
         true => taut_start(scene, x),
         false => None,
     };
@@ -363,13 +392,13 @@ pub fn solve_model(
     };
     if coarse.is_none()
         && taut.is_none()
-        && scene.solver.static_.start.is_shaped()
+        && opts.start.is_shaped()
         && scene.obstacles.is_empty()
         && crate::solve::folded_start(model, x).is_none()
     {
         crate::solve::sagged_start(model, x);
     }
-    let mut report = static_solve(scene, grid, model, x, observer);
+    let mut report = static_solve(scene, opts, grid, model, x, cold, observer);
     if let Some(r) = taut {
         report.merge(&r, crate::solve::Part::Start);
         report.message += " (from the taut net's drape)";
@@ -382,7 +411,7 @@ pub fn solve_model(
             grid.ny.div_ceil(2)
         );
     }
-    check_minimum(scene.solver.static_.check_minimum, model, x, &mut report);
+    check_minimum(opts.check_minimum, model, x, &mut report);
     report
 }
 
@@ -390,12 +419,13 @@ pub fn solve_model(
 /// scene asks for that contact treatment.
 fn static_solve(
     scene: &Scene,
+    opts: &StaticOptions,
     grid: &Grid,
     model: &mut crate::physics::Model,
     x: &mut [Vector3<f64>],
+    warm: WarmData<'_>,
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let opts = &scene.solver.static_;
     if scene.contact.method == crate::scene::ContactMethod::VerticalGap
         && !scene.obstacles.is_empty()
     {
@@ -405,11 +435,12 @@ fn static_solve(
             &scene.obstacles,
             grid.min_spacing_m(),
             opts,
+            warm,
             observer,
         )
     } else if scene.contact.friction_coefficient > 0.0 && !scene.obstacles.is_empty() {
-        solve_with_friction(scene, model, x, opts, observer)
+        solve_with_friction(scene, model, x, opts, warm, observer)
     } else {
-        solve_static(model, x, opts, observer)
+        solve_static_warm(model, x, opts, warm, observer)
     }
 }

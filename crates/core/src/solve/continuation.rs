@@ -7,6 +7,7 @@
 //! runs' reports ([`SolveReport::merge`]).
 
 use super::newton::{Goal, NewtonRun};
+use super::warm::WarmData;
 use super::{NoObserver, Observer, Part, SolveReport, StaticOptions, StopReason};
 use crate::physics::Model;
 use nalgebra::Vector3;
@@ -71,6 +72,7 @@ pub fn execute(
     model: &mut Model,
     x: &mut [Vector3<f64>],
     opts: &StaticOptions,
+    warm: WarmData<'_>,
     continuation: &mut dyn Continuation,
     observer: &mut dyn Observer,
 ) -> SolveReport {
@@ -107,7 +109,7 @@ pub fn execute(
             };
         let mut current = match run.take() {
             Some(r) => r,
-            None => match NewtonRun::new(model, x, opts) {
+            None => match NewtonRun::new(model, x, opts, warm.factor) {
                 Ok(r) => r,
                 Err(invalid) => return merged(total, *invalid),
             },
@@ -153,7 +155,14 @@ mod tests {
         let k = 100.0;
         let (mut model, mut x) = hung(k);
         let opts = StaticOptions::default();
-        let r = execute(&mut model, &mut x, &opts, &mut Ramp(0), &mut NoObserver);
+        let r = execute(
+            &mut model,
+            &mut x,
+            &opts,
+            WarmData::default(),
+            &mut Ramp(0),
+            &mut NoObserver,
+        );
         assert!(r.is_converged(), "{}", r.message);
         assert!(r.message.ends_with(" (ramped)"));
         // The message counts every stage's iterations, as the report does.

@@ -308,11 +308,15 @@ mod tests {
         xs.copy_from_slice(&x);
         let opts = crate::solve::StaticOptions {
             residual_tol_rel: 1e-12,
-            neighbour_factor: Some(crate::solve::NeighbourFactor(shared)),
             ..Default::default()
         };
-        let r =
-            crate::solve::solve_static(&mut seeded, &mut xs, &opts, &mut crate::solve::NoObserver);
+        let factor = crate::solve::NeighbourFactor(shared);
+        let warm = crate::solve::WarmData {
+            factor: Some(&factor),
+            candidates: None,
+        };
+        let mut obs = crate::solve::NoObserver;
+        let r = crate::solve::solve_static_warm(&mut seeded, &mut xs, &opts, warm, &mut obs);
         assert!(r.is_converged(), "{}", r.message);
         (r, xs, xp)
     }

@@ -220,20 +220,20 @@ fn step(
         // The Hessian changes little over one step's iterations: chord steps save factorizations
         // (37 % over eight scenes, reports/newton_iterations.md).
         factor_reuse: s.factor_reuse,
-        // The last step's factor preconditions this step's Newton steps (conjugate gradients): one
-        // step of a settling sheet changes its Hessian little, and the factorizations were most of
-        // a step's cost (issue 47's stress box: 29,608 of them in 3,539 steps of one run).
-        // Only where factors are reused at all (`"chord"`, the default).
-        neighbour_factor: carried
-            .take()
-            .filter(|_| s.factor_reuse == FactorReuse::Chord),
         // κ stiffens between steps (below), not within one step's Newton: within a step it
         // changed which slowly creeping nets settle within their simulated time (the stress box's
         // point 88 settled at t = 95,746 s with κ held and not within 10⁵ s without).
         kappa_adapt_gap_rel: 0.0,
         ..StaticOptions::default()
     };
-    let (r, factor) = super::newton::solve_static_keeping_factor(model, x, &opts);
+    // The last step's factor preconditions this step's Newton steps (conjugate gradients): one
+    // step of a settling sheet changes its Hessian little, and the factorizations were most of
+    // a step's cost (issue 47's stress box: 29,608 of them in 3,539 steps of one run).
+    // Only where factors are reused at all (`"chord"`, the default).
+    let last = carried
+        .take()
+        .filter(|_| s.factor_reuse == FactorReuse::Chord);
+    let (r, factor) = super::newton::solve_static_keeping_factor(model, x, &opts, last.as_ref());
     *carried = factor;
     model.terms.pop();
     report.merge(&r, super::Part::InnerSolve);

@@ -4,6 +4,7 @@
 
 use super::continuation::{Continuation, Stage, execute};
 use super::static_options::StaticOptions;
+use super::warm::WarmData;
 use super::{Observer, SolveReport};
 use crate::physics::Model;
 use nalgebra::Vector3;
@@ -16,9 +17,7 @@ pub fn solve_static(
     opts: &StaticOptions,
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let steps = opts.load_steps.max(1);
-    let loads: Vec<f64> = (1..=steps).map(|s| s as f64 / steps as f64).collect();
-    solve_static_loads(model, x, opts, &loads, observer)
+    solve_static_warm(model, x, opts, WarmData::default(), observer)
 }
 
 /// [`solve_static`] through the given load factors (increasing; the last one is solved to the
@@ -31,7 +30,22 @@ pub fn solve_static_loads(
     loads: &[f64],
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    execute(model, x, opts, &mut LoadRamp::new(loads), observer)
+    let ramp = &mut LoadRamp::new(loads);
+    execute(model, x, opts, WarmData::default(), ramp, observer)
+}
+
+/// [`solve_static`] from a neighbouring solve's data (`warm`: its factor; candidate sets are
+/// seeded into the model by whoever builds it).
+pub fn solve_static_warm(
+    model: &mut Model,
+    x: &mut [Vector3<f64>],
+    opts: &StaticOptions,
+    warm: WarmData<'_>,
+    observer: &mut dyn Observer,
+) -> SolveReport {
+    let steps = opts.load_steps.max(1);
+    let loads: Vec<f64> = (1..=steps).map(|s| s as f64 / steps as f64).collect();
+    execute(model, x, opts, warm, &mut LoadRamp::new(&loads), observer)
 }
 
 /// Incremental loading (seed 003 §10.3.3) as a continuation: the external loads raised through the

@@ -22,6 +22,7 @@ mod step;
 mod strategy;
 mod time_step;
 mod vertical_gap;
+mod warm;
 
 pub use continuation::{Continuation, Stage, execute};
 pub use dynamic::solve_dynamic;
@@ -30,7 +31,7 @@ pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use incremental::{ImplicitSettings, Inertia, Settle, integrate_implicit};
 pub use kind::{Integrator, SolverKind, by_report_name};
 pub use linear::{DofMap, SparseSpd};
-pub use load_ramp::{LoadRamp, solve_static, solve_static_loads};
+pub use load_ramp::{LoadRamp, solve_static, solve_static_loads, solve_static_warm};
 pub use neutral::{NEUTRAL_REL, NeutralMode, neutral_modes};
 pub use newton::is_minimum;
 pub use report::{
@@ -38,11 +39,12 @@ pub use report::{
 };
 pub use sag::{folded_start, sagged_start};
 pub use stability::{highest_mode, kinetic_energy, stability_limit_dt};
-pub use static_options::{NeighbourFactor, StaticOptions};
+pub use static_options::StaticOptions;
 pub use strategy::{
     Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Start, Verdict,
 };
 pub use vertical_gap::solve_vertical_gap;
+pub use warm::{NeighbourFactor, WarmData};
 
 use nalgebra::Vector3;
 

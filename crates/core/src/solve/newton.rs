@@ -12,8 +12,9 @@
 //! spring's length: the step follows the curve x + α dx + ½ α² a, a the geodesic acceleration
 //! (Transtrum & Sethna 2012), which bends it along the arcs the springs allow.
 
-use super::static_options::{NeighbourFactor, StaticOptions};
+use super::static_options::StaticOptions;
 use super::step::Workspace;
+use super::warm::NeighbourFactor;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
@@ -26,8 +27,9 @@ pub fn solve_static_keeping_factor(
     model: &mut Model,
     x: &mut [Vector3<f64>],
     opts: &StaticOptions,
+    factor: Option<&NeighbourFactor>,
 ) -> (SolveReport, Option<NeighbourFactor>) {
-    let mut run = match NewtonRun::new(model, x, opts) {
+    let mut run = match NewtonRun::new(model, x, opts, factor) {
         Ok(r) => r,
         Err(invalid) => return (*invalid, None),
     };
@@ -74,9 +76,10 @@ impl NewtonRun {
         model: &Model,
         x: &[Vector3<f64>],
         opts: &StaticOptions,
+        factor: Option<&NeighbourFactor>,
     ) -> Result<Self, Box<SolveReport>> {
         let mut report = SolveReport::unsolved(super::SolverKind::Static);
-        let ws = Workspace::new(model, x, opts);
+        let ws = Workspace::new(model, x, opts, factor);
         if ws.dofs.n == 0 || !model.reference_weight().is_finite() {
             report.stop_with(
                 StopReason::Invalid,

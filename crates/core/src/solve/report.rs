@@ -163,7 +163,7 @@ pub struct Globalization {
     #[serde(default)]
     pub chord_steps: usize,
     /// Iterations whose step was solved by conjugate gradients preconditioned with a neighbour's
-    /// factor (`StaticOptions::neighbour_factor`; no factorization of their own).
+    /// factor (`WarmData::factor`; no factorization of their own).
     #[serde(default)]
     pub krylov_steps: usize,
 }

@@ -97,12 +97,6 @@ pub struct StaticOptions {
     /// for a large drape that folds (a garment) whose run.json shows most steps projected.
     #[serde(default = "default_exact_retry_every")]
     pub exact_retry_every: usize,
-    /// The factor of a neighbouring equilibrium's Hessian (set in code, never read from a file):
-    /// each Newton step is then solved by conjugate gradients preconditioned with it, with no
-    /// factorization of its own while that converges ([`NeighbourFactor`]). The calibration sets it
-    /// to its lattice node's.
-    #[serde(skip)]
-    pub neighbour_factor: Option<NeighbourFactor>,
 }
 
 impl StaticOptions {
@@ -130,24 +124,6 @@ impl StaticOptions {
             return Err(KeyError::new("load_steps", "must be ≥ 1, got 0"));
         }
         Ok(())
-    }
-}
-
-/// A neighbouring equilibrium's factor, shared. As a preconditioner of conjugate gradients it
-/// needs no scale: a model whose energy is a multiple of the neighbour's takes the same steps.
-#[derive(Clone)]
-pub struct NeighbourFactor(pub std::sync::Arc<super::SparseSpd>);
-
-impl std::fmt::Debug for NeighbourFactor {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "NeighbourFactor")
-    }
-}
-
-/// Two options are equal whatever neighbour factor they carry (it is a start, not a setting).
-impl PartialEq for NeighbourFactor {
-    fn eq(&self, _: &Self) -> bool {
-        true
     }
 }
 
@@ -204,7 +180,6 @@ impl Default for StaticOptions {
             exact_contact_after: default_exact_contact_after(),
             kappa_adapt_gap_rel: default_kappa_adapt_gap(),
             exact_retry_every: default_exact_retry_every(),
-            neighbour_factor: None,
         }
     }
 }

@@ -54,6 +54,7 @@ pub fn solve_vertical_gap(
     obstacles: &[Obstacle],
     spacing_m: f64,
     opts: &StaticOptions,
+    warm: super::WarmData<'_>,
     observer: &mut dyn Observer,
 ) -> SolveReport {
     let increments = if opts.load_steps > 1 {
@@ -74,7 +75,7 @@ pub fn solve_vertical_gap(
         counts: (0, 0),
         g: Vec::new(),
     };
-    execute(model, x, opts, &mut gap, observer)
+    execute(model, x, opts, warm, &mut gap, observer)
 }
 
 /// The state at the start of a load increment, to roll a rejected one back to.

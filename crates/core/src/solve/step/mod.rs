@@ -137,7 +137,7 @@ pub(super) struct Workspace {
     /// What the globalization did so far.
     pub(super) stats: Globalization,
     /// Whether steps are solved by conjugate gradients preconditioned with a neighbour's factor
-    /// ([`StaticOptions::neighbour_factor`]); off for the rest of the run once that fails or the
+    /// ([`super::WarmData::factor`]); off for the rest of the run once that fails or the
     /// line search shortens one of its steps.
     krylov: bool,
     /// Whether the factorizer holds the Hessian in `h` assembled (a new shift of it needs no new
@@ -201,9 +201,16 @@ const CHORD_CONTRACTION: f64 = 0.5;
 const MU_MIN: f64 = 1e-8;
 
 impl Workspace {
-    pub(super) fn new(model: &Model, x: &[Vector3<f64>], opts: &StaticOptions) -> Self {
+    /// The workspace of a run of `model` from `x`; with a neighbour's `factor`, its Newton steps
+    /// are solved by conjugate gradients preconditioned with it while that converges.
+    pub(super) fn new(
+        model: &Model,
+        x: &[Vector3<f64>],
+        opts: &StaticOptions,
+        factor: Option<&super::NeighbourFactor>,
+    ) -> Self {
         let mut ws = Self::fresh(model, x, opts);
-        if let Some(nf) = &opts.neighbour_factor {
+        if let Some(nf) = factor {
             ws.spd = nf.0.copy();
             ws.krylov = true;
         }
