@@ -340,6 +340,14 @@ fn a_start_that_the_scene_cannot_have_is_refused_naming_the_particle() {
             "x[5], y[5], z[5] = x[6], y[6], z[6]",
             &["--start", "one point"][..],
         ),
+        (
+            // A corner laid 10 µm above a particle of the drape's far side: two layers closer
+            // than the sheet's thickness, which self-contact's barrier cannot start from.
+            sphere.clone(),
+            "layers",
+            "a, b = 3, 20 * 31 + 20\nx[a], y[a], z[a] = x[b], y[b], z[b] + 1e-5",
+            &["--start", "contact/self", "thickness"][..],
+        ),
     ];
     for (scene, name, code, names) in cases {
         let bad = edit(&scene, name, code);

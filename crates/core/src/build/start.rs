@@ -1,6 +1,7 @@
 //! The checks a start given from outside (`--start FILE`, a saved drape) must pass before a solve
 //! trusts it: the scene's fixed particles where the scene puts them, no particle inside an obstacle,
-//! no two particles of an edge at one point. A start that fails one is refused naming the particle,
+//! no two particles of an edge at one point, every term's energy finite (no layers closer than
+//! the sheet's thickness). A start that fails one is refused naming the particle,
 //! never run into a "diverged" without a message or a "converged in 0 iterations" whose pins moved.
 
 use super::BuiltScene;
@@ -59,7 +60,40 @@ pub fn check_start(
             });
         }
     }
-    coincident_neighbours(scene, built, x)
+    coincident_neighbours(scene, built, x)?;
+    finite_energy(built, x)
+}
+
+/// Refuses a start where a term's energy is not finite, naming the term: layers of the sheet
+/// closer than its thickness (self-contact), a particle on an obstacle's surface (its barrier),
+/// or positions no term can take.
+fn finite_energy(built: &BuiltScene, x: &[Vector3<f64>]) -> Result<(), StartDefect> {
+    let mut full = built.x0.clone();
+    full[..x.len()].copy_from_slice(x);
+    let Some(term) = built
+        .model
+        .terms
+        .iter()
+        .find(|t| !t.energy(&full).is_finite())
+    else {
+        return Ok(());
+    };
+    let why = match term.name().as_str() {
+        "contact/self" => {
+            "layers of the sheet start closer than its thickness (contact.self_thickness_m) or \
+             through each other"
+        }
+        "contact/barrier" => "a particle starts on an obstacle's surface",
+        _ => "the positions are out of its range",
+    };
+    Err(StartDefect {
+        column: "x_m",
+        message: format!(
+            "the start's energy is not finite in the term `{}`: {why}; start from a drape of \
+             this scene (pins, contact and thickness as it sets them)",
+            term.name()
+        ),
+    })
 }
 
 /// Refuses two particles joined by an edge of the grid (or of the mesh) at one point: a triangle
