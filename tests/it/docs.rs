@@ -184,3 +184,39 @@ fn every_path_the_module_map_names_exists() {
         "the module map names paths that do not exist: {missing:?}"
     );
 }
+
+/// Whether `text` speaks of a development session ("session 39", "this session", "same
+/// session"): the docs describe the build, and its history lives in git.
+fn speaks_of_sessions(text: &str) -> bool {
+    let lower = text.to_lowercase();
+    lower.match_indices("session").any(|(i, _)| {
+        let after = lower[i + "session".len()..].trim_start();
+        let last_word = lower[..i].split_whitespace().last().unwrap_or("");
+        after.starts_with(|c: char| c.is_ascii_digit())
+            || after.starts_with("'s")
+            || ["this", "same", "that", "last", "next", "earlier"].contains(&last_word)
+    })
+}
+
+#[test]
+fn no_page_or_report_speaks_of_development_sessions() {
+    let mut files = pages();
+    for e in glob::glob(&root().join("reports/**/*").to_string_lossy()).unwrap() {
+        let p = e.unwrap();
+        if p.extension().is_some_and(|x| x == "md" || x == "csv") {
+            files.push(p);
+        }
+    }
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        assert!(
+            !speaks_of_sessions(&text),
+            "{} speaks of a development session",
+            f.display()
+        );
+    }
+    assert!(speaks_of_sessions("measured in session 31"));
+    assert!(speaks_of_sessions("Also in this session, the"));
+    assert!(!speaks_of_sessions("a Python session reads the .rrd"));
+    assert!(!speaks_of_sessions("a camera session"));
+}
