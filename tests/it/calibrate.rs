@@ -173,7 +173,7 @@ outputs.fabric = "{run}/fabrics/sample_08.toml"
     // hang4 draped in it converges.
     let fabric_file = tmp.path().join("runs/c/fabrics/sample_08.toml");
     let fabric = drapelab::scene::Fabric::read(&fabric_file).unwrap();
-    let results: Vec<drapelab::app::calibration_tables::ResultRow> =
+    let results: Vec<drapelab::app::calibration::tables::ResultRow> =
         drapelab::io::read_table(&tmp.path().join("runs/c/calibrate/results.parquet")).unwrap();
     let ms = fabric.mass_spring.as_ref().unwrap();
     assert_eq!(ms.stiffness_N_per_m, results[0].stiffness_N_per_m);

@@ -394,7 +394,7 @@ fn a_scene_made_invalid_in_code_solves_to_an_invalid_status_naming_the_key() {
 /// exact elastica at second order as the uniform grid refines; the report shows what the tables hold.
 #[test]
 fn seed003_solve_writes_the_cantilevers_tables_and_the_report_reads_them() {
-    use drapelab::app::seed003_tables::{
+    use drapelab::app::seed003::tables::{
         CantileverGridRow, DrapeParticleRow, LoadStepRow, Loading, Seed003SceneRow,
     };
     let pipeline = r#"

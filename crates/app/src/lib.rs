@@ -11,39 +11,17 @@
 
 pub mod job;
 
-pub mod benchmark;
-pub mod calibrate;
-pub mod calibration_tables;
-pub mod cusick_captures;
-pub mod cusick_fabric;
-pub mod cusick_face_prior;
-pub mod cusick_measure;
-pub mod cusick_node_prior;
-pub mod cusick_predict;
-pub mod cusick_tables;
-pub mod cusick_targets;
+pub mod calibration;
+pub mod cusick;
 pub mod defaults;
-pub mod fit_edges;
 pub mod garment;
-pub mod knitted_fabric;
-pub mod peers;
+pub mod photos;
 pub mod scene_keys;
-pub mod score;
-pub mod seed003_solve;
-pub mod seed003_studies;
-pub mod seed003_tables;
+pub mod seed003;
 pub mod simulate;
-pub mod skips;
 pub mod surface;
-pub mod sweep;
-pub mod sweep_table;
-pub mod tune;
-pub mod validate;
+pub mod sweeps;
 pub mod wrinkles;
-pub mod wrinkles_full;
-pub mod wrinkles_params;
-pub mod wrinkles_points;
-pub mod wrinkles_tables;
 
 pub use job::{Job, Progress, Quiet};
 
@@ -62,37 +40,37 @@ pub fn tables_markdown() -> anyhow::Result<String> {
         md::<drapelab_record::IterationRow>()?,
         md::<drapelab_record::SensitivityRow>()?,
         md::<drapelab_record::EdgeRow>()?,
-        md::<crate::sweep_table::SweepPoint>()?,
-        md::<crate::sweep_table::SweepOutcome>()?,
+        md::<crate::sweeps::table::SweepPoint>()?,
+        md::<crate::sweeps::table::SweepOutcome>()?,
         md::<drapelab_core::edges::ScoreRow>()?,
-        md::<crate::calibration_tables::ResultRow>()?,
-        md::<crate::calibration_tables::ComparisonRow>()?,
-        md::<crate::calibration_tables::EvaluationRow>()?,
-        md::<crate::validate::ValidationRow>()?,
-        md::<crate::tune::TuneRow>()?,
-        md::<crate::tune::MainEffectRow>()?,
+        md::<crate::calibration::tables::ResultRow>()?,
+        md::<crate::calibration::tables::ComparisonRow>()?,
+        md::<crate::calibration::tables::EvaluationRow>()?,
+        md::<crate::calibration::validate::ValidationRow>()?,
+        md::<crate::calibration::tune::TuneRow>()?,
+        md::<crate::calibration::tune::MainEffectRow>()?,
         md::<crate::wrinkles::WrinkleRow>()?,
         md::<crate::wrinkles::WrinkleMeshRow>()?,
-        md::<crate::wrinkles_tables::WrinkleFullRow>()?,
-        md::<crate::wrinkles_tables::FibreRow>()?,
-        md::<crate::wrinkles_tables::StartRow>()?,
+        md::<crate::wrinkles::tables::WrinkleFullRow>()?,
+        md::<crate::wrinkles::tables::FibreRow>()?,
+        md::<crate::wrinkles::tables::StartRow>()?,
         md::<drapelab_core::benchmark::BenchRow>()?,
         md::<drapelab_core::benchmark::PopulationRow>()?,
         md::<drapelab_core::benchmark::SkipRow>()?,
-        md::<crate::peers::PeerRow>()?,
-        md::<crate::cusick_measure::ShadowRow>()?,
-        md::<crate::cusick_tables::PredictionRow>()?,
+        md::<crate::sweeps::peers::PeerRow>()?,
+        md::<crate::cusick::measure::ShadowRow>()?,
+        md::<crate::cusick::tables::PredictionRow>()?,
         md::<crate::garment::GarmentRow>()?,
-        md::<crate::cusick_captures::CaptureRow>()?,
-        md::<crate::cusick_tables::OutlineRow>()?,
-        md::<crate::cusick_tables::ProfileRow>()?,
-        md::<crate::seed003_tables::Seed003SceneRow>()?,
-        md::<crate::seed003_tables::DrapeParticleRow>()?,
-        md::<crate::seed003_tables::TableEdgeRow>()?,
-        md::<crate::seed003_tables::RodCornerRow>()?,
-        md::<crate::seed003_tables::RodGridRow>()?,
-        md::<crate::seed003_tables::CantileverGridRow>()?,
-        md::<crate::seed003_tables::LoadStepRow>()?,
+        md::<crate::cusick::captures::CaptureRow>()?,
+        md::<crate::cusick::tables::OutlineRow>()?,
+        md::<crate::cusick::tables::ProfileRow>()?,
+        md::<crate::seed003::tables::Seed003SceneRow>()?,
+        md::<crate::seed003::tables::DrapeParticleRow>()?,
+        md::<crate::seed003::tables::TableEdgeRow>()?,
+        md::<crate::seed003::tables::RodCornerRow>()?,
+        md::<crate::seed003::tables::RodGridRow>()?,
+        md::<crate::seed003::tables::CantileverGridRow>()?,
+        md::<crate::seed003::tables::LoadStepRow>()?,
     ];
     Ok(sections.join("\n"))
 }

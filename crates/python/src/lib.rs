@@ -14,7 +14,7 @@ mod interrupt;
 mod watch;
 
 use convert::{bytes_f64, f64_bytes, json, load_scene, u32_bytes};
-use drapelab_app::calibrate::{CalibrateParams, calibrate_one, calibrate_one_lm};
+use drapelab_app::calibration::calibrate::{CalibrateParams, calibrate_one, calibrate_one_lm};
 use interrupt::Interrupt;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -177,7 +177,11 @@ fn drape_of_silhouette(path: &str, scale_json: &str) -> PyResult<String> {
 fn fit_edges(py: Python<'_>, photo: &str, camera: &str, degree: usize) -> PyResult<String> {
     let edges = py
         .detach(|| {
-            drapelab_app::fit_edges::photo_edges(Path::new(photo), Path::new(camera), degree)
+            drapelab_app::photos::fit_edges::photo_edges(
+                Path::new(photo),
+                Path::new(camera),
+                degree,
+            )
         })
         .map_err(to_py)?;
     json(&edges)

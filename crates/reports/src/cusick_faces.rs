@@ -3,8 +3,8 @@
 //! use, the 90 % intervals' coverage, and the harder test — face-down DC from face-up captures only.
 
 use crate::format::opt;
-use drapelab_app::cusick_captures::CaptureRow;
-use drapelab_app::cusick_tables::PredictionRow;
+use drapelab_app::cusick::captures::CaptureRow;
+use drapelab_app::cusick::tables::PredictionRow;
 use drapelab_core::cusick::Face;
 use drapelab_core::measure::mean;
 use std::collections::BTreeMap;

@@ -2,8 +2,8 @@
 //! calibration specimen's own measurement carried over to the fabric's other specimens — by every
 //! criterion the report scores, and where that baseline does as well, said first.
 
-use drapelab_app::cusick_captures::CaptureRow;
-use drapelab_app::cusick_tables::PredictionRow;
+use drapelab_app::cusick::captures::CaptureRow;
+use drapelab_app::cusick::tables::PredictionRow;
 use std::collections::BTreeMap;
 
 /// One criterion: its name, the model's score and the baseline's, and whether larger is better.

@@ -3,7 +3,7 @@
 //! and the flat specimen), and the measured against the simulated height profile z(r).
 
 use anyhow::Result;
-use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
+use drapelab_app::cusick::tables::{OutlineRow, PredictionRow, ProfileRow};
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 

@@ -67,8 +67,8 @@ impl ReportParams {
 fn sweep_columns() -> Vec<String> {
     let mut names = Vec::new();
     for fields in [
-        drapelab_record::table_fields::<drapelab_app::sweep_table::SweepPoint>(),
-        drapelab_record::table_fields::<drapelab_app::sweep_table::SweepOutcome>(),
+        drapelab_record::table_fields::<drapelab_app::sweeps::table::SweepPoint>(),
+        drapelab_record::table_fields::<drapelab_app::sweeps::table::SweepOutcome>(),
     ] {
         names.extend(fields.into_iter().flatten().map(|f| f.name().clone()));
     }

@@ -13,7 +13,7 @@ use crate::seed003_rod::table_10_4;
 use crate::seed003_scenes::{Drape, drapes};
 use anyhow::{Result, bail};
 use drapelab_app::Job;
-use drapelab_app::seed003_tables::{
+use drapelab_app::seed003::tables::{
     CantileverGridRow, LoadStepRow, Loading, Seed003SceneRow, TableEdgeRow,
 };
 use drapelab_core::scene::ContactMethod;

@@ -3,7 +3,7 @@
 //! experiment and the finite elements.
 
 use anyhow::{Context, Result};
-use drapelab_app::seed003_tables::{RodCornerRow, RodGridRow, RodMaterial};
+use drapelab_app::seed003::tables::{RodCornerRow, RodGridRow, RodMaterial};
 use drapelab_core::scene::ContactMethod;
 use drapelab_core::solve::Status;
 use std::collections::BTreeMap;

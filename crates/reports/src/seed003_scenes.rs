@@ -2,7 +2,7 @@
 //! and sheet particles, what the drawings and the montage show.
 
 use anyhow::{Result, bail};
-use drapelab_app::seed003_tables::{DrapeParticleRow, Seed003SceneRow};
+use drapelab_app::seed003::tables::{DrapeParticleRow, Seed003SceneRow};
 use drapelab_core::cloth::Grid;
 use nalgebra::Vector3;
 

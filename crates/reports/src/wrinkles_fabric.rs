@@ -3,9 +3,9 @@
 //! length × shear rigidity, and the seed's photographed cloth (Fig. 4).
 
 use crate::format::opt;
-use drapelab_app::wrinkles_full::WrinklesFull;
-use drapelab_app::wrinkles_points::{SheetRole, SheetVerdict, TensionFieldFit};
-use drapelab_app::wrinkles_tables::WrinkleFullRow;
+use drapelab_app::wrinkles::full::WrinklesFull;
+use drapelab_app::wrinkles::points::{SheetRole, SheetVerdict, TensionFieldFit};
+use drapelab_app::wrinkles::tables::WrinkleFullRow;
 use drapelab_core::wrinkles::full::ReadingKind;
 use std::fmt::Write;
 

@@ -6,11 +6,11 @@
 use crate::format::opt;
 use anyhow::Result;
 use drapelab_app::Job;
+use drapelab_app::wrinkles::full::WrinklesFull;
+use drapelab_app::wrinkles::params::WrinklesSimulateParams;
+use drapelab_app::wrinkles::points::SheetRole;
+use drapelab_app::wrinkles::tables::{StartRow, WrinkleFullRow, rows, start_rows};
 use drapelab_app::wrinkles::{SolvedCase, report_markdown};
-use drapelab_app::wrinkles_full::WrinklesFull;
-use drapelab_app::wrinkles_params::WrinklesSimulateParams;
-use drapelab_app::wrinkles_points::SheetRole;
-use drapelab_app::wrinkles_tables::{StartRow, WrinkleFullRow, rows, start_rows};
 use drapelab_core::wrinkles::WrinkleConfig;
 use drapelab_core::wrinkles::full::ReadingKind;
 use drapelab_record::write_text;
@@ -290,7 +290,7 @@ pub fn sheets_png(found: &WrinklesFull) -> image::RgbImage {
         .iter()
         .filter(|q| q.spec.role == SheetRole::Photograph)
         .map(|q| (format!("{} fabric", q.spec.case), &q.pair.fine));
-    let sheets: Vec<(String, &drapelab_app::wrinkles_full::SheetSolve)> = found
+    let sheets: Vec<(String, &drapelab_app::wrinkles::full::SheetSolve)> = found
         .cases
         .iter()
         .flat_map(|c| {

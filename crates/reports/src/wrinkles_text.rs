@@ -1,8 +1,8 @@
 //! The fixed text of the full-simulation wrinkles report (how the sheets are set up, how n is
 //! counted, how Eq. 7 is read) and the findings written from the numbers.
 
-use drapelab_app::wrinkles_full::WrinklesFull;
-use drapelab_app::wrinkles_tables::{StartRow, WrinkleFullRow};
+use drapelab_app::wrinkles::full::WrinklesFull;
+use drapelab_app::wrinkles::tables::{StartRow, WrinkleFullRow};
 use std::fmt::Write;
 
 /// How each case is simulated, with every reading of the seed stated.

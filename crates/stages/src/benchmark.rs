@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::benchmark`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::sweeps::benchmark`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::benchmark::*;
+pub use drapelab_app::sweeps::benchmark::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
 /// Runs a benchmark stage.

@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::calibrate`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::calibration::calibrate`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::calibrate::*;
+pub use drapelab_app::calibration::calibrate::*;
 use drapelab_pipeline::{ItemKind, KeyError, Slot, StageContext, StageKind};
 use std::path::{Path, PathBuf};
 

@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::cusick_fabric`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::cusick::fabric`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::cusick_fabric::*;
+pub use drapelab_app::cusick::fabric::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
 /// The calibration's table.

@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::cusick_measure`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::cusick::measure`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::cusick_measure::*;
+pub use drapelab_app::cusick::measure::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
 /// The `cusick-measure` stage kind.

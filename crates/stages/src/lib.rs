@@ -39,7 +39,7 @@ pub use cusick_fabric::{CusickFabric, CusickFabricParams};
 pub use cusick_measure::{CusickMeasure, CusickMeasureParams, ShadowRow, measure_dataset};
 pub use cusick_predict::{CusickPredict, CusickPredictParams};
 pub use cusick_report::{CusickReport, CusickReportParams, dc_within, nodes_within};
-pub use drapelab_app::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
+pub use drapelab_app::cusick::tables::{OutlineRow, PredictionRow, ProfileRow};
 pub use fit_edges::{FitEdges, FitEdgesParams};
 pub use garment::{Garment, GarmentParams};
 pub use garment_report::{GarmentReport, GarmentReportParams};
@@ -79,8 +79,8 @@ const SCENE_SLOT: Slot = Slot::one("scene", "the hang scene each sample is simul
 fn sample_inputs(
     ctx: &drapelab_pipeline::StageContext<'_>,
     [edges, samples, scene]: [&Slot; 3],
-) -> anyhow::Result<drapelab_app::calibrate::SampleInputs> {
-    Ok(drapelab_app::calibrate::SampleInputs {
+) -> anyhow::Result<drapelab_app::calibration::calibrate::SampleInputs> {
+    Ok(drapelab_app::calibration::calibrate::SampleInputs {
         edges: ctx.file(edges)?,
         samples: ctx.file(samples)?,
         scene: ctx.file(scene)?,

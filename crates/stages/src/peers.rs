@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::peers`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::sweeps::peers`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::peers::*;
+pub use drapelab_app::sweeps::peers::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
 /// The scene the peers solve.

@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::score`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::photos::score`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::score::*;
+pub use drapelab_app::photos::score::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
 /// The edges measured.

@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::seed003_solve`]: its slots and parameters checked when the plan
+//! The stage kind over [`drapelab_app::seed003::solve`]: its slots and parameters checked when the plan
 //! loads, and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::seed003_solve::*;
+pub use drapelab_app::seed003::solve::*;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 
 /// The scenes solved.

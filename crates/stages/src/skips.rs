@@ -1,8 +1,8 @@
 //! `skips`: each skip the engine makes, measured on and off in the same run; the workflow is
-//! [`drapelab_app::skips`], and the skip of an up-to-date stage is measured here, with the engine.
+//! [`drapelab_app::sweeps::skips`], and the skip of an up-to-date stage is measured here, with the engine.
 
 use anyhow::Result;
-pub use drapelab_app::skips::*;
+pub use drapelab_app::sweeps::skips::*;
 use drapelab_core::benchmark::SkipRow;
 use drapelab_pipeline::{Slot, StageContext, StageKind};
 use std::path::Path;

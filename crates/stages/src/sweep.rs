@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::sweep`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::sweeps::sweep`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::sweep::*;
+pub use drapelab_app::sweeps::sweep::*;
 use drapelab_pipeline::{ItemKind, KeyError, Slot, StageContext, StageKind};
 use std::path::{Path, PathBuf};
 

@@ -1,8 +1,8 @@
-//! The stage kind over [`drapelab_app::tune`]: its slots and parameters checked when the plan loads,
+//! The stage kind over [`drapelab_app::calibration::tune`]: its slots and parameters checked when the plan loads,
 //! and a call of the workflow with the stage's files.
 
 use anyhow::Result;
-pub use drapelab_app::tune::*;
+pub use drapelab_app::calibration::tune::*;
 use drapelab_pipeline::{KeyError, Slot, StageContext, StageKind};
 
 /// The `tune` stage kind.

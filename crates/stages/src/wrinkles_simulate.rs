@@ -1,10 +1,10 @@
-//! The stage kind over [`drapelab_app::wrinkles_full`] and [`drapelab_reports::wrinkles_report`]:
+//! The stage kind over [`drapelab_app::wrinkles::full`] and [`drapelab_reports::wrinkles_report`]:
 //! seed 002's hung sheets as full simulations beside the seed and the tension-field model.
 
 use anyhow::Result;
-use drapelab_app::wrinkles_full::simulate;
-pub use drapelab_app::wrinkles_params::WrinklesSimulateParams;
-use drapelab_app::wrinkles_tables::write_outputs;
+use drapelab_app::wrinkles::full::simulate;
+pub use drapelab_app::wrinkles::params::WrinklesSimulateParams;
+use drapelab_app::wrinkles::tables::write_outputs;
 use drapelab_pipeline::{KeyError, Slot, StageContext, StageKind};
 
 /// The `wrinkles-simulate` stage kind.

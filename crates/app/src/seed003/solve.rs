@@ -6,10 +6,10 @@
 //! only; the `seed003-report` stage reads them.
 
 use crate::job::Job;
-use crate::seed003_studies::{
+use crate::seed003::studies::{
     Solved, cantilever_rows, load, load_steps, rod_grid_rows, rod_rows, solve_pair, table_edge_rows,
 };
-use crate::seed003_tables::{DrapeParticleRow, Seed003SceneRow};
+use crate::seed003::tables::{DrapeParticleRow, Seed003SceneRow};
 use anyhow::{Result, bail};
 use drapelab_core::measure::drape_measures;
 use drapelab_core::obstacle::Obstacle;

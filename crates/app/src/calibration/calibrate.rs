@@ -4,7 +4,7 @@
 //! identifiability) and `evaluations.parquet` (every country of every decade of every run). Each
 //! sample is an item: one part per sample, run by the pipeline's executor, then gathered.
 
-use crate::calibration_tables::{ComparisonRow, EvaluationRow, ResultRow};
+use crate::calibration::tables::{ComparisonRow, EvaluationRow, ResultRow};
 use crate::job::Job;
 use anyhow::{Context, Result, bail};
 use drapelab_core::calibrate::{

@@ -3,7 +3,7 @@
 //! Parquet table. The schema is documented in the README.
 
 use crate::job::Job;
-use crate::sweep_table::{SweepOutcome, SweepPoint, as_f64, write_sweep};
+use crate::sweeps::table::{SweepOutcome, SweepPoint, as_f64, write_sweep};
 use anyhow::{Result, bail};
 use drapelab_core::error::KeyError;
 use drapelab_core::scene::Scene;

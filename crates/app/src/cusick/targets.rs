@@ -2,10 +2,10 @@
 //! specimens' DC and node statistics) and the prediction row that carries it, filled in from a
 //! calibration's fit, its node distribution and its per-face predictions.
 
-use crate::cusick_captures::FacePredictions;
-use crate::cusick_face_prior::{GapLine, face_gap};
-use crate::cusick_measure::ShadowRow;
-use crate::cusick_tables::PredictionRow;
+use crate::cusick::captures::FacePredictions;
+use crate::cusick::face_prior::{GapLine, face_gap};
+use crate::cusick::measure::ShadowRow;
+use crate::cusick::tables::PredictionRow;
 use drapelab_core::cusick::*;
 use drapelab_core::measure::{mean_sd, median};
 use drapelab_record::cusick::CaptureKey;

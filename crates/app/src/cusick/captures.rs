@@ -11,7 +11,7 @@
 //! one or two fabrics) it falls back to ±1.645 of the model's own spread (its seeds' DC SD and the
 //! calibration specimen's), and says so.
 
-use crate::cusick_measure::ShadowRow;
+use crate::cusick::measure::ShadowRow;
 use drapelab_core::cusick::{Face, NodeDistribution};
 use drapelab_core::measure::mean;
 use drapelab_core::table::Table;
@@ -36,7 +36,7 @@ pub struct CaptureRow {
     /// Upper end of the 90 % prediction interval, %.
     pub dc_high_pct: f64,
     /// Predicted node count for this face: the mean over its seeds plus the fabric's node
-    /// correction ([`crate::cusick_node_prior`]).
+    /// correction ([`crate::cusick::node_prior`]).
     pub nodes_predicted: f64,
     /// The predicted node count as a whole number: `nodes_predicted` rounded (the likeliest count;
     /// six seeds' mean estimates it better than their mode).

@@ -5,7 +5,7 @@
 //! combination, which `calibrate` reads from its `ica` input) and `main_effects.svg`.
 
 use crate::Panels;
-use crate::calibrate::SampleInputs;
+use crate::calibration::calibrate::SampleInputs;
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::calibrate::{Problem, read_sample_densities, sample_scene};

@@ -46,7 +46,7 @@ pub struct PeersParams {
     #[serde(default = "default_python")]
     pub python: String,
     /// Sides of the hang4 grid for the static comparison. Default [11, 21, 41].
-    #[serde(default = "crate::benchmark::default_sizes")]
+    #[serde(default = "crate::sweeps::benchmark::default_sizes")]
     pub static_sizes: Vec<usize>,
     /// Sides for the per-step explicit Euler comparison. Default [21, 41].
     #[serde(default = "default_step_sizes")]

@@ -16,7 +16,7 @@
 //! (`bending_length_warp_m`, `bending_length_weft_m`) in place of rigidities and no density: a
 //! scene draping it gives the density, and the rigidity B = w g c³ follows.
 
-use crate::cusick_tables::PredictionRow;
+use crate::cusick::tables::PredictionRow;
 use crate::job::Job;
 use anyhow::{Result, bail};
 use drapelab_core::material::Continuum;

@@ -3,6 +3,11 @@
 //! Parquet table, a `.rrd` (each grid as a rerun mesh) and a `.md` report with the seed's results
 //! beside drapelab's.
 
+pub mod full;
+pub mod params;
+pub mod points;
+pub mod tables;
+
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::wrinkles::{

@@ -2,8 +2,8 @@
 //! hang, scored against the sample's measured 2-corner edges (a fit-edges table): `validation.parquet`
 //! with `sample`, `objective_pct` (Eq. 5, mean over the edges) and `curve_distance_pct` (seed 000 Table 6).
 
-use crate::calibrate::SampleInputs;
-use crate::calibration_tables::ResultRow;
+use crate::calibration::calibrate::SampleInputs;
+use crate::calibration::tables::ResultRow;
 use crate::job::Job;
 use anyhow::{Context, Result};
 use drapelab_core::calibrate::{

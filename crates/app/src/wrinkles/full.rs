@@ -3,12 +3,12 @@
 //! and as a fabric, and the map's and photographs' fabric sheets; their wrinkles measured on the
 //! centre fibre by the seed's definitions. The lobe threshold of the count and Eq. 7's reading that
 //! the simulations support are chosen by leave-one-out over the cases, with held-out scores. The
-//! parameters are [`crate::wrinkles_params`]'s, the tables [`crate::wrinkles_tables`]'s, the report
+//! parameters are [`crate::wrinkles::params`]'s, the tables [`crate::wrinkles::tables`]'s, the report
 //! and pictures the reports crate's.
 
 use crate::job::Job;
-use crate::wrinkles_params::{Variant, WrinklesSimulateParams};
-use crate::wrinkles_points::{
+use crate::wrinkles::params::{Variant, WrinklesSimulateParams};
+use crate::wrinkles::points::{
     FitSheet, MapAxes, PointSpec, SheetRole, SheetVerdict, TensionFieldFit, fit_tension_field,
     point_specs,
 };

@@ -2,7 +2,7 @@
 //! its silhouette photo and from its 3D mesh (or hem), so that each measure checks the other:
 //! the drape coefficient (BS 5058) and the node count of the shadow's outline.
 
-use crate::cusick_tables::OutlineRow;
+use crate::cusick::tables::OutlineRow;
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{

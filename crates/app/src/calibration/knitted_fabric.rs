@@ -4,7 +4,7 @@
 //! sample's areal density from Table 2, `calibrated` the parameters the photos pin down, and their
 //! intervals (the calibration's: the parameter ± the half-width the photos allow).
 
-use crate::calibration_tables::ResultRow;
+use crate::calibration::tables::ResultRow;
 use crate::job::Job;
 use anyhow::{Result, bail};
 use drapelab_core::calibrate::{read_sample_densities, sample_number};

@@ -6,12 +6,12 @@
 //! simulated shadow outlines and height profiles (for the report's pictures) and a rerun recording
 //! overlaying each fabric's registered meshes and simulated drapes.
 
-use crate::cusick_captures::{CaptureRow, capture_rows, fill_intervals};
-use crate::cusick_face_prior::{GapLine, gap_lines};
-use crate::cusick_measure::ShadowRow;
-use crate::cusick_node_prior::correct_nodes;
-use crate::cusick_tables::{OutlineRow, PredictionRow, ProfileRow};
-use crate::cusick_targets::{empty_row, fill_distribution, fill_faces, fill_fit, targets};
+use crate::cusick::captures::{CaptureRow, capture_rows, fill_intervals};
+use crate::cusick::face_prior::{GapLine, gap_lines};
+use crate::cusick::measure::ShadowRow;
+use crate::cusick::node_prior::correct_nodes;
+use crate::cusick::tables::{OutlineRow, PredictionRow, ProfileRow};
+use crate::cusick::targets::{empty_row, fill_distribution, fill_faces, fill_fit, targets};
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{

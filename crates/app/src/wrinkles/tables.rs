@@ -3,9 +3,9 @@
 //! (`starts.parquet`), and the recording of every sheet.
 
 use crate::job::Job;
-use crate::wrinkles_full::{FabricPoint, MeshPair, SheetSolve, SimulatedCase, WrinklesFull};
-use crate::wrinkles_params::{Variant, WrinklesSimulateParams};
-use crate::wrinkles_points::{SheetRole, SheetVerdict};
+use crate::wrinkles::full::{FabricPoint, MeshPair, SheetSolve, SimulatedCase, WrinklesFull};
+use crate::wrinkles::params::{Variant, WrinklesSimulateParams};
+use crate::wrinkles::points::{SheetRole, SheetVerdict};
 use anyhow::Result;
 use drapelab_core::solve::Status;
 use drapelab_core::table::Table;
@@ -214,7 +214,7 @@ pub struct RowSource<'a> {
     /// Case name.
     pub case: &'a str,
     /// A case's result, a map point or a photograph.
-    pub role: crate::wrinkles_points::SheetRole,
+    pub role: crate::wrinkles::points::SheetRole,
     /// The case's inputs.
     pub inputs: &'a WrinkleInputs,
     /// The seed's result, where it gives one.
@@ -228,7 +228,7 @@ impl SimulatedCase {
     pub fn source(&self) -> RowSource<'_> {
         RowSource {
             case: &self.case,
-            role: crate::wrinkles_points::SheetRole::Table,
+            role: crate::wrinkles::points::SheetRole::Table,
             inputs: &self.inputs,
             seed: self.seed.as_ref(),
             tension_field: &self.tension_field,

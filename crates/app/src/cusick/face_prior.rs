@@ -6,7 +6,7 @@
 //! fabrics only (leave one fabric out) — empirical Bayes, b the share of one specimen's gap that is
 //! its fabric's and a the population's face effect where b is small.
 
-use crate::cusick_measure::ShadowRow;
+use crate::cusick::measure::ShadowRow;
 use drapelab_core::cusick::{Face, FaceGap};
 use drapelab_core::measure::{least_squares_line, mean_sd};
 use std::collections::BTreeMap;

@@ -3,7 +3,7 @@
 //! the quarter table, Table 10.4's rod corners under every contact treatment and material with their
 //! grid study, Table 10.1's cantilever against the grid, and §10.3.3's load–displacement curve.
 
-use crate::seed003_tables::{
+use crate::seed003::tables::{
     CantileverGridRow, LoadStepRow, Loading, RodCornerRow, RodGridRow, RodMaterial, TableEdgeRow,
 };
 use anyhow::Result;

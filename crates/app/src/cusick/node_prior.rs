@@ -3,14 +3,14 @@
 //! nearest law leaves (up to ~2 nodes on fabrics 1–15: fabric 3's folds are more and narrower than
 //! the fabric's at every law). How much of that discrepancy D = n_calibration − n̄_model is the
 //! fabric's, and how much the specimen's, is read off the other fabrics as for the face gap
-//! ([`crate::cusick_face_prior`]): the least-squares line of the siblings' mean residual
+//! ([`crate::cusick::face_prior`]): the least-squares line of the siblings' mean residual
 //! (measured − model, per capture) on D, fitted on the *other* fabrics only (leave one fabric out;
 //! slope kept in [0, 1]). A capture's predicted count is its face's drapes' mean plus the line's
-//! correction a + bD; with fewer than [`crate::cusick_face_prior::MIN_FABRICS`] other fabrics the whole of D.
+//! correction a + bD; with fewer than [`crate::cusick::face_prior::MIN_FABRICS`] other fabrics the whole of D.
 
-use crate::cusick_captures::CaptureRow;
-use crate::cusick_face_prior::line_without;
-use crate::cusick_tables::PredictionRow;
+use crate::cusick::captures::CaptureRow;
+use crate::cusick::face_prior::line_without;
+use crate::cusick::tables::PredictionRow;
 use drapelab_core::measure::mean;
 use std::collections::BTreeMap;
 
@@ -85,9 +85,9 @@ pub fn correct_nodes(rows: &mut [PredictionRow], caps: &mut [CaptureRow]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cusick_captures::tests::row as capture;
-    use crate::cusick_measure::ShadowRow;
-    use crate::cusick_targets::{empty_row, targets};
+    use crate::cusick::captures::tests::row as capture;
+    use crate::cusick::measure::ShadowRow;
+    use crate::cusick::targets::{empty_row, targets};
     use drapelab_core::cusick::Face;
 
     /// A fabric whose model gives `model` nodes, calibration specimen `calib`, siblings `siblings`.
