@@ -3,6 +3,7 @@
 //! a path through a parent's `pub use` followed to the module that defines the item), read by
 //! parsing the files as Rust (syn), has no cycle. `#[cfg(test)]` items are left out.
 
+use crate::layering::rust_files;
 use crate::support::root;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -205,17 +206,6 @@ fn pub_uses(file: &syn::File, here: &[String]) -> BTreeMap<String, ModPath> {
         }
     }
     out
-}
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap().flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
 }
 
 /// A cycle of the graph, if any (depth-first search).
