@@ -8,6 +8,7 @@ mod continuation;
 mod dynamic;
 mod dynamic_options;
 mod equilibrium;
+mod executor;
 mod incremental;
 mod kind;
 mod linear;

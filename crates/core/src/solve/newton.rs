@@ -12,6 +12,7 @@
 //! spring's length: the step follows the curve x + α dx + ½ α² a, a the geodesic acceleration
 //! (Transtrum & Sethna 2012), which bends it along the arcs the springs allow.
 
+use super::executor::Verdict;
 use super::static_options::StaticOptions;
 use super::step::Workspace;
 use super::warm::NeighbourFactor;
@@ -98,8 +99,9 @@ impl NewtonRun {
         })
     }
 
-    /// Newton's iterations at load factor `load` up to `goal`: true when reached, false when the
-    /// run stopped (its report says why).
+    /// Newton's iterations at load factor `load` up to `goal`, under the executor
+    /// ([`super::executor::run`]): true when reached, false when the run stopped (its report says
+    /// why).
     pub(super) fn stage(
         &mut self,
         model: &mut Model,
@@ -110,75 +112,21 @@ impl NewtonRun {
     ) -> bool {
         self.load = load;
         let w_ref = model.reference_weight();
-        let tol = opts.residual_tol_rel * w_ref;
-        let last = goal == Goal::Tolerance;
-        let (ws, report) = (&mut self.ws, &mut self.report);
-        let mut e = model.energy(x, load);
-        loop {
-            model.gradient(x, load, &mut ws.g);
-            let r = model.max_residual(&ws.g);
-            if !r.is_finite() || !e.is_finite() {
-                report.diverge(self.iter, None, DivergenceReason::NonFinite);
-                return false;
-            }
-            if let Err(err) = observe_iterate(observer, self.iter, x, (r, e)) {
-                report.stop_with(
-                    StopReason::Observer,
-                    format!("an observer failed at iteration {}: {err:#}", self.iter),
-                );
-                return false;
-            }
-            if r <= tol && last {
-                report.stop_for(StopReason::Converged);
-                return true;
-            }
-            // Round-off floor: the residual cannot fall below ~16 ε k |x| (see Model::roundoff_force);
-            // reaching it after the tolerance proved unreachable is convergence, said in the message.
-            if last && r <= model.roundoff_force(x) && r <= 1e3 * tol {
-                report.stop_for(StopReason::RoundoffFloor);
-                self.floor = true;
-                return true;
-            }
-            if r <= tol.max(1e-6 * w_ref) && !last {
-                return true;
-            }
-            if self.iter >= opts.max_iterations {
-                report.message = format!(
-                    "{} Newton iterations without reaching the tolerance",
-                    opts.max_iterations
-                );
-                return false;
-            }
-            self.iter += 1;
-            model.set_exact_contact(self.iter > opts.exact_contact_after);
-            if !ws.iterate(model, x, load, &mut e, (r, tol), report) {
-                // A step that does not decrease the energy: near the solution, round-off.
-                model.gradient(x, load, &mut ws.g);
-                let r = model.max_residual(&ws.g);
-                if r <= tol && last {
-                    report.stop_for(StopReason::Converged);
-                    return true;
-                }
-                report.stop_with(
-                    StopReason::LineSearch,
-                    format!(
-                        "line search failed at iteration {} with residual {r:.3e} N",
-                        self.iter
-                    ),
-                );
-                return false;
-            }
-            if adapt_kappa(model, x, opts, &mut self.last_gap_rel) {
-                e = model.energy(x, load);
-            }
-            let strain = model.max_strain(x);
-            if strain > opts.strain_bound {
-                let bound = opts.strain_bound;
-                let reason = DivergenceReason::StrainBeyondBound { strain, bound };
-                report.diverge(self.iter, None, reason);
-                return false;
-            }
-        }
+        let e = model.energy(x, load);
+        let mut stage = Stage {
+            run: self,
+            model,
+            x,
+            opts,
+            load,
+            last: goal == Goal::Tolerance,
+            tol: opts.residual_tol_rel * w_ref,
+            w_ref,
+            e,
+            r: f64::NAN,
+        };
+        let verdict = super::executor::run(&mut stage, opts.max_iterations, observer);
+        super::executor::conclude(verdict, self.iter, &mut self.report)
     }
 
     /// The run's report, with the final numbers at its last stage's load.
@@ -187,6 +135,103 @@ impl NewtonRun {
         let timing = (self.iter, self.floor, self.start);
         finish_report(model, x, self.load, &mut self.ws, timing, &mut self.report);
         self.report
+    }
+}
+
+/// One stage of a Newton run as an iterative solver: its run, the model and state, and the
+/// stage's load and goal.
+struct Stage<'a> {
+    run: &'a mut NewtonRun,
+    model: &'a mut Model,
+    x: &'a mut [Vector3<f64>],
+    opts: &'a StaticOptions,
+    load: f64,
+    /// Whether the stage solves to the tolerance (the last of a ramp), not to an increment's.
+    last: bool,
+    /// The tolerance on the largest residual force, N.
+    tol: f64,
+    /// The lightest free particle's weight, N.
+    w_ref: f64,
+    /// The energy at the current state, J.
+    e: f64,
+    /// The largest residual force at the current state, N.
+    r: f64,
+}
+
+impl super::executor::Iterative for Stage<'_> {
+    fn iterations(&self) -> usize {
+        self.run.iter
+    }
+
+    fn terminate(&mut self, observer: &mut dyn Observer) -> Option<Verdict> {
+        let ws = &mut self.run.ws;
+        self.model.gradient(self.x, self.load, &mut ws.g);
+        let (r, tol) = (self.model.max_residual(&ws.g), self.tol);
+        self.r = r;
+        if !r.is_finite() || !self.e.is_finite() {
+            return Some(Verdict::Diverged(DivergenceReason::NonFinite));
+        }
+        if let Err(err) = observe_iterate(observer, self.run.iter, self.x, (r, self.e)) {
+            let message = format!("an observer failed at iteration {}: {err:#}", self.run.iter);
+            return Some(Verdict::Stopped(StopReason::Observer, message));
+        }
+        if r <= tol && self.last {
+            return Some(Verdict::Reached(Some(StopReason::Converged)));
+        }
+        // Round-off floor: the residual cannot fall below ~16 ε k |x| (see Model::roundoff_force);
+        // reaching it after the tolerance proved unreachable is convergence, said in the message.
+        if self.last && r <= self.model.roundoff_force(self.x) && r <= 1e3 * tol {
+            self.run.floor = true;
+            return Some(Verdict::Reached(Some(StopReason::RoundoffFloor)));
+        }
+        if r <= tol.max(1e-6 * self.w_ref) && !self.last {
+            return Some(Verdict::Reached(None));
+        }
+        None
+    }
+
+    fn next_iter(&mut self) -> Result<(), Verdict> {
+        let run = &mut *self.run;
+        run.iter += 1;
+        self.model
+            .set_exact_contact(run.iter > self.opts.exact_contact_after);
+        let (model, x, load) = (&*self.model, &mut *self.x, self.load);
+        if !run.ws.iterate(
+            model,
+            x,
+            load,
+            &mut self.e,
+            (self.r, self.tol),
+            &mut run.report,
+        ) {
+            // A step that does not decrease the energy: near the solution, round-off.
+            model.gradient(x, load, &mut run.ws.g);
+            let r = model.max_residual(&run.ws.g);
+            if r <= self.tol && self.last {
+                return Err(Verdict::Reached(Some(StopReason::Converged)));
+            }
+            let message = format!(
+                "line search failed at iteration {} with residual {r:.3e} N",
+                run.iter
+            );
+            return Err(Verdict::Stopped(StopReason::LineSearch, message));
+        }
+        if adapt_kappa(self.model, self.x, self.opts, &mut run.last_gap_rel) {
+            self.e = self.model.energy(self.x, load);
+        }
+        let strain = self.model.max_strain(self.x);
+        if strain > self.opts.strain_bound {
+            let bound = self.opts.strain_bound;
+            return Err(Verdict::Diverged(DivergenceReason::StrainBeyondBound {
+                strain,
+                bound,
+            }));
+        }
+        Ok(())
+    }
+
+    fn out_of_iterations(&self, budget: usize) -> String {
+        format!("{budget} Newton iterations without reaching the tolerance")
     }
 }
 

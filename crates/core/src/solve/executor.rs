@@ -1,0 +1,149 @@
+//! The loop of an iterative solver, owned in one place (argmin's executor): the solver says
+//! whether its current state ends the loop ([`Iterative::terminate`]) and takes one iteration
+//! ([`Iterative::next_iter`]); [`run`] owns the loop, the iteration budget and the observer, and
+//! [`conclude`] writes why the loop ended into the report, always one [`StopReason`].
+
+use super::{DivergenceReason, Observer, SolveReport, StopReason};
+
+/// How an iterative loop ends.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Verdict {
+    /// The goal is met, for a reason (converged, the round-off floor); none for a goal short of
+    /// the solve's own (a load increment reached), which leaves the report's reason as it is.
+    Reached(Option<StopReason>),
+    /// The loop cannot go on, for a reason said in words.
+    Stopped(StopReason, String),
+    /// The state diverged.
+    Diverged(DivergenceReason),
+}
+
+/// An iterative solver over its own state: its checks and its iteration.
+pub(super) trait Iterative {
+    /// Iterations taken so far.
+    fn iterations(&self) -> usize;
+    /// Whether the current state ends the loop, checked before every iteration (the observer
+    /// sees the state first).
+    fn terminate(&mut self, observer: &mut dyn Observer) -> Option<Verdict>;
+    /// One iteration; the verdict that ends the loop where it cannot be taken or finishes it.
+    fn next_iter(&mut self) -> Result<(), Verdict>;
+    /// What running out of `budget` iterations means, in words.
+    fn out_of_iterations(&self, budget: usize) -> String;
+}
+
+/// Runs `solver` until its state ends the loop, an iteration ends it, or it has taken `budget`
+/// iterations; the verdict.
+pub(super) fn run(
+    solver: &mut impl Iterative,
+    budget: usize,
+    observer: &mut dyn Observer,
+) -> Verdict {
+    loop {
+        if let Some(v) = solver.terminate(observer) {
+            return v;
+        }
+        if solver.iterations() >= budget {
+            return Verdict::Stopped(StopReason::Iterations, solver.out_of_iterations(budget));
+        }
+        if let Err(v) = solver.next_iter() {
+            return v;
+        }
+    }
+}
+
+/// Writes `verdict`, reached at iteration `iter`, into `report`: true when the goal was met.
+pub(super) fn conclude(verdict: Verdict, iter: usize, report: &mut SolveReport) -> bool {
+    match verdict {
+        Verdict::Reached(reason) => {
+            if let Some(r) = reason {
+                report.stop_for(r);
+            }
+            true
+        }
+        Verdict::Stopped(reason, message) => {
+            report.stop_with(reason, message);
+            false
+        }
+        Verdict::Diverged(reason) => {
+            report.diverge(iter, None, reason);
+            false
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::{NoObserver, SolverKind, Status};
+
+    /// Newton's method for √2 from `x`, each iterate checked: reached below `tol`, diverged when
+    /// not finite.
+    struct Root {
+        x: f64,
+        iterations: usize,
+        tol: f64,
+    }
+
+    impl Iterative for Root {
+        fn iterations(&self) -> usize {
+            self.iterations
+        }
+        fn terminate(&mut self, _observer: &mut dyn Observer) -> Option<Verdict> {
+            let r = (self.x * self.x - 2.0).abs();
+            if !r.is_finite() {
+                return Some(Verdict::Diverged(DivergenceReason::NonFinite));
+            }
+            (r <= self.tol).then_some(Verdict::Reached(Some(StopReason::Converged)))
+        }
+        fn next_iter(&mut self) -> Result<(), Verdict> {
+            self.iterations += 1;
+            self.x -= (self.x * self.x - 2.0) / (2.0 * self.x);
+            Ok(())
+        }
+        fn out_of_iterations(&self, budget: usize) -> String {
+            format!("{budget} iterations")
+        }
+    }
+
+    #[test]
+    fn the_executor_ends_each_loop_for_one_reason_written_in_one_place() {
+        let fresh = || SolveReport::unsolved(SolverKind::Static);
+        // Converges quadratically: 1e-12 in 5 iterations from 1.
+        let mut root = Root {
+            x: 1.0,
+            iterations: 0,
+            tol: 1e-12,
+        };
+        let mut report = fresh();
+        let v = run(&mut root, 50, &mut NoObserver);
+        assert!(conclude(v, root.iterations, &mut report));
+        assert_eq!(
+            (report.stop, report.status),
+            (StopReason::Converged, Status::Converged)
+        );
+        assert!((root.x - 2f64.sqrt()).abs() < 1e-12 && root.iterations == 5);
+        // The same with a budget of 2: the budget's reason and words, not a default.
+        let mut short = Root {
+            x: 1.0,
+            iterations: 0,
+            tol: 1e-12,
+        };
+        let mut report = fresh();
+        let v = run(&mut short, 2, &mut NoObserver);
+        assert!(!conclude(v, short.iterations, &mut report));
+        assert_eq!(
+            (report.stop, report.message.as_str()),
+            (StopReason::Iterations, "2 iterations")
+        );
+        // From 0 the first step is not finite: diverged at the iteration it was found.
+        let mut zero = Root {
+            x: 0.0,
+            iterations: 0,
+            tol: 1e-12,
+        };
+        let mut report = fresh();
+        let v = run(&mut zero, 50, &mut NoObserver);
+        assert!(!conclude(v, zero.iterations, &mut report));
+        assert_eq!(report.stop, StopReason::Diverged);
+        assert_eq!(report.divergence.as_ref().map(|d| d.step), Some(1));
+    }
+}
