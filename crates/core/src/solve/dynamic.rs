@@ -14,7 +14,8 @@
 //! carry a particle into an obstacle: their step cannot resolve the barrier there.
 
 use super::dynamic_options::DynamicOptions;
-use super::incremental::{ImplicitSettings, Settle, integrate_implicit, observe_start};
+use super::implicit_euler::{Settle, integrate_implicit, observe_start};
+use super::incremental::ImplicitSettings;
 use super::kind::Integrator;
 use super::stability::{kinetic_energy, stability_limit_dt};
 use super::time_step::Stepper;

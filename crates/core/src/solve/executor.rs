@@ -8,13 +8,22 @@ use super::{DivergenceReason, Observer, SolveReport, StopReason};
 /// How an iterative loop ends.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum Verdict {
-    /// The goal is met, for a reason (converged, the round-off floor); none for a goal short of
-    /// the solve's own (a load increment reached), which leaves the report's reason as it is.
-    Reached(Option<StopReason>),
+    /// The goal is met, for a reason (converged, the round-off floor) and in words where the
+    /// solver has them; no reason for a goal short of the solve's own (a load increment reached),
+    /// which leaves the report's reason as it is.
+    Reached(Option<StopReason>, Option<String>),
     /// The loop cannot go on, for a reason said in words.
     Stopped(StopReason, String),
-    /// The state diverged.
-    Diverged(DivergenceReason),
+    /// The state diverged: why, at which time step (dynamics), and in words where the solver has
+    /// them.
+    Diverged {
+        /// Why.
+        reason: DivergenceReason,
+        /// The time step that diverged, s (none in a static solve).
+        dt_s: Option<f64>,
+        /// The solver's words, where it has them.
+        message: Option<String>,
+    },
 }
 
 /// An iterative solver over its own state: its checks and its iteration.
@@ -53,9 +62,12 @@ pub(super) fn run(
 /// Writes `verdict`, reached at iteration `iter`, into `report`: true when the goal was met.
 pub(super) fn conclude(verdict: Verdict, iter: usize, report: &mut SolveReport) -> bool {
     match verdict {
-        Verdict::Reached(reason) => {
+        Verdict::Reached(reason, message) => {
             if let Some(r) = reason {
                 report.stop_for(r);
+            }
+            if let Some(m) = message {
+                report.message = m;
             }
             true
         }
@@ -63,8 +75,15 @@ pub(super) fn conclude(verdict: Verdict, iter: usize, report: &mut SolveReport) 
             report.stop_with(reason, message);
             false
         }
-        Verdict::Diverged(reason) => {
-            report.diverge(iter, None, reason);
+        Verdict::Diverged {
+            reason,
+            dt_s,
+            message,
+        } => {
+            report.diverge(iter, dt_s, reason);
+            if let Some(m) = message {
+                report.message = m;
+            }
             false
         }
     }
@@ -90,9 +109,14 @@ mod tests {
         fn terminate(&mut self, _observer: &mut dyn Observer) -> Option<Verdict> {
             let r = (self.x * self.x - 2.0).abs();
             if !r.is_finite() {
-                return Some(Verdict::Diverged(DivergenceReason::NonFinite));
+                let reason = DivergenceReason::NonFinite;
+                return Some(Verdict::Diverged {
+                    reason,
+                    dt_s: None,
+                    message: None,
+                });
             }
-            (r <= self.tol).then_some(Verdict::Reached(Some(StopReason::Converged)))
+            (r <= self.tol).then_some(Verdict::Reached(Some(StopReason::Converged), None))
         }
         fn next_iter(&mut self) -> Result<(), Verdict> {
             self.iterations += 1;

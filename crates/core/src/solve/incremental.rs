@@ -11,12 +11,11 @@
 //! and are halved and retried when it does not, and land on every frame time a recorder asks for.
 
 use super::FactorReuse;
-use super::clock::{Clock, StepBounds, grown};
+use super::clock::StepBounds;
 use super::static_options::StaticOptions;
-use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
+use super::{DivergenceReason, SolveReport};
 use crate::physics::{EnergyTerm, HessianBlocks, Model, Vecs};
 use nalgebra::{Matrix3, Vector3};
-use std::time::Instant;
 
 /// The inertia and damping part of the incremental potential: Σ w_p/2 |x_p − c_p|² (the two
 /// quadratics about x̃ and xₙ merged: w = m/h² + d/h, c = (m/h² x̃ + d/h xₙ)/w) plus β/(2h) Δxᵀ Kₙ Δx.
@@ -142,7 +141,7 @@ pub struct ImplicitSettings {
 
 impl ImplicitSettings {
     /// The bounds of its adaptive steps.
-    fn bounds(&self) -> StepBounds {
+    pub(super) fn bounds(&self) -> StepBounds {
         StepBounds {
             adaptive: self.adaptive,
             min_dt_s: self.min_dt_s,
@@ -174,7 +173,7 @@ impl ImplicitSettings {
 }
 
 /// The outcome of one step attempt.
-enum Attempt {
+pub(super) enum Attempt {
     /// Accepted after this many Newton iterations.
     Accepted(usize),
     /// Newton did not converge; the state is unchanged.
@@ -184,7 +183,7 @@ enum Attempt {
 }
 
 /// One step of `h` from (`x`, `v`), both updated on success; `work` gets the report's counters.
-fn step(
+pub(super) fn step(
     model: &mut Model,
     x: &mut [Vector3<f64>],
     v: &mut [Vector3<f64>],
@@ -259,201 +258,4 @@ fn step(
         x.copy_from_slice(&x_n);
         Attempt::Rejected
     }
-}
-
-/// What a settled (or stopped) integration is checked against, and where it stands.
-pub struct Settle {
-    /// Largest residual force of W (without inertia) allowed, N.
-    pub residual_N: f64,
-    /// Largest speed allowed, m/s.
-    pub speed_m_per_s: f64,
-    /// Size of the drape (its bounding box's diagonal), m.
-    pub extent_m: f64,
-}
-
-/// Integrates from (`x`, `v`) (updated in place) until settled, stopped or out of time: each step
-/// minimises the incremental potential ([`Inertia`] + the model). `frame_s`: land a step on every
-/// multiple of it and hand that state to `observer` (stamped with the exact frame time).
-/// Newton's Hessian is that of a time step ([`Model::set_time_stepping`]) while it integrates.
-#[allow(clippy::too_many_arguments)]
-pub fn integrate_implicit(
-    model: &mut Model,
-    x: &mut [Vector3<f64>],
-    v: &mut [Vector3<f64>],
-    s: &ImplicitSettings,
-    settle: &Settle,
-    budget: (f64, Option<f64>),
-    frame_s: Option<f64>,
-    observer: &mut dyn Observer,
-    report: &mut SolveReport,
-) {
-    model.set_time_stepping(true);
-    integrate(model, x, v, s, settle, budget, frame_s, observer, report);
-    model.set_time_stepping(false);
-}
-
-/// [`integrate_implicit`]'s loop.
-#[allow(clippy::too_many_arguments)]
-fn integrate(
-    model: &mut Model,
-    x: &mut [Vector3<f64>],
-    v: &mut [Vector3<f64>],
-    s: &ImplicitSettings,
-    settle: &Settle,
-    (max_time_s, max_wall_s): (f64, Option<f64>),
-    frame_s: Option<f64>,
-    observer: &mut dyn Observer,
-    report: &mut SolveReport,
-) {
-    let start = Instant::now();
-    let (mut h, mut cooldown, mut g, mut carried) = (s.dt_s, 0usize, Vec::new(), None);
-    let mut c = Clock::default();
-    loop {
-        model.gradient(x, 1.0, &mut g);
-        let r = model.max_residual(&g);
-        let speed = v.iter().map(|p| p.norm()).fold(0.0, f64::max);
-        if !r.is_finite() {
-            report.diverge(c.steps, Some(h), DivergenceReason::NonFinite);
-            return;
-        }
-        // Recording frames, the state is judged on frame times only (the last one recorded is the
-        // final state).
-        let on_frame = frame_s.is_none() || c.at_frame;
-        if on_frame && settled(model, x, settle, (r, speed, c.last_dt)) {
-            report.stop_with(StopReason::Converged, c.settled(model, v, r, speed));
-            break;
-        }
-        if let Some((reason, message)) =
-            out_of_budget(c.t, (max_time_s, max_wall_s), start, r, speed)
-        {
-            report.stop_with(reason, message);
-            break;
-        }
-        // The step: capped by the time budget and, when recording frames, landing on the next one.
-        let (t, next_frame) = (c.t, frame_s.map(|f| f * c.frame as f64));
-        let dt = next_frame.map_or(h, |tf| h.min(tf - t)).min(max_time_s - t);
-        match step(model, x, v, dt, s, &mut carried, report) {
-            Attempt::Accepted(iterations) => {
-                c.accept(dt, next_frame);
-                let t = c.t;
-                if (c.at_frame || (frame_s.is_none() && observer.wants(c.steps)))
-                    && let Err(e) = observe_state(observer, model, x, v, (c.steps, t, r))
-                {
-                    report.stop_with(
-                        StopReason::Observer,
-                        format!("an observer failed at t = {t:.4} s: {e:#}"),
-                    );
-                    break;
-                }
-                // A step shortened to land on a frame does not set the next one, and for three
-                // steps after a rejected one the step does not grow.
-                cooldown = cooldown.saturating_sub(1);
-                h = grown(h, dt, iterations, cooldown, s.bounds());
-            }
-            Attempt::Diverged(reason) => {
-                report.diverge(c.steps, Some(dt), reason);
-                report.message = format!("diverged at t = {t:.4} s (step {dt:e} s): {reason}");
-                break;
-            }
-            Attempt::Rejected => {
-                (h, cooldown) = (dt * 0.5, 3);
-                if h < s.min_dt_s {
-                    report.stop_with(
-                        StopReason::StepTooSmall,
-                        format!(
-                            "Newton failed at every step down to {:.1e} s at t = {t:.4} s",
-                            s.min_dt_s
-                        ),
-                    );
-                    break;
-                }
-            }
-        }
-    }
-    report.iterations = c.steps;
-    report.sim_time_s = Some(c.t);
-    report.dt_s = Some(if c.steps > 0 { c.largest } else { s.dt_s });
-}
-
-/// Whether a state with largest residual `r` N and speed m/s after a step of `last_dt` s has
-/// settled: forces and speed below the criterion. Near the round-off floor of forces a soft mode
-/// keeps moving by floor/stiffness per step: there the speed criterion becomes "no particle moved
-/// more than 1e-7 of the drape's size". (Each step's Newton stops within 100 times the floor of
-/// its own, inertia-stiffened forces.)
-fn settled(
-    model: &Model,
-    x: &[Vector3<f64>],
-    settle: &Settle,
-    (r, speed, last_dt): (f64, f64, f64),
-) -> bool {
-    let floor = 100.0 * model.roundoff_force(x);
-    let still =
-        speed <= settle.speed_m_per_s || (r <= floor && speed * last_dt <= 1e-7 * settle.extent_m);
-    r <= settle.residual_N.max(floor) && still
-}
-
-/// Why an implicit integration must stop for its budgets, if it must: the simulated time
-/// `max_time_s` reached, or the wall time `max_wall_s` spent since `start`.
-fn out_of_budget(
-    t: f64,
-    (max_time_s, max_wall_s): (f64, Option<f64>),
-    start: Instant,
-    r: f64,
-    speed: f64,
-) -> Option<(StopReason, String)> {
-    if t >= max_time_s * (1.0 - 1e-12) {
-        return Some((
-            StopReason::SimulatedTime,
-            format!(
-                "not settled within {max_time_s} s (residual {r:.3e} N, speed {speed:.3e} m/s)"
-            ),
-        ));
-    }
-    if max_wall_s.is_some_and(|b| start.elapsed().as_secs_f64() > b) {
-        return Some((
-            StopReason::WallTime,
-            format!("wall-time budget spent at t = {t:.4} s (residual {r:.3e} N)"),
-        ));
-    }
-    None
-}
-
-/// Hands the state after step `steps` (time `t`, residual `r` N) to `observer`, with its total
-/// (potential and kinetic) energy.
-fn observe_state(
-    observer: &mut dyn Observer,
-    model: &Model,
-    x: &[Vector3<f64>],
-    v: &[Vector3<f64>],
-    (steps, t, r): (usize, f64, f64),
-) -> anyhow::Result<()> {
-    observer.observe(&StateEvent {
-        index: steps,
-        time_s: Some(t),
-        x,
-        max_residual_N: r,
-        energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
-    })
-}
-
-/// Hands the initial state (t = 0) to `observer` when it records frames or wants step 0.
-pub fn observe_start(
-    model: &Model,
-    x: &[Vector3<f64>],
-    v: &[Vector3<f64>],
-    frame_s: Option<f64>,
-    observer: &mut dyn Observer,
-) -> anyhow::Result<()> {
-    if frame_s.is_some() || observer.wants(0) {
-        let mut g = Vec::new();
-        model.gradient(x, 1.0, &mut g);
-        observer.observe(&StateEvent {
-            index: 0,
-            time_s: Some(0.0),
-            x,
-            max_residual_N: model.max_residual(&g),
-            energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
-        })?;
-    }
-    Ok(())
 }

@@ -169,23 +169,28 @@ impl super::executor::Iterative for Stage<'_> {
         let (r, tol) = (self.model.max_residual(&ws.g), self.tol);
         self.r = r;
         if !r.is_finite() || !self.e.is_finite() {
-            return Some(Verdict::Diverged(DivergenceReason::NonFinite));
+            let reason = DivergenceReason::NonFinite;
+            return Some(Verdict::Diverged {
+                reason,
+                dt_s: None,
+                message: None,
+            });
         }
         if let Err(err) = observe_iterate(observer, self.run.iter, self.x, (r, self.e)) {
             let message = format!("an observer failed at iteration {}: {err:#}", self.run.iter);
             return Some(Verdict::Stopped(StopReason::Observer, message));
         }
         if r <= tol && self.last {
-            return Some(Verdict::Reached(Some(StopReason::Converged)));
+            return Some(Verdict::Reached(Some(StopReason::Converged), None));
         }
         // Round-off floor: the residual cannot fall below ~16 ε k |x| (see Model::roundoff_force);
         // reaching it after the tolerance proved unreachable is convergence, said in the message.
         if self.last && r <= self.model.roundoff_force(self.x) && r <= 1e3 * tol {
             self.run.floor = true;
-            return Some(Verdict::Reached(Some(StopReason::RoundoffFloor)));
+            return Some(Verdict::Reached(Some(StopReason::RoundoffFloor), None));
         }
         if r <= tol.max(1e-6 * self.w_ref) && !self.last {
-            return Some(Verdict::Reached(None));
+            return Some(Verdict::Reached(None, None));
         }
         None
     }
@@ -208,7 +213,7 @@ impl super::executor::Iterative for Stage<'_> {
             model.gradient(x, load, &mut run.ws.g);
             let r = model.max_residual(&run.ws.g);
             if r <= self.tol && self.last {
-                return Err(Verdict::Reached(Some(StopReason::Converged)));
+                return Err(Verdict::Reached(Some(StopReason::Converged), None));
             }
             let message = format!(
                 "line search failed at iteration {} with residual {r:.3e} N",
@@ -222,10 +227,12 @@ impl super::executor::Iterative for Stage<'_> {
         let strain = self.model.max_strain(self.x);
         if strain > self.opts.strain_bound {
             let bound = self.opts.strain_bound;
-            return Err(Verdict::Diverged(DivergenceReason::StrainBeyondBound {
-                strain,
-                bound,
-            }));
+            let reason = DivergenceReason::StrainBeyondBound { strain, bound };
+            return Err(Verdict::Diverged {
+                reason,
+                dt_s: None,
+                message: None,
+            });
         }
         Ok(())
     }
