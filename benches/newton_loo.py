@@ -1,6 +1,6 @@
 """Leave-one-out choice of `solver.static.shift_max_rel` over the bundled scenes (issue 34).
 
-    python3 benches/newton_loo.py 1e-6=A.csv 1e-5=B.csv 1e-4=C.csv 1e-3=D.csv >> reports/newton_iterations.md
+    python3 benches/newton_loo.py 1e-6=A.csv 1e-5=B.csv 1e-4=C.csv 1e-3=D.csv
 
 Each CSV is `bash benches/newton_iterations.sh` with that value as the default. For every scene held out, the
 value with the fewest Newton iterations over the other sixteen is chosen, and the held-out scene's iterations

@@ -181,7 +181,7 @@ pub fn baselines_table(rows: &[PredictionRow]) -> String {
         counts[7],
         counts[8]
     );
-    s += "\n\"Model + node line\": the model's mean count plus the share of the calibration specimen's discrepancy (its median less the model's mean) that the other fabrics' specimens carry (`nodes_line_slope`; `cusick_node_prior`): with a slope near 1 this is close to carrying the calibration specimen's count over, and says that the model's fold count adds little to it.\n";
+    s += "\n\"Model + node line\": the model's mean count plus the share of the calibration specimen's discrepancy (its median less the model's mean) that the other fabrics' specimens carry (`nodes_line_slope`; `core::cusick::node_lines`): with a slope near 1 this is close to carrying the calibration specimen's count over, and says that the model's fold count adds little to it.\n";
     s
 }
 

@@ -7,12 +7,13 @@
 //! prediction plus the 5 % and 95 % quantiles of the residuals (measured − predicted) of every
 //! *other* fabric's captures of the same kind (known face, or face average) — leave one fabric
 //! out, never this fabric's own data — widened to hold the prediction itself where those residuals
-//! lie all on one side (issue 78: a point is never outside its own interval). With fewer than [`MIN_POOL`] such residuals (a dataset of
+//! lie all on one side (issue 78: a point is never outside its own interval). With fewer than
+//! [`drapelab_core::cusick::MIN_POOL`] such residuals (a dataset of
 //! one or two fabrics) it falls back to ±1.645 of the model's own spread (its seeds' DC SD and the
 //! calibration specimen's), and says so.
 
 use crate::cusick::measure::ShadowRow;
-use drapelab_core::cusick::{Face, NodeDistribution};
+use drapelab_core::cusick::{DcPrediction, Face, Interval, NodeDistribution};
 use drapelab_core::measure::mean;
 use drapelab_core::table::Table;
 use serde::{Deserialize, Serialize};
@@ -36,7 +37,7 @@ pub struct CaptureRow {
     /// Upper end of the 90 % prediction interval, %.
     pub dc_high_pct: f64,
     /// Predicted node count for this face: the mean over its seeds plus the fabric's node
-    /// correction ([`crate::cusick::node_prior`]).
+    /// correction ([`drapelab_core::cusick::node_lines`]).
     pub nodes_predicted: f64,
     /// The predicted node count as a whole number: `nodes_predicted` rounded (the likeliest count;
     /// six seeds' mean estimates it better than their mode).
@@ -71,10 +72,6 @@ impl Table for CaptureRow {
     const ROW: &'static str = "One capture of a predicted Cusick specimen: its face's predicted DC with a 90 % interval (leave one fabric out), nodes, and baselines.";
 }
 
-/// Residuals of other fabrics' captures below this many: the interval falls back to the model's
-/// own spread.
-pub const MIN_POOL: usize = 10;
-
 /// A fabric's predictions per face: the node and DC distributions of its face-up and face-down
 /// seeds (both none for a face-blind fit) and of all of them, the face average.
 #[derive(Debug, Clone, PartialEq)]
@@ -108,9 +105,50 @@ impl FacePredictions {
     }
 }
 
+/// The captures of a fabric's specimens but its calibration specimen `calib`, in order.
+fn predicted<'a>(rows: &'a [&'a ShadowRow], calib: i32) -> impl Iterator<Item = &'a ShadowRow> {
+    rows.iter().copied().filter(move |r| r.sample != calib)
+}
+
+/// What the prediction intervals need of one fabric's predicted captures (`rows`: all its
+/// captures; `calib`: the calibration specimen), in the order of [`capture_rows`].
+pub fn dc_predictions(
+    rows: &[&ShadowRow],
+    calib: i32,
+    pred: &FacePredictions,
+) -> Vec<DcPrediction> {
+    predicted(rows, calib)
+        .map(|r| DcPrediction {
+            fabric: r.fabric,
+            face: r.face,
+            measured_pct: r.dc_photo_pct,
+            predicted_pct: pred.dc_pct(r.face),
+            face_average_pct: pred.average.dc_mean_pct,
+        })
+        .collect()
+}
+
+/// The mean residual (measured − the model's mean for the capture's face) of a fabric's predicted
+/// captures' node counts, where the model has one: what the node line is fitted on.
+pub fn node_residual(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> Option<f64> {
+    let residuals: Vec<f64> = predicted(rows, calib)
+        .map(|r| (r.nodes_photo as f64, pred.of(r.face).nodes_mean))
+        .filter(|(_, model)| model.is_finite())
+        .map(|(measured, model)| measured - model)
+        .collect();
+    mean(&residuals)
+}
+
 /// The rows of one fabric's predicted captures (`rows`: all its captures; `calib`: the calibration
-/// specimen), intervals not yet set (NaN; [`fill_intervals`] sets them).
-pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> Vec<CaptureRow> {
+/// specimen), each with the fabric's node `correction` (nodes) and its interval (`intervals`, in
+/// the order of [`dc_predictions`]).
+pub fn capture_rows(
+    rows: &[&ShadowRow],
+    calib: i32,
+    pred: &FacePredictions,
+    correction: f64,
+    intervals: &[Interval],
+) -> Vec<CaptureRow> {
     let dc_where = |keep: &dyn Fn(&ShadowRow) -> bool| {
         mean(
             &rows
@@ -121,26 +159,27 @@ pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> 
         )
     };
     let carry = dc_where(&|r| r.sample == calib).unwrap_or(f64::NAN);
-    rows.iter()
-        .filter(|r| r.sample != calib)
-        .map(|r| {
+    predicted(rows, calib)
+        .zip(intervals)
+        .map(|(r, iv)| {
             let face = r.face;
             let p = pred.of(face);
             let known = face != Face::Unknown;
             let same_face = |o: &ShadowRow| known && o.face == face;
+            let nodes_predicted = p.nodes_mean + correction;
             CaptureRow {
                 fabric: r.fabric,
                 sample: r.sample,
                 capture: r.capture,
                 face,
                 dc_predicted_pct: pred.dc_pct(face),
-                dc_low_pct: f64::NAN,
-                dc_high_pct: f64::NAN,
-                nodes_predicted: p.nodes_mean,
-                nodes_predicted_mode: p.nodes_mode as i32,
+                dc_low_pct: iv.low_pct,
+                dc_high_pct: iv.high_pct,
+                nodes_predicted,
+                nodes_predicted_mode: nodes_predicted.round() as i32,
                 nodes_model_mean: p.nodes_mean,
                 nodes_model_mode: p.nodes_mode as i32,
-                interval: String::new(),
+                interval: iv.source.label().into(),
                 dc_measured_pct: r.dc_photo_pct,
                 nodes_measured: r.nodes_photo as i32,
                 dc_face_average_pct: pred.average.dc_mean_pct,
@@ -156,80 +195,10 @@ pub fn capture_rows(rows: &[&ShadowRow], calib: i32, pred: &FacePredictions) -> 
         .collect()
 }
 
-/// The `q`-quantile of sorted `v` (linear between order statistics).
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let at = q * (v.len() - 1) as f64;
-    let (lo, hi) = (at.floor() as usize, at.ceil() as usize);
-    v[lo] + (v[hi] - v[lo]) * (at - lo as f64)
-}
-
-/// Sets every row's 90 % interval from the other fabrics' residuals (see the module), or from
-/// `spread(fabric)` (the model's own DC spread, %) where they are too few.
-pub fn fill_intervals(rows: &mut [CaptureRow], spread: impl Fn(i32) -> f64) {
-    let residual = |r: &CaptureRow, average: bool| {
-        r.dc_measured_pct
-            - if average {
-                r.dc_face_average_pct
-            } else {
-                r.dc_predicted_pct
-            }
-    };
-    let snapshot = rows.to_vec();
-    for r in rows.iter_mut() {
-        let average = r.face == Face::Unknown;
-        let mut pool: Vec<f64> = snapshot
-            .iter()
-            .filter(|o| o.fabric != r.fabric && (average || o.face != Face::Unknown))
-            .map(|o| residual(o, average))
-            .filter(|v| v.is_finite())
-            .collect();
-        pool.sort_by(f64::total_cmp);
-        let (lo, hi, how) = if pool.len() >= MIN_POOL {
-            // Widened to hold the point itself where the others' residuals lie all on one side
-            // (a model biased on them): a prediction is never outside its own interval.
-            (
-                quantile(&pool, 0.05).min(0.0),
-                quantile(&pool, 0.95).max(0.0),
-                "leave-one-fabric-out",
-            )
-        } else {
-            let h = 1.645 * spread(r.fabric);
-            (-h, h, "model spread")
-        };
-        r.dc_low_pct = r.dc_predicted_pct + lo;
-        r.dc_high_pct = r.dc_predicted_pct + hi;
-        r.interval = how.into();
-    }
-}
-
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
-
-    pub(crate) fn row(fabric: i32, face: &str, measured: f64, predicted: f64) -> CaptureRow {
-        CaptureRow {
-            fabric,
-            sample: 2,
-            capture: 1,
-            face: Face::of(face),
-            dc_predicted_pct: predicted,
-            dc_low_pct: f64::NAN,
-            dc_high_pct: f64::NAN,
-            nodes_predicted: 7.0,
-            nodes_predicted_mode: 7,
-            nodes_model_mean: 7.0,
-            nodes_model_mode: 7,
-            interval: String::new(),
-            dc_measured_pct: measured,
-            nodes_measured: 7,
-            dc_face_average_pct: predicted,
-            dc_face_drapes_pct: predicted,
-            dc_carry_over_pct: predicted,
-            dc_carry_over_face_pct: None,
-            dc_other_specimens_pct: None,
-            dc_other_specimens_face_pct: None,
-        }
-    }
+    use drapelab_core::cusick::IntervalSource;
 
     fn distribution(dc: f64, nodes: usize) -> NodeDistribution {
         NodeDistribution {
@@ -262,7 +231,15 @@ pub(crate) mod tests {
             shadow(3, Face::Unknown, 62.5),
         ];
         let refs: Vec<&ShadowRow> = rows.iter().collect();
-        let caps = capture_rows(&refs, 1, &pred);
+        let iv = Interval {
+            low_pct: 1.0,
+            high_pct: 2.0,
+            source: IntervalSource::ModelSpread,
+        };
+        let dc = dc_predictions(&refs, 1, &pred);
+        assert_eq!(dc.len(), 3);
+        assert_eq!((dc[1].predicted_pct, dc[1].face_average_pct), (63.5, 62.0));
+        let caps = capture_rows(&refs, 1, &pred, 0.5, &[iv; 3]);
         let got: Vec<(Face, f64, f64, f64)> = caps
             .iter()
             .map(|c| {
@@ -277,57 +254,23 @@ pub(crate) mod tests {
         assert_eq!(
             got,
             vec![
-                (Face::Up, 60.5, 7.0, 60.0),
-                (Face::Down, 63.5, 9.0, 66.0),
-                (Face::Unknown, 62.0, 8.0, 62.0)
+                (Face::Up, 60.5, 7.5, 60.0),
+                (Face::Down, 63.5, 9.5, 66.0),
+                (Face::Unknown, 62.0, 8.5, 62.0)
             ]
         );
         assert!(caps.iter().all(|c| c.dc_carry_over_pct == 58.0));
-    }
-
-    #[test]
-    fn an_interval_is_made_of_the_other_fabrics_residuals_only() {
-        // Fabric 1's residuals are all +50; the others' spread uniformly over −10…+10: fabric 1's
-        // interval ignores its own and spans the others' 5–95 %, the others' include fabric 1's.
-        let mut rows: Vec<CaptureRow> = (0..21)
-            .map(|k| row(2 + k % 3, "up", 50.0 + (k as f64 - 10.0), 50.0))
-            .collect();
-        rows.extend((0..4).map(|_| row(1, "down", 100.0, 50.0)));
-        fill_intervals(&mut rows, |_| 1.0);
-        let own = rows.iter().find(|r| r.fabric == 1).unwrap();
-        assert_eq!(own.interval, "leave-one-fabric-out");
-        assert!((own.dc_low_pct - 41.0).abs() < 1e-9 && (own.dc_high_pct - 59.0).abs() < 1e-9);
-        let other = rows.iter().find(|r| r.fabric == 2).unwrap();
-        assert!(other.dc_high_pct > 60.0, "{}", other.dc_high_pct);
-        // A capture of unknown face: the face-average prediction's residuals of the others (here
-        // fabric 1's, +50 against its face average) and its interval built on them.
-        let mut unknown = row(3, "unknown", 50.0, 50.0);
-        unknown.dc_face_average_pct = 48.0;
-        let mut mixed = rows.clone();
-        mixed.push(unknown);
-        fill_intervals(&mut mixed, |_| 1.0);
-        let u = mixed.last().unwrap();
-        assert!(u.dc_high_pct >= 50.0 + 49.0, "{u:?}");
-        // The others' residuals all positive (a model that predicts too low on them): the
-        // interval reaches down to the point itself, never above it.
-        let mut biased: Vec<CaptureRow> = (0..21)
-            .map(|k| row(2 + k % 3, "up", 55.0 + k as f64 * 0.5, 50.0))
-            .collect();
-        biased.push(row(1, "up", 60.0, 50.0));
-        fill_intervals(&mut biased, |_| 1.0);
-        for r in &biased {
-            assert!(
-                r.dc_low_pct <= r.dc_predicted_pct && r.dc_predicted_pct <= r.dc_high_pct,
-                "{r:?}"
-            );
-        }
-        let own = biased.last().unwrap();
-        assert_eq!(own.dc_low_pct, 50.0);
-        assert!(own.dc_high_pct > 60.0, "{own:?}");
-        // One fabric alone: the model's own spread.
-        let mut lone = vec![row(5, "up", 52.0, 50.0), row(5, "down", 49.0, 50.0)];
-        fill_intervals(&mut lone, |_| 2.0);
-        assert_eq!(lone[0].interval, "model spread");
-        assert!((lone[0].dc_high_pct - 53.29).abs() < 1e-9);
+        // The correction rounds into the whole count; the model's own count stays in its column;
+        // the interval is the one given.
+        assert_eq!(
+            (caps[0].nodes_predicted_mode, caps[0].nodes_model_mean),
+            (8, 7.0)
+        );
+        assert_eq!(
+            (caps[0].dc_low_pct, caps[0].interval.as_str()),
+            (1.0, "model spread")
+        );
+        // The node residual: measured 8 (ShadowRow::photo) less each face's model mean 7, 9, 8.
+        assert_eq!(node_residual(&refs, 1, &pred), Some(0.0));
     }
 }

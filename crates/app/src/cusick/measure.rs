@@ -6,7 +6,7 @@ use crate::cusick::tables::OutlineRow;
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{
-    Face, ShadowMeasures, SilhouetteScale, Tester, hem_projection, mesh_projection,
+    DcCapture, Face, ShadowMeasures, SilhouetteScale, Tester, hem_projection, mesh_projection,
     sector_angle_rad, shadow_measures, silhouette_projection,
 };
 use drapelab_core::table::Table;
@@ -57,6 +57,18 @@ pub struct ShadowRow {
     pub r_outline_min_m: f64,
     /// Largest radius of the photo's smoothed outline, m.
     pub r_outline_max_m: f64,
+}
+
+impl ShadowRow {
+    /// The capture's photo DC as the statistics over fabrics take it.
+    pub fn dc_capture(&self) -> DcCapture {
+        DcCapture {
+            fabric: self.fabric,
+            sample: self.sample,
+            face: self.face,
+            dc_pct: self.dc_photo_pct,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -2,9 +2,8 @@
 
 pub mod captures;
 pub mod fabric;
-pub mod face_prior;
 pub mod measure;
-pub mod node_prior;
+pub mod over_fabrics;
 pub mod predict;
 pub mod tables;
 pub mod targets;

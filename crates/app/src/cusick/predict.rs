@@ -6,17 +6,17 @@
 //! simulated shadow outlines and height profiles (for the report's pictures) and a rerun recording
 //! overlaying each fabric's registered meshes and simulated drapes.
 
-use crate::cusick::captures::{CaptureRow, capture_rows, fill_intervals};
-use crate::cusick::face_prior::{GapLine, gap_lines};
+use crate::cusick::captures::FacePredictions;
 use crate::cusick::measure::ShadowRow;
-use crate::cusick::node_prior::correct_nodes;
+use crate::cusick::over_fabrics::{Outcome, rows_over_fabrics};
 use crate::cusick::tables::{OutlineRow, PredictionRow, ProfileRow};
 use crate::cusick::targets::{empty_row, fill_distribution, fill_faces, fill_fit, targets};
 use crate::job::Job;
 use anyhow::Result;
 use drapelab_core::cusick::{
-    DiscMesh, DrapeParams, FabricSettings, Face, SeededDrape, Tester, calibrate_and_predict,
-    height_profile, polar_disc, sector_angle_rad, subdivide_disc, two_fold,
+    DiscMesh, DrapeParams, FabricSettings, Face, GapLine, SeededDrape, Tester,
+    calibrate_and_predict, gap_lines, height_profile, polar_disc, sector_angle_rad, subdivide_disc,
+    two_fold,
 };
 use drapelab_core::measure::mean_sd;
 use drapelab_record::cusick::{CaptureKey, CusickDataset, Template};
@@ -105,14 +105,27 @@ pub struct FabricPrediction {
     drapes: Vec<(u64, Vec<Vector3<f64>>)>,
     /// The registered meshes of the fabric (key, vertices).
     measured: Vec<KeyedMesh>,
-    /// Its predicted captures (intervals set once every fabric is predicted).
-    captures: Vec<CaptureRow>,
+    /// The calibration specimen.
+    calib: i32,
+    /// The model's predictions per face (none where the fabric was not predicted).
+    faces: Option<FacePredictions>,
     /// The model's own DC spread, % (the fallback interval's): its seeds' SD and the calibration
     /// specimen's standard error.
     spread_pct: f64,
 }
 
 impl FabricPrediction {
+    /// What the tables over fabrics take of it, with its captures `shadows`.
+    fn outcome<'a>(&'a self, shadows: Vec<&'a ShadowRow>) -> Outcome<'a> {
+        Outcome {
+            row: &self.row,
+            calib: self.calib,
+            faces: self.faces.as_ref(),
+            spread_pct: self.spread_pct,
+            shadows,
+        }
+    }
+
     /// The meshes of the rerun overlay: every registered mesh and every simulated drape.
     fn overlay<'a>(
         &'a self,
@@ -198,7 +211,8 @@ pub fn predict_fabric(
         profiles: Vec::new(),
         drapes: Vec::new(),
         measured: measured.of_fabric(fabric),
-        captures: Vec::new(),
+        calib: tg.calib,
+        faces: None,
         spread_pct: f64::NAN,
     };
     let outcome = match calibrate_and_predict(
@@ -229,9 +243,7 @@ pub fn predict_fabric(
         }
         None => out.row.status = "no perturbed drape converged".into(),
     }
-    if let Some(faces) = fill_faces(&mut out.row, &outcome) {
-        out.captures = capture_rows(rows, tg.calib, &faces);
-    }
+    out.faces = fill_faces(&mut out.row, &outcome);
     let drapes = outcome.drapes;
     fill_two_fold(&mut out.row, rows, measured, tg.calib, &drapes);
     if !drapes.is_empty() {
@@ -359,7 +371,12 @@ pub fn run(
         rotated: rotated_captures(&data),
     };
     ctx.started(data.fabrics.len());
-    let lines = gap_lines(&shadows);
+    let lines = gap_lines(
+        &shadows
+            .iter()
+            .map(ShadowRow::dc_capture)
+            .collect::<Vec<_>>(),
+    );
     let rows_of = |fabric: i32| -> Vec<&ShadowRow> {
         shadows.iter().filter(|r| r.fabric == fabric).collect()
     };
@@ -394,17 +411,11 @@ pub fn run(
     let mut order: Vec<usize> = (0..data.fabrics.len()).collect();
     order.sort_by(|&a, &b| cost[a].total_cmp(&cost[b]));
     let fabrics = longest_first(&order, predict);
-    let mut rows: Vec<PredictionRow> = fabrics.iter().map(|f| f.row.clone()).collect();
-    let mut captures: Vec<CaptureRow> = fabrics.iter().flat_map(|f| f.captures.clone()).collect();
-    correct_nodes(&mut rows, &mut captures);
-    write_table(ctx.output("predictions")?, &rows)?;
-    let spread: BTreeMap<i32, f64> = fabrics
-        .iter()
-        .map(|f| (f.row.fabric, f.spread_pct))
+    let outcomes: Vec<Outcome<'_>> = (fabrics.iter())
+        .map(|f| f.outcome(rows_of(f.row.fabric)))
         .collect();
-    fill_intervals(&mut captures, |fabric| {
-        spread.get(&fabric).copied().unwrap_or(f64::NAN)
-    });
+    let (rows, captures) = rows_over_fabrics(&outcomes);
+    write_table(ctx.output("predictions")?, &rows)?;
     write_table(ctx.output("by_capture")?, &captures)?;
     let outlines: Vec<OutlineRow> = fabrics.iter().flat_map(|f| f.outlines.clone()).collect();
     write_table(ctx.output("outlines")?, &outlines)?;

@@ -3,7 +3,6 @@
 //! calibration's fit, its node distribution and its per-face predictions.
 
 use crate::cusick::captures::FacePredictions;
-use crate::cusick::face_prior::{GapLine, face_gap};
 use crate::cusick::measure::ShadowRow;
 use crate::cusick::tables::PredictionRow;
 use drapelab_core::cusick::*;
@@ -38,7 +37,7 @@ pub fn targets(rows: &[&ShadowRow]) -> Targets {
             dc_pct,
             dc_se_pct: sd / (own.len().max(1) as f64).sqrt(),
             nodes: median(&own.iter().map(|r| r.nodes_photo as f64).collect::<Vec<_>>()),
-            face_gap: face_gap(&own),
+            face_gap: face_gap(own.iter().map(|r| (r.face, r.dc_photo_pct))),
             predicted_face_gap_pct: None,
         },
         others: others

@@ -10,6 +10,7 @@ mod drape;
 mod fabric;
 mod face;
 mod params;
+mod priors;
 
 pub use branch::{
     Continuation, DrapeBranch, MAX_CONTINUATION_LN, bending_length_tangent, continue_drape,
@@ -29,6 +30,10 @@ pub use fabric::{
 };
 pub use face::{CurlFit, Face, FaceGap, GAP_TOL_PCT, MAX_CURL_PER_M, fit_curl};
 pub use params::{SPECIMEN_KEYS, SpecimenParameters};
+pub use priors::{
+    DcCapture, DcPrediction, GapLine, Interval, IntervalSource, MIN_FABRICS, MIN_POOL, NodeLine,
+    face_gap, gap_lines, node_lines, prediction_intervals, shrinkage_line,
+};
 
 use crate::measure::{Projection, count_rises, outline_radii, smooth_circular};
 use nalgebra::Vector3;

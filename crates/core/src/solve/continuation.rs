@@ -6,6 +6,7 @@
 //! observer the first run, stops at the first stage that does not reach its goal, and merges the
 //! runs' reports ([`SolveReport::merge`]).
 
+use super::executor::{Budget, Verdict};
 use super::newton::{Goal, NewtonRun};
 use super::warm::WarmData;
 use super::{NoObserver, Observer, Part, SolveReport, StaticOptions, StopReason};
@@ -65,9 +66,10 @@ fn whole_count(message: &str, total: usize) -> String {
     }
 }
 
-/// Runs `continuation` on `model` from `x` (updated in place) with Newton under `opts`: the
-/// observer sees the first run's iterations; a stage that does not reach its goal ends it with that
-/// run's status. The work of every run adds up in the report.
+/// Runs `continuation` on `model` from `x` (updated in place) with Newton under `opts`, its
+/// stages under the executor ([`super::executor::run`]): the observer sees the runs until the
+/// first one reaches the tolerance; a stage that does not reach its goal ends it with that run's
+/// status. The work of every run adds up in the report.
 pub fn execute(
     model: &mut Model,
     x: &mut [Vector3<f64>],
@@ -76,57 +78,127 @@ pub fn execute(
     continuation: &mut dyn Continuation,
     observer: &mut dyn Observer,
 ) -> SolveReport {
-    let mut total: Option<SolveReport> = None;
-    let mut run: Option<NewtonRun> = None;
-    let mut solved = false;
-    loop {
-        let (load, goal) =
-            match continuation.next(model, x, solved) {
-                Stage::Solve(load) => (load, Goal::Tolerance),
-                Stage::Increment(load) => (load, Goal::Increment),
-                Stage::Done(note) => {
-                    let staged = total.is_some();
-                    let mut t = match run.take() {
-                        Some(r) => merged(total, r.finish(model, x)),
-                        None => total
-                            .unwrap_or_else(|| SolveReport::unsolved(super::SolverKind::Static)),
-                    };
-                    if staged {
-                        t.message = whole_count(&t.message, t.iterations);
-                    }
-                    t.message += &note;
-                    return t;
+    let mut staged = Staged {
+        model,
+        x,
+        opts,
+        warm,
+        continuation,
+        observer,
+        total: None,
+        run: None,
+        solved: false,
+        next: (1.0, Goal::Tolerance),
+        stages: 0,
+    };
+    let verdict =
+        super::executor::run(&mut staged, Budget::iterations(usize::MAX), &mut NoObserver);
+    let mut total = staged
+        .total
+        .take()
+        .unwrap_or_else(|| SolveReport::unsolved(super::SolverKind::Static));
+    let iterations = total.iterations;
+    super::executor::conclude(verdict, iterations, &mut total);
+    total
+}
+
+/// A continuation's stages as an iterative solver ([`super::executor`]): the model and state, the
+/// Newton run an increment carries on, and the reports of the runs so far.
+struct Staged<'a> {
+    model: &'a mut Model,
+    x: &'a mut [Vector3<f64>],
+    opts: &'a StaticOptions,
+    warm: WarmData<'a>,
+    continuation: &'a mut dyn Continuation,
+    /// Sees the runs until the first one reaches the tolerance.
+    observer: &'a mut dyn Observer,
+    /// The runs' reports so far, merged; at the end, the whole solve's.
+    total: Option<SolveReport>,
+    /// The run an increment leaves open for the next stage.
+    run: Option<NewtonRun>,
+    /// Whether a stage has reached its goal.
+    solved: bool,
+    /// The next stage's load factor and goal.
+    next: (f64, Goal),
+    stages: usize,
+}
+
+impl Staged<'_> {
+    /// Ends the open run, if any, and merges its report into the total.
+    fn close(&mut self) {
+        if let Some(r) = self.run.take() {
+            self.total = Some(merged(self.total.take(), r.finish(self.model, self.x)));
+        }
+    }
+}
+
+impl super::executor::Iterative for Staged<'_> {
+    fn iterations(&self) -> usize {
+        self.stages
+    }
+
+    /// Asks the continuation for the next stage: done or stopped ends the loop.
+    fn terminate(&mut self, _observer: &mut dyn Observer) -> Option<Verdict> {
+        match self.continuation.next(self.model, self.x, self.solved) {
+            Stage::Solve(load) => self.next = (load, Goal::Tolerance),
+            Stage::Increment(load) => self.next = (load, Goal::Increment),
+            Stage::Done(note) => {
+                let staged = self.total.is_some();
+                self.close();
+                let t = self
+                    .total
+                    .get_or_insert_with(|| SolveReport::unsolved(super::SolverKind::Static));
+                if staged {
+                    t.message = whole_count(&t.message, t.iterations);
                 }
-                Stage::Stop(reason, message) => {
-                    let mut t = match run.take() {
-                        Some(r) => merged(total, r.finish(model, x)),
-                        None => total
-                            .unwrap_or_else(|| SolveReport::unsolved(super::SolverKind::Static)),
-                    };
-                    t.stop_with(reason, message);
-                    return t;
-                }
-            };
-        let mut current = match run.take() {
+                t.message += &note;
+                return Some(Verdict::Reached(None, None));
+            }
+            Stage::Stop(reason, message) => {
+                self.close();
+                return Some(Verdict::Stopped(reason, message));
+            }
+        }
+        None
+    }
+
+    /// Runs the next stage: the open run carried on, or a fresh one.
+    fn next_iter(&mut self) -> Result<(), Verdict> {
+        self.stages += 1;
+        let (load, goal) = self.next;
+        let mut current = match self.run.take() {
             Some(r) => r,
-            None => match NewtonRun::new(model, x, opts, warm.factor) {
+            None => match NewtonRun::new(self.model, self.x, self.opts, self.warm.factor) {
                 Ok(r) => r,
-                Err(invalid) => return merged(total, *invalid),
+                Err(invalid) => {
+                    self.total = Some(merged(self.total.take(), *invalid));
+                    return Err(Verdict::PartFailed);
+                }
             },
         };
-        let obs: &mut dyn Observer = match total {
-            None => &mut *observer,
+        let obs: &mut dyn Observer = match self.total {
+            None => &mut *self.observer,
             Some(_) => &mut NoObserver,
         };
-        let reached = current.stage(model, x, opts, (load, goal), obs);
+        let reached = current.stage(self.model, self.x, self.opts, (load, goal), obs);
         if !reached {
-            return merged(total, current.finish(model, x));
+            let last = current.finish(self.model, self.x);
+            self.total = Some(merged(self.total.take(), last));
+            return Err(Verdict::PartFailed);
         }
         match goal {
-            Goal::Increment => run = Some(current),
-            Goal::Tolerance => total = Some(merged(total, current.finish(model, x))),
+            Goal::Increment => self.run = Some(current),
+            Goal::Tolerance => {
+                let last = current.finish(self.model, self.x);
+                self.total = Some(merged(self.total.take(), last));
+            }
         }
-        solved = true;
+        self.solved = true;
+        Ok(())
+    }
+
+    fn out_of_iterations(&self, budget: usize) -> String {
+        format!("{budget} continuation stages")
     }
 }
 

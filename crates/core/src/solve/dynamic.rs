@@ -14,6 +14,7 @@
 //! carry a particle into an obstacle: their step cannot resolve the barrier there.
 
 use super::dynamic_options::DynamicOptions;
+use super::executor::{Budget, Verdict};
 use super::implicit_euler::{Settle, integrate_implicit, observe_start};
 use super::incremental::ImplicitSettings;
 use super::kind::Integrator;
@@ -57,49 +58,37 @@ pub fn solve_dynamic(
         );
         return report;
     }
-    let limits = Limits::new(model, x, v, opts, dt, start);
+    let limits = Limits::new(model, x, v, opts, dt);
     hold_fixed(model, v);
-    let mut stepper = Stepper::new(model, integrator, x, c, dt, free);
-    let mut g = Vec::with_capacity(n);
-    let check = opts.check_every.max(1);
-    let mut step = 0usize;
-    loop {
-        let want = observer.wants(step);
-        model.gradient(x, 1.0, &mut g);
-        // The stopping criteria are checked every `check_every` steps whether or not anyone
-        // watches: an observer sees states between them without moving where the run stops.
-        let stop = if step.is_multiple_of(check) || step == limits.max_steps {
-            limits.check(model, x, v, &g, step, want.then_some(&mut *observer))
-        } else if want {
-            limits.observe(model, x, v, &g, step, observer)
-        } else {
-            None
-        };
-        if let Some((reason, message)) = stop {
-            match reason {
-                Stop::Diverged(d) => report.diverge(step, Some(dt), d),
-                Stop::Reason(r) => report.stop_for(r),
-            }
-            report.message = message;
-            break;
-        }
-        stepper.step(model, x, v, &g, opts.cg_tol_rel, &mut report);
-        step += 1;
-        if stepper.cut_steps > 0 && integrator != Integrator::BaraffWitkin {
-            report.stop_for(StopReason::ContactTooStiff);
-            report.message = format!(
-                "contact too stiff for an explicit step: at t = {:.4} s a step of {dt:e} s would carry a particle into an obstacle; use implicit-euler",
-                step as f64 * dt
-            );
-            break;
-        }
-    }
+    let mut run = ExplicitRun {
+        stepper: Stepper::new(model, integrator, x, c, dt, free),
+        model,
+        x,
+        v,
+        limits,
+        g: Vec::with_capacity(n),
+        check: opts.check_every.max(1),
+        step: 0,
+        cg_tol_rel: opts.cg_tol_rel,
+        integrator,
+        report: &mut report,
+    };
+    let budget = Budget {
+        iterations: usize::MAX,
+        wall_s: opts.max_wall_time_s,
+    };
+    let verdict = super::executor::run(&mut run, budget, observer);
+    let ExplicitRun {
+        x, step, stepper, ..
+    } = run;
+    let cut_steps = stepper.cut_steps;
+    super::executor::conclude(verdict, step, &mut report);
     finish(model, x, step, dt, start, &mut report);
-    if stepper.cut_steps > 0 && integrator == Integrator::BaraffWitkin {
-        report.contact_cut_steps = stepper.cut_steps;
+    if cut_steps > 0 && integrator == Integrator::BaraffWitkin {
+        report.contact_cut_steps = cut_steps;
         report.message = format!(
             "{} ({} steps cut short by contact)",
-            report.message, stepper.cut_steps
+            report.message, cut_steps
         );
     }
     report
@@ -244,12 +233,10 @@ struct Limits {
     w_ref: f64,
     e0: f64,
     blowup: f64,
-    start: Instant,
     residual_tol_rel: f64,
     speed_tol: f64,
     strain_bound: f64,
     max_time_s: f64,
-    max_wall_time_s: Option<f64>,
 }
 
 impl Limits {
@@ -259,7 +246,6 @@ impl Limits {
         v: &[Vector3<f64>],
         opts: &DynamicOptions,
         dt: f64,
-        start: Instant,
     ) -> Self {
         let total_weight: f64 = model.masses.iter().sum::<f64>() * model.gravity_m_per_s2.max(1.0);
         let extent = extent_m(x);
@@ -270,12 +256,10 @@ impl Limits {
             w_ref: model.reference_weight(),
             e0,
             blowup: 100.0 * total_weight * extent + 100.0 * e0.abs(),
-            start,
             residual_tol_rel: opts.residual_tol_rel,
             speed_tol: opts.speed_tol_m_per_s,
             strain_bound: opts.strain_bound,
             max_time_s: opts.max_time_s,
-            max_wall_time_s: opts.max_wall_time_s,
         }
     }
 
@@ -367,14 +351,88 @@ impl Limits {
             );
             return Some((Stop::Reason(StopReason::SimulatedTime), msg));
         }
-        if let Some(budget) = self.max_wall_time_s
-            && self.start.elapsed().as_secs_f64() > budget
-        {
-            let msg = format!(
-                "wall-time budget of {budget} s spent at t = {time:.4} s (residual {r:.3e} N, speed {vmax:.3e} m/s)"
-            );
-            return Some((Stop::Reason(StopReason::WallTime), msg));
-        }
         None
+    }
+}
+
+/// The explicit, symplectic and Baraff–Witkin integrators' fixed steps as an iterative solver
+/// ([`super::executor`]): the state, its stepper and the checks of [`Limits`].
+struct ExplicitRun<'a, 'r> {
+    model: &'a Model,
+    x: &'a mut [Vector3<f64>],
+    v: &'a mut [Vector3<f64>],
+    limits: Limits,
+    stepper: Stepper,
+    /// The gradient at the current state.
+    g: Vec<Vector3<f64>>,
+    /// The stopping criteria are checked every `check` steps.
+    check: usize,
+    step: usize,
+    cg_tol_rel: f64,
+    integrator: Integrator,
+    report: &'r mut SolveReport,
+}
+
+impl super::executor::Iterative for ExplicitRun<'_, '_> {
+    fn iterations(&self) -> usize {
+        self.step
+    }
+
+    /// The stopping criteria, checked every `check_every` steps whether or not anyone watches: an
+    /// observer sees states between them without moving where the run stops.
+    fn terminate(&mut self, observer: &mut dyn Observer) -> Option<Verdict> {
+        let (model, x, v, step) = (self.model, &*self.x, &*self.v, self.step);
+        let want = observer.wants(step);
+        model.gradient(x, 1.0, &mut self.g);
+        let g = &self.g;
+        let stop = if step.is_multiple_of(self.check) || step == self.limits.max_steps {
+            self.limits
+                .check(model, x, v, g, step, want.then_some(observer))
+        } else if want {
+            self.limits.observe(model, x, v, g, step, observer)
+        } else {
+            None
+        };
+        stop.map(|(stop, message)| match stop {
+            Stop::Diverged(reason) => Verdict::Diverged {
+                reason,
+                dt_s: Some(self.limits.dt),
+                message: Some(message),
+            },
+            Stop::Reason(StopReason::Converged) => {
+                Verdict::Reached(Some(StopReason::Converged), Some(message))
+            }
+            Stop::Reason(reason) => Verdict::Stopped(reason, message),
+        })
+    }
+
+    fn next_iter(&mut self) -> Result<(), Verdict> {
+        let (model, g) = (self.model, &self.g);
+        let tol = self.cg_tol_rel;
+        self.stepper
+            .step(model, self.x, self.v, g, tol, self.report);
+        self.step += 1;
+        if self.stepper.cut_steps > 0 && self.integrator != Integrator::BaraffWitkin {
+            let message = format!(
+                "contact too stiff for an explicit step: at t = {:.4} s a step of {:e} s would carry a particle into an obstacle; use implicit-euler",
+                self.step as f64 * self.limits.dt,
+                self.limits.dt
+            );
+            return Err(Verdict::Stopped(StopReason::ContactTooStiff, message));
+        }
+        Ok(())
+    }
+
+    fn out_of_iterations(&self, budget: usize) -> String {
+        format!("{budget} time steps")
+    }
+
+    fn out_of_wall_time(&self, budget_s: f64) -> String {
+        let time = self.step as f64 * self.limits.dt;
+        let r = self.model.max_residual(&self.g);
+        let vmax = self.v.iter().map(|vi| vi.norm()).fold(0.0, f64::max);
+        format!(
+            "wall-time budget of {budget_s} s spent at t = {time:.4} s (residual {r:.3e} N, speed {vmax:.3e} m/s)"
+        )
     }
 }

@@ -1,9 +1,30 @@
 //! The loop of an iterative solver, owned in one place (argmin's executor): the solver says
 //! whether its current state ends the loop ([`Iterative::terminate`]) and takes one iteration
-//! ([`Iterative::next_iter`]); [`run`] owns the loop, the iteration budget and the observer, and
-//! [`conclude`] writes why the loop ended into the report, always one [`StopReason`].
+//! ([`Iterative::next_iter`]); [`run`] owns the loop, the iteration and wall-time budgets
+//! ([`Budget`]) and the observer, and [`conclude`] writes why the loop ended into the report,
+//! always one [`StopReason`].
 
 use super::{DivergenceReason, Observer, SolveReport, StopReason};
+use std::time::Instant;
+
+/// What a loop may spend: iterations, and wall time from the moment [`run`] is called.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Budget {
+    /// Iterations (or time steps) at most.
+    pub iterations: usize,
+    /// Wall time at most, s (none: no limit).
+    pub wall_s: Option<f64>,
+}
+
+impl Budget {
+    /// `n` iterations and no wall-time limit.
+    pub(super) fn iterations(n: usize) -> Self {
+        Self {
+            iterations: n,
+            wall_s: None,
+        }
+    }
+}
 
 /// How an iterative loop ends.
 #[derive(Debug, Clone, PartialEq)]
@@ -24,6 +45,9 @@ pub(super) enum Verdict {
         /// The solver's words, where it has them.
         message: Option<String>,
     },
+    /// A part of the solve (a continuation's stage) did not reach its goal; its own verdict is
+    /// written in its report, which the whole's report has taken over ([`super::Part::Stage`]).
+    PartFailed,
 }
 
 /// An iterative solver over its own state: its checks and its iteration.
@@ -37,21 +61,35 @@ pub(super) trait Iterative {
     fn next_iter(&mut self) -> Result<(), Verdict>;
     /// What running out of `budget` iterations means, in words.
     fn out_of_iterations(&self, budget: usize) -> String;
+    /// What spending the wall-time budget of `budget_s` seconds means, in words.
+    fn out_of_wall_time(&self, budget_s: f64) -> String {
+        format!(
+            "wall-time budget of {budget_s} s spent after {} iterations",
+            self.iterations()
+        )
+    }
 }
 
-/// Runs `solver` until its state ends the loop, an iteration ends it, or it has taken `budget`
-/// iterations; the verdict.
+/// Runs `solver` until its state ends the loop, an iteration ends it, or it has spent its
+/// `budget` (checked after the state's own tests, before each iteration); the verdict.
 pub(super) fn run(
     solver: &mut impl Iterative,
-    budget: usize,
+    budget: Budget,
     observer: &mut dyn Observer,
 ) -> Verdict {
+    let start = Instant::now();
     loop {
         if let Some(v) = solver.terminate(observer) {
             return v;
         }
-        if solver.iterations() >= budget {
-            return Verdict::Stopped(StopReason::Iterations, solver.out_of_iterations(budget));
+        if solver.iterations() >= budget.iterations {
+            let words = solver.out_of_iterations(budget.iterations);
+            return Verdict::Stopped(StopReason::Iterations, words);
+        }
+        if let Some(wall) = budget.wall_s
+            && start.elapsed().as_secs_f64() > wall
+        {
+            return Verdict::Stopped(StopReason::WallTime, solver.out_of_wall_time(wall));
         }
         if let Err(v) = solver.next_iter() {
             return v;
@@ -86,6 +124,7 @@ pub(super) fn conclude(verdict: Verdict, iter: usize, report: &mut SolveReport) 
             }
             false
         }
+        Verdict::PartFailed => false,
     }
 }
 
@@ -138,7 +177,7 @@ mod tests {
             tol: 1e-12,
         };
         let mut report = fresh();
-        let v = run(&mut root, 50, &mut NoObserver);
+        let v = run(&mut root, Budget::iterations(50), &mut NoObserver);
         assert!(conclude(v, root.iterations, &mut report));
         assert_eq!(
             (report.stop, report.status),
@@ -152,7 +191,7 @@ mod tests {
             tol: 1e-12,
         };
         let mut report = fresh();
-        let v = run(&mut short, 2, &mut NoObserver);
+        let v = run(&mut short, Budget::iterations(2), &mut NoObserver);
         assert!(!conclude(v, short.iterations, &mut report));
         assert_eq!(
             (report.stop, report.message.as_str()),
@@ -165,9 +204,65 @@ mod tests {
             tol: 1e-12,
         };
         let mut report = fresh();
-        let v = run(&mut zero, 50, &mut NoObserver);
+        let v = run(&mut zero, Budget::iterations(50), &mut NoObserver);
         assert!(!conclude(v, zero.iterations, &mut report));
         assert_eq!(report.stop, StopReason::Diverged);
         assert_eq!(report.divergence.as_ref().map(|d| d.step), Some(1));
+    }
+
+    /// A solver that never reaches its goal and takes a millisecond an iteration.
+    struct Slow(usize);
+
+    impl Iterative for Slow {
+        fn iterations(&self) -> usize {
+            self.0
+        }
+        fn terminate(&mut self, _observer: &mut dyn Observer) -> Option<Verdict> {
+            None
+        }
+        fn next_iter(&mut self) -> Result<(), Verdict> {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+            self.0 += 1;
+            Ok(())
+        }
+        fn out_of_iterations(&self, budget: usize) -> String {
+            format!("{budget} iterations")
+        }
+    }
+
+    #[test]
+    fn the_executor_spends_a_wall_time_budget_and_says_so() {
+        let budget = Budget {
+            iterations: usize::MAX,
+            wall_s: Some(0.02),
+        };
+        let mut slow = Slow(0);
+        let mut report = SolveReport::unsolved(SolverKind::Static);
+        let start = std::time::Instant::now();
+        let v = run(&mut slow, budget, &mut NoObserver);
+        let spent = start.elapsed().as_secs_f64();
+        assert!(!conclude(v, slow.0, &mut report));
+        assert_eq!(report.stop, StopReason::WallTime);
+        // It ran until the 20 ms were spent, and stopped at the first check after: within the
+        // last iteration's time (a millisecond's sleep, however long the machine makes it).
+        assert!(
+            spent >= 0.02 && slow.0 >= 1,
+            "{spent} s, {} iterations",
+            slow.0
+        );
+        assert!(
+            spent < 0.02 + 2.0 * spent / slow.0 as f64 + 0.05,
+            "{spent} s"
+        );
+        assert!(report.message.contains("0.02 s"), "{}", report.message);
+        // The iteration budget, when smaller, ends it first.
+        let mut slow = Slow(0);
+        let budget = Budget {
+            iterations: 3,
+            wall_s: Some(60.0),
+        };
+        let v = run(&mut slow, budget, &mut NoObserver);
+        assert!(matches!(v, Verdict::Stopped(StopReason::Iterations, _)));
+        assert_eq!(slow.0, 3);
     }
 }

@@ -3,13 +3,12 @@
 //! budget is spent, a step diverges or the step size falls below its minimum.
 
 use super::clock::{Clock, grown};
-use super::executor::Verdict;
+use super::executor::{Budget, Verdict};
 use super::incremental::{Attempt, ImplicitSettings, step};
 use super::warm::NeighbourFactor;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
 use crate::physics::Model;
 use nalgebra::Vector3;
-use std::time::Instant;
 
 /// What a settled (or stopped) integration is checked against, and where it stands.
 pub struct Settle {
@@ -47,7 +46,6 @@ pub fn integrate_implicit(
         budget,
         frame_s,
         report,
-        start: Instant::now(),
         h: s.dt_s,
         cooldown: 0,
         g: Vec::new(),
@@ -56,7 +54,11 @@ pub fn integrate_implicit(
         r: f64::NAN,
         pending: None,
     };
-    let verdict = super::executor::run(&mut run, usize::MAX, observer);
+    let budget = Budget {
+        iterations: usize::MAX,
+        wall_s: budget.1,
+    };
+    let verdict = super::executor::run(&mut run, budget, observer);
     let (steps, t, largest) = (run.clock.steps, run.clock.t, run.clock.largest);
     run.model.set_time_stepping(false);
     super::executor::conclude(verdict, steps, report);
@@ -73,11 +75,10 @@ struct ImplicitRun<'a> {
     v: &'a mut [Vector3<f64>],
     s: &'a ImplicitSettings,
     settle: &'a Settle,
-    /// The simulated-time and wall-time budgets, s.
+    /// The simulated-time and wall-time budgets, s (the executor spends the wall time).
     budget: (f64, Option<f64>),
     frame_s: Option<f64>,
     report: &'a mut SolveReport,
-    start: Instant,
     /// The next step's size, s.
     h: f64,
     /// Steps left before the step may grow again after a rejected one.
@@ -126,8 +127,13 @@ impl super::executor::Iterative for ImplicitRun<'_> {
             let message = c.settled(self.model, self.v, r, speed);
             return Some(Verdict::Reached(Some(StopReason::Converged), Some(message)));
         }
-        out_of_budget(c.t, self.budget, self.start, r, speed)
-            .map(|(reason, message)| Verdict::Stopped(reason, message))
+        let max_time_s = self.budget.0;
+        (c.t >= max_time_s * (1.0 - 1e-12)).then(|| {
+            let message = format!(
+                "not settled within {max_time_s} s (residual {r:.3e} N, speed {speed:.3e} m/s)"
+            );
+            Verdict::Stopped(StopReason::SimulatedTime, message)
+        })
     }
 
     fn next_iter(&mut self) -> Result<(), Verdict> {
@@ -178,6 +184,11 @@ impl super::executor::Iterative for ImplicitRun<'_> {
     fn out_of_iterations(&self, budget: usize) -> String {
         format!("{budget} time steps")
     }
+
+    fn out_of_wall_time(&self, _budget_s: f64) -> String {
+        let (t, r) = (self.clock.t, self.r);
+        format!("wall-time budget spent at t = {t:.4} s (residual {r:.3e} N)")
+    }
 }
 
 /// Whether a state with largest residual `r` N and speed m/s after a step of `last_dt` s has
@@ -195,32 +206,6 @@ fn settled(
     let still =
         speed <= settle.speed_m_per_s || (r <= floor && speed * last_dt <= 1e-7 * settle.extent_m);
     r <= settle.residual_N.max(floor) && still
-}
-
-/// Why an implicit integration must stop for its budgets, if it must: the simulated time
-/// `max_time_s` reached, or the wall time `max_wall_s` spent since `start`.
-fn out_of_budget(
-    t: f64,
-    (max_time_s, max_wall_s): (f64, Option<f64>),
-    start: Instant,
-    r: f64,
-    speed: f64,
-) -> Option<(StopReason, String)> {
-    if t >= max_time_s * (1.0 - 1e-12) {
-        return Some((
-            StopReason::SimulatedTime,
-            format!(
-                "not settled within {max_time_s} s (residual {r:.3e} N, speed {speed:.3e} m/s)"
-            ),
-        ));
-    }
-    if max_wall_s.is_some_and(|b| start.elapsed().as_secs_f64() > b) {
-        return Some((
-            StopReason::WallTime,
-            format!("wall-time budget spent at t = {t:.4} s (residual {r:.3e} N)"),
-        ));
-    }
-    None
 }
 
 /// Hands the state after step `steps` (time `t`, residual `r` N) to `observer`, with its total

@@ -12,9 +12,9 @@
 //! spring's length: the step follows the curve x + α dx + ½ α² a, a the geodesic acceleration
 //! (Transtrum & Sethna 2012), which bends it along the arcs the springs allow.
 
-use super::executor::Verdict;
+use super::executor::{Budget, Verdict};
 use super::static_options::StaticOptions;
-use super::step::Workspace;
+use super::step::{Iteration, Workspace};
 use super::warm::NeighbourFactor;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
 use crate::physics::{HessianBlocks, Model};
@@ -125,7 +125,8 @@ impl NewtonRun {
             e,
             r: f64::NAN,
         };
-        let verdict = super::executor::run(&mut stage, opts.max_iterations, observer);
+        let budget = Budget::iterations(opts.max_iterations);
+        let verdict = super::executor::run(&mut stage, budget, observer);
         super::executor::conclude(verdict, self.iter, &mut self.report)
     }
 
@@ -201,15 +202,16 @@ impl super::executor::Iterative for Stage<'_> {
         self.model
             .set_exact_contact(run.iter > self.opts.exact_contact_after);
         let (model, x, load) = (&*self.model, &mut *self.x, self.load);
-        if !run.ws.iterate(
+        let taken = run.ws.iterate(
             model,
             x,
             load,
             &mut self.e,
             (self.r, self.tol),
             &mut run.report,
-        ) {
-            // A step that does not decrease the energy: near the solution, round-off.
+        );
+        if taken != Iteration::Stepped {
+            // No step lowers the energy: near the solution, round-off.
             model.gradient(x, load, &mut run.ws.g);
             let r = model.max_residual(&run.ws.g);
             if r <= self.tol && self.last {

@@ -8,6 +8,8 @@
 mod factor;
 mod reuse;
 
+pub(super) use factor::mean_free_diagonal;
+
 use super::linear::{DofMap, SparseSpd};
 use super::static_options::StaticOptions;
 use super::strategy::{
@@ -16,35 +18,6 @@ use super::strategy::{
 use super::{Globalization, SolveReport};
 use crate::physics::{HessianBlocks, Model};
 use nalgebra::Vector3;
-
-/// Mean of the Hessian's diagonal over the free DOFs (the scale of the damping), 1 if empty.
-pub(super) fn mean_free_diagonal(h: &HessianBlocks, dofs: &DofMap) -> f64 {
-    let constant = h
-        .constant
-        .as_deref()
-        .map_or(-0.0, |c| free_trace(-0.0, c, dofs));
-    mean_of(free_trace(constant, h, dofs), dofs)
-}
-
-/// The free diagonal blocks' traces of `h`'s own list (not its constant part) added to `acc` in
-/// order: continuing the constant part's sum, this is the whole matrix's sum bit for bit.
-fn free_trace(acc: f64, h: &HessianBlocks, dofs: &DofMap) -> f64 {
-    // Summed block by block (no per-particle buffer: it was 4 % of a Cusick drape's solve).
-    h.pairs
-        .iter()
-        .zip(&h.blocks)
-        .filter(|&(&(p, q), _)| p == q && dofs.dof(p as usize).is_some())
-        .fold(acc, |s, (_, b)| s + b.trace())
-}
-
-/// The mean over the free DOFs of a diagonal summing to `sum`, 1 if empty.
-fn mean_of(sum: f64, dofs: &DofMap) -> f64 {
-    if dofs.n > 0 && sum > 0.0 {
-        sum / dofs.n as f64
-    } else {
-        1.0
-    }
-}
 
 /// (first DOF, component) of every held component of the free particles.
 fn held_dofs(model: &Model, dofs: &DofMap) -> Vec<(usize, usize)> {
@@ -74,6 +47,20 @@ impl Hessian {
 }
 
 /// How an iteration's step was taken.
+/// How one Newton iteration ([`Workspace::iterate`]) ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Iteration {
+    /// A step that lowered the energy was taken.
+    Stepped,
+    /// No damping made the Hessian factorizable: no step.
+    Unfactorizable,
+    /// No step lowered the energy, the residual within ten times the tolerance: round-off near the
+    /// solution.
+    NoDecreaseNearSolution,
+    /// No step lowered the energy at any damping tried.
+    NoDecrease,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Taken {
     /// Whole (length 1, no term bounding it): the factor at hand may serve a chord step.
@@ -255,21 +242,6 @@ impl Workspace {
         }
     }
 
-    /// The damping's scale: the mean free diagonal of the Hessian in `h` ([`mean_free_diagonal`],
-    /// its constant part's sum kept).
-    fn damping_scale(&mut self) -> f64 {
-        let constant = match (&self.h.constant, &self.constant_trace) {
-            (Some(c), Some((k, s))) if std::sync::Arc::ptr_eq(c, k) => *s,
-            (Some(c), _) => {
-                let s = free_trace(-0.0, c, &self.dofs);
-                self.constant_trace = Some((c.clone(), s));
-                s
-            }
-            (None, _) => -0.0,
-        };
-        mean_of(free_trace(constant, &self.h, &self.dofs), &self.dofs)
-    }
-
     /// The Newton step −(H + μD)⁻¹ g into `dx` (zero on fixed particles and held components), and
     /// the directional derivative gᵀdx.
     fn step(&mut self, x_len: usize) -> f64 {
@@ -385,7 +357,7 @@ impl Workspace {
 
     /// One damped Newton iteration from `x`: factorize, step (curved where the acceleration is
     /// small), line search, then adapt the damping (divided by 4 after a whole step, raised tenfold
-    /// from 1e-8 when no step lowers the energy). False when no step lowers the energy.
+    /// from 1e-8 when no step lowers the energy); how it ended.
     pub(super) fn iterate(
         &mut self,
         model: &Model,
@@ -394,10 +366,10 @@ impl Workspace {
         e: &mut f64,
         (r, tol): (f64, f64),
         report: &mut SolveReport,
-    ) -> bool {
+    ) -> Iteration {
         if self.krylov {
             if self.krylov_step(model, x, load, e, r, report) {
-                return true;
+                return Iteration::Stepped;
             }
             // The neighbour's factor no longer serves: factorize from here on.
             self.krylov = false;
@@ -410,7 +382,7 @@ impl Workspace {
         self.r_prev = r;
         if chord && self.chord_step(model, x, load, e, report) {
             self.last_step = Taken::Whole;
-            return true;
+            return Iteration::Stepped;
         }
         self.last_step = Taken::Partial;
         let mut hessian = match self.skips_exact() {
@@ -422,7 +394,7 @@ impl Workspace {
         let scale = self.damping_scale();
         for _ in 0..DAMPED_ROUNDS {
             if !self.factorize(model, x, &mut hessian, scale, report) {
-                return false;
+                return Iteration::Unfactorizable;
             }
             let slope = self.step(x.len());
             let mut bound = model.max_step(x, &self.dx);
@@ -454,14 +426,14 @@ impl Workspace {
                             self.mu / DAMPING_DECREASE
                         };
                     }
-                    return true;
+                    return Iteration::Stepped;
                 }
                 // A step that does not decrease the energy: near the solution, round-off.
-                None if r <= 10.0 * tol => return false,
+                None if r <= 10.0 * tol => return Iteration::NoDecreaseNearSolution,
                 None => self.mu = (self.mu * DAMPING_GROWTH).max(MU_MIN),
             }
         }
-        false
+        Iteration::NoDecrease
     }
 
     /// Whether this iteration goes straight to the projected Hessian: on the ladder of shifts,
