@@ -291,6 +291,34 @@ fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
 }
 
 #[test]
+fn a_warm_nested_path_lands_on_the_same_hang_with_fewer_factorizations() {
+    // hang4 on 81 × 81 starts from the 41 × 41 drape (itself from 21 × 21, 11 × 11): with
+    // `nested_path = "warm"` the finer grids take straight steps with the damping carried on.
+    // The same equilibrium (a unique hang), a minimum, with fewer factorizations.
+    let at = |path: &str| {
+        let s = scene("hang4.toml", &[TOL, "cloth.nx=81", "cloth.ny=81", path]);
+        solve_scene(&s, &mut NoObserver)
+    };
+    let given = at("solver.static.nested_path=as-given");
+    let warm = at("solver.static.nested_path=warm");
+    let (a, b) = (&given.report, &warm.report);
+    assert!(
+        a.is_converged() && b.is_converged(),
+        "{} / {}",
+        a.message,
+        b.message
+    );
+    assert_eq!(b.minimum, Some(true));
+    let d = largest_distance(given.grid_positions(), warm.grid_positions());
+    eprintln!(
+        "hang4 81²: {} / {} factorizations (as given / warm), {d:.1e} m apart",
+        a.factorizations, b.factorizations
+    );
+    assert!(d < 1e-8, "{d} m apart");
+    assert!(b.factorizations < a.factorizations);
+}
+
+#[test]
 fn a_shift_that_fails_means_every_smaller_one_fails() {
     // The static solve skips the ladder of shifts of an indefinite exact Hessian when its top
     // fails: that is the same step only if positive definiteness grows with the shift. Check it on

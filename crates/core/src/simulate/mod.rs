@@ -398,6 +398,8 @@ fn solve_model_with(
     {
         crate::solve::sagged_start(model, x);
     }
+    let nested = opts.nested_for(coarse.is_some());
+    let opts = &nested;
     let mut report = static_solve(scene, opts, grid, model, x, cold, observer);
     if let Some(r) = taut {
         report.merge(&r, crate::solve::Part::Start);

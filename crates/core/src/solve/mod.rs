@@ -44,7 +44,8 @@ pub use sag::{folded_start, sagged_start};
 pub use stability::{highest_mode, kinetic_energy, stability_limit_dt};
 pub use static_options::StaticOptions;
 pub use strategy::{
-    Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Start, Verdict,
+    Acceptance, Armijo, Backtracking, Direction, FactorReuse, NestedPath, Regularization, Start,
+    Verdict,
 };
 pub use vertical_gap::solve_vertical_gap;
 pub use warm::{NeighbourFactor, WarmData};

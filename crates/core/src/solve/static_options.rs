@@ -2,7 +2,7 @@
 //! when to change it, checked once at load ([`StaticOptions::check`]), and the warm start a
 //! calibration hands a solve ([`NeighbourFactor`]).
 
-use super::strategy::{Direction, FactorReuse, Regularization, Start};
+use super::strategy::{Direction, FactorReuse, NestedPath, Regularization, Start};
 use serde::{Deserialize, Serialize};
 /// Options of the static solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -97,9 +97,29 @@ pub struct StaticOptions {
     /// for a large drape that folds (a garment) whose run.json shows most steps projected.
     #[serde(default = "default_exact_retry_every")]
     pub exact_retry_every: usize,
+    /// The steps of each grid's solve that starts from a coarser grid's drape (`start =
+    /// "nested"`, a sheet without obstacles): `"as-given"` (this table's `direction` and
+    /// `regularization` on every grid) or `"warm"` (straight steps with the shift carried on as
+    /// damping on the finer grids, [`NestedPath`]). Default `"as-given"`, the path the bundled
+    /// pipelines were measured on. `"warm"` halves the factorizations of a large hang (hang4 on
+    /// 161 × 161: 158 → 68, the same energy to 14 digits; `docs/src/benchmarks.md`, "Scale"): set
+    /// it for sheets of 10⁴ particles and more hung without obstacles.
+    #[serde(default)]
+    pub nested_path: NestedPath,
 }
 
 impl StaticOptions {
+    /// The options of a solve that starts from a coarser grid's drape (`from_coarse`) or not:
+    /// [`StaticOptions::nested_path`] applied.
+    pub fn nested_for(&self, from_coarse: bool) -> StaticOptions {
+        let mut o = self.clone();
+        if from_coarse && self.nested_path == NestedPath::Warm {
+            o.direction = Direction::Straight;
+            o.regularization = Regularization::CarriedDamping;
+        }
+        o
+    }
+
     /// Checks every option (keys relative to `[solver.static]`).
     pub fn check(&self) -> Result<(), crate::error::KeyError> {
         use crate::error::KeyError;
@@ -180,6 +200,7 @@ impl Default for StaticOptions {
             exact_contact_after: default_exact_contact_after(),
             kappa_adapt_gap_rel: default_kappa_adapt_gap(),
             exact_retry_every: default_exact_retry_every(),
+            nested_path: NestedPath::default(),
         }
     }
 }

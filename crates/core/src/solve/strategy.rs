@@ -37,6 +37,20 @@ pub enum Direction {
     Curved,
 }
 
+/// The steps of a grid's solve that starts from a coarser grid's drape (`solver.static.nested_path`,
+/// with `start = "nested"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NestedPath {
+    /// The options as given, on every grid. Default.
+    #[default]
+    AsGiven,
+    /// On every grid that starts from a coarser one's drape, straight steps with the shift
+    /// carried on as damping ([`Direction::Straight`], [`Regularization::CarriedDamping`]): the
+    /// path of a warm start next to the answer, as the calibration's solves take.
+    Warm,
+}
+
 /// Whether a factorization is used for more than one step (`solver.static.factor_reuse`,
 /// `solver.dynamic.factor_reuse`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
