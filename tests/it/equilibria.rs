@@ -8,7 +8,7 @@
 //! today's model; the test prints which of the two has the lower energy.
 
 use crate::support::{root, scene};
-use drapelab::simulate::solve_scene;
+use drapelab::simulate::{Solution, solve_scene};
 use drapelab::solve::NoObserver;
 use nalgebra::Vector3;
 
@@ -290,32 +290,56 @@ fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
     }
 }
 
-#[test]
-fn a_warm_nested_path_lands_on_the_same_hang_with_fewer_factorizations() {
-    // hang4 on 81 × 81 starts from the 41 × 41 drape (itself from 21 × 21, 11 × 11): with
-    // `nested_path = "warm"` the finer grids take straight steps with the damping carried on.
-    // The same equilibrium (a unique hang), a minimum, with fewer factorizations.
-    let at = |path: &str| {
-        let s = scene("hang4.toml", &[TOL, "cloth.nx=81", "cloth.ny=81", path]);
+/// hang4 on 81 × 81 (from the 41 × 41 drape, itself from 21 × 21 and 11 × 11) solved with
+/// either of two settings: both converged, and how far apart their drapes are (m).
+fn hang4_81_two_ways(a: &str, b: &str) -> (Solution, Solution, f64) {
+    let at = |setting: &str| {
+        let s = scene("hang4.toml", &[TOL, "cloth.nx=81", "cloth.ny=81", setting]);
         solve_scene(&s, &mut NoObserver)
     };
-    let given = at("solver.static.nested_path=as-given");
-    let warm = at("solver.static.nested_path=warm");
-    let (a, b) = (&given.report, &warm.report);
+    let (first, second) = (at(a), at(b));
+    let (ra, rb) = (&first.report, &second.report);
     assert!(
-        a.is_converged() && b.is_converged(),
+        ra.is_converged() && rb.is_converged(),
         "{} / {}",
-        a.message,
-        b.message
+        ra.message,
+        rb.message
     );
-    assert_eq!(b.minimum, Some(true));
-    let d = largest_distance(given.grid_positions(), warm.grid_positions());
+    let d = largest_distance(first.grid_positions(), second.grid_positions());
     eprintln!(
-        "hang4 81²: {} / {} factorizations (as given / warm), {d:.1e} m apart",
-        a.factorizations, b.factorizations
+        "hang4 81², {a} / {b}: {} / {} factorizations, {d:.1e} m apart",
+        ra.factorizations, rb.factorizations
     );
+    (first, second, d)
+}
+
+#[test]
+fn a_warm_nested_path_lands_on_the_same_hang_with_fewer_factorizations() {
+    // With `nested_path = "warm"` the finer grids take straight steps with the damping carried
+    // on. The same equilibrium (a unique hang), a minimum, with fewer factorizations.
+    let (given, warm, d) = hang4_81_two_ways(
+        "solver.static.nested_path=as-given",
+        "solver.static.nested_path=warm",
+    );
+    assert_eq!(warm.report.minimum, Some(true));
     assert!(d < 1e-8, "{d} m apart");
-    assert!(b.factorizations < a.factorizations);
+    assert!(warm.report.factorizations < given.report.factorizations);
+}
+
+#[test]
+fn nested_dissection_and_amd_land_on_the_same_hang() {
+    // The fill-reducing ordering changes round-off only: the same unique hang, a minimum; not
+    // the same bits (the key reached the factorization).
+    let (_, dissected, d) = hang4_81_two_ways(
+        "solver.static.ordering=amd",
+        "solver.static.ordering=nested-dissection",
+    );
+    assert_eq!(dissected.report.minimum, Some(true));
+    assert!(d < 1e-8, "{d} m apart");
+    assert!(
+        d > 0.0,
+        "the same bits: the ordering key did not reach the factorization"
+    );
 }
 
 #[test]

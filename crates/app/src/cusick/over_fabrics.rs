@@ -27,20 +27,21 @@ pub struct Outcome<'a> {
 /// The fabrics' rows and their captures' rows, each built once with what the statistics over
 /// fabrics give it (leave one fabric out): the node line, the captures' intervals.
 pub fn rows_over_fabrics(fabrics: &[Outcome<'_>]) -> (Vec<PredictionRow>, Vec<CaptureRow>) {
-    let shadows: Vec<&[&ShadowRow]> = fabrics.iter().map(|f| &f.shadows[..]).collect();
-    let discrepancies: BTreeMap<i32, (f64, Option<f64>)> = (fabrics.iter().zip(&shadows))
-        .filter_map(|(f, rows)| {
+    let discrepancies: BTreeMap<i32, (f64, Option<f64>)> = fabrics
+        .iter()
+        .filter_map(|f| {
             let d = f.row.nodes_calibration_median - f.row.nodes_predicted?;
             let residual = f
                 .faces
                 .as_ref()
-                .and_then(|p| node_residual(rows, f.calib, p));
+                .and_then(|p| node_residual(&f.shadows, f.calib, p));
             d.is_finite().then_some((f.row.fabric, (d, residual)))
         })
         .collect();
     let node = node_lines(&discrepancies);
-    let dc: Vec<_> = (fabrics.iter().zip(&shadows))
-        .filter_map(|(f, rows)| Some(dc_predictions(rows, f.calib, f.faces?)))
+    let dc: Vec<_> = fabrics
+        .iter()
+        .filter_map(|f| Some(dc_predictions(&f.shadows, f.calib, f.faces?)))
         .collect();
     let spread: BTreeMap<i32, f64> = fabrics
         .iter()
@@ -51,10 +52,10 @@ pub fn rows_over_fabrics(fabrics: &[Outcome<'_>]) -> (Vec<PredictionRow>, Vec<Ca
     });
     let mut at = 0;
     let mut captures = Vec::new();
-    for (f, rows) in fabrics.iter().zip(&shadows) {
+    for f in fabrics {
         let Some(p) = f.faces else { continue };
         let correction = node.get(&f.row.fabric).map_or(0.0, |l| l.correction);
-        let built = capture_rows(rows, f.calib, p, correction, &intervals[at..]);
+        let built = capture_rows(&f.shadows, f.calib, p, correction, &intervals[at..]);
         at += built.len();
         captures.extend(built);
     }

@@ -181,17 +181,13 @@ impl super::executor::Iterative for Staged<'_> {
             Some(_) => &mut NoObserver,
         };
         let reached = current.stage(self.model, self.x, self.opts, (load, goal), obs);
+        self.run = Some(current);
         if !reached {
-            let last = current.finish(self.model, self.x);
-            self.total = Some(merged(self.total.take(), last));
+            self.close();
             return Err(Verdict::PartFailed);
         }
-        match goal {
-            Goal::Increment => self.run = Some(current),
-            Goal::Tolerance => {
-                let last = current.finish(self.model, self.x);
-                self.total = Some(merged(self.total.take(), last));
-            }
+        if goal == Goal::Tolerance {
+            self.close();
         }
         self.solved = true;
         Ok(())

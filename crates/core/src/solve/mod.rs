@@ -33,7 +33,7 @@ pub use equilibrium::{EquilibriumFactor, NoFactor};
 pub use implicit_euler::{Settle, integrate_implicit};
 pub use incremental::{ImplicitSettings, Inertia};
 pub use kind::{Integrator, SolverKind, by_report_name};
-pub use linear::{DofMap, SparseSpd};
+pub use linear::{DISSECTION_MIN_PARTICLES, DofMap, FillOrdering, SparseSpd};
 pub use load_ramp::{LoadRamp, solve_static, solve_static_loads, solve_static_warm};
 pub use neutral::{NEUTRAL_REL, NeutralMode, neutral_modes};
 pub use newton::is_minimum;

@@ -7,6 +7,7 @@
 //! an obstacle's active particles) is mapped into it without a new analysis; one that leaves it
 //! grows it to the union.
 
+pub mod dissection;
 mod structure;
 
 use crate::physics::HessianBlocks;
@@ -55,6 +56,40 @@ impl DofMap {
     }
 }
 
+/// The fill-reducing ordering of a factorization's unknowns (`solver.static.ordering`).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum FillOrdering {
+    /// Approximate minimum degree (faer's AMD) on the DOFs.
+    Amd,
+    /// Nested dissection of the free particles' graph ([`dissection`]), a particle's three DOFs
+    /// together.
+    NestedDissection,
+    /// Nested dissection from [`DISSECTION_MIN_PARTICLES`] free particles, AMD below. Default.
+    #[default]
+    BySize,
+}
+
+/// Free particles from which [`FillOrdering::BySize`] orders by nested dissection: beyond every
+/// bundled scene and pipeline's sheet (their paths stay AMD's), where it clearly pays. On hang4 it
+/// factorizes 1.67× faster than AMD at 321² (103,037 free particles) and 4 % faster at 161²;
+/// on the skirt with its contact pairs at 121², as fast as AMD (`cargo bench --bench ordering`,
+/// `docs/src/benchmarks.md`).
+pub const DISSECTION_MIN_PARTICLES: usize = 25_000;
+
+impl FillOrdering {
+    /// Whether a structure over `particles` free particles is ordered by nested dissection.
+    pub(super) fn dissects(self, particles: usize) -> bool {
+        match self {
+            Self::Amd => false,
+            Self::NestedDissection => true,
+            Self::BySize => particles >= DISSECTION_MIN_PARTICLES,
+        }
+    }
+}
+
 /// The compressed values of a Hessian's constant part on one pattern (held with the part itself,
 /// so that the pointer identifies it while the values live).
 struct Base {
@@ -66,6 +101,8 @@ struct Base {
 /// A sparse SPD matrix H + diag(shift) over the free DOFs, assembled from Hessian blocks, factorized
 /// with a shared symbolic analysis and numeric buffers kept between calls.
 pub struct SparseSpd {
+    /// The fill-reducing ordering of its factorizations.
+    ordering: FillOrdering,
     pattern: Option<Arc<Pattern>>,
     values: Vec<f64>,
     /// The last assembled matrix's diagonal before its shift (the rest of `values` stays as
@@ -98,9 +135,16 @@ impl Default for SparseSpd {
 }
 
 impl SparseSpd {
-    /// An empty solver (AMD ordering); the pattern is looked up at the first factorization.
+    /// An empty solver ([`FillOrdering::BySize`]); the pattern is looked up at the first
+    /// factorization.
     pub fn new() -> Self {
+        Self::with_ordering(FillOrdering::default())
+    }
+
+    /// An empty solver whose factorizations use `ordering`.
+    pub fn with_ordering(ordering: FillOrdering) -> Self {
         Self {
+            ordering,
             pattern: None,
             values: Vec::new(),
             unshifted_diagonal: Vec::new(),
@@ -127,7 +171,7 @@ impl SparseSpd {
     /// rule, never factorizes (copying the values and a factorization's scratch was 4 % of the main
     /// job's calibrate stage).
     pub fn copy(&self) -> Self {
-        let mut out = Self::new();
+        let mut out = Self::with_ordering(self.ordering);
         if let Some(pattern) = &self.pattern {
             let symbolic = &pattern.structure.symbolic;
             out.mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
@@ -279,7 +323,7 @@ impl SparseSpd {
         let stale = self.pattern.as_ref().is_none_or(|p| !p.holds(dofs, h));
         if stale {
             let start = Instant::now();
-            let (pattern, analysed) = Pattern::next(dofs, h, self.pattern.as_ref())?;
+            let (pattern, analysed) = Pattern::next(dofs, h, self.pattern.as_ref(), self.ordering)?;
             self.analyses += usize::from(analysed);
             let same_structure = self
                 .pattern
@@ -293,6 +337,13 @@ impl SparseSpd {
             self.analysis_time_s += start.elapsed().as_secs_f64();
         }
         self.pattern.clone()
+    }
+
+    /// Non-zeros of the last factorization's Cholesky factor (0 before the first).
+    pub fn factor_nonzeros(&self) -> usize {
+        self.pattern
+            .as_ref()
+            .map_or(0, |p| p.structure.symbolic.len_val())
     }
 
     /// Solves (H + diag(shift)) y = rhs in place with the last successful factorization.
@@ -317,7 +368,7 @@ impl SparseSpd {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Matrix3;
+    use nalgebra::{Matrix3, Vector3};
 
     /// A chain of `n` free particles, each coupled to the next, plus the extra blocks `extra`
     /// (p > q): an SPD matrix (diagonally dominant).
@@ -340,6 +391,65 @@ mod tests {
         let mut x: Vec<f64> = (0..dofs.n).map(|k| (k as f64 * 0.7).sin()).collect();
         spd.solve_in_place(&mut x);
         x
+    }
+
+    /// An m × m grid of particles, each coupled to its neighbours along the lines and diagonals
+    /// and to the particles two away (a cloth's stretch, shear and bending stencil): SPD.
+    fn sheet(m: usize) -> HessianBlocks {
+        let mut h = HessianBlocks::default();
+        let couple = |(di, dj): (usize, usize)| {
+            (0..m * m).filter_map(move |p| {
+                let (i, j) = (p / m + di, p % m + dj);
+                (i < m && j < m).then_some((i * m + j, p))
+            })
+        };
+        for p in 0..m * m {
+            h.push(
+                p,
+                p,
+                Matrix3::new(14.0, 0.3, 0.0, 0.3, 14.0, 0.1, 0.0, 0.1, 14.0),
+            );
+        }
+        for step in [(0, 1), (1, 0), (1, 1), (0, 2), (2, 0)] {
+            for (p, q) in couple(step) {
+                h.push(p, q, Matrix3::from_diagonal_element(-0.9));
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn nested_dissection_and_amd_solve_the_same_sheet_and_by_size_keeps_amd_below_its_threshold() {
+        let m = 60;
+        let dofs = DofMap::new(&vec![false; m * m]);
+        let h = sheet(m);
+        let (mut amd, mut nd) = (
+            SparseSpd::with_ordering(FillOrdering::Amd),
+            SparseSpd::with_ordering(FillOrdering::NestedDissection),
+        );
+        let (ya, yn) = (solve(&mut amd, &dofs, &h), solve(&mut nd, &dofs, &h));
+        let scale = ya.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let gap = ya
+            .iter()
+            .zip(&yn)
+            .fold(0.0f64, |a, (u, v)| a.max((u - v).abs()));
+        assert!(
+            gap <= 1e-12 * scale,
+            "solutions {gap:e} apart (scale {scale:e})"
+        );
+        // The product H y reproduces the right-hand side through the dissected factor.
+        let y: Vec<Vector3<f64>> = yn.chunks(3).map(Vector3::from_column_slice).collect();
+        let mut hy = vec![Vector3::zeros(); m * m];
+        h.mul_add(&y, &mut hy);
+        for (k, v) in hy.iter().flat_map(|v| v.iter()).enumerate() {
+            assert!((v - (k as f64 * 0.7).sin()).abs() < 1e-10);
+        }
+        // By size: AMD below the threshold, the dissection's factor at and above it.
+        let mut by_size = SparseSpd::new();
+        solve(&mut by_size, &dofs, &h);
+        assert!(m * m < DISSECTION_MIN_PARTICLES);
+        assert_eq!(by_size.factor_nonzeros(), amd.factor_nonzeros());
+        assert_ne!(nd.factor_nonzeros(), amd.factor_nonzeros());
     }
 
     #[test]
@@ -518,7 +628,7 @@ mod tests {
             with(&[(15, 1), (12, 12)]),
             with(&[(22, 11), (18, 5), (12, 12)]),
         );
-        let (whole, _) = Pattern::exact(&dofs, &all).expect("a structure");
+        let (whole, _) = Pattern::exact(&dofs, &all, FillOrdering::default()).expect("a structure");
         let last = Pattern::map(&dofs, &first, whole.structure.clone());
         let extended = Pattern::extend(&last, &dofs, &next).expect("within the structure");
         let fresh = Pattern::map(&dofs, &next, whole.structure.clone());

@@ -2,10 +2,11 @@
 //! structure's pattern (ordering, supernodes, the map from Hessian blocks into compressed values),
 //! a solve's structure grown to a superset when its contact pairs leave it.
 
-use super::DofMap;
+use super::{DofMap, FillOrdering};
 use crate::physics::HessianBlocks;
 use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::perm::PermRef;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
@@ -19,6 +20,8 @@ use std::sync::{Arc, Mutex};
 /// blocks, and its symbolic Cholesky factorization (ordering, supernodes).
 pub(super) struct Structure {
     pub(super) first: Vec<u32>,
+    /// The fill-reducing ordering asked for.
+    pub(super) ordering: FillOrdering,
     /// The particle blocks (p ≥ q) it holds, sorted and unique.
     pub(super) blocks: Vec<(u32, u32)>,
     pub(super) sym: SymbolicSparseColMat<usize>,
@@ -41,8 +44,15 @@ const MAX_STRUCTURES: usize = 64;
 /// than the analyses it saves).
 const MAX_SUPERSET: f64 = 1.25;
 
-fn structure_key(first: &[u32], blocks: &[(u32, u32)]) -> u64 {
+/// A permutation of the DOFs: the DOF eliminated k-th (`forward`), each DOF's place (`inverse`).
+struct DofOrder {
+    forward: Vec<usize>,
+    inverse: Vec<usize>,
+}
+
+fn structure_key(first: &[u32], blocks: &[(u32, u32)], ordering: FillOrdering) -> u64 {
     let mut s = std::collections::hash_map::DefaultHasher::new();
+    ordering.hash(&mut s);
     blocks.hash(&mut s);
     first.hash(&mut s);
     s.finish()
@@ -61,7 +71,14 @@ fn free_blocks(dofs: &DofMap, h: &HessianBlocks) -> Vec<(u32, u32)> {
 }
 
 impl Structure {
-    pub(super) fn analyse(dofs: &DofMap, blocks: Vec<(u32, u32)>) -> Option<Self> {
+    /// The structure of `blocks` over `dofs` under `ordering`. A structure grown by contact pairs
+    /// is ordered afresh: the order of the structure it grew from, kept, cost 15 % more a
+    /// factorization on the 121² skirt.
+    pub(super) fn analyse(
+        dofs: &DofMap,
+        blocks: Vec<(u32, u32)>,
+        ordering: FillOrdering,
+    ) -> Option<Self> {
         let n = dofs.n;
         let mut idx: Vec<Pair<usize, usize>> = Vec::new();
         for &(p, q) in &blocks {
@@ -84,14 +101,21 @@ impl Structure {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        // AMD: faer 0.24 offers no nested dissection (AMD, COLAMD, identity or a given permutation),
-        // and its supernodal path panics with the identity ordering on these patterns.
+        // faer 0.24 offers AMD or a given permutation (its supernodal path panics with the identity
+        // ordering on these patterns): nested dissection of the particles on large sheets.
+        let dissection = ordering
+            .dissects(n / 3)
+            .then(|| dissection_order(dofs, &blocks));
+        let fill_reducing = match &dissection {
+            Some(o) => SymmetricOrdering::Custom(PermRef::new_checked(&o.forward, &o.inverse, n)),
+            None => SymmetricOrdering::Amd,
+        };
         let symbolic =
-            factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, SymmetricOrdering::Amd, params)
-                .ok()?;
+            factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, fill_reducing, params).ok()?;
         let (permuted, to_permuted) = permute_once(&sym, &symbolic)?;
         Some(Self {
             first: dofs.first.clone(),
+            ordering,
             blocks,
             sym,
             symbolic,
@@ -102,16 +126,21 @@ impl Structure {
 
     /// The structure of `blocks` over `dofs`, from the process-wide cache or analysed now (with
     /// whether it was analysed now).
-    pub(super) fn shared(dofs: &DofMap, blocks: Vec<(u32, u32)>) -> Option<(Arc<Self>, bool)> {
-        let key = structure_key(&dofs.first, &blocks);
-        let same = |s: &Structure| s.blocks == blocks && s.first == dofs.first;
+    pub(super) fn shared(
+        dofs: &DofMap,
+        blocks: Vec<(u32, u32)>,
+        ordering: FillOrdering,
+    ) -> Option<(Arc<Self>, bool)> {
+        let key = structure_key(&dofs.first, &blocks, ordering);
+        let same =
+            |s: &Structure| s.blocks == blocks && s.first == dofs.first && s.ordering == ordering;
         {
             let cache = STRUCTURES.lock().unwrap_or_else(|e| e.into_inner());
             if let Some((_, s)) = cache.iter().find(|(k, s)| *k == key && same(s)) {
                 return Some((s.clone(), false));
             }
         }
-        let s = Arc::new(Self::analyse(dofs, blocks)?);
+        let s = Arc::new(Self::analyse(dofs, blocks, ordering)?);
         let mut cache = STRUCTURES.lock().unwrap_or_else(|e| e.into_inner());
         if cache.len() >= MAX_STRUCTURES {
             cache.remove(0);
@@ -157,6 +186,27 @@ impl Structure {
     pub(super) fn covers(&self, dofs: &DofMap, blocks: &[(u32, u32)]) -> bool {
         self.first == dofs.first && blocks.iter().all(|b| self.blocks.binary_search(b).is_ok())
     }
+}
+
+/// The DOFs' nested-dissection order from their particles' (forward: the DOF eliminated k-th;
+/// inverse: each DOF's place), a particle's three DOFs together.
+fn dissection_order(dofs: &DofMap, blocks: &[(u32, u32)]) -> DofOrder {
+    let particle = |p: u32| dofs.dof(p as usize).map(|d| d / 3);
+    let edges: Vec<(usize, usize)> = blocks
+        .iter()
+        .filter_map(|&(p, q)| Some((particle(p)?, particle(q)?)))
+        .collect();
+    let order = super::dissection::nested_dissection(dofs.n / 3, &edges);
+    let forward: Vec<usize> = order
+        .iter()
+        .flat_map(|&p| [3 * p, 3 * p + 1, 3 * p + 2])
+        .collect();
+    let mut inverse = vec![0; forward.len()];
+    forward
+        .iter()
+        .enumerate()
+        .for_each(|(k, &d)| inverse[d] = k);
+    DofOrder { forward, inverse }
 }
 
 /// The lower triangle `sym` permuted by `symbolic`'s ordering (faer's own permutation, run once on
@@ -277,20 +327,25 @@ impl Pattern {
 
     /// The pattern of `h` on its own structure, from the process-wide cache or mapped now (with
     /// whether its structure was analysed now).
-    pub(super) fn exact(dofs: &DofMap, h: &HessianBlocks) -> Option<(Arc<Self>, bool)> {
+    pub(super) fn exact(
+        dofs: &DofMap,
+        h: &HessianBlocks,
+        ordering: FillOrdering,
+    ) -> Option<(Arc<Self>, bool)> {
         let mut key = std::collections::hash_map::DefaultHasher::new();
+        ordering.hash(&mut key);
         h.pairs.hash(&mut key);
         h.constant_pairs().hash(&mut key);
         dofs.first.hash(&mut key);
         let key = key.finish();
-        let same = |p: &Pattern| p.holds(dofs, h);
+        let same = |p: &Pattern| p.holds(dofs, h) && p.structure.ordering == ordering;
         {
             let cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
             if let Some((_, p)) = cache.iter().find(|(k, p)| *k == key && same(p)) {
                 return Some((p.clone(), false));
             }
         }
-        let (structure, analysed) = Structure::shared(dofs, free_blocks(dofs, h))?;
+        let (structure, analysed) = Structure::shared(dofs, free_blocks(dofs, h), ordering)?;
         let p = Arc::new(Self::map(dofs, h, structure));
         let mut cache = PATTERNS.lock().unwrap_or_else(|e| e.into_inner());
         if cache.len() >= MAX_STRUCTURES {
@@ -311,9 +366,11 @@ impl Pattern {
         dofs: &DofMap,
         h: &HessianBlocks,
         last: Option<&Arc<Pattern>>,
+        ordering: FillOrdering,
     ) -> Option<(Arc<Self>, bool)> {
-        let Some(own) = last.map(|p| &p.structure).filter(|s| s.first == dofs.first) else {
-            return Self::exact(dofs, h);
+        let fits = |s: &&Arc<Structure>| s.first == dofs.first && s.ordering == ordering;
+        let Some(own) = last.map(|p| &p.structure).filter(fits) else {
+            return Self::exact(dofs, h, ordering);
         };
         if let Some(p) = last.and_then(|l| Self::extend(l, dofs, h)) {
             return Some((Arc::new(p), false));
@@ -327,7 +384,7 @@ impl Pattern {
         union.sort_unstable();
         union.dedup();
         if union.len() as f64 > MAX_SUPERSET * blocks.len() as f64 {
-            return Self::exact(dofs, h);
+            return Self::exact(dofs, h, ordering);
         }
         // The blocks the terms expect next, where they fit under the same bound.
         let free =
@@ -339,7 +396,7 @@ impl Pattern {
         if hinted.len() as f64 <= MAX_SUPERSET * blocks.len() as f64 {
             union = hinted;
         }
-        let (structure, analysed) = Structure::shared(dofs, union)?;
+        let (structure, analysed) = Structure::shared(dofs, union, ordering)?;
         Some((Arc::new(Self::map(dofs, h, structure)), analysed))
     }
 }

@@ -211,7 +211,7 @@ impl Workspace {
         Self {
             dofs,
             held,
-            spd: SparseSpd::new(),
+            spd: SparseSpd::with_ordering(opts.ordering),
             g: Vec::new(),
             h: HessianBlocks::default(),
             rhs: vec![0.0; n],
