@@ -13,7 +13,7 @@ use crate::solve::{
 };
 use friction::solve_with_friction;
 use nalgebra::Vector3;
-use start::{coarse_start, disc_coarse_start, taut_start};
+use start::{coarse_start, taut_start};
 
 /// A solved scene.
 pub struct Solution {
@@ -388,7 +388,7 @@ fn solve_model_with(
     };
     let coarse = match taut {
         Some(_) => None,
-        None => coarse_start(scene, grid, x).or_else(|| disc_coarse_start(scene, grid, model, x)),
+        None => coarse_start(scene, grid, x),
     };
     if coarse.is_none()
         && taut.is_none()
@@ -405,9 +405,13 @@ fn solve_model_with(
         report.merge(&r, crate::solve::Part::Start);
         report.message += " (from the taut net's drape)";
     }
-    if let Some((r, note)) = coarse {
+    if let Some((r, _)) = coarse {
         report.merge(&r, crate::solve::Part::Start);
-        report.message += &format!(" ({note})");
+        report.message += &format!(
+            " (from a {}×{} start)",
+            grid.nx.div_ceil(2),
+            grid.ny.div_ceil(2)
+        );
     }
     check_minimum(opts.check_minimum, model, x, &mut report);
     report

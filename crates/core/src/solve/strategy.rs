@@ -85,23 +85,12 @@ pub enum Start {
     Shaped,
     /// From the sheet as built (flat, with its initial perturbation).
     Flat,
-    /// For a disc sheet on a uniform grid of 77 or more points a side (obstacles and self-contact
-    /// allowed: a skirt), from the drape of the disc one coarse spacing larger in radius on the grid
-    /// of half the spacing, itself so started, placed on the coarse drape's triangles (the finer
-    /// mesh a subdivision of the coarser surface, so that no fold is crossed), particles within a
-    /// tenth of the contact distance of an obstacle pushed out; else, and where that start is not
-    /// free of crossings, from the sheet as built.
-    NestedDisc,
 }
 
 impl Start {
     /// Whether a solve starts from a coarser grid's solution where one exists.
     pub fn is_nested(self) -> bool {
         matches!(self, Start::Nested | Start::NestedFlat)
-    }
-    /// Whether a disc's solve starts from a larger disc's drape on the coarser grid.
-    pub fn is_nested_disc(self) -> bool {
-        self == Start::NestedDisc
     }
     /// Whether a solve that does not start from a coarser grid starts from a shaped sheet.
     pub fn is_shaped(self) -> bool {
