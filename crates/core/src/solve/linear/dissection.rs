@@ -1,8 +1,9 @@
 //! Nested dissection of the free particles' graph (George 1973): a separator of level sets
 //! (George & Liu 1978's automatic nested dissection) splits the graph in two, each half is ordered
-//! the same way, the separator last. On a sheet of 100,000 particles its Cholesky factor holds
-//! 15 % fewer non-zeros than AMD's and factorizes 1.4× faster; on small sheets AMD does as well
-//! or better (`docs/src/benchmarks.md`, linear algebra).
+//! the same way, the separator last. On hang4 at 321² (103,037 free particles) its Cholesky
+//! factor holds 22 % fewer non-zeros than AMD's and factorizes 1.7× faster; on sheets below
+//! ~25,000 particles, or with self-contact pairs joining distant rows, AMD does as well or better
+//! (`cargo bench --bench ordering`; `docs/src/benchmarks.md`, "Scale").
 
 /// Parts this small (particles) are not split further.
 const LEAF: usize = 8;
