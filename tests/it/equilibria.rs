@@ -260,16 +260,10 @@ fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
             &scene(name, &[TOL, "solver.static.start=nested-flat"]),
             &mut NoObserver,
         );
+        let mut d = both_converged_apart(name, &folded, &flat);
         let (a, b) = (&folded.report, &flat.report);
-        assert!(
-            a.is_converged() && b.is_converged(),
-            "{name}: {} / {}",
-            a.message,
-            b.message
-        );
         assert_eq!(a.minimum, Some(true), "{name}");
         let (x, y) = (folded.grid_positions(), flat.grid_positions());
-        let mut d = largest_distance(x, y);
         if let Some(Symmetry::Reflect(axis, c)) = mirror {
             let m: Vec<_> = y
                 .iter()
@@ -290,6 +284,19 @@ fn the_folded_start_lands_on_the_same_hang_in_fewer_iterations() {
     }
 }
 
+/// Asserts that both solves converged (naming `what` and their messages); how far apart their
+/// drapes are (m).
+fn both_converged_apart(what: &str, first: &Solution, second: &Solution) -> f64 {
+    let (a, b) = (&first.report, &second.report);
+    assert!(
+        a.is_converged() && b.is_converged(),
+        "{what}: {} / {}",
+        a.message,
+        b.message
+    );
+    largest_distance(first.grid_positions(), second.grid_positions())
+}
+
 /// hang4 on 81 × 81 (from the 41 × 41 drape, itself from 21 × 21 and 11 × 11) solved with
 /// either of two settings: both converged, the second a minimum, the same unique hang within
 /// 10⁻⁸ m; with how far apart their drapes are (m).
@@ -299,14 +306,8 @@ fn hang4_81_two_ways(a: &str, b: &str) -> (Solution, Solution, f64) {
         solve_scene(&s, &mut NoObserver)
     };
     let (first, second) = (at(a), at(b));
+    let d = both_converged_apart("hang4 81²", &first, &second);
     let (ra, rb) = (&first.report, &second.report);
-    assert!(
-        ra.is_converged() && rb.is_converged(),
-        "{} / {}",
-        ra.message,
-        rb.message
-    );
-    let d = largest_distance(first.grid_positions(), second.grid_positions());
     eprintln!(
         "hang4 81², {a} / {b}: {} / {} factorizations, {d:.1e} m apart",
         ra.factorizations, rb.factorizations
@@ -413,14 +414,8 @@ fn reusing_the_factorization_lands_on_the_same_equilibrium_with_fewer_factorizat
             drapelab::simulate::solve_scene_from(&s, &near.x, &mut NoObserver)
         };
         let (with, without) = (warm(&[reuse]), warm(&[]));
+        let d = both_converged_apart(name, &with, &without);
         let (a, b) = (&with.report, &without.report);
-        assert!(
-            a.is_converged() && b.is_converged(),
-            "{name}: {} / {}",
-            a.message,
-            b.message
-        );
-        let d = largest_distance(with.grid_positions(), without.grid_positions());
         eprintln!(
             "{name}: {} factorizations, {} iterations ({} chord steps) reusing; {} and {} not; {d:.1e} m apart",
             a.factorizations,
