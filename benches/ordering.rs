@@ -34,7 +34,9 @@ fn main() {
                 .expect("a bundled scene");
         let built = drapelab::build::build_scene(&loaded.scene);
         let mut h = HessianBlocks::default();
-        built.model.hessian(&built.x0, &mut h, true);
+        built
+            .model
+            .hessian(&built.x0, &mut h, drapelab::physics::HessianMode::Projected);
         let dofs = DofMap::new(&built.model.fixed);
         let diagonal = h.diagonal(built.x0.len());
         let free = (0..built.x0.len()).filter(|&p| dofs.dof(p).is_some());

@@ -357,7 +357,7 @@ fn a_shift_that_fails_means_every_smaller_one_fails() {
         p.y *= 0.9;
     }
     let mut h = HessianBlocks::default();
-    model.hessian(&x, &mut h, false);
+    model.hessian(&x, &mut h, drapelab::physics::HessianMode::NEWTON);
     let dofs = DofMap::new(&model.fixed);
     let mean = h
         .diagonal(model.len())

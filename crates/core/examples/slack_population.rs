@@ -94,7 +94,7 @@ fn floor(scene: &Scene) {
     let assembly = time(&mut || {
         std::hint::black_box(model.energy(x, 1.0));
         model.gradient(x, 1.0, &mut g);
-        model.hessian(x, &mut h, false);
+        model.hessian(x, &mut h, drapelab_core::physics::HessianMode::NEWTON);
     });
     let shift = vec![1e-6; dofs.n];
     let mut spd = SparseSpd::new();

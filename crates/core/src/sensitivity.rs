@@ -224,7 +224,8 @@ impl<'a> Equilibrium<'a> {
         de += g.iter().zip(&dxf).map(|(a, b)| a.dot(b)).sum::<f64>();
         // The fixed particles' motion moves the drape through the Hessian's coupling blocks.
         let mut hess = crate::physics::HessianBlocks::default();
-        self.model.exact_hessian(self.x, &mut hess);
+        self.model
+            .hessian(self.x, &mut hess, crate::physics::HessianMode::Exact);
         hess.mul_add(&dxf, &mut dg);
         Ok((theta, dg, dxf, de))
     }

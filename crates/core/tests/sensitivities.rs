@@ -137,7 +137,7 @@ fn neutral_modes(
         .find(|&p| model.fixed[p])
         .map_or(Vector3::zeros(), |p| x[p]);
     let mut h = drapelab_core::physics::HessianBlocks::default();
-    model.exact_hessian(x, &mut h);
+    model.hessian(x, &mut h, drapelab_core::physics::HessianMode::Exact);
     let scale = h.diagonal(x.len()).iter().map(|b| b.trace()).sum::<f64>() / (3 * x.len()) as f64;
     let mut modes: Vec<Vec<Vector3<f64>>> = Vec::new();
     for axis in 0..6 {

@@ -1,11 +1,11 @@
 //! The finite-difference harness of the energy terms: for every bundled scene (on an 11 × 11 grid,
 //! at a state a thousandth of the spacing off its drape, so that contact and folds are in play), every term's gradient against
-//! central differences of its energy and its exact Hessian (`add_exact_hessian`) against central differences of its
+//! central differences of its energy and its exact Hessian (`add_hessian` with `HessianMode::Exact`) against central differences of its
 //! gradient, along random directions; and every term's derivatives in its coefficients (the mixed derivative
 //! ∂g/∂c and ∂E/∂c the sensitivities are built on), contact's where it is in contact. A term whose derivative
 //! is wrong fails here by name.
 
-use drapelab_core::physics::{EnergyTerm, HessianBlocks};
+use drapelab_core::physics::{EnergyTerm, HessianBlocks, HessianMode};
 use drapelab_core::scene::Scene;
 use drapelab_core::simulate::solve_scene;
 use drapelab_core::solve::NoObserver;
@@ -73,7 +73,7 @@ fn errors(
     let an = dot(&grad(x), v);
     let e_grad = (fd - an).abs() / fd.abs().max(an.abs()).max(1e-300);
     let mut h = HessianBlocks::default();
-    t.add_exact_hessian(x, &mut h);
+    t.add_hessian(x, &mut h, HessianMode::Exact);
     let mut hv = vec![Vector3::zeros(); n];
     h.mul_add(v, &mut hv);
     let (gp, gm) = (grad(&xp), grad(&xm));
@@ -502,16 +502,20 @@ fn the_model_hessian_with_its_constant_part_kept_is_the_sum_of_its_terms() {
         let (model, n) = (&built.model, built.x0.len());
         let v = random(n, 1.0);
         for (k, project) in [(0, false), (1, true), (2, false)] {
+            let mode = match project {
+                true => HessianMode::Projected,
+                false => HessianMode::NEWTON,
+            };
             let shift = random(n, if k == 0 { 0.0 } else { 1e-5 });
             let x: Vec<Vector3<f64>> = built.x0.iter().zip(&shift).map(|(a, b)| a + b).collect();
             let mut h = HessianBlocks::default();
-            model.hessian(&x, &mut h, project);
+            model.hessian(&x, &mut h, mode);
             let mut got = vec![Vector3::zeros(); n];
             h.mul_add(&v, &mut got);
             let mut want = vec![Vector3::zeros(); n];
             for t in &model.terms {
                 let mut ht = HessianBlocks::default();
-                t.add_hessian(&x, &mut ht, project);
+                t.add_hessian(&x, &mut ht, mode);
                 ht.mul_add(&v, &mut want);
             }
             let size = dot(&want, &want).sqrt();

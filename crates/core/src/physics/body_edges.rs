@@ -17,7 +17,7 @@
 //! far as its farthest vertex, so 90 % of its distance to the nearest feature bounds it.
 
 use super::barrier::barrier;
-use super::{EnergyTerm, HessianBlocks, ObstacleBarrier, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, ObstacleBarrier, Vecs};
 use crate::obstacle::{Obstacle, TriangleBody};
 use crate::proximity::{Aabb, point_triangle_distance, segment_segment_distance};
 use nalgebra::{Matrix3, Vector3};
@@ -226,7 +226,8 @@ impl EnergyTerm for BodyEdgeBarrier {
             }
         }
     }
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
+        let project = mode.is_projected();
         for p in self.pairs(x) {
             let (_, db, d2b) = barrier(p.d, self.d_hat_m);
             let k = self.kappa_J[p.stencil];
@@ -308,7 +309,7 @@ mod tests {
         let mut g = vec![V3::zeros(); n];
         term.add_gradient(x, &mut g);
         let mut hb = HessianBlocks::default();
-        term.add_hessian(x, &mut hb, false);
+        term.add_hessian(x, &mut hb, crate::physics::HessianMode::NEWTON);
         let column = |p: usize, c: usize| {
             let (mut col, mut e) = (vec![V3::zeros(); n], vec![V3::zeros(); n]);
             e[p][c] = 1.0;

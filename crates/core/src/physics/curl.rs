@@ -223,7 +223,7 @@ mod tests {
             .map(|k| Vector3::new(wobble(k, 1.0), wobble(k + 2, 1.0), wobble(k + 3, 1.0)))
             .collect();
         let mut h = crate::physics::HessianBlocks::default();
-        term.add_hessian(&x, &mut h, false);
+        term.add_hessian(&x, &mut h, crate::physics::HessianMode::NEWTON);
         let mut hv = vec![Vector3::zeros(); x.len()];
         h.mul_add(&v, &mut hv);
         let shifted =
@@ -240,7 +240,7 @@ mod tests {
         }
         // The projected Hessian leaves the term out.
         let mut hp = crate::physics::HessianBlocks::default();
-        term.add_hessian(&x, &mut hp, true);
+        term.add_hessian(&x, &mut hp, crate::physics::HessianMode::Projected);
         let mut hpv = vec![Vector3::zeros(); x.len()];
         hp.mul_add(&v, &mut hpv);
         assert!(hpv.iter().all(|w| w.amax() == 0.0));

@@ -4,7 +4,7 @@
 //! coefficients (the stiffnesses, rest lengths and weights the scene's parameters become);
 //! [`Potential`] runs it over all stencils and scatters into the whole mesh.
 
-use super::{EnergyTerm, HessianBlocks, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, Vecs};
 use nalgebra::{Matrix3, Vector3};
 
 /// Positions (or vectors) of one stencil's particles.
@@ -33,7 +33,7 @@ pub trait Kernel<const N: usize>: Send + Sync {
         push: &mut impl FnMut(usize, usize, Matrix3<f64>),
     );
     /// The exact Hessian blocks of stencil `s` for derivatives of an equilibrium (see
-    /// [`EnergyTerm::add_exact_hessian`]): the unprojected [`Kernel::hessian`] unless the solver's
+    /// [`HessianMode::Exact`]): the unprojected [`Kernel::hessian`] unless the solver's
     /// Hessian leaves a curvature out.
     fn exact_hessian(
         &self,
@@ -117,19 +117,14 @@ impl<K: Kernel<N>, const N: usize> EnergyTerm for Potential<K, N> {
             }
         }
     }
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
         for s in 0..self.len() {
             let (xs, idx) = self.gather(s, x);
-            self.kernel.hessian(s, &xs, project, &mut |a, b, blk| {
-                h.push(idx[a], idx[b], blk)
-            });
-        }
-    }
-    fn add_exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
-        for s in 0..self.len() {
-            let (xs, idx) = self.gather(s, x);
-            self.kernel
-                .exact_hessian(s, &xs, &mut |a, b, blk| h.push(idx[a], idx[b], blk));
+            let mut push = |a: usize, b: usize, blk| h.push(idx[a], idx[b], blk);
+            match mode {
+                HessianMode::Exact => self.kernel.exact_hessian(s, &xs, &mut push),
+                _ => self.kernel.hessian(s, &xs, mode.is_projected(), &mut push),
+            }
         }
     }
     fn stiffness_scale(&self) -> f64 {

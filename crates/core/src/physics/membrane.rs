@@ -289,7 +289,11 @@ mod tests {
     /// The whole Hessian as a dense 3n × 3n matrix, column by column (H e_k).
     fn dense(term: &dyn EnergyTerm, x: &[Vector3<f64>], project: bool) -> nalgebra::DMatrix<f64> {
         let mut h = crate::physics::HessianBlocks::default();
-        term.add_hessian(x, &mut h, project);
+        let mode = match project {
+            true => crate::physics::HessianMode::Projected,
+            false => crate::physics::HessianMode::NEWTON,
+        };
+        term.add_hessian(x, &mut h, mode);
         let n = x.len();
         nalgebra::DMatrix::from_fn(3 * n, 3 * n, |r, c| {
             let mut e = vec![Vector3::zeros(); n];

@@ -304,7 +304,7 @@ mod tests {
         );
         // Hessian · dx equals the gradient's change (the energy is quadratic).
         let mut hb = HessianBlocks::default();
-        term.add_hessian(&rolled, &mut hb, false);
+        term.add_hessian(&rolled, &mut hb, crate::physics::HessianMode::NEWTON);
         let dx: Vec<Vector3<f64>> = (0..rolled.len())
             .map(|k| Vector3::new((k as f64).sin(), (k as f64 * 0.7).cos(), 0.1))
             .collect();
@@ -352,7 +352,7 @@ mod tests {
             }
         }
         let mut hb = HessianBlocks::default();
-        term.add_hessian(&x, &mut hb, false);
+        term.add_hessian(&x, &mut hb, crate::physics::HessianMode::NEWTON);
         let dx: Vec<Vector3<f64>> = (0..x.len())
             .map(|k| Vector3::new((k as f64).sin(), (k as f64 * 0.7).cos(), 0.3) * 1e-3)
             .collect();

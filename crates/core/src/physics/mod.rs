@@ -8,6 +8,7 @@ mod bending;
 mod body_edges;
 mod curl;
 mod friction;
+mod hessian_mode;
 mod kernel;
 mod loads;
 mod membrane;
@@ -27,6 +28,7 @@ pub use bending::{
 pub use body_edges::BodyEdgeBarrier;
 pub use curl::{Curl, CurlKernel, hinge_curl};
 pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
+pub use hessian_mode::{HessianMode, PairCurvature};
 pub use kernel::{Kernel, Local, Potential};
 pub use loads::{Gravity, LoadKernel, PointLoads};
 pub use membrane::{Membrane, MembraneError, MembraneKernel};
@@ -155,15 +157,9 @@ pub trait EnergyTerm: Send + Sync {
     fn energy(&self, x: &Vecs) -> f64;
     /// Adds ∂E/∂x (N) to `g`.
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs);
-    /// Pushes the Hessian blocks (N/m): exact, or with `project` its indefinite parts dropped so
-    /// that it is positive semi-definite (projected Newton). The block pattern must not depend on `project`.
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool);
-    /// Pushes the exact Hessian blocks (N/m) for derivatives of an equilibrium (sensitivities,
-    /// adjoints): the same as the unprojected [`EnergyTerm::add_hessian`] unless the term's solver
-    /// Hessian leaves a curvature out (self-contact leaves out the distance's own curvature).
-    fn add_exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
-        self.add_hessian(x, h, false);
-    }
+    /// Pushes the Hessian blocks (N/m) the solver asks for ([`HessianMode`]). The block pattern
+    /// must not depend on the mode.
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode);
     /// Whether the Hessian is the same at every x, projected or not (a quadratic energy: bending
     /// along grid lines, linear hinge bending): a [`Model`] then computes its blocks once.
     fn hessian_is_constant(&self) -> bool {
@@ -197,14 +193,6 @@ pub trait EnergyTerm: Send + Sync {
     fn closest_gap_rel(&self, _x: &Vecs) -> Option<f64> {
         None
     }
-    /// Told by the implicit integrator that Newton now solves its time steps (`on`) or, again,
-    /// equilibria: a term whose Newton Hessian differs between the two (self-contact's pinned
-    /// pairs) switches. Default: nothing.
-    fn set_time_stepping(&mut self, _on: bool) {}
-    /// Told by an equilibrium solve that has run long without converging that Newton's
-    /// (unprojected) Hessian should carry the exact curvature of every contact pair (`on`), or,
-    /// again, its usual one ([`crate::solve::StaticOptions::exact_contact_after`]). Default: nothing.
-    fn set_exact_contact(&self, _on: bool) {}
     /// The largest fraction of the step `dx` from `x` that the term allows (contact: a step that
     /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
     fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
@@ -315,38 +303,30 @@ impl Model {
             }
         }
     }
-    /// Hessian blocks of the total energy into `h` (cleared first); `project` makes it positive semi-definite.
-    pub fn hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
+    /// Hessian blocks of the total energy into `h` (cleared first), as `mode` asks
+    /// ([`HessianMode`]). The exact one assembles every term afresh; the others take the constant
+    /// terms' blocks computed once.
+    pub fn hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
         h.clear();
+        if mode == HessianMode::Exact {
+            for t in &self.terms {
+                t.add_hessian(x, h, mode);
+            }
+            return;
+        }
         h.constant = self
             .constant_hessian
             .get_or_init(|| {
                 let mut c = HessianBlocks::default();
                 for t in self.terms.iter().filter(|t| t.hessian_is_constant()) {
-                    t.add_hessian(x, &mut c, false);
+                    t.add_hessian(x, &mut c, HessianMode::NEWTON);
                 }
                 (!c.pairs.is_empty()).then(|| Arc::new(c))
             })
             .clone();
         for t in self.terms.iter().filter(|t| !t.hessian_is_constant()) {
-            t.add_hessian(x, h, project);
+            t.add_hessian(x, h, mode);
         }
-    }
-    /// The exact Hessian blocks of the total energy into `h` (cleared first): see
-    /// [`EnergyTerm::add_exact_hessian`].
-    pub fn exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
-        h.clear();
-        for t in &self.terms {
-            t.add_exact_hessian(x, h);
-        }
-    }
-    /// [`EnergyTerm::set_time_stepping`] of every term.
-    pub fn set_time_stepping(&mut self, on: bool) {
-        self.terms.iter_mut().for_each(|t| t.set_time_stepping(on));
-    }
-    /// [`EnergyTerm::set_exact_contact`] of every term.
-    pub fn set_exact_contact(&self, on: bool) {
-        self.terms.iter().for_each(|t| t.set_exact_contact(on));
     }
     /// The smallest [`EnergyTerm::closest_gap_rel`] of every term (infinity when none has a pair in
     /// range).

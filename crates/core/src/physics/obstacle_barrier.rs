@@ -7,7 +7,7 @@
 //! makes the line search reject any step that would still end inside.
 
 use super::barrier::{barrier, barrier_band_derivatives};
-use super::{EnergyTerm, HessianBlocks, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, Vecs};
 use crate::obstacle::Obstacle;
 use nalgebra::{Matrix3, Vector3};
 
@@ -99,7 +99,8 @@ impl EnergyTerm for ObstacleBarrier {
             g[p] += n * (self.kappa_J[p] * barrier(d, self.d_hat_m).1);
         });
     }
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
+        let project = mode.is_projected();
         // Every particle gets a diagonal block (zero when out of range) so the pattern never changes.
         let mut diag = vec![Matrix3::zeros(); x.len()];
         self.each(x, |p, d, n, o| {

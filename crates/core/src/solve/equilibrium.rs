@@ -63,11 +63,11 @@ pub struct EquilibriumFactor {
 }
 
 impl EquilibriumFactor {
-    /// Factorizes the exact Hessian of `model` at `x` ([`Model::exact_hessian`]); fails where it
+    /// Factorizes the exact Hessian of `model` at `x` ([`crate::physics::HessianMode::Exact`]); fails where it
     /// is not positive definite.
     pub fn new(model: &Model, x: &Vecs) -> Result<Self, NoFactor> {
         let mut h = HessianBlocks::default();
-        model.exact_hessian(x, &mut h);
+        model.hessian(x, &mut h, crate::physics::HessianMode::Exact);
         Self::of(model, h)
     }
 

@@ -23,7 +23,8 @@ pub struct Settle {
 /// Integrates from (`x`, `v`) (updated in place) until settled, stopped or out of time: each step
 /// minimises the incremental potential ([`Inertia`] + the model). `frame_s`: land a step on every
 /// multiple of it and hand that state to `observer` (stamped with the exact frame time).
-/// Newton's Hessian is that of a time step ([`Model::set_time_stepping`]) while it integrates.
+/// Newton's Hessian is that of a time step: pinned contact pairs carry their distance's
+/// curvature ([`crate::physics::PairCurvature::Pinned`]).
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_implicit(
     model: &mut Model,
@@ -36,7 +37,6 @@ pub fn integrate_implicit(
     observer: &mut dyn Observer,
     report: &mut SolveReport,
 ) {
-    model.set_time_stepping(true);
     let mut run = ImplicitRun {
         model,
         x,
@@ -60,7 +60,6 @@ pub fn integrate_implicit(
     };
     let verdict = super::executor::run(&mut run, budget, observer);
     let (steps, t, largest) = (run.clock.steps, run.clock.t, run.clock.largest);
-    run.model.set_time_stepping(false);
     super::executor::conclude(verdict, steps, report);
     report.iterations = steps;
     report.sim_time_s = Some(t);

@@ -14,7 +14,7 @@ use super::FactorReuse;
 use super::clock::StepBounds;
 use super::static_options::StaticOptions;
 use super::{DivergenceReason, SolveReport};
-use crate::physics::{EnergyTerm, HessianBlocks, Model, Vecs};
+use crate::physics::{EnergyTerm, HessianBlocks, HessianMode, Model, PairCurvature, Vecs};
 use nalgebra::{Matrix3, Vector3};
 
 /// The inertia and damping part of the incremental potential: Σ w_p/2 |x_p − c_p|² (the two
@@ -55,7 +55,7 @@ impl Inertia {
         }
         let stiffness = (beta > 0.0).then(|| {
             let mut k = HessianBlocks::default();
-            model.hessian(x_n, &mut k, true);
+            model.hessian(x_n, &mut k, HessianMode::Projected);
             (k, beta / h)
         });
         Self {
@@ -100,7 +100,7 @@ impl EnergyTerm for Inertia {
             }
         }
     }
-    fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _project: bool) {
+    fn add_hessian(&self, _x: &Vecs, h: &mut HessianBlocks, _mode: HessianMode) {
         for (p, &w) in self.weight.iter().enumerate() {
             if w > 0.0 {
                 h.push(p, p, Matrix3::identity() * w);
@@ -182,6 +182,27 @@ pub(super) enum Attempt {
     Diverged(DivergenceReason),
 }
 
+/// The options of one step's Newton solve at `x` (the step's inertia in `model`).
+fn step_options(model: &Model, x: &[Vector3<f64>], s: &ImplicitSettings) -> StaticOptions {
+    // Short steps make the inertia stiff (m/h²) and raise the round-off floor of forces with it:
+    // the step's tolerance stays 100 times above that floor.
+    let floor_rel = model.roundoff_force(x) / model.reference_weight();
+    StaticOptions {
+        residual_tol_rel: s.newton_tol_rel.max(100.0 * floor_rel),
+        max_iterations: s.newton_iterations,
+        lm_damping_initial: 1e-6,
+        strain_bound: s.strain_bound,
+        // The Hessian changes little over one step's iterations: chord steps save factorizations
+        // (37 % over eight scenes, reports/newton_iterations.md).
+        factor_reuse: s.factor_reuse,
+        // κ stiffens between steps (below), not within one step's Newton: within a step it
+        // changed which slowly creeping nets settle within their simulated time (the stress box's
+        // point 88 settled at t = 95,746 s with κ held and not within 10⁵ s without).
+        kappa_adapt_gap_rel: 0.0,
+        ..StaticOptions::default()
+    }
+}
+
 /// One step of `h` from (`x`, `v`), both updated on success; `work` gets the report's counters.
 pub(super) fn step(
     model: &mut Model,
@@ -208,23 +229,7 @@ pub(super) fn step(
     if model.energy(&x_n, 1.0) < model.energy(x, 1.0) {
         x.copy_from_slice(&x_n);
     }
-    // Short steps make the inertia stiff (m/h²) and raise the round-off floor of forces with it:
-    // the step's tolerance stays 100 times above that floor.
-    let floor_rel = model.roundoff_force(x) / model.reference_weight();
-    let opts = StaticOptions {
-        residual_tol_rel: s.newton_tol_rel.max(100.0 * floor_rel),
-        max_iterations: s.newton_iterations,
-        lm_damping_initial: 1e-6,
-        strain_bound: s.strain_bound,
-        // The Hessian changes little over one step's iterations: chord steps save factorizations
-        // (37 % over eight scenes, reports/newton_iterations.md).
-        factor_reuse: s.factor_reuse,
-        // κ stiffens between steps (below), not within one step's Newton: within a step it
-        // changed which slowly creeping nets settle within their simulated time (the stress box's
-        // point 88 settled at t = 95,746 s with κ held and not within 10⁵ s without).
-        kappa_adapt_gap_rel: 0.0,
-        ..StaticOptions::default()
-    };
+    let opts = step_options(model, x, s);
     // The last step's factor preconditions this step's Newton steps (conjugate gradients): one
     // step of a settling sheet changes its Hessian little, and the factorizations were most of
     // a step's cost (issue 47's stress box: 29,608 of them in 3,539 steps of one run).
@@ -232,7 +237,13 @@ pub(super) fn step(
     let last = carried
         .take()
         .filter(|_| s.factor_reuse == FactorReuse::Chord);
-    let (r, factor) = super::newton::solve_static_keeping_factor(model, x, &opts, last.as_ref());
+    let (r, factor) = super::newton::solve_static_keeping_factor(
+        model,
+        x,
+        &opts,
+        last.as_ref(),
+        PairCurvature::Pinned,
+    );
     *carried = factor;
     model.terms.pop();
     report.merge(&r, super::Part::InnerSolve);

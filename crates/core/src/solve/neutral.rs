@@ -37,7 +37,7 @@ pub fn neutral_modes(model: &Model, x: &Vecs) -> Vec<NeutralMode> {
         |p| x[p],
     );
     let mut h = HessianBlocks::default();
-    model.exact_hessian(x, &mut h);
+    model.hessian(x, &mut h, crate::physics::HessianMode::Exact);
     let diagonal = h.diagonal(x.len());
     let scale = free.iter().map(|&p| diagonal[p].trace()).sum::<f64>() / (3 * free.len()) as f64;
     let mut kept: Vec<Vec<Vector3<f64>>> = Vec::new();

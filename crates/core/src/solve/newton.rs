@@ -17,7 +17,7 @@ use super::static_options::StaticOptions;
 use super::step::{Iteration, Workspace};
 use super::warm::NeighbourFactor;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
-use crate::physics::{HessianBlocks, Model};
+use crate::physics::{HessianBlocks, HessianMode, Model, PairCurvature};
 use nalgebra::Vector3;
 use std::time::Instant;
 
@@ -29,9 +29,10 @@ pub fn solve_static_keeping_factor(
     x: &mut [Vector3<f64>],
     opts: &StaticOptions,
     factor: Option<&NeighbourFactor>,
+    pairs: PairCurvature,
 ) -> (SolveReport, Option<NeighbourFactor>) {
     let mut run = match NewtonRun::new(model, x, opts, factor) {
-        Ok(r) => r,
+        Ok(r) => r.with_pairs(pairs),
         Err(invalid) => return (*invalid, None),
     };
     let reached = run.stage(
@@ -69,6 +70,9 @@ pub(super) struct NewtonRun {
     load: f64,
     /// The closest barrier pair's gap after the last accepted step, relative to its band.
     last_gap_rel: f64,
+    /// Which contact pairs carry their distance's curvature in Newton's Hessian until
+    /// [`StaticOptions::exact_contact_after`] iterations, then every active pair's.
+    pairs: PairCurvature,
 }
 
 impl NewtonRun {
@@ -96,7 +100,15 @@ impl NewtonRun {
             start: Instant::now(),
             load: 1.0,
             last_gap_rel: f64::INFINITY,
+            pairs: PairCurvature::NormalOnly,
         })
+    }
+
+    /// The run with `pairs` carrying their distance's curvature in Newton's Hessian (an implicit
+    /// time step's [`PairCurvature::Pinned`]; an equilibrium solve's default is none).
+    pub(super) fn with_pairs(mut self, pairs: PairCurvature) -> Self {
+        self.pairs = pairs;
+        self
     }
 
     /// Newton's iterations at load factor `load` up to `goal`, under the executor
@@ -132,7 +144,6 @@ impl NewtonRun {
 
     /// The run's report, with the final numbers at its last stage's load.
     pub(super) fn finish(mut self, model: &Model, x: &[Vector3<f64>]) -> SolveReport {
-        model.set_exact_contact(false);
         let timing = (self.iter, self.floor, self.start);
         finish_report(model, x, self.load, &mut self.ws, timing, &mut self.report);
         self.report
@@ -199,8 +210,10 @@ impl super::executor::Iterative for Stage<'_> {
     fn next_iter(&mut self) -> Result<(), Verdict> {
         let run = &mut *self.run;
         run.iter += 1;
-        self.model
-            .set_exact_contact(run.iter > self.opts.exact_contact_after);
+        run.ws.pairs = match run.iter > self.opts.exact_contact_after {
+            true => PairCurvature::All,
+            false => run.pairs,
+        };
         let (model, x, load) = (&*self.model, &mut *self.x, self.load);
         let taken = run.ws.iterate(
             model,
@@ -320,7 +333,7 @@ fn finish_report(
 /// equilibrium, e.g. a flat sheet under compression).
 pub fn is_minimum(model: &Model, x: &[Vector3<f64>]) -> bool {
     let mut h = HessianBlocks::default();
-    model.hessian(x, &mut h, false);
+    model.hessian(x, &mut h, HessianMode::NEWTON);
     !matches!(
         super::EquilibriumFactor::of(model, h),
         Err(super::NoFactor::NotAMinimum)

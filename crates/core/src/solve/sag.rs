@@ -22,7 +22,7 @@ use std::f64::consts::FRAC_PI_2;
 /// None when nothing is free or the sheet is not tied to any fixed particle.
 fn sag_shape(model: &Model, x0: &[Vector3<f64>]) -> Option<Vec<f64>> {
     let mut h = HessianBlocks::default();
-    model.hessian(x0, &mut h, true);
+    model.hessian(x0, &mut h, crate::physics::HessianMode::Projected);
     let mut edges: Vec<(u32, u32)> = h.all().map(|(&e, _)| e).filter(|(p, q)| p != q).collect();
     edges.sort_unstable();
     edges.dedup();

@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 /// start; a lower bound that converges to ω_max).
 pub fn highest_mode(model: &Model, x: &[Vector3<f64>]) -> (f64, f64) {
     let mut h = HessianBlocks::default();
-    model.hessian(x, &mut h, true);
+    model.hessian(x, &mut h, crate::physics::HessianMode::Projected);
     let n = model.len();
     let free: Vec<bool> = model
         .fixed

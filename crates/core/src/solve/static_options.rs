@@ -60,7 +60,7 @@ pub struct StaticOptions {
     pub check_minimum: bool,
     /// Newton iterations after which self-contact's active pairs carry their exact curvature in
     /// Newton's Hessian, the distance's own κ b′∇²d with the barrier's κ b″∇d∇dᵀ
-    /// ([`crate::physics::EnergyTerm::set_exact_contact`]): where folds press many pairs
+    /// ([`crate::physics::PairCurvature::All`]): where folds press many pairs
     /// together, the normal-only curvature leaves Newton's steps across them too short and the
     /// solve crawls (the limp table on a 61 × 61 grid: 3,000 iterations, 1.7e-3 of a particle's
     /// weight off; 1,186 iterations and converged with it after 500). Default 500: the bundled

@@ -171,7 +171,7 @@ impl ImplicitState {
         tol: f64,
     ) -> usize {
         let n = model.len();
-        model.hessian(x, &mut self.h, true);
+        model.hessian(x, &mut self.h, crate::physics::HessianMode::Projected);
         // b = Δt (f − Δt K v), f = −∇E − c v
         let mut kv = vec![Vector3::zeros(); n];
         self.h.mul_add(v, &mut kv);

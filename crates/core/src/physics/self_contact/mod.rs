@@ -18,7 +18,7 @@ mod candidates;
 mod pair;
 
 use super::barrier::{barrier, barrier_band_derivatives};
-use super::{EnergyTerm, HessianBlocks, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, PairCurvature, Vecs};
 use crate::proximity::{
     Aabb, MeshTopology, additive_ccd, candidate_pairs, pair_distance, relative_motion,
 };
@@ -27,7 +27,6 @@ pub use candidates::CandidateSet;
 use nalgebra::{Matrix3, Vector3};
 use pair::{pair_force, push_pair};
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// What self-contact looks like at a state (for run reports).
@@ -59,12 +58,6 @@ pub struct SelfContact {
     pub kappa_J: f64,
     /// The largest κ [`EnergyTerm::stiffen_barrier`] raises it to, J.
     kappa_limit_J: f64,
-    /// Whether Newton's (unprojected) Hessian carries pinned pairs' exact curvature: on during
-    /// implicit time steps ([`EnergyTerm::set_time_stepping`]), off for equilibrium solves.
-    exact_pinned: bool,
-    /// Whether Newton's (unprojected) Hessian carries every active pair's exact curvature: an
-    /// equilibrium solve that has run long without converging ([`EnergyTerm::set_exact_contact`]).
-    exact_all: AtomicBool,
     margin_m: f64,
     /// The longest vertex move checked with one broad phase, m: four of the longest rest edge.
     piece_m: f64,
@@ -105,8 +98,6 @@ impl SelfContact {
             band_m,
             kappa_J,
             kappa_limit_J: KAPPA_GROWTH_LIMIT * kappa_J,
-            exact_pinned: false,
-            exact_all: AtomicBool::new(false),
             margin_m,
             piece_m: (4.0 * longest).max(margin_m),
             cache: Mutex::new(Cache::default()),
@@ -290,12 +281,6 @@ impl EnergyTerm for SelfContact {
     fn name(&self) -> String {
         "contact/self".into()
     }
-    fn set_time_stepping(&mut self, on: bool) {
-        self.exact_pinned = on;
-    }
-    fn set_exact_contact(&self, on: bool) {
-        self.exact_all.store(on, Ordering::Relaxed);
-    }
     /// Doubles κ when the closest active pair's gap beyond the thickness is under [`STIFFEN_GAP`]
     /// of the band, up to [`KAPPA_GROWTH_LIMIT`] times its start.
     fn stiffen_barrier(&mut self, x: &Vecs) -> bool {
@@ -324,28 +309,40 @@ impl EnergyTerm for SelfContact {
         });
     }
     /// The barrier's curvature along the line between the closest points, κ b″ n nᵀ (positive
-    /// semi-definite: the curvature of the distance itself is left out; pinned pairs below). Only
-    /// pairs in range push blocks: pushing every candidate's (zero) blocks to keep the pattern fixed made
+    /// semi-definite: the curvature of the distance itself is left out), for every pair in range
+    /// but those [`HessianMode::Newton`]'s [`PairCurvature`] names, which get their exact
+    /// curvature ([`Self::pair_exact_blocks`], the distance's own κ b′∇²d included). Only pairs in
+    /// range push blocks: pushing every candidate's (zero) blocks to keep the pattern fixed made
     /// the factor denser and the drapes slower (skirt_wool 9.8 s against 5.9 s).
     ///
-    /// In implicit time steps a pair pinned within [`STIFFEN_GAP`] of the band beyond the
-    /// thickness gets its exact curvature unless projecting ([`Self::pair_exact_blocks`], the
-    /// distance's own curvature κ b′∇²d included): there b′ is large, and the curvature left out
-    /// kept Newton from converging in the stress box's steps (a pair pinned at the thickness,
-    /// every iteration cut by the collision bound; with the Krylov hand-over 46 → 48 of 50
-    /// settle). Not in equilibrium solves: there it slowed the touching drapes (l_panel_sphere
-    /// 197 → 577 iterations, ending a pair 1.5e-11 m from the thickness at 150) — but every
-    /// active pair gets it once an equilibrium solve has run long without converging
-    /// ([`EnergyTerm::set_exact_contact`]: the limp table at 61 × 61 converges with it).
-    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, project: bool) {
-        let pinned = match self.exact_all.load(Ordering::Relaxed) {
-            true => f64::INFINITY,
-            false if self.exact_pinned => self.thickness_m + STIFFEN_GAP * self.band_m,
-            false => f64::NEG_INFINITY,
+    /// [`PairCurvature::Pinned`], in implicit time steps: a pair pinned within [`STIFFEN_GAP`] of
+    /// the band beyond the thickness, where b′ is large, and the curvature left out kept Newton
+    /// from converging in the stress box's steps (a pair pinned at the thickness, every iteration
+    /// cut by the collision bound; with the Krylov hand-over 46 → 48 of 50 settle). Not in
+    /// equilibrium solves: there it slowed the touching drapes (l_panel_sphere 197 → 577
+    /// iterations, ending a pair 1.5e-11 m from the thickness at 150) — but every active pair gets
+    /// it ([`PairCurvature::All`]) once an equilibrium solve has run long without converging (the
+    /// limp table at 61 × 61 converges with it). [`HessianMode::Exact`]: every active pair's
+    /// κ b″ ∇d∇dᵀ + κ b′ ∇²d, ∇²d the curvature of the distance with the closest points moving.
+    fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
+        let exact_within = match mode {
+            HessianMode::Exact => {
+                self.each_active_pair(x, |idx, _, _, pt| {
+                    push_pair(h, &idx, &self.pair_exact_blocks(pt, &idx.map(|v| x[v])));
+                });
+                return;
+            }
+            HessianMode::Projected | HessianMode::Newton(PairCurvature::NormalOnly) => {
+                f64::NEG_INFINITY
+            }
+            HessianMode::Newton(PairCurvature::Pinned) => {
+                self.thickness_m + STIFFEN_GAP * self.band_m
+            }
+            HessianMode::Newton(PairCurvature::All) => f64::INFINITY,
         };
         self.each_active_pair(x, |idx, d, coef, pt| {
             let y = idx.map(|v| x[v]);
-            if !project && d < pinned {
+            if d < exact_within {
                 push_pair(h, &idx, &self.pair_exact_blocks(pt, &y));
                 return;
             }
@@ -360,13 +357,6 @@ impl EnergyTerm for SelfContact {
             h.push_outer(&idx, &coef, &k);
         });
         self.hint_near(h);
-    }
-    /// The exact Hessian of every active pair: κ b″ ∇d∇dᵀ + κ b′ ∇²d, ∇²d the curvature of the
-    /// distance with the closest points moving ([`Self::pair_exact_blocks`]).
-    fn add_exact_hessian(&self, x: &Vecs, h: &mut HessianBlocks) {
-        self.each_active_pair(x, |idx, _, _, pt| {
-            push_pair(h, &idx, &self.pair_exact_blocks(pt, &idx.map(|v| x[v])));
-        });
     }
     /// Additive CCD over every candidate pair. A long step (far from equilibrium Newton may propose
     /// a vertex move of a metre) is checked in pieces of at most `piece_m` per vertex, each
@@ -507,7 +497,7 @@ mod tests {
     /// How far `term`'s Newton Hessian (or its projected one) at `x` misses the change of its
     /// gradient along a sliding, closing move of the upper layer (central differences): the
     /// relative norm of the difference.
-    fn hessian_miss(term: &SelfContact, x: &[Vector3<f64>], project: bool) -> f64 {
+    fn hessian_miss(term: &SelfContact, x: &[Vector3<f64>], mode: HessianMode) -> f64 {
         let v: Vec<Vector3<f64>> = (0..x.len())
             .map(|k| match k >= 9 {
                 true => Vector3::new(1.0, 0.3 * (k as f64).sin(), -0.2),
@@ -528,7 +518,7 @@ mod tests {
             .map(|(a, b)| (a - b) / (2.0 * eps))
             .collect();
         let mut h = HessianBlocks::default();
-        term.add_hessian(x, &mut h, project);
+        term.add_hessian(x, &mut h, mode);
         let mut hv = vec![Vector3::zeros(); x.len()];
         h.mul_add(&v, &mut hv);
         let num: f64 = hv
@@ -573,17 +563,17 @@ mod tests {
     fn a_pinned_pair_gets_its_exact_curvature_unless_projected() {
         let (xi, band) = (5e-4, 1e-3);
         let (x, tris) = pressed(xi + 0.05 * band);
-        let mut term = SelfContact::new(tris, &x, xi, band, 1e-3);
+        let term = SelfContact::new(tris, &x, xi, band, 1e-3);
         // An equilibrium solve's Newton Hessian: the normal-only curvature, as projected.
         let (equilibrium, projected) = (
-            hessian_miss(&term, &x, false),
-            hessian_miss(&term, &x, true),
+            hessian_miss(&term, &x, HessianMode::NEWTON),
+            hessian_miss(&term, &x, HessianMode::Projected),
         );
         assert!((equilibrium - projected).abs() <= 1e-12 * projected);
-        term.set_time_stepping(true);
+        let time_step = HessianMode::Newton(PairCurvature::Pinned);
         let (exact, projected) = (
-            hessian_miss(&term, &x, false),
-            hessian_miss(&term, &x, true),
+            hessian_miss(&term, &x, time_step),
+            hessian_miss(&term, &x, HessianMode::Projected),
         );
         // What remains (0.4 %) is no error of the blocks (analytic, each its pair's central
         // difference to 1e-6): the layers' grids are aligned, so closest points sit on region
@@ -601,21 +591,24 @@ mod tests {
         // Hessian keeps their normal-only curvature; a solve that has run long does not.
         let (xi, band) = (5e-4, 1e-3);
         let (x, tris) = pressed(xi + 0.5 * band);
-        let mut term = SelfContact::new(tris, &x, xi, band, 1e-3);
+        let term = SelfContact::new(tris, &x, xi, band, 1e-3);
         assert!(term.energy(&x) > 0.0);
-        let usual = hessian_miss(&term, &x, false);
-        term.set_time_stepping(true);
-        assert_eq!(hessian_miss(&term, &x, false), usual);
-        term.set_time_stepping(false);
-        term.set_exact_contact(true);
-        let all = hessian_miss(&term, &x, false);
+        let usual = hessian_miss(&term, &x, HessianMode::NEWTON);
+        let time_step = HessianMode::Newton(PairCurvature::Pinned);
+        assert_eq!(hessian_miss(&term, &x, time_step), usual);
+        let all = hessian_miss(&term, &x, HessianMode::Newton(PairCurvature::All));
         assert!(
             all < 0.01 && usual > 10.0 * all,
             "all {all:e}, usual {usual:e}"
         );
-        assert_eq!(hessian_miss(&term, &x, true), usual, "projected as before");
-        term.set_exact_contact(false);
-        assert_eq!(hessian_miss(&term, &x, false), usual);
+        let projected = hessian_miss(&term, &x, HessianMode::Projected);
+        assert_eq!(projected, usual, "projected as before");
+        // The exact Hessian of derivatives: every pair's whole curvature, as a long solve's.
+        let exact = hessian_miss(&term, &x, HessianMode::Exact);
+        assert!(
+            (exact - all).abs() <= 1e-12 * all,
+            "exact {exact:e}, all {all:e}"
+        );
     }
 
     /// The active pairs are measured once per state and serve energy, gradient and Hessian there:
@@ -891,11 +884,10 @@ mod tests {
         let (x, tris) = turned(xi + 0.3 * band, 0.01, SHIFT);
         let term = SelfContact::new(tris, &x, xi, band, 1e-3);
         crate::physics::tests::check_gradient_scaled(&term, &x, 9..x.len(), (1e-9, 1e-5));
-        term.set_exact_contact(true);
-        let miss = hessian_miss(&term, &x, false);
+        let miss = hessian_miss(&term, &x, HessianMode::Newton(PairCurvature::All));
         assert!(miss < 1e-6, "{miss:e}");
         let mut h = HessianBlocks::default();
-        term.add_hessian(&x, &mut h, true);
+        term.add_hessian(&x, &mut h, HessianMode::Projected);
         // The projected Hessian is positive semi-definite.
         let n = x.len() * 3;
         let mut dense = nalgebra::DMatrix::<f64>::zeros(n, n);

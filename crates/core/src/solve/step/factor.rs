@@ -105,7 +105,11 @@ impl Workspace {
 
     /// The Hessian at `x` into `h`, projected or not: a new matrix to assemble.
     pub(super) fn hessian(&mut self, model: &Model, x: &[Vector3<f64>], kind: Hessian) {
-        model.hessian(x, &mut self.h, kind.is_projected());
+        let mode = match kind {
+            Hessian::Projected => HessianMode::Projected,
+            Hessian::Exact => HessianMode::Newton(self.pairs),
+        };
+        model.hessian(x, &mut self.h, mode);
         self.assembled = false;
     }
 

@@ -16,7 +16,7 @@ use super::strategy::{
     Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Verdict,
 };
 use super::{Globalization, SolveReport};
-use crate::physics::{HessianBlocks, Model};
+use crate::physics::{HessianBlocks, HessianMode, Model, PairCurvature};
 use nalgebra::Vector3;
 
 /// (first DOF, component) of every held component of the free particles.
@@ -115,6 +115,9 @@ pub(super) struct Workspace {
     parts: Parts,
     /// The Hessian of the last factorization (see [`Workspace::top_fails`]).
     last_hessian: Hessian,
+    /// Which contact pairs carry their distance's curvature in the exact Hessian this iteration
+    /// ([`HessianMode::Newton`]): set by the run ([`super::newton`]) before each iteration.
+    pub(super) pairs: PairCurvature,
     /// Iterations in a row that stepped on the projected Hessian ([`Workspace::skips_exact`]).
     projected_run: usize,
     /// The largest residual force at the start of the previous iteration, N.
@@ -232,6 +235,7 @@ impl Workspace {
                 search: SEARCH,
             },
             last_hessian: Hessian::Exact,
+            pairs: PairCurvature::NormalOnly,
             projected_run: 0,
             r_prev: f64::INFINITY,
             last_step: Taken::Partial,
