@@ -5,6 +5,7 @@
 //! triangles and between edges.
 
 use crate::support::{root, run_python, scene};
+use drapelab::physics::EnergyTerm;
 use drapelab::scene::Scene;
 use drapelab::simulate::{Solution, solve_scene};
 use drapelab::solve::{NoObserver, Observer, StateEvent};
@@ -659,9 +660,7 @@ fn a_crumpling_slack_net_settles_with_its_barrier_stiffened_where_layers_press()
     assert!(sol.report.is_converged(), "{}", sol.report.message);
     let term = sol
         .model
-        .terms
-        .iter()
-        .find(|t| t.is_self_contact())
+        .self_contact_term()
         .expect("self-contact modelled");
     // ξ, d̂ and κ as built (the term's coefficients); κ now and its growth from its state.
     let [xi, band, kappa0] = term.coefficients()[..] else {
@@ -677,9 +676,7 @@ fn a_crumpling_slack_net_settles_with_its_barrier_stiffened_where_layers_press()
     // κ as the scene builds it is the term's coefficient κ₀ (a rebuilt scene's κ).
     let built = drapelab::build::build_scene(&s.clone().validated().unwrap()).model;
     let rebuilt = built
-        .terms
-        .iter()
-        .find(|t| t.is_self_contact())
+        .self_contact_term()
         .map(|t| t.coefficients()[2])
         .unwrap();
     assert_eq!(rebuilt, kappa0);

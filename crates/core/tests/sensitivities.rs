@@ -3,6 +3,7 @@
 //! with obstacle contact, a sheet in self-contact), and the adjoint against the sensitivities.
 
 use drapelab_core::params::{continuous_keys, free_keys, value, with_value};
+use drapelab_core::physics::EnergyTerm;
 use drapelab_core::scene::{Scene, ValidatedScene};
 use drapelab_core::sensitivity::{Equilibrium, NoSensitivity, mean_height_gradient};
 use drapelab_core::simulate::{Solution, solve_scene, solve_scene_from};
@@ -66,7 +67,7 @@ fn neighbour(scene: &ValidatedScene, sol: &Solution) -> Option<Vec<Vector3<f64>>
         .model
         .self_contact(&sol.x)
         .map_or(1.0, |s| s.kappa_growth);
-    for t in b.model.terms.iter_mut().filter(|t| t.is_self_contact()) {
+    if let Some(t) = b.model.self_contact_term_mut() {
         let mut c = t.coefficients();
         c[2] *= growth;
         t.set_coefficients(&c);

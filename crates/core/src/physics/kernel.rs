@@ -99,7 +99,7 @@ impl<K: Kernel<N>, const N: usize> Potential<K, N> {
     }
 }
 
-impl<K: Kernel<N>, const N: usize> EnergyTerm for Potential<K, N> {
+impl<K: Kernel<N> + 'static, const N: usize> EnergyTerm for Potential<K, N> {
     fn name(&self) -> String {
         self.kernel.name()
     }

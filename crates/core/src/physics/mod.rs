@@ -149,8 +149,27 @@ impl HessianBlocks {
     }
 }
 
+/// A term as [`std::any::Any`]: how a solver that needs one kind of term (the sheet's
+/// self-contact, for its candidate sets and report) finds it by type, with no hook for it on
+/// every term.
+pub trait AsAny {
+    /// The term as `Any`, to downcast.
+    fn as_any(&self) -> &dyn std::any::Any;
+    /// The term as mutable `Any`, to downcast.
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
+}
+
+impl<T: std::any::Any> AsAny for T {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
+    }
+}
+
 /// One energy term of the total potential energy.
-pub trait EnergyTerm: Send + Sync {
+pub trait EnergyTerm: Send + Sync + AsAny {
     /// A short name for reports ("springs/structural", "gravity", ...).
     fn name(&self) -> String;
     /// Energy in J.
@@ -197,27 +216,6 @@ pub trait EnergyTerm: Send + Sync {
     /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
     fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
         f64::INFINITY
-    }
-    /// The state of the sheet's self-contact at `x`, for a self-contact term (None for others).
-    fn self_contact(&self, _x: &Vecs) -> Option<SelfContactState> {
-        None
-    }
-    /// Whether this is the sheet's self-contact term.
-    fn is_self_contact(&self) -> bool {
-        false
-    }
-    /// The term's candidate set (self-contact's broad phase), to seed a model solved nearby.
-    fn candidates(&self) -> Option<CandidateSet> {
-        None
-    }
-    /// A candidate set at `x` valid while each vertex v stays within `spread[v]` (m) of it.
-    fn candidates_covering(&self, _x: &Vecs, _spread: &[f64]) -> Option<CandidateSet> {
-        None
-    }
-    /// Takes a candidate set from a model solved nearby ([`EnergyTerm::candidates`]); true when
-    /// it fits the term.
-    fn seed_candidates(&self, _set: &CandidateSet) -> bool {
-        false
     }
     /// The term's coefficients, flat: the numbers its stencils are built over from the scene's
     /// parameters (stiffnesses, rest lengths, weights; SI units). Empty for a term that does not
@@ -405,13 +403,25 @@ impl Model {
             .map(|t| t.max_strain(x))
             .fold(0.0, f64::max)
     }
+    /// The sheet's self-contact term, when the model has one.
+    pub fn self_contact_term(&self) -> Option<&SelfContact> {
+        self.terms
+            .iter()
+            .find_map(|t| (**t).as_any().downcast_ref::<SelfContact>())
+    }
+    /// The sheet's self-contact term to change (its coefficients), when the model has one.
+    pub fn self_contact_term_mut(&mut self) -> Option<&mut SelfContact> {
+        self.terms
+            .iter_mut()
+            .find_map(|t| (**t).as_any_mut().downcast_mut::<SelfContact>())
+    }
     /// Whether the model has the sheet's self-contact term (cheap: no state is computed).
     pub fn models_self_contact(&self) -> bool {
-        self.terms.iter().any(|t| t.is_self_contact())
+        self.self_contact_term().is_some()
     }
     /// The state of the sheet's self-contact at `x`, when the model has the term.
     pub fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {
-        self.terms.iter().find_map(|t| t.self_contact(x))
+        self.self_contact_term().map(|t| t.state(x))
     }
     /// Names of the terms that were built.
     pub fn term_names(&self) -> Vec<String> {
@@ -419,19 +429,18 @@ impl Model {
     }
     /// The candidate set of the model's self-contact, when it has one and a broad phase ran.
     pub fn candidates(&self) -> Option<CandidateSet> {
-        self.terms.iter().find_map(|t| t.candidates())
+        self.self_contact_term().and_then(SelfContact::candidates)
     }
     /// The candidate set of the model's self-contact at `x`, valid while each vertex v stays within
     /// `spread[v]` (m) of it; None without self-contact.
     pub fn candidates_covering(&self, x: &Vecs, spread: &[f64]) -> Option<CandidateSet> {
-        self.terms
-            .iter()
-            .find_map(|t| t.candidates_covering(x, spread))
+        self.self_contact_term()
+            .map(|t| t.candidates_covering(x, spread))
     }
     /// Seeds the model's self-contact with `set` from a model solved nearby (on the same mesh);
-    /// true when a term took it.
+    /// true when the term took it.
     pub fn seed_candidates(&self, set: &CandidateSet) -> bool {
-        self.terms.iter().any(|t| t.seed_candidates(set))
+        self.self_contact_term().is_some_and(|t| t.seed(set))
     }
 }
 

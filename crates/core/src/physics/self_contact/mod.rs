@@ -433,21 +433,6 @@ impl EnergyTerm for SelfContact {
             dkappa * b + self.kappa_J * (db_dband * dband - db * dxi)
         }))
     }
-    fn self_contact(&self, x: &Vecs) -> Option<SelfContactState> {
-        Some(self.state(x))
-    }
-    fn is_self_contact(&self) -> bool {
-        true
-    }
-    fn candidates(&self) -> Option<CandidateSet> {
-        SelfContact::candidates(self)
-    }
-    fn seed_candidates(&self, set: &CandidateSet) -> bool {
-        self.seed(set)
-    }
-    fn candidates_covering(&self, x: &Vecs, spread: &[f64]) -> Option<CandidateSet> {
-        Some(SelfContact::candidates_covering(self, x, spread))
-    }
 }
 
 #[cfg(test)]
