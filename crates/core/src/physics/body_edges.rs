@@ -17,7 +17,7 @@
 //! far as its farthest vertex, so 90 % of its distance to the nearest feature bounds it.
 
 use super::barrier::barrier;
-use super::{EnergyTerm, HessianBlocks, HessianMode, ObstacleBarrier, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, ObstacleBarrier, StepBound, Vecs};
 use crate::obstacle::{Obstacle, TriangleBody};
 use crate::proximity::{Aabb, point_triangle_distance, segment_segment_distance};
 use nalgebra::{Matrix3, Vector3};
@@ -248,6 +248,12 @@ impl EnergyTerm for BodyEdgeBarrier {
             }
         }
     }
+    fn step_bound(&self) -> Option<&dyn StepBound> {
+        Some(self)
+    }
+}
+
+impl StepBound for BodyEdgeBarrier {
     fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
         let mut alpha = f64::INFINITY;
         let mut near = Vec::new();

@@ -168,6 +168,16 @@ impl<T: std::any::Any> AsAny for T {
     }
 }
 
+/// The collision-free step size of a contact term, a query apart from its energy (ipc-toolkit's
+/// `compute_collision_free_stepsize`): how far along a step the term's primitives can go without
+/// touching.
+pub trait StepBound {
+    /// The largest fraction of the step `dx` from `x` that the term allows (a step that cannot
+    /// carry a particle into an obstacle, or the sheet through itself); infinite when nothing is
+    /// in reach.
+    fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64;
+}
+
 /// One energy term of the total potential energy.
 pub trait EnergyTerm: Send + Sync + AsAny {
     /// A short name for reports ("springs/structural", "gravity", ...).
@@ -198,24 +208,9 @@ pub trait EnergyTerm: Send + Sync + AsAny {
     fn is_external_load(&self) -> bool {
         false
     }
-    /// Raises the term's barrier stiffness κ where a pair has been pressed to within a small
-    /// fraction of its band (incremental potential contact's adaptive κ, Li et al. 2020): at a gap
-    /// where κ b′ balances a force F the barrier's curvature is about F²/(κ d̂²), so stacked layers
-    /// that press a pair nanometres from its limit leave Newton a nearly singular system until κ
-    /// grows. Called between the steps of a dynamic solve; true when it changed the energy.
-    fn stiffen_barrier(&mut self, _x: &Vecs) -> bool {
-        false
-    }
-    /// The smallest gap of a barrier pair beyond its limit at `x`, as a fraction of the barrier's
-    /// band (0 at the limit, 1 at the edge of the band), or None for a term without barrier pairs
-    /// in range: what a static solve watches to adapt κ ([`crate::solve::StaticOptions::kappa_adapt_gap_rel`]).
-    fn closest_gap_rel(&self, _x: &Vecs) -> Option<f64> {
+    /// The term's collision-free step query, for a contact term ([`StepBound`]); None for others.
+    fn step_bound(&self) -> Option<&dyn StepBound> {
         None
-    }
-    /// The largest fraction of the step `dx` from `x` that the term allows (contact: a step that
-    /// cannot carry a particle into an obstacle); infinite when the term sets no bound.
-    fn max_step(&self, _x: &Vecs, _dx: &Vecs) -> f64 {
-        f64::INFINITY
     }
     /// The term's coefficients, flat: the numbers its stencils are built over from the scene's
     /// parameters (stiffnesses, rest lengths, weights; SI units). Empty for a term that does not
@@ -326,27 +321,25 @@ impl Model {
             t.add_hessian(x, h, mode);
         }
     }
-    /// The smallest [`EnergyTerm::closest_gap_rel`] of every term (infinity when none has a pair in
-    /// range).
+    /// The closest self-contact pair's gap beyond the thickness at `x`, relative to the band
+    /// ([`SelfContact::closest_gap_rel`]; infinity when no pair is in range or the model has no
+    /// self-contact).
     pub fn closest_gap_rel(&self, x: &Vecs) -> f64 {
-        self.terms
-            .iter()
-            .filter_map(|t| t.closest_gap_rel(x))
-            .fold(f64::INFINITY, f64::min)
+        self.self_contact_term()
+            .and_then(|t| t.closest_gap_rel(x))
+            .unwrap_or(f64::INFINITY)
     }
-    /// [`EnergyTerm::stiffen_barrier`] of every term: true when one changed its energy.
+    /// [`SelfContact::stiffen_barrier`]: true when κ grew (the energy changed).
     pub fn stiffen_barriers(&mut self, x: &Vecs) -> bool {
-        let mut changed = false;
-        for t in &mut self.terms {
-            changed |= t.stiffen_barrier(x);
-        }
-        changed
+        self.self_contact_term_mut()
+            .is_some_and(|t| t.stiffen_barrier(x))
     }
-    /// The largest fraction of the step `dx` that every term allows (see [`EnergyTerm::max_step`]).
+    /// The largest fraction of the step `dx` that every contact term allows ([`StepBound`]).
     pub fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
         self.terms
             .iter()
-            .map(|t| t.max_step(x, dx))
+            .filter_map(|t| t.step_bound())
+            .map(|b| b.max_step(x, dx))
             .fold(f64::INFINITY, f64::min)
     }
     /// Largest residual force on a free particle in N, from the gradient.

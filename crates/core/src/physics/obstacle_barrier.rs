@@ -1,13 +1,13 @@
 //! Frictionless rigid contact by a smooth barrier (in the manner of incremental potential contact): for a
 //! particle at distance d from an obstacle, E = κ b(d) with b(d) = −(d − d̂)² ln(d/d̂) for 0 < d < d̂ and
 //! 0 beyond. The energy grows without bound as d → 0, so a line search that keeps the energy finite
-//! keeps every particle outside every obstacle, in any direction; [`EnergyTerm::max_step`] caps each
+//! keeps every particle outside every obstacle, in any direction; [`super::StepBound::max_step`] caps each
 //! step so that no particle closes more than 90 % of its gap, counting its approach along the normal;
 //! the infinite energy inside an obstacle
 //! makes the line search reject any step that would still end inside.
 
 use super::barrier::{barrier, barrier_band_derivatives};
-use super::{EnergyTerm, HessianBlocks, HessianMode, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, StepBound, Vecs};
 use crate::obstacle::Obstacle;
 use nalgebra::{Matrix3, Vector3};
 
@@ -112,21 +112,8 @@ impl EnergyTerm for ObstacleBarrier {
             }
         }
     }
-    fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
-        let mut alpha = f64::INFINITY;
-        for (p, xp) in x.iter().enumerate() {
-            if self.kappa_J.get(p).copied().unwrap_or(0.0) == 0.0 {
-                continue;
-            }
-            let len = dx[p].norm();
-            if len == 0.0 {
-                continue;
-            }
-            for o in &self.obstacles {
-                alpha = alpha.min(gap_bound(o, xp, &dx[p]));
-            }
-        }
-        alpha
+    fn step_bound(&self) -> Option<&dyn StepBound> {
+        Some(self)
     }
     fn stiffness_scale(&self) -> f64 {
         0.0
@@ -178,6 +165,25 @@ impl EnergyTerm for ObstacleBarrier {
         });
         self.shape_difference(x, &dc[n + 1..], |_, de, _| e += de);
         Some(e)
+    }
+}
+
+impl StepBound for ObstacleBarrier {
+    fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
+        let mut alpha = f64::INFINITY;
+        for (p, xp) in x.iter().enumerate() {
+            if self.kappa_J.get(p).copied().unwrap_or(0.0) == 0.0 {
+                continue;
+            }
+            let len = dx[p].norm();
+            if len == 0.0 {
+                continue;
+            }
+            for o in &self.obstacles {
+                alpha = alpha.min(gap_bound(o, xp, &dx[p]));
+            }
+        }
+        alpha
     }
 }
 

@@ -5,7 +5,7 @@
 //! Two edges within ~1.8° of parallel repel by κ m b(d − ξ), m IPC's mollifier of their angle
 //! ([`edge_edge_mollifier`]): their distance has a kink where they turn parallel, a valley Newton
 //! crawls in where folded layers lie on each other with their edges aligned.
-//! The energy is infinite at d ≤ ξ, and [`EnergyTerm::max_step`] bounds every step by additive
+//! The energy is infinite at d ≤ ξ, and [`super::StepBound::max_step`] bounds every step by additive
 //! continuous collision detection so that no pair comes closer than ξ + 10 % of its gap along it: a
 //! line search that keeps the energy finite can never carry the sheet through itself.
 //!
@@ -18,7 +18,7 @@ mod candidates;
 mod pair;
 
 use super::barrier::{barrier, barrier_band_derivatives};
-use super::{EnergyTerm, HessianBlocks, HessianMode, PairCurvature, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, PairCurvature, StepBound, Vecs};
 use crate::proximity::{
     Aabb, MeshTopology, additive_ccd, candidate_pairs, pair_distance, relative_motion,
 };
@@ -56,7 +56,7 @@ pub struct SelfContact {
     pub band_m: f64,
     /// Barrier stiffness κ, J.
     pub kappa_J: f64,
-    /// The largest κ [`EnergyTerm::stiffen_barrier`] raises it to, J.
+    /// The largest κ [`SelfContact::stiffen_barrier`] raises it to, J.
     kappa_limit_J: f64,
     margin_m: f64,
     /// The longest vertex move checked with one broad phase, m: four of the longest rest edge.
@@ -102,6 +102,34 @@ impl SelfContact {
             piece_m: (4.0 * longest).max(margin_m),
             cache: Mutex::new(Cache::default()),
         }
+    }
+
+    /// Raises κ where a pair has been pressed to within a small fraction of its band
+    /// (incremental potential contact's adaptive κ, Li et al. 2020): at a gap where κ b′ balances
+    /// a force F the barrier's curvature is about F²/(κ d̂²), so stacked layers that press a pair
+    /// nanometres from its limit leave Newton a nearly singular system until κ grows. Doubles κ
+    /// when the closest active pair's gap beyond the thickness is under [`STIFFEN_GAP`] of the
+    /// band, up to [`KAPPA_GROWTH_LIMIT`] times its start; true when it did. Called between the
+    /// steps of a dynamic solve and after closing steps of a static one
+    /// ([`crate::solve::StaticOptions::kappa_adapt_gap_rel`]).
+    pub fn stiffen_barrier(&mut self, x: &Vecs) -> bool {
+        if self.kappa_J * 2.0 > self.kappa_limit_J {
+            return false;
+        }
+        let closest = self.closest_gap_rel(x).unwrap_or(f64::INFINITY);
+        let pressed = closest < STIFFEN_GAP;
+        if pressed {
+            self.kappa_J *= 2.0;
+        }
+        pressed
+    }
+    /// The smallest gap of an active pair beyond the thickness at `x`, as a fraction of the band
+    /// (0 at the thickness, 1 at the edge of the band), or None with no pair in range: what a
+    /// static solve watches to adapt κ.
+    pub fn closest_gap_rel(&self, x: &Vecs) -> Option<f64> {
+        let mut closest = f64::INFINITY;
+        self.each_active(x, |_, d, _| closest = closest.min(d - self.thickness_m));
+        closest.is_finite().then_some(closest / self.band_m)
     }
 
     /// The activation distance ξ + d̂, m.
@@ -281,24 +309,6 @@ impl EnergyTerm for SelfContact {
     fn name(&self) -> String {
         "contact/self".into()
     }
-    /// Doubles κ when the closest active pair's gap beyond the thickness is under [`STIFFEN_GAP`]
-    /// of the band, up to [`KAPPA_GROWTH_LIMIT`] times its start.
-    fn stiffen_barrier(&mut self, x: &Vecs) -> bool {
-        if self.kappa_J * 2.0 > self.kappa_limit_J {
-            return false;
-        }
-        let closest = self.closest_gap_rel(x).unwrap_or(f64::INFINITY);
-        let pressed = closest < STIFFEN_GAP;
-        if pressed {
-            self.kappa_J *= 2.0;
-        }
-        pressed
-    }
-    fn closest_gap_rel(&self, x: &Vecs) -> Option<f64> {
-        let mut closest = f64::INFINITY;
-        self.each_active(x, |_, d, _| closest = closest.min(d - self.thickness_m));
-        closest.is_finite().then_some(closest / self.band_m)
-    }
     fn energy(&self, x: &Vecs) -> f64 {
         self.sum_pairs(x, |gap| self.kappa_J * barrier(gap, self.band_m).0)
     }
@@ -358,39 +368,8 @@ impl EnergyTerm for SelfContact {
         });
         self.hint_near(h);
     }
-    /// Additive CCD over every candidate pair. A long step (far from equilibrium Newton may propose
-    /// a vertex move of a metre) is checked in pieces of at most `piece_m` per vertex, each
-    /// with its own broad phase, so that no swept box spans the sheet; the first piece with an
-    /// impact gives the bound.
-    fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
-        let start = Instant::now();
-        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        let longest = self
-            .topo
-            .vertices
-            .iter()
-            .map(|&v| dx[v as usize].norm())
-            .fold(0.0, f64::max);
-        let pieces = (longest / self.piece_m).ceil().clamp(1.0, 10_000.0) as usize;
-        let share = 1.0 / pieces as f64;
-        let seg: Vec<Vector3<f64>> = dx.iter().map(|d| d * share).collect();
-        let mut xk = x.to_vec();
-        let mut bound = f64::INFINITY;
-        for k in 0..pieces {
-            if k > 0 {
-                for (p, d) in xk.iter_mut().zip(&seg) {
-                    *p += d;
-                }
-            }
-            self.ensure(&mut c, &xk, Some(&seg));
-            let toi = self.piece_impact(&mut c, &xk, &seg);
-            if toi.is_finite() {
-                bound = (k as f64 + toi) * share;
-                break;
-            }
-        }
-        c.time_s += start.elapsed().as_secs_f64();
-        bound
+    fn step_bound(&self) -> Option<&dyn StepBound> {
+        Some(self)
     }
     /// ξ (m), d̂ (m), κ₀ (J): the fabric's thickness, the barrier's band and its stiffness as built
     /// (κ = κ₀ times the growth a solve gave it where layers pressed, held as κ₀ moves: a scene
@@ -432,6 +411,43 @@ impl EnergyTerm for SelfContact {
             let db_dband = barrier_band_derivatives(gap, self.band_m).0;
             dkappa * b + self.kappa_J * (db_dband * dband - db * dxi)
         }))
+    }
+}
+
+impl StepBound for SelfContact {
+    /// Additive CCD over every candidate pair. A long step (far from equilibrium Newton may propose
+    /// a vertex move of a metre) is checked in pieces of at most `piece_m` per vertex, each
+    /// with its own broad phase, so that no swept box spans the sheet; the first piece with an
+    /// impact gives the bound.
+    fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
+        let start = Instant::now();
+        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        let longest = self
+            .topo
+            .vertices
+            .iter()
+            .map(|&v| dx[v as usize].norm())
+            .fold(0.0, f64::max);
+        let pieces = (longest / self.piece_m).ceil().clamp(1.0, 10_000.0) as usize;
+        let share = 1.0 / pieces as f64;
+        let seg: Vec<Vector3<f64>> = dx.iter().map(|d| d * share).collect();
+        let mut xk = x.to_vec();
+        let mut bound = f64::INFINITY;
+        for k in 0..pieces {
+            if k > 0 {
+                for (p, d) in xk.iter_mut().zip(&seg) {
+                    *p += d;
+                }
+            }
+            self.ensure(&mut c, &xk, Some(&seg));
+            let toi = self.piece_impact(&mut c, &xk, &seg);
+            if toi.is_finite() {
+                bound = (k as f64 + toi) * share;
+                break;
+            }
+        }
+        c.time_s += start.elapsed().as_secs_f64();
+        bound
     }
 }
 
