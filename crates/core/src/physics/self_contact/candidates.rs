@@ -28,7 +28,7 @@ pub(super) struct Cache {
     pub(super) time_s: f64,
     /// The active pairs (vertices, distance, coefficients) at `active_at` for the activation
     /// distance `active_m`: energy, gradient and Hessian at one state measure them once.
-    pub(super) active: Vec<([usize; 4], f64, [f64; 4], bool)>,
+    pub(super) active: super::ContactSet,
     pub(super) active_at: Vec<Vector3<f64>>,
     pub(super) active_m: f64,
 }

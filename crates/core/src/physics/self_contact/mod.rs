@@ -15,17 +15,19 @@
 //! reach, the list is empty, and the term costs a comparison of positions with boxes.
 
 mod candidates;
+mod contact_set;
 mod pair;
+mod potential;
 
 use super::barrier::{barrier, barrier_band_derivatives};
-use super::{EnergyTerm, HessianBlocks, HessianMode, PairCurvature, StepBound, Vecs};
+use super::{EnergyTerm, HessianBlocks, HessianMode, StepBound, Vecs};
 use crate::proximity::{
     Aabb, MeshTopology, additive_ccd, candidate_pairs, pair_distance, relative_motion,
 };
 use candidates::Cache;
 pub use candidates::CandidateSet;
-use nalgebra::{Matrix3, Vector3};
-use pair::{pair_force, push_pair};
+pub use contact_set::{ContactPair, ContactSet, PairKind};
+use nalgebra::Vector3;
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -150,45 +152,37 @@ impl SelfContact {
 
     /// [`Self::each_active`] with whether the pair is point–triangle (else edge–edge).
     fn each_active_pair(&self, x: &Vecs, mut f: impl FnMut([usize; 4], f64, [f64; 4], bool)) {
+        self.with_active(x, |set| {
+            for p in &set.pairs {
+                f(
+                    p.vertices,
+                    p.distance_m,
+                    p.coefficients,
+                    p.is_point_triangle(),
+                );
+            }
+        });
+    }
+
+    /// `f` of the contact set at `x`, measured once per state (the cache serves energy, gradient
+    /// and Hessian at one state from one narrow phase).
+    fn with_active<R>(&self, x: &Vecs, f: impl FnOnce(&ContactSet) -> R) -> R {
         let start = Instant::now();
         let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
         let act = self.activation_m();
         if c.active_m != act || c.active_at.as_slice() != x {
             self.measure_active(&mut c, x);
         }
-        for &(idx, d, coef, pt) in &c.active {
-            f(idx, d, coef, pt);
-        }
+        let out = f(&c.active);
         c.time_s += start.elapsed().as_secs_f64();
+        out
     }
 
-    /// Σ m·value(d − ξ) over the active pairs at `x`, m each pair's mollifier (1 where the value is
-    /// infinite, within the thickness: never 0 · ∞).
-    fn sum_pairs(&self, x: &Vecs, value: impl Fn(f64) -> f64) -> f64 {
-        let mut sum = 0.0;
-        self.each_active_pair(x, |idx, d, _, pt| {
-            let v = value(d - self.thickness_m);
-            let m = match v.is_finite() {
-                true => self.mollifier(pt, &idx.map(|k| x[k])).map_or(1.0, |m| m.0),
-                false => 1.0,
-            };
-            sum += m * v;
-        });
-        sum
-    }
-
-    /// Adds every active pair's slope·m∇d + value·∇m at `x` to `g` ([`pair_force`]), (slope, value)
-    /// = `along(d − ξ)`: the energy's gradient, or its derivative along a change of coefficients.
-    fn add_pair_forces(&self, x: &Vecs, g: &mut Vecs, along: impl Fn(f64) -> (f64, f64)) {
-        self.each_active_pair(x, |idx, d, coef, pt| {
-            let y = idx.map(|k| x[k]);
-            let (slope, value) = along(d - self.thickness_m);
-            let moll = self.mollifier(pt, &y);
-            let f = pair_force(&y, d, &coef, moll.as_ref(), slope, value);
-            for k in 0..4 {
-                g[idx[k]] += f[k];
-            }
-        });
+    /// The contact set at `x`: every pair of primitives sharing no vertex within the activation
+    /// distance ξ + d̂, from the candidate set's narrow phase (a broad phase first where `x` left
+    /// the region the candidate list covers).
+    pub fn contact_set(&self, x: &Vecs) -> ContactSet {
+        self.with_active(x, ContactSet::clone)
     }
 
     /// The candidate pairs within the activation distance at `x`, into the cache's active list.
@@ -197,7 +191,7 @@ impl SelfContact {
         let act = self.activation_m();
         c.measure_moves(x);
         let mut active = std::mem::take(&mut c.active);
-        active.clear();
+        active.pairs.clear();
         for (&pair, &gap) in c.pairs.iter().zip(c.gaps.iter()) {
             // A pair whose gap still exceeds its vertices' moves is out of range, unmeasured.
             if c.gap_left(&self.topo, pair, gap) >= 0.0 {
@@ -207,7 +201,16 @@ impl SelfContact {
             let pt = pair.is_point_triangle();
             let (d, coef) = pair_distance(pt, &idx.map(|k| x[k]));
             if d < act {
-                active.push((idx, d, coef, pt));
+                let kind = match pt {
+                    true => PairKind::PointTriangle,
+                    false => PairKind::EdgeEdge,
+                };
+                active.pairs.push(ContactPair {
+                    kind,
+                    vertices: idx,
+                    distance_m: d,
+                    coefficients: coef,
+                });
             }
         }
         c.active = active;
@@ -310,63 +313,19 @@ impl EnergyTerm for SelfContact {
         "contact/self".into()
     }
     fn energy(&self, x: &Vecs) -> f64 {
-        self.sum_pairs(x, |gap| self.kappa_J * barrier(gap, self.band_m).0)
+        self.with_active(x, |set| self.energy_of(set, x))
     }
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
-        self.add_pair_forces(x, g, |gap| {
-            let (b, db, _) = barrier(gap, self.band_m);
-            (self.kappa_J * db, self.kappa_J * b)
-        });
+        self.with_active(x, |set| self.add_gradient_of(set, x, g));
     }
-    /// The barrier's curvature along the line between the closest points, κ b″ n nᵀ (positive
-    /// semi-definite: the curvature of the distance itself is left out), for every pair in range
-    /// but those [`HessianMode::Newton`]'s [`PairCurvature`] names, which get their exact
-    /// curvature ([`Self::pair_exact_blocks`], the distance's own κ b′∇²d included). Only pairs in
-    /// range push blocks: pushing every candidate's (zero) blocks to keep the pattern fixed made
-    /// the factor denser and the drapes slower (skirt_wool 9.8 s against 5.9 s).
-    ///
-    /// [`PairCurvature::Pinned`], in implicit time steps: a pair pinned within [`STIFFEN_GAP`] of
-    /// the band beyond the thickness, where b′ is large, and the curvature left out kept Newton
-    /// from converging in the stress box's steps (a pair pinned at the thickness, every iteration
-    /// cut by the collision bound; with the Krylov hand-over 46 → 48 of 50 settle). Not in
-    /// equilibrium solves: there it slowed the touching drapes (l_panel_sphere 197 → 577
-    /// iterations, ending a pair 1.5e-11 m from the thickness at 150) — but every active pair gets
-    /// it ([`PairCurvature::All`]) once an equilibrium solve has run long without converging (the
-    /// limp table at 61 × 61 converges with it). [`HessianMode::Exact`]: every active pair's
-    /// κ b″ ∇d∇dᵀ + κ b′ ∇²d, ∇²d the curvature of the distance with the closest points moving.
+    /// The barrier's Hessian over the pairs at `x` as `mode` asks ([`SelfContact::add_hessian_of`]),
+    /// then zero blocks for the candidate pairs near range (a factor's pattern that holds over the
+    /// next steps), except for the exact Hessian of derivatives.
     fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
-        let exact_within = match mode {
-            HessianMode::Exact => {
-                self.each_active_pair(x, |idx, _, _, pt| {
-                    push_pair(h, &idx, &self.pair_exact_blocks(pt, &idx.map(|v| x[v])));
-                });
-                return;
-            }
-            HessianMode::Projected | HessianMode::Newton(PairCurvature::NormalOnly) => {
-                f64::NEG_INFINITY
-            }
-            HessianMode::Newton(PairCurvature::Pinned) => {
-                self.thickness_m + STIFFEN_GAP * self.band_m
-            }
-            HessianMode::Newton(PairCurvature::All) => f64::INFINITY,
-        };
-        self.each_active_pair(x, |idx, d, coef, pt| {
-            let y = idx.map(|v| x[v]);
-            if d < exact_within {
-                push_pair(h, &idx, &self.pair_exact_blocks(pt, &y));
-                return;
-            }
-            // A mollified pair's normal-only curvature is scaled by its mollifier (a stand-in, as
-            // for the others: its exact Hessian, projected, slowed the 0.30 m limp table's
-            // drape from 685 to 895 iterations).
-            let m = self.mollifier(pt, &y).map_or(1.0, |m| m.0);
-            let d2b = barrier(d - self.thickness_m, self.band_m).2;
-            let r: Vector3<f64> = (0..4).map(|k| x[idx[k]] * coef[k]).sum();
-            let n = r / d;
-            let k: Matrix3<f64> = n * n.transpose() * (self.kappa_J * m * d2b);
-            h.push_outer(&idx, &coef, &k);
-        });
-        self.hint_near(h);
+        self.with_active(x, |set| self.add_hessian_of(set, x, h, mode));
+        if mode != HessianMode::Exact {
+            self.hint_near(h);
+        }
     }
     fn step_bound(&self) -> Option<&dyn StepBound> {
         Some(self)
@@ -392,7 +351,8 @@ impl EnergyTerm for SelfContact {
             [a, b, c] => [*a, *b, *c * self.kappa_growth()],
             _ => return false,
         };
-        self.add_pair_forces(x, g, |gap| {
+        let set = self.contact_set(x);
+        self.add_pair_forces(&set, (x, g), |gap| {
             let (b, db, d2b) = barrier(gap, self.band_m);
             let (db_dband, ddb) = barrier_band_derivatives(gap, self.band_m);
             let slope = dkappa * db + self.kappa_J * (ddb * dband - d2b * dxi);
@@ -406,7 +366,8 @@ impl EnergyTerm for SelfContact {
             [a, b, c] => [*a, *b, *c * self.kappa_growth()],
             _ => return None,
         };
-        Some(self.sum_pairs(x, |gap| {
+        let set = self.contact_set(x);
+        Some(self.sum_pairs(&set, x, |gap| {
             let (b, db, _) = barrier(gap, self.band_m);
             let db_dband = barrier_band_derivatives(gap, self.band_m).0;
             dkappa * b + self.kappa_J * (db_dband * dband - db * dxi)
@@ -454,6 +415,7 @@ impl StepBound for SelfContact {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::PairCurvature;
     use crate::physics::tests::check_gradient;
     use crate::proximity::Pair;
 
@@ -1029,13 +991,14 @@ mod tests {
     /// The contact set against a brute-force one: along a random walk of the upper layer (steps
     /// cut to 90 % of the term's own step bound, as a line search takes them), the pairs the term
     /// measures active at each state, with their distances, are exactly those of a check of every
-    /// vertex–triangle and edge–edge pair, and no pair ever comes within the thickness.
+    /// vertex–triangle and edge–edge pair, and no pair ever comes within the thickness; the barrier
+    /// evaluated on that contact set gives the energy and gradient a fresh term measures there.
     #[test]
-    fn the_active_set_along_a_random_walk_is_the_brute_force_one() {
+    fn the_contact_set_along_a_random_walk_is_the_brute_force_one() {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let (mut x, tris) = stacked(4e-3);
-        let term = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
+        let term = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
         let mut seen_active = 0;
         for step in 0..60 {
             let drift = Vector3::new(
@@ -1051,9 +1014,33 @@ mod tests {
                 .collect();
             let alpha = (0.9 * term.max_step(&x, &dx)).min(1.0);
             x.iter_mut().zip(&dx).for_each(|(p, d)| *p += d * alpha);
-            let mut active = Vec::new();
-            term.each_active(&x, |idx, d, _| active.push((idx, d)));
+            let set = term.contact_set(&x);
+            let mut active: Vec<([usize; 4], f64)> = set
+                .pairs
+                .iter()
+                .map(|p| (p.vertices, p.distance_m))
+                .collect();
             active.sort_by_key(|a| a.0);
+            // The barrier on the set is the energy and gradient a fresh term measures at x.
+            let fresh = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+            let (e, e_fresh) = (term.energy_of(&set, &x), fresh.energy(&x));
+            assert!(
+                (e - e_fresh).abs() <= 1e-12 * e.abs(),
+                "step {step}: {e} {e_fresh}"
+            );
+            let (mut g, mut g_fresh) = (
+                vec![Vector3::zeros(); x.len()],
+                vec![Vector3::zeros(); x.len()],
+            );
+            term.add_gradient_of(&set, &x, &mut g);
+            fresh.add_gradient(&x, &mut g_fresh);
+            let scale = g_fresh.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            let miss = g
+                .iter()
+                .zip(&g_fresh)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            assert!(miss <= 1e-12 * scale, "step {step}: {miss:e} of {scale:e}");
             let topo = term.topology();
             let mut brute: Vec<([usize; 4], f64)> =
                 crate::proximity::brute_force_pairs(topo, &x, term.activation_m())
