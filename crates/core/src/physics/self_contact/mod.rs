@@ -129,8 +129,7 @@ impl SelfContact {
     /// (0 at the thickness, 1 at the edge of the band), or None with no pair in range: what a
     /// static solve watches to adapt κ.
     pub fn closest_gap_rel(&self, x: &Vecs) -> Option<f64> {
-        let mut closest = f64::INFINITY;
-        self.each_active(x, |_, d, _| closest = closest.min(d - self.thickness_m));
+        let closest = self.with_active(x, ContactSet::min_distance_m) - self.thickness_m;
         closest.is_finite().then_some(closest / self.band_m)
     }
 
@@ -142,26 +141,6 @@ impl SelfContact {
     /// The mesh's primitives.
     pub fn topology(&self) -> &MeshTopology {
         &self.topo
-    }
-
-    /// Calls `f(vertices, distance, coefficients)` for every candidate pair within the activation
-    /// distance at `x`.
-    fn each_active(&self, x: &Vecs, mut f: impl FnMut([usize; 4], f64, [f64; 4])) {
-        self.each_active_pair(x, |idx, d, coef, _| f(idx, d, coef));
-    }
-
-    /// [`Self::each_active`] with whether the pair is point–triangle (else edge–edge).
-    fn each_active_pair(&self, x: &Vecs, mut f: impl FnMut([usize; 4], f64, [f64; 4], bool)) {
-        self.with_active(x, |set| {
-            for p in &set.pairs {
-                f(
-                    p.vertices,
-                    p.distance_m,
-                    p.coefficients,
-                    p.is_point_triangle(),
-                );
-            }
-        });
     }
 
     /// `f` of the contact set at `x`, measured once per state (the cache serves energy, gradient
@@ -287,8 +266,7 @@ impl SelfContact {
             false
         });
         let min_distance_m = f64::from_bits(least.into_inner());
-        let mut active_pairs = 0;
-        self.each_active(x, |_, _, _| active_pairs += 1);
+        let active_pairs = self.with_active(x, ContactSet::len);
         let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
         SelfContactState {
             min_distance_m,
@@ -351,14 +329,14 @@ impl EnergyTerm for SelfContact {
             [a, b, c] => [*a, *b, *c * self.kappa_growth()],
             _ => return false,
         };
-        let set = self.contact_set(x);
-        self.add_pair_forces(&set, (x, g), |gap| {
+        let along = |gap| {
             let (b, db, d2b) = barrier(gap, self.band_m);
             let (db_dband, ddb) = barrier_band_derivatives(gap, self.band_m);
             let slope = dkappa * db + self.kappa_J * (ddb * dband - d2b * dxi);
             let value = dkappa * b + self.kappa_J * (db_dband * dband - db * dxi);
             (slope, value)
-        });
+        };
+        self.with_active(x, |set| self.add_pair_forces(set, (x, g), along));
         true
     }
     fn coefficient_energy(&self, x: &Vecs, dc: &[f64]) -> Option<f64> {
@@ -366,12 +344,12 @@ impl EnergyTerm for SelfContact {
             [a, b, c] => [*a, *b, *c * self.kappa_growth()],
             _ => return None,
         };
-        let set = self.contact_set(x);
-        Some(self.sum_pairs(&set, x, |gap| {
+        let value = |gap| {
             let (b, db, _) = barrier(gap, self.band_m);
             let db_dband = barrier_band_derivatives(gap, self.band_m).0;
             dkappa * b + self.kappa_J * (db_dband * dband - db * dxi)
-        }))
+        };
+        Some(self.with_active(x, |set| self.sum_pairs(set, x, value)))
     }
 }
 
@@ -832,10 +810,12 @@ mod tests {
         assert_eq!(term.energy(&inside), f64::INFINITY);
         // Mollified pairs are there and active.
         let (y, _) = turned(xi + 0.3 * band, 0.01, SHIFT);
-        let mut mollified = 0;
-        term.each_active_pair(&y, |idx, _, _, pt| {
-            mollified += usize::from(term.mollifier(pt, &idx.map(|k| y[k])).is_some());
-        });
+        let mollified = (term.contact_set(&y).pairs.iter())
+            .filter(|p| {
+                let corners = p.vertices.map(|k| y[k]);
+                term.mollifier(p.is_point_triangle(), &corners).is_some()
+            })
+            .count();
         assert!(mollified >= 4, "{mollified}");
     }
 
