@@ -6,6 +6,7 @@ mod assembly;
 mod barrier;
 mod bending;
 mod body_edges;
+mod contacts;
 mod curl;
 mod friction;
 mod hessian_mode;
@@ -26,6 +27,7 @@ pub use bending::{
     CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,
 };
 pub use body_edges::BodyEdgeBarrier;
+pub use contacts::Contacts;
 pub use curl::{Curl, CurlKernel, hinge_curl};
 pub use friction::{FrictionAnchor, FrictionKernel, LaggedFriction};
 pub use hessian_mode::{HessianMode, PairCurvature};
@@ -38,7 +40,9 @@ pub use mesh_bending::{
 };
 pub use obstacle_barrier::{ObstacleBarrier, max_penetration_m};
 pub use patch_bending::{patch_bending, reads_creases};
-pub use self_contact::{CandidateSet, SelfContact, SelfContactState};
+pub use self_contact::{
+    CandidateSet, ContactPair, ContactSet, PairKind, SelfContact, SelfContactState,
+};
 pub use shear::{CellShear, ShearKernel};
 pub use springs::{SpringFamily, SpringKernel, Springs};
 
@@ -265,74 +269,20 @@ impl Model {
     pub fn is_empty(&self) -> bool {
         self.masses.is_empty()
     }
-    /// Total potential energy in J, external loads scaled by `load` (1 = full load).
+    /// Total potential energy in J, external loads scaled by `load` (1 = full load), with the
+    /// contact set measured at `x` ([`Model::energy_on`]).
     pub fn energy(&self, x: &Vecs, load: f64) -> f64 {
-        self.terms
-            .iter()
-            .map(|t| {
-                if t.is_external_load() {
-                    load * t.energy(x)
-                } else {
-                    t.energy(x)
-                }
-            })
-            .sum()
+        self.energy_on(x, &self.contacts(x), load)
     }
-    /// Gradient of the total energy (N) into `g` (overwritten), external loads scaled by `load`.
+    /// Gradient of the total energy (N) into `g` (overwritten), external loads scaled by `load`,
+    /// with the contact set measured at `x` ([`Model::gradient_on`]).
     pub fn gradient(&self, x: &Vecs, load: f64, g: &mut Vec<Vector3<f64>>) {
-        g.clear();
-        g.resize(x.len(), Vector3::zeros());
-        let mut gl = Vec::new();
-        for t in &self.terms {
-            if t.is_external_load() && load != 1.0 {
-                gl.clear();
-                gl.resize(x.len(), Vector3::zeros());
-                t.add_gradient(x, &mut gl);
-                for (a, b) in g.iter_mut().zip(&gl) {
-                    *a += b * load;
-                }
-            } else {
-                t.add_gradient(x, g);
-            }
-        }
+        self.gradient_on(x, &self.contacts(x), load, g);
     }
-    /// Hessian blocks of the total energy into `h` (cleared first), as `mode` asks
-    /// ([`HessianMode`]). The exact one assembles every term afresh; the others take the constant
-    /// terms' blocks computed once.
+    /// Hessian blocks of the total energy into `h` (cleared first), as `mode` asks, with the
+    /// contact set measured at `x` ([`Model::hessian_on`]).
     pub fn hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
-        h.clear();
-        if mode == HessianMode::Exact {
-            for t in &self.terms {
-                t.add_hessian(x, h, mode);
-            }
-            return;
-        }
-        h.constant = self
-            .constant_hessian
-            .get_or_init(|| {
-                let mut c = HessianBlocks::default();
-                for t in self.terms.iter().filter(|t| t.hessian_is_constant()) {
-                    t.add_hessian(x, &mut c, HessianMode::NEWTON);
-                }
-                (!c.pairs.is_empty()).then(|| Arc::new(c))
-            })
-            .clone();
-        for t in self.terms.iter().filter(|t| !t.hessian_is_constant()) {
-            t.add_hessian(x, h, mode);
-        }
-    }
-    /// The closest self-contact pair's gap beyond the thickness at `x`, relative to the band
-    /// ([`SelfContact::closest_gap_rel`]; infinity when no pair is in range or the model has no
-    /// self-contact).
-    pub fn closest_gap_rel(&self, x: &Vecs) -> f64 {
-        self.self_contact_term()
-            .and_then(|t| t.closest_gap_rel(x))
-            .unwrap_or(f64::INFINITY)
-    }
-    /// [`SelfContact::stiffen_barrier`]: true when κ grew (the energy changed).
-    pub fn stiffen_barriers(&mut self, x: &Vecs) -> bool {
-        self.self_contact_term_mut()
-            .is_some_and(|t| t.stiffen_barrier(x))
+        self.hessian_on(x, &self.contacts(x), h, mode);
     }
     /// The largest fraction of the step `dx` that every contact term allows ([`StepBound`]).
     pub fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {

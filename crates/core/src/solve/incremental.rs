@@ -256,7 +256,8 @@ pub(super) fn step(
             };
         }
         // Barriers stiffened where layers press (the factor then no longer serves the next step).
-        if model.stiffen_barriers(x) {
+        let contacts = model.contacts(x);
+        if model.stiffen_barriers(&contacts) {
             *carried = None;
         }
         // The step grows with Newton's factorizing iterations (its cost); chord and Krylov steps

@@ -17,7 +17,7 @@ use super::static_options::StaticOptions;
 use super::step::{Iteration, Workspace};
 use super::warm::NeighbourFactor;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
-use crate::physics::{HessianBlocks, HessianMode, Model, PairCurvature};
+use crate::physics::{Contacts, HessianBlocks, HessianMode, Model, PairCurvature};
 use nalgebra::Vector3;
 use std::time::Instant;
 
@@ -124,7 +124,7 @@ impl NewtonRun {
     ) -> bool {
         self.load = load;
         let w_ref = model.reference_weight();
-        let e = model.energy(x, load);
+        let e = self.ws.enter(model, x, load);
         let mut stage = Stage {
             run: self,
             model,
@@ -177,7 +177,7 @@ impl super::executor::Iterative for Stage<'_> {
 
     fn terminate(&mut self, observer: &mut dyn Observer) -> Option<Verdict> {
         let ws = &mut self.run.ws;
-        self.model.gradient(self.x, self.load, &mut ws.g);
+        ws.gradient_here(self.model, self.x, self.load);
         let (r, tol) = (self.model.max_residual(&ws.g), self.tol);
         self.r = r;
         if !r.is_finite() || !self.e.is_finite() {
@@ -225,7 +225,7 @@ impl super::executor::Iterative for Stage<'_> {
         );
         if taken != Iteration::Stepped {
             // No step lowers the energy: near the solution, round-off.
-            model.gradient(x, load, &mut run.ws.g);
+            run.ws.gradient_here(model, x, load);
             let r = model.max_residual(&run.ws.g);
             if r <= self.tol && self.last {
                 return Err(Verdict::Reached(Some(StopReason::Converged), None));
@@ -236,8 +236,9 @@ impl super::executor::Iterative for Stage<'_> {
             );
             return Err(Verdict::Stopped(StopReason::LineSearch, message));
         }
-        if adapt_kappa(self.model, self.x, self.opts, &mut run.last_gap_rel) {
-            self.e = self.model.energy(self.x, load);
+        let contacts = &run.ws.contacts;
+        if adapt_kappa(self.model, contacts, self.opts, &mut run.last_gap_rel) {
+            self.e = self.model.energy_on(self.x, contacts, load);
         }
         let strain = self.model.max_strain(self.x);
         if strain > self.opts.strain_bound {
@@ -257,22 +258,23 @@ impl super::executor::Iterative for Stage<'_> {
     }
 }
 
-/// Doubles the barriers' κ after an accepted step that left the closest barrier pair within
+/// Doubles the barriers' κ after an accepted step whose state's contact set (`contacts`) has the
+/// closest barrier pair within
 /// [`StaticOptions::kappa_adapt_gap_rel`] of its band and closer than the step before did
 /// (`last_gap_rel`, updated; IPC's adaptive κ): true when the energy changed.
 fn adapt_kappa(
     model: &mut Model,
-    x: &[Vector3<f64>],
+    contacts: &Contacts,
     opts: &StaticOptions,
     last_gap_rel: &mut f64,
 ) -> bool {
     if opts.kappa_adapt_gap_rel <= 0.0 {
         return false;
     }
-    let gap = model.closest_gap_rel(x);
+    let gap = model.closest_gap_rel(contacts);
     let closing = gap < opts.kappa_adapt_gap_rel && gap < *last_gap_rel;
     *last_gap_rel = gap;
-    closing && model.stiffen_barriers(x)
+    closing && model.stiffen_barriers(contacts)
 }
 
 /// Hands Newton iterate `iter` (residual `r` N, energy `e` J) to `observer` when it wants it.

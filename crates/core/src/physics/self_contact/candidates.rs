@@ -1,6 +1,6 @@
-//! Self-contact's candidate set (ipc-toolkit's collision set as data): the broad phase's pairs, the
-//! region each vertex may move in while the list stays complete, the active pairs measured once per
-//! state, and a set handed from a solved neighbour to a new model.
+//! Self-contact's candidate set (ipc-toolkit's candidates as data): the broad phase's pairs and the
+//! region each vertex may move in while the list stays complete, and a set handed from a solved
+//! neighbour to a new model.
 
 use super::SelfContact;
 use crate::physics::Vecs;
@@ -10,8 +10,12 @@ use crate::proximity::{
 };
 use nalgebra::Vector3;
 
+/// The broad phase's candidate list: the pairs that could come within the activation distance
+/// while every vertex stays in the region the list covers (its box, or a step's sweep), with each
+/// pair's gap at the state the list was built at. It says which pairs may be near, never an
+/// energy's value: the contact set is measured from it at each state the solve evaluates.
 #[derive(Default, Clone)]
-pub(super) struct Cache {
+pub(super) struct CandidateList {
     /// Per particle, the box its vertex may move in while `pairs` stays complete.
     pub(super) region: Vec<Aabb>,
     pub(super) pairs: Vec<Pair>,
@@ -26,14 +30,9 @@ pub(super) struct Cache {
     pub(super) sweep: Option<Sweep>,
     pub(super) broad_phases: usize,
     pub(super) time_s: f64,
-    /// The active pairs (vertices, distance, coefficients) at `active_at` for the activation
-    /// distance `active_m`: energy, gradient and Hessian at one state measure them once.
-    pub(super) active: super::ContactSet,
-    pub(super) active_at: Vec<Vector3<f64>>,
-    pub(super) active_m: f64,
 }
 
-impl Cache {
+impl CandidateList {
     /// Each vertex's distance from the list's anchor, into `moved`.
     pub(super) fn measure_moves(&mut self, x: &Vecs) {
         self.moved.clear();
@@ -45,7 +44,7 @@ impl Cache {
     }
 
     /// A lower bound on what is left of `pair`'s `gap` (its distance beyond the activation
-    /// distance at the anchor) after the moves [`Cache::measure_moves`] took: vertices moved by at
+    /// distance at the anchor) after the moves [`CandidateList::measure_moves`] took: vertices moved by at
     /// most δ move a primitive's every point by at most the largest δ (its points are convex
     /// combinations of them), so the distance falls by at most δ_A + δ_B.
     pub(super) fn gap_left(&self, topo: &MeshTopology, pair: Pair, gap: f64) -> f64 {
@@ -163,17 +162,17 @@ pub struct CandidateSet {
     pub(super) activation_m: f64,
     /// Vertices and triangles of the mesh it was built on.
     pub(super) size: (usize, usize),
-    pub(super) cache: Cache,
+    pub(super) list: CandidateList,
 }
 
 impl SelfContact {
     /// The candidate set at hand, when a broad phase has run.
     pub fn candidates(&self) -> Option<CandidateSet> {
-        let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        let c = self.list.lock().unwrap_or_else(|e| e.into_inner());
         c.valid.then(|| CandidateSet {
             activation_m: self.activation_m(),
             size: (c.region.len(), self.topo.triangles.len()),
-            cache: Cache {
+            list: CandidateList {
                 moved: Vec::new(),
                 broad_phases: 0,
                 time_s: 0.0,
@@ -185,7 +184,7 @@ impl SelfContact {
     /// Takes `set` as this term's candidate set where it was built for the same mesh and
     /// activation distance (true); else leaves the term as it is (false).
     pub fn seed(&self, set: &CandidateSet) -> bool {
-        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
         let fits = set.activation_m == self.activation_m()
             && set.size.1 == self.topo.triangles.len()
             && self
@@ -195,10 +194,10 @@ impl SelfContact {
                 .all(|&v| (v as usize) < set.size.0);
         if fits {
             let (phases, time) = (c.broad_phases, c.time_s);
-            *c = Cache {
+            *c = CandidateList {
                 broad_phases: phases,
                 time_s: time,
-                ..set.cache.clone()
+                ..set.list.clone()
             };
         }
         fits
@@ -208,7 +207,7 @@ impl SelfContact {
     /// vertex would leave its box or the state its sweep. A step longer than the margin gets a
     /// list for its sweep ([`Sweep`]; with the last one's direction where that was swept from the
     /// same state: a curved step's chord after its tangent); else each vertex's box.
-    pub(super) fn ensure(&self, c: &mut Cache, x: &Vecs, dx: Option<&Vecs>) {
+    pub(super) fn ensure(&self, c: &mut CandidateList, x: &Vecs, dx: Option<&Vecs>) {
         let reach = |v: usize| {
             let b = Aabb::point(&x[v]);
             dx.map_or(b, |d| b.union(&Aabb::point(&(x[v] + d[v]))))
@@ -252,7 +251,7 @@ impl SelfContact {
     /// The broad phase for the sweep from `x` along `dirs` ([`Sweep`]): each vertex's box holds
     /// its sweep less each direction's median over the mesh (distances do not change when the
     /// sheet moves as a whole), grown by the slack.
-    fn sweep_phase(&self, c: &mut Cache, x: &Vecs, dirs: Vec<Vec<Vector3<f64>>>) {
+    fn sweep_phase(&self, c: &mut CandidateList, x: &Vecs, dirs: Vec<Vec<Vector3<f64>>>) {
         let vertices = &self.topo.vertices;
         let median = |d: &Vecs| {
             Vector3::from_fn(|k, _| {
@@ -291,7 +290,7 @@ impl SelfContact {
     }
 
     /// The list's gaps at `x`, its anchor.
-    fn anchor_list(&self, c: &mut Cache, x: &Vecs) {
+    fn anchor_list(&self, c: &mut CandidateList, x: &Vecs) {
         let (topo, act) = (&self.topo, self.activation_m());
         c.gaps = c
             .pairs
@@ -308,7 +307,12 @@ impl SelfContact {
 
     /// The broad phase at `x`: each vertex's box is `reach(v)` grown by the margin, and the list keeps
     /// the pairs that could come within the activation distance anywhere inside their boxes.
-    pub(super) fn broad_phase(&self, c: &mut Cache, x: &Vecs, reach: impl Fn(usize) -> Aabb) {
+    pub(super) fn broad_phase(
+        &self,
+        c: &mut CandidateList,
+        x: &Vecs,
+        reach: impl Fn(usize) -> Aabb,
+    ) {
         c.region = vec![Aabb::point(&Vector3::zeros()); x.len()];
         for &v in &self.topo.vertices {
             c.region[v as usize] = reach(v as usize).inflate(self.margin_m);
@@ -339,14 +343,14 @@ impl SelfContact {
     /// (m) from it (and the margin beyond): a start anywhere in that reach begins without a broad
     /// phase. A calibration lattice node gives it for the reach of its tangent predictions.
     pub fn candidates_covering(&self, x: &Vecs, spread: &[f64]) -> CandidateSet {
-        let mut c = Cache::default();
+        let mut c = CandidateList::default();
         self.broad_phase(&mut c, x, |v| {
             Aabb::point(&x[v]).inflate(spread.get(v).copied().unwrap_or(0.0))
         });
         CandidateSet {
             activation_m: self.activation_m(),
             size: (c.region.len(), self.topo.triangles.len()),
-            cache: Cache {
+            list: CandidateList {
                 broad_phases: 0,
                 ..c
             },
@@ -356,9 +360,13 @@ impl SelfContact {
 
 impl SelfContact {
     /// The blocks between the two primitives of every candidate pair within the margin of range
-    /// at the last measured state, as hints ([`HessianBlocks::hints`]).
-    pub(super) fn hint_near(&self, h: &mut crate::physics::HessianBlocks) {
-        let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+    /// at `x`, as hints ([`HessianBlocks::hints`]).
+    pub(super) fn hint_near(&self, x: &Vecs, h: &mut crate::physics::HessianBlocks) {
+        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
+        if c.anchor.len() != x.len() {
+            return;
+        }
+        c.measure_moves(x);
         for (&pair, &gap) in c.pairs.iter().zip(&c.gaps) {
             if c.gap_left(&self.topo, pair, gap) >= self.margin_m {
                 continue;

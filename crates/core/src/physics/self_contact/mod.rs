@@ -24,7 +24,7 @@ use super::{EnergyTerm, HessianBlocks, HessianMode, StepBound, Vecs};
 use crate::proximity::{
     Aabb, MeshTopology, additive_ccd, candidate_pairs, pair_distance, relative_motion,
 };
-use candidates::Cache;
+use candidates::CandidateList;
 pub use candidates::CandidateSet;
 pub use contact_set::{ContactPair, ContactSet, PairKind};
 use nalgebra::Vector3;
@@ -63,7 +63,7 @@ pub struct SelfContact {
     margin_m: f64,
     /// The longest vertex move checked with one broad phase, m: four of the longest rest edge.
     piece_m: f64,
-    cache: Mutex<Cache>,
+    list: Mutex<CandidateList>,
 }
 
 impl SelfContact {
@@ -102,7 +102,7 @@ impl SelfContact {
             kappa_limit_J: KAPPA_GROWTH_LIMIT * kappa_J,
             margin_m,
             piece_m: (4.0 * longest).max(margin_m),
-            cache: Mutex::new(Cache::default()),
+            list: Mutex::new(CandidateList::default()),
         }
     }
 
@@ -110,26 +110,27 @@ impl SelfContact {
     /// (incremental potential contact's adaptive κ, Li et al. 2020): at a gap where κ b′ balances
     /// a force F the barrier's curvature is about F²/(κ d̂²), so stacked layers that press a pair
     /// nanometres from its limit leave Newton a nearly singular system until κ grows. Doubles κ
-    /// when the closest active pair's gap beyond the thickness is under [`STIFFEN_GAP`] of the
-    /// band, up to [`KAPPA_GROWTH_LIMIT`] times its start; true when it did. Called between the
-    /// steps of a dynamic solve and after closing steps of a static one
-    /// ([`crate::solve::StaticOptions::kappa_adapt_gap_rel`]).
-    pub fn stiffen_barrier(&mut self, x: &Vecs) -> bool {
+    /// when the closest pair of `set` (the contact set at the solve's state) has a gap beyond the
+    /// thickness under [`STIFFEN_GAP`] of the band, up to [`KAPPA_GROWTH_LIMIT`] times its start;
+    /// true when it did. Called between the steps of a dynamic solve and after closing steps of a
+    /// static one ([`crate::solve::StaticOptions::kappa_adapt_gap_rel`]). The set stays valid: κ
+    /// scales the barrier, not its activation distance.
+    pub fn stiffen_barrier(&mut self, set: &ContactSet) -> bool {
         if self.kappa_J * 2.0 > self.kappa_limit_J {
             return false;
         }
-        let closest = self.closest_gap_rel(x).unwrap_or(f64::INFINITY);
+        let closest = self.closest_gap_rel(set).unwrap_or(f64::INFINITY);
         let pressed = closest < STIFFEN_GAP;
         if pressed {
             self.kappa_J *= 2.0;
         }
         pressed
     }
-    /// The smallest gap of an active pair beyond the thickness at `x`, as a fraction of the band
-    /// (0 at the thickness, 1 at the edge of the band), or None with no pair in range: what a
-    /// static solve watches to adapt κ.
-    pub fn closest_gap_rel(&self, x: &Vecs) -> Option<f64> {
-        let closest = self.with_active(x, ContactSet::min_distance_m) - self.thickness_m;
+    /// The smallest gap of a pair of `set` beyond the thickness, as a fraction of the band (0 at
+    /// the thickness, 1 at the edge of the band), or None with no pair in range: what a static
+    /// solve watches to adapt κ.
+    pub fn closest_gap_rel(&self, set: &ContactSet) -> Option<f64> {
+        let closest = set.min_distance_m() - self.thickness_m;
         closest.is_finite().then_some(closest / self.band_m)
     }
 
@@ -143,34 +144,17 @@ impl SelfContact {
         &self.topo
     }
 
-    /// `f` of the contact set at `x`, measured once per state (the cache serves energy, gradient
-    /// and Hessian at one state from one narrow phase).
-    fn with_active<R>(&self, x: &Vecs, f: impl FnOnce(&ContactSet) -> R) -> R {
-        let start = Instant::now();
-        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        let act = self.activation_m();
-        if c.active_m != act || c.active_at.as_slice() != x {
-            self.measure_active(&mut c, x);
-        }
-        let out = f(&c.active);
-        c.time_s += start.elapsed().as_secs_f64();
-        out
-    }
-
     /// The contact set at `x`: every pair of primitives sharing no vertex within the activation
     /// distance ξ + d̂, from the candidate set's narrow phase (a broad phase first where `x` left
-    /// the region the candidate list covers).
+    /// the region the candidate list covers). Measured afresh at every call: the solve builds one
+    /// per state and hands it to [`SelfContact::energy_of`] and the rest.
     pub fn contact_set(&self, x: &Vecs) -> ContactSet {
-        self.with_active(x, ContactSet::clone)
-    }
-
-    /// The candidate pairs within the activation distance at `x`, into the cache's active list.
-    fn measure_active(&self, c: &mut Cache, x: &Vecs) {
-        self.ensure(c, x, None);
-        let act = self.activation_m();
+        let start = Instant::now();
+        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
+        self.ensure(&mut c, x, None);
         c.measure_moves(x);
-        let mut active = std::mem::take(&mut c.active);
-        active.pairs.clear();
+        let act = self.activation_m();
+        let mut set = ContactSet::default();
         for (&pair, &gap) in c.pairs.iter().zip(c.gaps.iter()) {
             // A pair whose gap still exceeds its vertices' moves is out of range, unmeasured.
             if c.gap_left(&self.topo, pair, gap) >= 0.0 {
@@ -184,7 +168,7 @@ impl SelfContact {
                     true => PairKind::PointTriangle,
                     false => PairKind::EdgeEdge,
                 };
-                active.pairs.push(ContactPair {
+                set.pairs.push(ContactPair {
                     kind,
                     vertices: idx,
                     distance_m: d,
@@ -192,10 +176,8 @@ impl SelfContact {
                 });
             }
         }
-        c.active = active;
-        c.active_at.clear();
-        c.active_at.extend_from_slice(x);
-        c.active_m = act;
+        c.time_s += start.elapsed().as_secs_f64();
+        set
     }
 
     /// The first impact time in (0, 1] of the candidate pairs moving from `x` by `seg`
@@ -204,7 +186,7 @@ impl SelfContact {
     /// the list's anchor less its vertices' moves since, so (1 − 0.1)(d − ξ)/l > 1 holds without
     /// measuring d. The same result, without the distance computations that were a quarter of a
     /// settling implicit run's time (issue 47).
-    fn piece_impact(&self, c: &mut Cache, x: &Vecs, seg: &Vecs) -> f64 {
+    fn piece_impact(&self, c: &mut CandidateList, x: &Vecs, seg: &Vecs) -> f64 {
         const SHARE: f64 = 0.1;
         c.measure_moves(x);
         let act = self.activation_m();
@@ -266,8 +248,8 @@ impl SelfContact {
             false
         });
         let min_distance_m = f64::from_bits(least.into_inner());
-        let active_pairs = self.with_active(x, ContactSet::len);
-        let c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        let active_pairs = self.contact_set(x).len();
+        let c = self.list.lock().unwrap_or_else(|e| e.into_inner());
         SelfContactState {
             min_distance_m,
             kappa_J: self.kappa_J,
@@ -290,20 +272,17 @@ impl EnergyTerm for SelfContact {
     fn name(&self) -> String {
         "contact/self".into()
     }
+    /// [`SelfContact::energy_of`] the contact set measured at `x`.
     fn energy(&self, x: &Vecs) -> f64 {
-        self.with_active(x, |set| self.energy_of(set, x))
+        self.energy_of(&self.contact_set(x), x)
     }
+    /// [`SelfContact::add_gradient_of`] the contact set measured at `x`.
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
-        self.with_active(x, |set| self.add_gradient_of(set, x, g));
+        self.add_gradient_of(&self.contact_set(x), x, g);
     }
-    /// The barrier's Hessian over the pairs at `x` as `mode` asks ([`SelfContact::add_hessian_of`]),
-    /// then zero blocks for the candidate pairs near range (a factor's pattern that holds over the
-    /// next steps), except for the exact Hessian of derivatives.
+    /// [`SelfContact::add_hessian_with_hints`] of the contact set measured at `x`.
     fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
-        self.with_active(x, |set| self.add_hessian_of(set, x, h, mode));
-        if mode != HessianMode::Exact {
-            self.hint_near(h);
-        }
+        self.add_hessian_with_hints(&self.contact_set(x), x, h, mode);
     }
     fn step_bound(&self) -> Option<&dyn StepBound> {
         Some(self)
@@ -320,7 +299,7 @@ impl EnergyTerm for SelfContact {
         self.kappa_J = c[2] * growth;
         self.kappa_limit_J = KAPPA_GROWTH_LIMIT * c[2];
         // The activation distance moved: the candidate list is rebuilt for it.
-        self.cache.lock().unwrap_or_else(|e| e.into_inner()).valid = false;
+        self.list.lock().unwrap_or_else(|e| e.into_inner()).valid = false;
     }
     /// Analytic in all three: κ ∂b′/∂c ∇d per pair, with ∂b′/∂ξ = −b″ and ∂b′/∂d̂ from
     /// [`barrier_band_derivatives`].
@@ -336,7 +315,7 @@ impl EnergyTerm for SelfContact {
             let value = dkappa * b + self.kappa_J * (db_dband * dband - db * dxi);
             (slope, value)
         };
-        self.with_active(x, |set| self.add_pair_forces(set, (x, g), along));
+        self.add_pair_forces(&self.contact_set(x), (x, g), along);
         true
     }
     fn coefficient_energy(&self, x: &Vecs, dc: &[f64]) -> Option<f64> {
@@ -349,7 +328,7 @@ impl EnergyTerm for SelfContact {
             let db_dband = barrier_band_derivatives(gap, self.band_m).0;
             dkappa * b + self.kappa_J * (db_dband * dband - db * dxi)
         };
-        Some(self.with_active(x, |set| self.sum_pairs(set, x, value)))
+        Some(self.sum_pairs(&self.contact_set(x), x, value))
     }
 }
 
@@ -360,7 +339,7 @@ impl StepBound for SelfContact {
     /// impact gives the bound.
     fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
         let start = Instant::now();
-        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
         let longest = self
             .topo
             .vertices
@@ -488,6 +467,7 @@ mod tests {
         let (held, _) = flat(xi + 0.2 * band);
         let mut term = SelfContact::new(tris, &held, xi, band, 1e-3);
         let k0 = term.kappa_J;
+        let (held, pressed) = (term.contact_set(&held), term.contact_set(&pressed));
         assert!(!term.stiffen_barrier(&held));
         assert_eq!(term.kappa_J, k0);
         assert!(term.stiffen_barrier(&pressed));
@@ -660,7 +640,7 @@ mod tests {
         assert!(seeded.seed(&set));
         let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 2e-3);
         assert_measures_alike(&seeded, &fresh, &y);
-        let phases = seeded.cache.lock().expect("cache").broad_phases;
+        let phases = seeded.list.lock().expect("candidate list").broad_phases;
         assert_eq!(phases, 0, "the seeded list covered the move");
         // A set built for another activation distance does not fit.
         let thicker = SelfContact::new(tris, &x, 6e-4, 1e-3, 1e-3);
@@ -680,12 +660,12 @@ mod tests {
         assert!(seeded.seed(&set));
         let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 1e-3);
         assert_measures_alike(&seeded, &fresh, &y);
-        assert_eq!(seeded.cache.lock().expect("cache").broad_phases, 0);
+        assert_eq!(seeded.list.lock().expect("candidate list").broad_phases, 0);
         // Without the spread the same move needs a broad phase of its own.
         let narrow = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
         assert!(narrow.seed(&node.candidates_covering(&x, &[0.0; 18])));
         assert_eq!(narrow.energy(&y), fresh.energy(&y));
-        assert_eq!(narrow.cache.lock().expect("cache").broad_phases, 1);
+        assert_eq!(narrow.list.lock().expect("candidate list").broad_phases, 1);
     }
 
     #[test]
@@ -724,7 +704,7 @@ mod tests {
         assert_eq!(bound, want);
         {
             // Only pairs across the layers: within a layer nothing moves relative to anything.
-            let c = term.cache.lock().expect("cache");
+            let c = term.list.lock().expect("candidate list");
             assert!(c.sweep.is_some() && !c.pairs.is_empty());
             let across = |p: &Pair| {
                 let idx = p.vertices(topo);
@@ -746,7 +726,7 @@ mod tests {
             &SelfContact::new(tris, &at(bound), 5e-4, 1e-3, 1e-3),
             &at(bound),
         );
-        assert_eq!(term.cache.lock().expect("cache").broad_phases, 1);
+        assert_eq!(term.list.lock().expect("candidate list").broad_phases, 1);
     }
 
     /// Two flat 3 × 3 layers `gap` apart, the upper one shifted by `shift` along x and turned by
@@ -942,7 +922,7 @@ mod tests {
                 .map(|p| Vector3::new(f(p), f(p + 5), f(p + 11) - 0.5) * size)
                 .collect();
             let bound = term.max_step(&y, &dx);
-            let c = term.cache.lock().expect("cache");
+            let c = term.list.lock().expect("candidate list");
             let every = c
                 .pairs
                 .iter()

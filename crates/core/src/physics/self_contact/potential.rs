@@ -103,6 +103,22 @@ impl SelfContact {
         }
     }
 
+    /// [`SelfContact::add_hessian_of`], then zero blocks for the candidate pairs near range at `x`
+    /// (a factor's pattern that holds over the next steps), except for the exact Hessian of
+    /// derivatives.
+    pub fn add_hessian_with_hints(
+        &self,
+        set: &ContactSet,
+        x: &Vecs,
+        h: &mut HessianBlocks,
+        mode: HessianMode,
+    ) {
+        self.add_hessian_of(set, x, h, mode);
+        if mode != HessianMode::Exact {
+            self.hint_near(x, h);
+        }
+    }
+
     /// The barrier's energy over the pairs of `set` at `x`, J: Σ κ m b(d − ξ).
     pub fn energy_of(&self, set: &ContactSet, x: &Vecs) -> f64 {
         self.sum_pairs(set, x, |gap| self.kappa_J * barrier(gap, self.band_m).0)

@@ -103,13 +103,14 @@ impl Workspace {
         self.spd.factorize(&self.dofs, &self.h, &self.shift)
     }
 
-    /// The Hessian at `x` into `h`, projected or not: a new matrix to assemble.
+    /// The Hessian at `x` (the run's current state, its contact set at hand) into `h`, projected
+    /// or not: a new matrix to assemble.
     pub(super) fn hessian(&mut self, model: &Model, x: &[Vector3<f64>], kind: Hessian) {
         let mode = match kind {
             Hessian::Projected => HessianMode::Projected,
             Hessian::Exact => HessianMode::Newton(self.pairs),
         };
-        model.hessian(x, &mut self.h, mode);
+        model.hessian_on(x, &self.contacts, &mut self.h, mode);
         self.assembled = false;
     }
 

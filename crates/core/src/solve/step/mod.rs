@@ -16,7 +16,7 @@ use super::strategy::{
     Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Verdict,
 };
 use super::{Globalization, SolveReport};
-use crate::physics::{HessianBlocks, HessianMode, Model, PairCurvature};
+use crate::physics::{Contacts, HessianBlocks, HessianMode, Model, PairCurvature};
 use nalgebra::Vector3;
 
 /// (first DOF, component) of every held component of the free particles.
@@ -136,6 +136,10 @@ pub(super) struct Workspace {
     /// The constant part of the Hessian and its free diagonal's trace (summed once per model:
     /// summing its blocks at every iteration was 6 % of a Cusick drape's solve).
     constant_trace: Option<(std::sync::Arc<HessianBlocks>, f64)>,
+    /// The contact set at the run's current state, built by the run: at its start
+    /// ([`Workspace::enter`]) and with every step it accepts (the accepted trial's set), so that
+    /// gradient and Hessian at a state use the set its energy was measured with.
+    pub(super) contacts: Contacts,
 }
 
 /// Conjugate-gradient iterations of one Newton step with a neighbour's factor before the step
@@ -243,7 +247,19 @@ impl Workspace {
             krylov: false,
             assembled: false,
             constant_trace: None,
+            contacts: Contacts::default(),
         }
+    }
+
+    /// Enters the state `x` (a stage's start): its contact set, and its energy at `load`, J.
+    pub(super) fn enter(&mut self, model: &Model, x: &[Vector3<f64>], load: f64) -> f64 {
+        self.contacts = model.contacts(x);
+        model.energy_on(x, &self.contacts, load)
+    }
+
+    /// The gradient at the current state `x` into `g`, with its contact set.
+    pub(super) fn gradient_here(&mut self, model: &Model, x: &[Vector3<f64>], load: f64) {
+        model.gradient_on(x, &self.contacts, load, &mut self.g);
     }
 
     /// The Newton step −(H + μD)⁻¹ g into `dx` (zero on fixed particles and held components), and
@@ -331,19 +347,25 @@ impl Workspace {
             acc,
             stats,
             parts,
+            contacts,
             ..
         } = self;
         let trial = std::cell::RefCell::new(trial);
+        // The last trial's contact set: the accepted state's, once the search returns.
+        let at_trial = std::cell::RefCell::new(Contacts::default());
         let energy_at = |alpha: f64| {
             let half = 0.5 * alpha * alpha;
             let mut t = trial.borrow_mut();
             for (p, xp) in x.iter().enumerate() {
                 t[p] = xp + dx[p] * alpha + acc[p] * half;
             }
-            model.energy(&t[..], load)
+            let contacts = model.contacts(&t[..]);
+            let et = model.energy_on(&t[..], &contacts, load);
+            *at_trial.borrow_mut() = contacts;
+            et
         };
         let lowers_residual = || {
-            model.gradient(&trial.borrow()[..], load, g_trial);
+            model.gradient_on(&trial.borrow()[..], &at_trial.borrow(), load, g_trial);
             model.max_residual(g_trial) < r
         };
         let found = parts.search.search(
@@ -355,6 +377,7 @@ impl Workspace {
         );
         let (alpha, et) = found?;
         x.copy_from_slice(&trial.borrow()[..]);
+        *contacts = at_trial.into_inner();
         *e = et;
         Some(alpha)
     }
@@ -467,3 +490,6 @@ impl Workspace {
         s.projected_steps += usize::from(projected);
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -117,12 +117,14 @@ impl Workspace {
         for (p, xp) in x.iter().enumerate() {
             self.trial[p] = xp + self.dx[p];
         }
-        let et = model.energy(&self.trial, load);
+        let contacts = model.contacts(&self.trial);
+        let et = model.energy_on(&self.trial, &contacts, load);
         if self.parts.search.condition.verdict(*e, et, 1.0, slope) == Verdict::Reject {
             self.stats.rejected_trials += 1;
             return false;
         }
         x.copy_from_slice(&self.trial);
+        self.contacts = contacts;
         *e = et;
         self.stats.full_steps += 1;
         self.stats.chord_steps += 1;
