@@ -5,8 +5,7 @@
 use super::SelfContact;
 use crate::physics::Vecs;
 use crate::proximity::{
-    Aabb, MeshTopology, Pair, candidate_pairs, pair_distance, pair_distance_lower_bound,
-    relative_motion,
+    Aabb, MeshTopology, Pair, pair_distance, pair_distance_lower_bound, relative_motion,
 };
 use nalgebra::Vector3;
 
@@ -274,16 +273,18 @@ impl SelfContact {
             .collect();
         let act = self.activation_m();
         let topo = &self.topo;
-        c.pairs = candidate_pairs(topo, &boxes, 0.5 * act, |pair| {
-            let (idx, pt) = (pair.vertices(topo), pair.is_point_triangle());
-            let reach = dirs
-                .iter()
-                .map(|d| relative_motion(pt, &idx.map(|k| d[k])).1)
-                .fold(0.0, f64::max);
-            let at = idx.map(|k| x[k]);
-            pair_distance_lower_bound(pt, &at) - reach - 2.0 * slack < act
-                && pair_distance(pt, &at).0 - reach - 2.0 * slack < act
-        });
+        c.pairs = self
+            .broad_phase
+            .candidate_pairs(topo, &boxes, 0.5 * act, &|pair| {
+                let (idx, pt) = (pair.vertices(topo), pair.is_point_triangle());
+                let reach = dirs
+                    .iter()
+                    .map(|d| relative_motion(pt, &idx.map(|k| d[k])).1)
+                    .fold(0.0, f64::max);
+                let at = idx.map(|k| x[k]);
+                pair_distance_lower_bound(pt, &at) - reach - 2.0 * slack < act
+                    && pair_distance(pt, &at).0 - reach - 2.0 * slack < act
+            });
         self.anchor_list(c, x);
         c.region.clear();
         c.sweep = Some(Sweep::new(dirs, slack, vertices));
@@ -329,12 +330,14 @@ impl SelfContact {
             .collect();
         let act = self.activation_m();
         let topo = &self.topo;
-        c.pairs = candidate_pairs(topo, &c.region, 0.5 * act, |pair| {
-            let (idx, pt) = (pair.vertices(topo), pair.is_point_triangle());
-            let (at, reach) = (idx.map(|k| x[k]), farthest(pair, &idx, &rho));
-            pair_distance_lower_bound(pt, &at) - reach < act
-                && pair_distance(pt, &at).0 - reach < act
-        });
+        c.pairs = self
+            .broad_phase
+            .candidate_pairs(topo, &c.region, 0.5 * act, &|pair| {
+                let (idx, pt) = (pair.vertices(topo), pair.is_point_triangle());
+                let (at, reach) = (idx.map(|k| x[k]), farthest(pair, &idx, &rho));
+                pair_distance_lower_bound(pt, &at) - reach < act
+                    && pair_distance(pt, &at).0 - reach < act
+            });
         self.anchor_list(c, x);
         c.sweep = None;
     }

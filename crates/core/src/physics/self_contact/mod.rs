@@ -9,7 +9,7 @@
 //! continuous collision detection so that no pair comes closer than ξ + 10 % of its gap along it: a
 //! line search that keeps the energy finite can never carry the sheet through itself.
 //!
-//! The broad phase (a spatial hash, [`candidate_pairs`]) is rebuilt only when the sheet leaves the
+//! The broad phase (a swappable [`BroadPhase`], the spatial hash by default) is rebuilt only when the sheet leaves the
 //! region its candidate list covers: each vertex's box, swept along the step and grown by a margin of
 //! a quarter of the shortest edge. On a smooth sheet no pair of non-adjacent primitives is within
 //! reach, the list is empty, and the term costs a comparison of positions with boxes.
@@ -22,7 +22,7 @@ mod potential;
 use super::barrier::{barrier, barrier_band_derivatives};
 use super::{EnergyTerm, HessianBlocks, HessianMode, StepBound, Vecs};
 use crate::proximity::{
-    Aabb, MeshTopology, additive_ccd, candidate_pairs, pair_distance, relative_motion,
+    Aabb, BroadPhase, HashGrid, MeshTopology, additive_ccd, pair_distance, relative_motion,
 };
 use candidates::CandidateList;
 pub use candidates::CandidateSet;
@@ -63,6 +63,9 @@ pub struct SelfContact {
     margin_m: f64,
     /// The longest vertex move checked with one broad phase, m: four of the longest rest edge.
     piece_m: f64,
+    /// The broad phase that builds the candidate list ([`HashGrid`] unless set by
+    /// [`SelfContact::with_broad_phase`]).
+    broad_phase: Box<dyn BroadPhase>,
     list: Mutex<CandidateList>,
 }
 
@@ -102,8 +105,15 @@ impl SelfContact {
             kappa_limit_J: KAPPA_GROWTH_LIMIT * kappa_J,
             margin_m,
             piece_m: (4.0 * longest).max(margin_m),
+            broad_phase: Box::new(HashGrid),
             list: Mutex::new(CandidateList::default()),
         }
+    }
+
+    /// The term with `broad_phase` building its candidate lists (the same pairs, another cost).
+    pub fn with_broad_phase(mut self, broad_phase: Box<dyn BroadPhase>) -> Self {
+        self.broad_phase = broad_phase;
+        self
     }
 
     /// Raises κ where a pair has been pressed to within a small fraction of its band
@@ -241,12 +251,14 @@ impl SelfContact {
         let boxes: Vec<Aabb> = x.iter().map(Aabb::point).collect();
         // Distances are non-negative, so their bits order as they do (an atomic minimum).
         let least = std::sync::atomic::AtomicU64::new(f64::INFINITY.to_bits());
-        candidate_pairs(&self.topo, &boxes, 0.5 * longest, |p| {
-            let idx = p.vertices(&self.topo);
-            let d = pair_distance(p.is_point_triangle(), &idx.map(|k| x[k])).0;
-            least.fetch_min(d.to_bits(), std::sync::atomic::Ordering::Relaxed);
-            false
-        });
+        let topo = &self.topo;
+        self.broad_phase
+            .candidate_pairs(topo, &boxes, 0.5 * longest, &|p| {
+                let idx = p.vertices(&self.topo);
+                let d = pair_distance(p.is_point_triangle(), &idx.map(|k| x[k])).0;
+                least.fetch_min(d.to_bits(), std::sync::atomic::Ordering::Relaxed);
+                false
+            });
         let min_distance_m = f64::from_bits(least.into_inner());
         let active_pairs = self.contact_set(x).len();
         let c = self.list.lock().unwrap_or_else(|e| e.into_inner());
@@ -959,6 +971,9 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let (mut x, tris) = stacked(4e-3);
         let term = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        // The same walk's term with the other broad phase: another candidate list, the same set.
+        let tree = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3)
+            .with_broad_phase(Box::new(crate::proximity::Hierarchy));
         let mut seen_active = 0;
         for step in 0..60 {
             let drift = Vector3::new(
@@ -973,8 +988,14 @@ mod tests {
                 })
                 .collect();
             let alpha = (0.9 * term.max_step(&x, &dx)).min(1.0);
+            assert_eq!(
+                tree.max_step(&x, &dx),
+                term.max_step(&x, &dx),
+                "step {step}"
+            );
             x.iter_mut().zip(&dx).for_each(|(p, d)| *p += d * alpha);
             let set = term.contact_set(&x);
+            assert_eq!(tree.contact_set(&x), set, "step {step}");
             let mut active: Vec<([usize; 4], f64)> = set
                 .pairs
                 .iter()
