@@ -38,12 +38,12 @@ impl BroadPhase for HashGrid {
     }
 }
 
-/// Hierarchies over the triangles' and the edges' boxes, built per call
-/// ([`candidate_pairs_bvh`]).
+/// Hierarchies ([`Bvh`]) over the triangles' and the edges' boxes, built per call.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Hierarchy;
 
 impl BroadPhase for Hierarchy {
+    /// Each vertex's box queried in the triangles' hierarchy and each edge's in the edges'.
     fn candidate_pairs(
         &self,
         topo: &MeshTopology,
@@ -51,7 +51,38 @@ impl BroadPhase for Hierarchy {
         r: f64,
         keep: &(dyn Fn(Pair) -> bool + Sync),
     ) -> Vec<Pair> {
-        candidate_pairs_bvh(topo, vbox, r, keep)
+        let (tboxes, eboxes) = primitive_boxes(topo, vbox, r);
+        let (tris, edges) = (Bvh::build(tboxes), Bvh::build(eboxes));
+        let point_triangle = topo.vertices.par_iter().flat_map_iter(|&v| {
+            let mut out = Vec::new();
+            tris.query(&vbox[v as usize].inflate(r), |t| {
+                let pair = Pair::PointTriangle(v, t);
+                if !topo.triangles[t as usize].contains(&v) && keep(pair) {
+                    out.push(pair);
+                }
+            });
+            out
+        });
+        let edge_edge = (0..topo.edges.len() as u32)
+            .into_par_iter()
+            .flat_map_iter(|a| {
+                let ea = topo.edges[a as usize];
+                let mut out = Vec::new();
+                edges.query(&edges.boxes[a as usize], |b| {
+                    let eb = topo.edges[b as usize];
+                    if b > a && !ea.iter().any(|v| eb.contains(v)) {
+                        let pair = Pair::EdgeEdge(a, b);
+                        if keep(pair) {
+                            out.push(pair);
+                        }
+                    }
+                });
+                out
+            });
+        let mut pairs: Vec<Pair> = point_triangle.chain(edge_edge).collect();
+        pairs.sort_unstable();
+        pairs.dedup();
+        pairs
     }
 }
 
@@ -153,49 +184,6 @@ impl Bvh {
             }
         }
     }
-}
-
-/// [`super::candidate_pairs`] by hierarchies over the triangles' and the edges' boxes: every pair
-/// of primitives that share no vertex, whose boxes (the union of their vertices' boxes `vbox` grown
-/// by `r`) overlap and that `keep` accepts. Sorted, without duplicates: the same list.
-pub fn candidate_pairs_bvh(
-    topo: &MeshTopology,
-    vbox: &[Aabb],
-    r: f64,
-    keep: impl Fn(Pair) -> bool + Sync,
-) -> Vec<Pair> {
-    let (tboxes, eboxes) = primitive_boxes(topo, vbox, r);
-    let (tris, edges) = (Bvh::build(tboxes), Bvh::build(eboxes));
-    let point_triangle = topo.vertices.par_iter().flat_map_iter(|&v| {
-        let mut out = Vec::new();
-        tris.query(&vbox[v as usize].inflate(r), |t| {
-            let pair = Pair::PointTriangle(v, t);
-            if !topo.triangles[t as usize].contains(&v) && keep(pair) {
-                out.push(pair);
-            }
-        });
-        out
-    });
-    let edge_edge = (0..topo.edges.len() as u32)
-        .into_par_iter()
-        .flat_map_iter(|a| {
-            let ea = topo.edges[a as usize];
-            let mut out = Vec::new();
-            edges.query(&edges.boxes[a as usize], |b| {
-                let eb = topo.edges[b as usize];
-                if b > a && !ea.iter().any(|v| eb.contains(v)) {
-                    let pair = Pair::EdgeEdge(a, b);
-                    if keep(pair) {
-                        out.push(pair);
-                    }
-                }
-            });
-            out
-        });
-    let mut pairs: Vec<Pair> = point_triangle.chain(edge_edge).collect();
-    pairs.sort_unstable();
-    pairs.dedup();
-    pairs
 }
 
 #[cfg(test)]
