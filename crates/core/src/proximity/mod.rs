@@ -14,7 +14,7 @@ mod curvature;
 pub use bounds::{BOUND_SHARE, bounded_fraction, brute_force_pairs, pairs_within, vertex_bounds};
 pub use broad_phase::{Aabb, candidate_pairs};
 use broad_phase::{for_each_cell, hash_entries, owner_bucket, primitive_boxes};
-pub use bvh::{BroadPhase, Bvh, HashGrid, Hierarchy};
+pub use bvh::{BroadPhase, HashGrid, Hierarchy};
 pub use curvature::{Mat12, Vec12, edge_edge_mollifier_hessian, pair_distance_hessian};
 
 type V3 = Vector3<f64>;

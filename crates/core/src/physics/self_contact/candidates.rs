@@ -43,9 +43,9 @@ impl CandidateList {
     }
 
     /// A lower bound on what is left of `pair`'s `gap` (its distance beyond the activation
-    /// distance at the anchor) after the moves [`CandidateList::measure_moves`] took: vertices moved by at
-    /// most δ move a primitive's every point by at most the largest δ (its points are convex
-    /// combinations of them), so the distance falls by at most δ_A + δ_B.
+    /// distance at the anchor) after the moves [`CandidateList::measure_moves`] took: vertices
+    /// moved by at most δ move a primitive's every point by at most the largest δ (its points are
+    /// convex combinations of them), so the distance falls by at most δ_A + δ_B.
     pub(super) fn gap_left(&self, topo: &MeshTopology, pair: Pair, gap: f64) -> f64 {
         gap - farthest(pair, &pair.vertices(topo), &self.moved)
     }

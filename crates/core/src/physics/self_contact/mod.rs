@@ -9,10 +9,11 @@
 //! continuous collision detection so that no pair comes closer than ξ + 10 % of its gap along it: a
 //! line search that keeps the energy finite can never carry the sheet through itself.
 //!
-//! The broad phase (a swappable [`BroadPhase`], the spatial hash by default) is rebuilt only when the sheet leaves the
-//! region its candidate list covers: each vertex's box, swept along the step and grown by a margin of
-//! a quarter of the shortest edge. On a smooth sheet no pair of non-adjacent primitives is within
-//! reach, the list is empty, and the term costs a comparison of positions with boxes.
+//! The broad phase (a swappable [`BroadPhase`], the spatial hash by default) is rebuilt only when
+//! the sheet leaves the region its candidate list covers: each vertex's box, swept along the step
+//! and grown by a margin of a quarter of the shortest edge. On a smooth sheet no pair of
+//! non-adjacent primitives is within reach, the list is empty, and the term costs a comparison of
+//! positions with boxes.
 
 mod candidates;
 mod contact_set;
