@@ -88,7 +88,7 @@ impl LatticeDrape {
                     .collect();
                 sol.model.candidates_covering(&sol.x, &spread)
             }
-            None => sol.model.candidates(),
+            None => sol.model.candidates_covering(&sol.x, &[]),
         };
         Some(Self {
             factor,

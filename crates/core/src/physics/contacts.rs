@@ -1,10 +1,11 @@
 //! The contact data of a state, built by the solve and handed to the model's energy and
 //! derivatives (ipc-toolkit's `Collisions`, built by the caller and passed to its
-//! `BarrierPotential`): a solve measures the contact set once per state it evaluates, and nothing
-//! in a term remembers positions. The obstacle barriers need no set: each particle's distance to
-//! an analytic obstacle is a function of its own position.
+//! `BarrierPotential`): a solve measures the contact set once per state it evaluates, from the
+//! broad phase's [`CandidateSet`] it carries from state to state, and nothing in a term remembers
+//! positions. The obstacle barriers need no set: each particle's distance to an analytic obstacle
+//! is a function of its own position.
 
-use super::self_contact::ContactSet;
+use super::self_contact::{CandidateSet, ContactSet};
 use super::{EnergyTerm, HessianBlocks, HessianMode, Model, SelfContact, Vecs};
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -38,11 +39,35 @@ fn on_set<'a>(
 }
 
 impl Model {
-    /// The contact set at `x` (the self-contact term's narrow phase over its candidate list).
-    pub fn contacts(&self, x: &Vecs) -> Contacts {
+    /// The contact set at `x`, from the narrow phase over `candidates` (the solve's candidate set,
+    /// rebuilt by a broad phase where `x` left the region it covers).
+    pub fn contacts_with(&self, x: &Vecs, candidates: &mut CandidateSet) -> Contacts {
         Contacts {
-            self_pairs: self.self_contact_term().map(|t| t.contact_set(x)),
+            self_pairs: self
+                .self_contact_term()
+                .map(|t| t.contact_set(x, candidates)),
         }
+    }
+
+    /// The contact set at `x` with a candidate set of its own (a broad phase at `x`): for a
+    /// single evaluation; a solve carries its [`CandidateSet`] ([`Model::contacts_with`]).
+    pub fn contacts(&self, x: &Vecs) -> Contacts {
+        self.contacts_with(x, &mut CandidateSet::default())
+    }
+
+    /// The largest fraction of the step `dx` from `x` that every contact term allows
+    /// ([`super::StepBound`]), the self-contact term's over `candidates` (the solve's set, made to
+    /// cover the step).
+    pub fn max_step_with(&self, x: &Vecs, dx: &Vecs, candidates: &mut CandidateSet) -> f64 {
+        let mut bound = f64::INFINITY;
+        for t in &self.terms {
+            let b = match t.as_any().downcast_ref::<SelfContact>() {
+                Some(s) => s.max_step_with(x, dx, candidates),
+                None => t.step_bound().map_or(f64::INFINITY, |b| b.max_step(x, dx)),
+            };
+            bound = bound.min(b);
+        }
+        bound
     }
 
     /// Total potential energy in J at `x` with the contact set `contacts` built there, external

@@ -284,13 +284,10 @@ impl Model {
     pub fn hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
         self.hessian_on(x, &self.contacts(x), h, mode);
     }
-    /// The largest fraction of the step `dx` that every contact term allows ([`StepBound`]).
+    /// The largest fraction of the step `dx` that every contact term allows ([`StepBound`]), with
+    /// a candidate set of its own ([`Model::max_step_with`] is a solve's).
     pub fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
-        self.terms
-            .iter()
-            .filter_map(|t| t.step_bound())
-            .map(|b| b.max_step(x, dx))
-            .fold(f64::INFINITY, f64::min)
+        self.max_step_with(x, dx, &mut CandidateSet::default())
     }
     /// Largest residual force on a free particle in N, from the gradient.
     pub fn max_residual(&self, g: &Vecs) -> f64 {
@@ -370,20 +367,11 @@ impl Model {
     pub fn term_names(&self) -> Vec<String> {
         self.terms.iter().map(|t| t.name()).collect()
     }
-    /// The candidate set of the model's self-contact, when it has one and a broad phase ran.
-    pub fn candidates(&self) -> Option<CandidateSet> {
-        self.self_contact_term().and_then(SelfContact::candidates)
-    }
     /// The candidate set of the model's self-contact at `x`, valid while each vertex v stays within
     /// `spread[v]` (m) of it; None without self-contact.
     pub fn candidates_covering(&self, x: &Vecs, spread: &[f64]) -> Option<CandidateSet> {
         self.self_contact_term()
             .map(|t| t.candidates_covering(x, spread))
-    }
-    /// Seeds the model's self-contact with `set` from a model solved nearby (on the same mesh);
-    /// true when the term took it.
-    pub fn seed_candidates(&self, set: &CandidateSet) -> bool {
-        self.self_contact_term().is_some_and(|t| t.seed(set))
     }
 }
 

@@ -254,14 +254,18 @@ fn solve_built(
         mut model,
         x0: mut x,
     } = build_scene(scene);
-    if let Some(set) = warm.candidates {
-        model.seed_candidates(set);
-    }
+    // The starts are scored over the neighbour's candidate set (no broad phase where it covers
+    // them), which the solve then carries on.
+    let mut candidates = warm.candidates.cloned().unwrap_or_default();
     let opts = opts.unwrap_or(&scene.solver.static_);
+    let mut energy = |s: &[Vector3<f64>]| {
+        let contacts = model.contacts_with(s, &mut candidates);
+        model.energy_on(s, &contacts, 1.0)
+    };
     let mut scored = starts
         .iter()
         .filter(|s| s.len() == x.len())
-        .map(|s| (model.energy(s, 1.0), *s));
+        .map(|s| (energy(s), *s));
     let start = match choice {
         Choice::FirstFinite => scored.find(|(e, _)| e.is_finite()),
         Choice::Lowest => scored
@@ -269,6 +273,10 @@ fn solve_built(
             .min_by(|a, b| a.0.total_cmp(&b.0)),
     }
     .map(|(_, s)| s);
+    let warm = WarmData {
+        candidates: Some(&candidates),
+        ..warm
+    };
     let report = match start {
         Some(x0) => {
             x.copy_from_slice(x0);

@@ -10,7 +10,7 @@ use super::executor::{Budget, Verdict};
 use super::newton::{Goal, NewtonRun};
 use super::warm::WarmData;
 use super::{NoObserver, Observer, Part, SolveReport, StaticOptions, StopReason};
-use crate::physics::Model;
+use crate::physics::{CandidateSet, Model};
 use nalgebra::Vector3;
 
 /// What a continuation does next.
@@ -87,6 +87,7 @@ pub fn execute(
         observer,
         total: None,
         run: None,
+        candidates: warm.candidates.cloned().unwrap_or_default(),
         solved: false,
         next: (1.0, Goal::Tolerance),
         stages: 0,
@@ -116,6 +117,8 @@ struct Staged<'a> {
     total: Option<SolveReport>,
     /// The run an increment leaves open for the next stage.
     run: Option<NewtonRun>,
+    /// The candidate set the last closed run ended with (or the neighbour's): the next run's.
+    candidates: CandidateSet,
     /// Whether a stage has reached its goal.
     solved: bool,
     /// The next stage's load factor and goal.
@@ -127,7 +130,9 @@ impl Staged<'_> {
     /// Ends the open run, if any, and merges its report into the total.
     fn close(&mut self) {
         if let Some(r) = self.run.take() {
-            self.total = Some(merged(self.total.take(), r.finish(self.model, self.x)));
+            let (report, candidates) = r.finish(self.model, self.x);
+            self.candidates = candidates;
+            self.total = Some(merged(self.total.take(), report));
         }
     }
 }
@@ -168,7 +173,12 @@ impl super::executor::Iterative for Staged<'_> {
         let (load, goal) = self.next;
         let mut current = match self.run.take() {
             Some(r) => r,
-            None => match NewtonRun::new(self.model, self.x, self.opts, self.warm.factor) {
+            None => match NewtonRun::new(
+                self.model,
+                self.x,
+                self.opts,
+                (self.warm.factor, std::mem::take(&mut self.candidates)),
+            ) {
                 Ok(r) => r,
                 Err(invalid) => {
                     self.total = Some(merged(self.total.take(), *invalid));

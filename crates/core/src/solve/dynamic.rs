@@ -21,7 +21,7 @@ use super::kind::Integrator;
 use super::stability::{kinetic_energy, stability_limit_dt};
 use super::time_step::Stepper;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
-use crate::physics::Model;
+use crate::physics::{Contacts, Model};
 use nalgebra::Vector3;
 use std::time::Instant;
 
@@ -67,6 +67,7 @@ pub fn solve_dynamic(
         v,
         limits,
         g: Vec::with_capacity(n),
+        contacts: Contacts::default(),
         check: opts.check_every.max(1),
         step: 0,
         cg_tol_rel: opts.cg_tol_rel,
@@ -289,13 +290,13 @@ impl Limits {
     fn observe(
         &self,
         model: &Model,
-        x: &[Vector3<f64>],
+        (x, contacts): (&[Vector3<f64>], &Contacts),
         v: &[Vector3<f64>],
         g: &[Vector3<f64>],
         step: usize,
         observer: &mut dyn Observer,
     ) -> Option<(Stop, String)> {
-        let etot = model.energy(x, 1.0) + kinetic_energy(model, v);
+        let etot = model.energy_on(x, contacts, 1.0) + kinetic_energy(model, v);
         self.event(observer, x, (step, model.max_residual(g), etot))
     }
 
@@ -304,7 +305,7 @@ impl Limits {
     fn check(
         &self,
         model: &Model,
-        x: &[Vector3<f64>],
+        (x, contacts): (&[Vector3<f64>], &Contacts),
         v: &[Vector3<f64>],
         g: &[Vector3<f64>],
         step: usize,
@@ -313,7 +314,7 @@ impl Limits {
         let dt = self.dt;
         let r = model.max_residual(g);
         let vmax = v.iter().map(|vi| vi.norm()).fold(0.0, f64::max);
-        let etot = model.energy(x, 1.0) + kinetic_energy(model, v);
+        let etot = model.energy_on(x, contacts, 1.0) + kinetic_energy(model, v);
         let time = step as f64 * dt;
         if let Some(obs) = observer
             && let Some(failed) = self.event(obs, x, (step, r, etot))
@@ -365,6 +366,8 @@ struct ExplicitRun<'a, 'r> {
     stepper: Stepper,
     /// The gradient at the current state.
     g: Vec<Vector3<f64>>,
+    /// The contact set at the current state.
+    contacts: Contacts,
     /// The stopping criteria are checked every `check` steps.
     check: usize,
     step: usize,
@@ -383,13 +386,15 @@ impl super::executor::Iterative for ExplicitRun<'_, '_> {
     fn terminate(&mut self, observer: &mut dyn Observer) -> Option<Verdict> {
         let (model, x, v, step) = (self.model, &*self.x, &*self.v, self.step);
         let want = observer.wants(step);
-        model.gradient(x, 1.0, &mut self.g);
+        self.contacts = self.stepper.contacts(model, x);
+        model.gradient_on(x, &self.contacts, 1.0, &mut self.g);
+        let at = (x, &self.contacts);
         let g = &self.g;
         let stop = if step.is_multiple_of(self.check) || step == self.limits.max_steps {
             self.limits
-                .check(model, x, v, g, step, want.then_some(observer))
+                .check(model, at, v, g, step, want.then_some(observer))
         } else if want {
-            self.limits.observe(model, x, v, g, step, observer)
+            self.limits.observe(model, at, v, g, step, observer)
         } else {
             None
         };
@@ -409,8 +414,8 @@ impl super::executor::Iterative for ExplicitRun<'_, '_> {
     fn next_iter(&mut self) -> Result<(), Verdict> {
         let (model, g) = (self.model, &self.g);
         let tol = self.cg_tol_rel;
-        self.stepper
-            .step(model, self.x, self.v, g, tol, self.report);
+        let at = (&mut *self.x, &self.contacts);
+        self.stepper.step(model, at, self.v, g, tol, self.report);
         self.step += 1;
         if self.stepper.cut_steps > 0 && self.integrator != Integrator::BaraffWitkin {
             let message = format!(

@@ -4,10 +4,9 @@
 
 use super::clock::{Clock, grown};
 use super::executor::{Budget, Verdict};
-use super::incremental::{Attempt, ImplicitSettings, step};
-use super::warm::NeighbourFactor;
+use super::incremental::{Attempt, Carried, ImplicitSettings, step};
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, StopReason};
-use crate::physics::Model;
+use crate::physics::{Contacts, Model};
 use nalgebra::Vector3;
 
 /// What a settled (or stopped) integration is checked against, and where it stands.
@@ -49,7 +48,7 @@ pub fn integrate_implicit(
         h: s.dt_s,
         cooldown: 0,
         g: Vec::new(),
-        carried: None,
+        carried: Carried::default(),
         clock: Clock::default(),
         r: f64::NAN,
         pending: None,
@@ -83,8 +82,9 @@ struct ImplicitRun<'a> {
     /// Steps left before the step may grow again after a rejected one.
     cooldown: usize,
     g: Vec<Vector3<f64>>,
-    /// The last step's factor, the next step's preconditioner.
-    carried: Option<NeighbourFactor>,
+    /// The last step's factor (the next step's preconditioner) and the candidate set contact is
+    /// measured over.
+    carried: Carried,
     clock: Clock,
     /// The largest residual force at the current state, N.
     r: f64,
@@ -99,14 +99,21 @@ impl super::executor::Iterative for ImplicitRun<'_> {
     }
 
     fn terminate(&mut self, observer: &mut dyn Observer) -> Option<Verdict> {
+        let contacts = (self.model).contacts_with(self.x, &mut self.carried.candidates);
         if let Some((steps, t, r, at_frame)) = self.pending.take()
             && (at_frame || (self.frame_s.is_none() && observer.wants(steps)))
-            && let Err(e) = observe_state(observer, self.model, self.x, self.v, (steps, t, r))
+            && let Err(e) = observe_state(
+                observer,
+                (self.model, &contacts),
+                self.x,
+                self.v,
+                (steps, t, r),
+            )
         {
             let message = format!("an observer failed at t = {t:.4} s: {e:#}");
             return Some(Verdict::Stopped(StopReason::Observer, message));
         }
-        self.model.gradient(self.x, 1.0, &mut self.g);
+        (self.model).gradient_on(self.x, &contacts, 1.0, &mut self.g);
         let r = self.model.max_residual(&self.g);
         self.r = r;
         let speed = self.v.iter().map(|p| p.norm()).fold(0.0, f64::max);
@@ -208,10 +215,10 @@ fn settled(
 }
 
 /// Hands the state after step `steps` (time `t`, residual `r` N) to `observer`, with its total
-/// (potential and kinetic) energy.
+/// (potential and kinetic) energy (`contacts` the contact set at `x`).
 fn observe_state(
     observer: &mut dyn Observer,
-    model: &Model,
+    (model, contacts): (&Model, &Contacts),
     x: &[Vector3<f64>],
     v: &[Vector3<f64>],
     (steps, t, r): (usize, f64, f64),
@@ -221,7 +228,7 @@ fn observe_state(
         time_s: Some(t),
         x,
         max_residual_N: r,
-        energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
+        energy_J: model.energy_on(x, contacts, 1.0) + super::kinetic_energy(model, v),
     })
 }
 

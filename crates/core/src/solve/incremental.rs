@@ -14,7 +14,9 @@ use super::FactorReuse;
 use super::clock::StepBounds;
 use super::static_options::StaticOptions;
 use super::{DivergenceReason, SolveReport};
-use crate::physics::{EnergyTerm, HessianBlocks, HessianMode, Model, PairCurvature, Vecs};
+use crate::physics::{
+    CandidateSet, Contacts, EnergyTerm, HessianBlocks, HessianMode, Model, PairCurvature, Vecs,
+};
 use nalgebra::{Matrix3, Vector3};
 
 /// The inertia and damping part of the incremental potential: Σ w_p/2 |x_p − c_p|² (the two
@@ -28,11 +30,12 @@ pub struct Inertia {
 }
 
 impl Inertia {
-    /// The term for a step of `h` s from (`x_n`, `v_n`), particle damping `c` (N·s/m), Rayleigh
-    /// `alpha` (1/s) and `beta` (s); fixed particles get no weight.
+    /// The term for a step of `h` s from (`x_n`, `v_n`) (`contacts` the contact set at `x_n`),
+    /// particle damping `c` (N·s/m), Rayleigh `alpha` (1/s) and `beta` (s); fixed particles get no
+    /// weight.
     pub fn new(
         model: &Model,
-        x_n: &[Vector3<f64>],
+        (x_n, contacts): (&[Vector3<f64>], &Contacts),
         v_n: &[Vector3<f64>],
         h: f64,
         (c, alpha, beta): (f64, f64, f64),
@@ -55,7 +58,7 @@ impl Inertia {
         }
         let stiffness = (beta > 0.0).then(|| {
             let mut k = HessianBlocks::default();
-            model.hessian(x_n, &mut k, HessianMode::Projected);
+            model.hessian_on(x_n, contacts, &mut k, HessianMode::Projected);
             (k, beta / h)
         });
         Self {
@@ -203,6 +206,14 @@ fn step_options(model: &Model, x: &[Vector3<f64>], s: &ImplicitSettings) -> Stat
     }
 }
 
+/// What one implicit step hands the next: its factor (the next step's preconditioner) and the
+/// broad phase's candidate set its contact is measured over.
+#[derive(Default)]
+pub(super) struct Carried {
+    pub(super) factor: Option<super::NeighbourFactor>,
+    pub(super) candidates: CandidateSet,
+}
+
 /// One step of `h` from (`x`, `v`), both updated on success; `work` gets the report's counters.
 pub(super) fn step(
     model: &mut Model,
@@ -210,23 +221,27 @@ pub(super) fn step(
     v: &mut [Vector3<f64>],
     h: f64,
     s: &ImplicitSettings,
-    carried: &mut Option<super::NeighbourFactor>,
+    carried: &mut Carried,
     report: &mut SolveReport,
 ) -> Attempt {
     let x_n = x.to_vec();
-    let term = Inertia::new(model, &x_n, v, h, s.damping);
+    let at_n = model.contacts_with(&x_n, &mut carried.candidates);
+    let term = Inertia::new(model, (&x_n, &at_n), v, h, s.damping);
     // Start from the inertial prediction xₙ + h vₙ (as far along it as contact allows) or from xₙ,
     // whichever has the lower incremental potential: long steps of an overdamped sheet overshoot
     // their prediction by far.
     let dx: Vec<Vector3<f64>> = v.iter().map(|vp| vp * h).collect();
-    let alpha = model.max_step(&x_n, &dx).min(1.0);
+    let alpha = model
+        .max_step_with(&x_n, &dx, &mut carried.candidates)
+        .min(1.0);
     for p in 0..x.len() {
         if !model.fixed[p] {
             x[p] = x_n[p] + dx[p] * alpha;
         }
     }
     model.terms.push(Box::new(term));
-    if model.energy(&x_n, 1.0) < model.energy(x, 1.0) {
+    let predicted = model.contacts_with(x, &mut carried.candidates);
+    if model.energy_on(&x_n, &at_n, 1.0) < model.energy_on(x, &predicted, 1.0) {
         x.copy_from_slice(&x_n);
     }
     let opts = step_options(model, x, s);
@@ -234,17 +249,15 @@ pub(super) fn step(
     // step of a settling sheet changes its Hessian little, and the factorizations were most of
     // a step's cost (issue 47's stress box: 29,608 of them in 3,539 steps of one run).
     // Only where factors are reused at all (`"chord"`, the default).
-    let last = carried
-        .take()
-        .filter(|_| s.factor_reuse == FactorReuse::Chord);
+    let last = (carried.factor.take()).filter(|_| s.factor_reuse == FactorReuse::Chord);
     let (r, factor) = super::newton::solve_static_keeping_factor(
         model,
         x,
         &opts,
-        last.as_ref(),
+        (last.as_ref(), &mut carried.candidates),
         PairCurvature::Pinned,
     );
-    *carried = factor;
+    carried.factor = factor;
     model.terms.pop();
     report.merge(&r, super::Part::InnerSolve);
     if r.is_converged() && x.iter().all(|p| p.iter().all(|c| c.is_finite())) {
@@ -256,9 +269,9 @@ pub(super) fn step(
             };
         }
         // Barriers stiffened where layers press (the factor then no longer serves the next step).
-        let contacts = model.contacts(x);
+        let contacts = model.contacts_with(x, &mut carried.candidates);
         if model.stiffen_barriers(&contacts) {
-            *carried = None;
+            carried.factor = None;
         }
         // The step grows with Newton's factorizing iterations (its cost); chord and Krylov steps
         // are cheap.

@@ -17,21 +17,23 @@ use super::static_options::StaticOptions;
 use super::step::{Iteration, Workspace};
 use super::warm::NeighbourFactor;
 use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
-use crate::physics::{Contacts, HessianBlocks, HessianMode, Model, PairCurvature};
+use crate::physics::{CandidateSet, Contacts, HessianBlocks, HessianMode, Model, PairCurvature};
 use nalgebra::Vector3;
 use std::time::Instant;
 
 /// [`super::solve_static_loads`] at full load that also hands back the run's last factor when it
 /// converged: the preconditioner of the next solve of a nearby model ([`NeighbourFactor`]), as the
-/// next step of implicit Euler is.
+/// next step of implicit Euler is. The run measures contact over `candidates` and leaves there
+/// the candidate set it ends with, for the next solve.
 pub fn solve_static_keeping_factor(
     model: &mut Model,
     x: &mut [Vector3<f64>],
     opts: &StaticOptions,
-    factor: Option<&NeighbourFactor>,
+    (factor, candidates): (Option<&NeighbourFactor>, &mut CandidateSet),
     pairs: PairCurvature,
 ) -> (SolveReport, Option<NeighbourFactor>) {
-    let mut run = match NewtonRun::new(model, x, opts, factor) {
+    let carried = std::mem::take(candidates);
+    let mut run = match NewtonRun::new(model, x, opts, (factor, carried)) {
         Ok(r) => r.with_pairs(pairs),
         Err(invalid) => return (*invalid, None),
     };
@@ -44,7 +46,9 @@ pub fn solve_static_keeping_factor(
     );
     let factor = (reached && run.ws.spd.has_factor())
         .then(|| NeighbourFactor(std::sync::Arc::new(run.ws.spd.copy())));
-    (run.finish(model, x), factor)
+    let (report, left) = run.finish(model, x);
+    *candidates = left;
+    (report, factor)
 }
 
 /// How far a stage of a Newton run solves.
@@ -76,15 +80,16 @@ pub(super) struct NewtonRun {
 }
 
 impl NewtonRun {
-    /// A run of `model` from `x`; the report of an invalid one (no free particle with mass).
+    /// A run of `model` from `x`, with a neighbour's `factor` and the candidate set it starts
+    /// measuring contact over; the report of an invalid one (no free particle with mass).
     pub(super) fn new(
         model: &Model,
         x: &[Vector3<f64>],
         opts: &StaticOptions,
-        factor: Option<&NeighbourFactor>,
+        start: (Option<&NeighbourFactor>, CandidateSet),
     ) -> Result<Self, Box<SolveReport>> {
         let mut report = SolveReport::unsolved(super::SolverKind::Static);
-        let ws = Workspace::new(model, x, opts, factor);
+        let ws = Workspace::new(model, x, opts, start);
         if ws.dofs.n == 0 || !model.reference_weight().is_finite() {
             report.stop_with(
                 StopReason::Invalid,
@@ -142,11 +147,16 @@ impl NewtonRun {
         super::executor::conclude(verdict, self.iter, &mut self.report)
     }
 
-    /// The run's report, with the final numbers at its last stage's load.
-    pub(super) fn finish(mut self, model: &Model, x: &[Vector3<f64>]) -> SolveReport {
+    /// The run's report, with the final numbers at its last stage's load, and the candidate set
+    /// it ends with (the next run's start).
+    pub(super) fn finish(
+        mut self,
+        model: &Model,
+        x: &[Vector3<f64>],
+    ) -> (SolveReport, CandidateSet) {
         let timing = (self.iter, self.floor, self.start);
         finish_report(model, x, self.load, &mut self.ws, timing, &mut self.report);
-        self.report
+        (self.report, self.ws.candidates)
     }
 }
 
@@ -306,7 +316,10 @@ fn finish_report(
     (iter, floor, start): (usize, bool, Instant),
     report: &mut SolveReport,
 ) {
-    model.gradient(x, final_load, &mut ws.g);
+    // The state may have moved since the run's last step (a continuation's end): its contact set
+    // measured afresh, over the run's candidates.
+    let contacts = model.contacts_with(x, &mut ws.candidates);
+    model.gradient_on(x, &contacts, final_load, &mut ws.g);
     report.iterations = iter;
     report.globalization = ws.stats;
     report.factor_time_s = ws.spd.factor_time_s;
@@ -315,7 +328,7 @@ fn finish_report(
     report.analysis_time_s = ws.spd.analysis_time_s;
     report.max_residual_N = model.max_residual(&ws.g);
     report.max_residual_rel = report.max_residual_N / model.reference_weight();
-    report.energy_J = model.energy(x, final_load);
+    report.energy_J = model.energy_on(x, &contacts, final_load);
     report.wall_time_s = start.elapsed().as_secs_f64();
     if report.status == Status::Converged {
         report.message = if floor {

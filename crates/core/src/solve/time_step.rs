@@ -5,7 +5,7 @@
 use super::SolveReport;
 use super::kind::Integrator;
 use super::linear::DofMap;
-use crate::physics::{HessianBlocks, Model};
+use crate::physics::{CandidateSet, Contacts, HessianBlocks, Model};
 use nalgebra::{Matrix3, Vector3};
 
 /// One integrator's steps, cut short where a step would enter an obstacle.
@@ -23,6 +23,9 @@ pub(super) struct Stepper {
     x_old: Vec<Vector3<f64>>,
     dx: Vec<Vector3<f64>>,
     pub(super) cut_steps: usize,
+    /// The broad phase's candidate set the integration carries from step to step: the contact
+    /// sets and step bounds of every step are measured over it.
+    pub(super) candidates: CandidateSet,
 }
 
 impl Stepper {
@@ -53,14 +56,20 @@ impl Stepper {
             x_old: Vec::new(),
             dx: Vec::new(),
             cut_steps: 0,
+            candidates: CandidateSet::default(),
         }
     }
 
-    /// Advances `x`, `v` by one step from the gradient `g` at `x`.
+    /// The contact set at `x`, over the integration's candidate set.
+    pub(super) fn contacts(&mut self, model: &Model, x: &[Vector3<f64>]) -> Contacts {
+        model.contacts_with(x, &mut self.candidates)
+    }
+
+    /// Advances `x`, `v` by one step from the gradient `g` at `x` (`contacts` its contact set).
     pub(super) fn step(
         &mut self,
         model: &Model,
-        x: &mut [Vector3<f64>],
+        (x, contacts): (&mut [Vector3<f64>], &Contacts),
         v: &mut [Vector3<f64>],
         g: &[Vector3<f64>],
         cg_tol_rel: f64,
@@ -96,22 +105,28 @@ impl Stepper {
                 }
             }
             Integrator::ImplicitEuler | Integrator::BaraffWitkin => {
-                let iters = self.implicit.step(model, x, v, g, c, dt, cg_tol_rel);
+                let iters = (self.implicit).step((model, contacts), x, v, g, c, dt, cg_tol_rel);
                 report.linear_solves += 1;
                 report.inner_iterations += iters;
             }
         }
         if self.bounded {
-            self.dx.clear();
-            self.dx
-                .extend(x.iter().zip(&self.x_old).map(|(a, b)| a - b));
-            let alpha = model.max_step(&self.x_old, &self.dx);
-            if alpha < 1.0 {
-                self.cut_steps += 1;
-                for p in 0..n {
-                    x[p] = self.x_old[p] + self.dx[p] * alpha;
-                    v[p] *= alpha;
-                }
+            self.cut_by_contact(model, x, v);
+        }
+    }
+
+    /// Cuts the step just taken from `x_old` to `x` where contact bounds it (the collision-free
+    /// step over the integration's candidate set), and the velocities `v` with it.
+    fn cut_by_contact(&mut self, model: &Model, x: &mut [Vector3<f64>], v: &mut [Vector3<f64>]) {
+        self.dx.clear();
+        self.dx
+            .extend(x.iter().zip(&self.x_old).map(|(a, b)| a - b));
+        let alpha = model.max_step_with(&self.x_old, &self.dx, &mut self.candidates);
+        if alpha < 1.0 {
+            self.cut_steps += 1;
+            for p in 0..x.len() {
+                x[p] = self.x_old[p] + self.dx[p] * alpha;
+                v[p] *= alpha;
             }
         }
     }
@@ -158,11 +173,28 @@ impl ImplicitState {
         }
     }
 
+    /// The block-Jacobi preconditioner of A = M + Δt c I + Δt² K: each free particle's diagonal
+    /// block inverted.
+    fn precondition(&mut self, model: &Model, c: f64, dt: f64) {
+        let n = model.len();
+        let diag = self.h.diagonal(n);
+        self.precond = (0..n)
+            .map(|p| {
+                let a = diag[p] * (dt * dt) + Matrix3::identity() * (model.masses[p] + dt * c);
+                if self.dofs.dof(p).is_some() {
+                    a.try_inverse().unwrap_or_else(Matrix3::identity)
+                } else {
+                    Matrix3::zeros()
+                }
+            })
+            .collect();
+    }
+
     /// One Baraff–Witkin step; returns the CG iterations used.
     #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
     fn step(
         &mut self,
-        model: &Model,
+        (model, contacts): (&Model, &Contacts),
         x: &mut [Vector3<f64>],
         v: &mut [Vector3<f64>],
         g: &[Vector3<f64>],
@@ -171,7 +203,12 @@ impl ImplicitState {
         tol: f64,
     ) -> usize {
         let n = model.len();
-        model.hessian(x, &mut self.h, crate::physics::HessianMode::Projected);
+        model.hessian_on(
+            x,
+            contacts,
+            &mut self.h,
+            crate::physics::HessianMode::Projected,
+        );
         // b = Δt (f − Δt K v), f = −∇E − c v
         let mut kv = vec![Vector3::zeros(); n];
         self.h.mul_add(v, &mut kv);
@@ -185,17 +222,7 @@ impl ImplicitState {
         let b: Vec<Vector3<f64>> = (0..n)
             .map(|p| masked(p, (-g[p] - v[p] * c - kv[p] * dt) * dt))
             .collect();
-        let diag = self.h.diagonal(n);
-        self.precond = (0..n)
-            .map(|p| {
-                let a = diag[p] * (dt * dt) + Matrix3::identity() * (model.masses[p] + dt * c);
-                if self.dofs.dof(p).is_some() {
-                    a.try_inverse().unwrap_or_else(Matrix3::identity)
-                } else {
-                    Matrix3::zeros()
-                }
-            })
-            .collect();
+        self.precondition(model, c, dt);
         // Preconditioned conjugate gradients from Δv = 0.
         let dot = |a: &[Vector3<f64>], b: &[Vector3<f64>]| {
             a.iter().zip(b).map(|(x, y)| x.dot(y)).sum::<f64>()

@@ -24,6 +24,7 @@ pub struct WarmData<'a> {
     /// the last step's.
     pub factor: Option<&'a NeighbourFactor>,
     /// A self-contact candidate set from the neighbour's solve
-    /// ([`crate::physics::Model::candidates`]): it seeds the model's broad phase where it fits.
+    /// ([`crate::physics::Model::candidates_covering`]): the solve starts carrying it (rebuilt
+    /// where it was built for another mesh or activation distance).
     pub candidates: Option<&'a CandidateSet>,
 }

@@ -27,8 +27,8 @@ pub(super) struct CandidateList {
     pub(super) valid: bool,
     /// When set, the list covers this sweep from `anchor` instead of the vertices' regions.
     pub(super) sweep: Option<Sweep>,
+    /// Broad phases run on this list since it was made.
     pub(super) broad_phases: usize,
-    pub(super) time_s: f64,
 }
 
 impl CandidateList {
@@ -150,56 +150,44 @@ impl Sweep {
 /// gradient a tenth of the step behind its start.
 const SWEEP_BACK: f64 = 0.1;
 
-/// A self-contact term's candidate set as data (ipc-toolkit's collision set): the broad phase's
-/// pairs with the region each vertex may move in while the list stays complete. Taken from a
-/// solved neighbour (a calibration lattice's drape), it seeds a new model's term so that a solve
-/// starting nearby runs no broad phase until a vertex leaves its region; the pairs a seeded term
-/// measures are those a fresh broad phase would keep within range, in the same order.
-#[derive(Clone)]
+/// A self-contact term's candidate set as data (ipc-toolkit's candidates): the broad phase's pairs
+/// with the region each vertex may move in while the list stays complete. The solve owns it and
+/// carries it from state to state ([`super::SelfContact::contact_set`],
+/// [`super::SelfContact::max_step_with`] keep it covering the states they are asked about); the
+/// term remembers nothing. Handed from a solved neighbour (a calibration lattice's drape,
+/// [`crate::solve::WarmData::candidates`]) it starts a new model's solve without a broad phase
+/// until a vertex leaves its region. The default is an empty set, which the first query builds.
+#[derive(Clone, Default)]
 pub struct CandidateSet {
     /// The activation distance ξ + d̂ the list was built for, m.
     pub(super) activation_m: f64,
-    /// Vertices and triangles of the mesh it was built on.
-    pub(super) size: (usize, usize),
+    /// The number of triangles of the mesh it was built on (the vertices' are checked against
+    /// its anchor as it is used).
+    pub(super) triangles: usize,
     pub(super) list: CandidateList,
 }
 
-impl SelfContact {
-    /// The candidate set at hand, when a broad phase has run.
-    pub fn candidates(&self) -> Option<CandidateSet> {
-        let c = self.list.lock().unwrap_or_else(|e| e.into_inner());
-        c.valid.then(|| CandidateSet {
-            activation_m: self.activation_m(),
-            size: (c.region.len(), self.topo.triangles.len()),
-            list: CandidateList {
-                moved: Vec::new(),
-                broad_phases: 0,
-                time_s: 0.0,
-                ..c.clone()
-            },
-        })
+impl CandidateSet {
+    /// Broad phases this set has run since it was made (a seeded set counts from zero).
+    pub fn broad_phases(&self) -> usize {
+        self.list.broad_phases
     }
+}
 
-    /// Takes `set` as this term's candidate set where it was built for the same mesh and
-    /// activation distance (true); else leaves the term as it is (false).
-    pub fn seed(&self, set: &CandidateSet) -> bool {
-        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
-        let fits = set.activation_m == self.activation_m()
-            && set.size.1 == self.topo.triangles.len()
-            && self
-                .topo
-                .vertices
-                .iter()
-                .all(|&v| (v as usize) < set.size.0);
-        if fits {
-            let (phases, time) = (c.broad_phases, c.time_s);
-            *c = CandidateList {
-                broad_phases: phases,
-                time_s: time,
-                ..set.list.clone()
+impl SelfContact {
+    /// `set`'s list, emptied first where it was built for another mesh or activation distance (a
+    /// change of coefficients moved ξ + d̂, or the set came from another model): the pairs it
+    /// keeps would then not be those in range.
+    pub(super) fn fitted<'a>(&self, set: &'a mut CandidateSet) -> &'a mut CandidateList {
+        let (act, triangles) = (self.activation_m(), self.topo.triangles.len());
+        if set.activation_m != act || set.triangles != triangles {
+            *set = CandidateSet {
+                activation_m: act,
+                triangles,
+                list: CandidateList::default(),
             };
         }
-        fits
+        &mut set.list
     }
 
     /// Makes the candidate list cover `x` (and the step `dx` from it, if given): rebuilt when a
@@ -304,6 +292,9 @@ impl SelfContact {
         c.anchor = x.to_vec();
         c.valid = true;
         c.broad_phases += 1;
+        self.work
+            .broad_phases
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// The broad phase at `x`: each vertex's box is `reach(v)` grown by the margin, and the list keeps
@@ -352,35 +343,11 @@ impl SelfContact {
         });
         CandidateSet {
             activation_m: self.activation_m(),
-            size: (c.region.len(), self.topo.triangles.len()),
+            triangles: self.topo.triangles.len(),
             list: CandidateList {
                 broad_phases: 0,
                 ..c
             },
-        }
-    }
-}
-
-impl SelfContact {
-    /// The blocks between the two primitives of every candidate pair within the margin of range
-    /// at `x`, as hints ([`HessianBlocks::hints`]).
-    pub(super) fn hint_near(&self, x: &Vecs, h: &mut crate::physics::HessianBlocks) {
-        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
-        if c.anchor.len() != x.len() {
-            return;
-        }
-        c.measure_moves(x);
-        for (&pair, &gap) in c.pairs.iter().zip(&c.gaps) {
-            if c.gap_left(&self.topo, pair, gap) >= self.margin_m {
-                continue;
-            }
-            let idx = pair.vertices(&self.topo);
-            let split = if pair.is_point_triangle() { 1 } else { 2 };
-            for &a in &idx[..split] {
-                for &b in &idx[split..] {
-                    h.hints.push((a.max(b) as u32, a.min(b) as u32));
-                }
-            }
         }
     }
 }

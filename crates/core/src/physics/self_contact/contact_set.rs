@@ -35,10 +35,23 @@ impl ContactPair {
 }
 
 /// Every pair within the activation distance at one state.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default)]
 pub struct ContactSet {
     /// The pairs, in the candidate list's order.
     pub pairs: Vec<ContactPair>,
+    /// The particle blocks of the candidate pairs near range (within the candidate list's margin
+    /// of the activation distance, by the list's bound): zero blocks the Hessian adds so that its
+    /// factor's pattern holds over the next steps ([`crate::physics::HessianBlocks::hints`]).
+    /// A suggestion of the list the set was measured with, not part of the state's contact.
+    pub hints: Vec<(u32, u32)>,
+}
+
+/// Two sets are equal when they hold the same pairs (their hints depend on the list that measured
+/// them, not on the state).
+impl PartialEq for ContactSet {
+    fn eq(&self, other: &Self) -> bool {
+        self.pairs == other.pairs
+    }
 }
 
 impl ContactSet {

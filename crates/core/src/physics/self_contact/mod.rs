@@ -9,11 +9,13 @@
 //! continuous collision detection so that no pair comes closer than ξ + 10 % of its gap along it: a
 //! line search that keeps the energy finite can never carry the sheet through itself.
 //!
-//! The broad phase (a swappable [`BroadPhase`], the spatial hash by default) is rebuilt only when
-//! the sheet leaves the region its candidate list covers: each vertex's box, swept along the step
-//! and grown by a margin of a quarter of the shortest edge. On a smooth sheet no pair of
-//! non-adjacent primitives is within reach, the list is empty, and the term costs a comparison of
-//! positions with boxes.
+//! The broad phase (a swappable [`BroadPhase`], the spatial hash by default) builds a
+//! [`CandidateSet`], which the solve owns and hands to every query; it is rebuilt only when the
+//! sheet leaves the region the set covers: each vertex's box, swept along the step and grown by a
+//! margin of a quarter of the shortest edge. On a smooth sheet no pair of non-adjacent primitives
+//! is within reach, the list is empty, and the term costs a comparison of positions with boxes.
+//! The term itself keeps no state of a solve: its energy and derivatives at x, asked without a
+//! set, build one for x.
 
 mod candidates;
 mod contact_set;
@@ -25,11 +27,10 @@ use super::{EnergyTerm, HessianBlocks, HessianMode, StepBound, Vecs};
 use crate::proximity::{
     Aabb, BroadPhase, HashGrid, MeshTopology, additive_ccd, pair_distance, relative_motion,
 };
-use candidates::CandidateList;
 pub use candidates::CandidateSet;
 pub use contact_set::{ContactPair, ContactSet, PairKind};
 use nalgebra::Vector3;
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// What self-contact looks like at a state (for run reports).
@@ -44,9 +45,10 @@ pub struct SelfContactState {
     pub kappa_growth: f64,
     /// Pairs within the activation distance ξ + d̂.
     pub active_pairs: usize,
-    /// Broad phases run so far.
+    /// Broad phases the term has run so far, over every candidate set.
     pub broad_phases: usize,
-    /// Wall time spent in the term so far (broad phase, CCD, energy and derivatives), s.
+    /// Wall time spent so far in the term's contact-set and step-bound queries (broad and narrow
+    /// phase, CCD), s.
     pub time_s: f64,
 }
 
@@ -67,7 +69,23 @@ pub struct SelfContact {
     /// The broad phase that builds the candidate list ([`HashGrid`] unless set by
     /// [`SelfContact::with_broad_phase`]).
     broad_phase: Box<dyn BroadPhase>,
-    list: Mutex<CandidateList>,
+    /// What the term's queries cost so far (counters for the run report, no state of a solve).
+    work: Work,
+}
+
+/// The work counters of a self-contact term.
+#[derive(Default)]
+struct Work {
+    broad_phases: AtomicUsize,
+    nanos: AtomicU64,
+}
+
+impl Work {
+    /// Adds the time since `start`.
+    fn add_time(&self, start: Instant) {
+        let ns = start.elapsed().as_nanos().min(u64::MAX as u128) as u64;
+        self.nanos.fetch_add(ns, Ordering::Relaxed);
+    }
 }
 
 impl SelfContact {
@@ -107,7 +125,7 @@ impl SelfContact {
             margin_m,
             piece_m: (4.0 * longest).max(margin_m),
             broad_phase: Box::new(HashGrid),
-            list: Mutex::new(CandidateList::default()),
+            work: Work::default(),
         }
     }
 
@@ -156,22 +174,33 @@ impl SelfContact {
     }
 
     /// The contact set at `x`: every pair of primitives sharing no vertex within the activation
-    /// distance ξ + d̂, from the candidate set's narrow phase (a broad phase first where `x` left
-    /// the region the candidate list covers). Measured afresh at every call: the solve builds one
-    /// per state and hands it to [`SelfContact::energy_of`] and the rest.
-    pub fn contact_set(&self, x: &Vecs) -> ContactSet {
+    /// distance ξ + d̂, from the narrow phase over `candidates` (the solve's candidate set, made to
+    /// cover `x` first: a broad phase where `x` left its region), with the blocks of the pairs
+    /// near range as the Hessian's hints. The solve builds one per state and hands it to
+    /// [`SelfContact::energy_of`] and the rest.
+    pub fn contact_set(&self, x: &Vecs, candidates: &mut CandidateSet) -> ContactSet {
         let start = Instant::now();
-        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
-        self.ensure(&mut c, x, None);
+        let c = self.fitted(candidates);
+        self.ensure(c, x, None);
         c.measure_moves(x);
         let act = self.activation_m();
         let mut set = ContactSet::default();
         for (&pair, &gap) in c.pairs.iter().zip(c.gaps.iter()) {
             // A pair whose gap still exceeds its vertices' moves is out of range, unmeasured.
-            if c.gap_left(&self.topo, pair, gap) >= 0.0 {
+            let left = c.gap_left(&self.topo, pair, gap);
+            if left >= self.margin_m {
                 continue;
             }
             let idx = pair.vertices(&self.topo);
+            let split = if pair.is_point_triangle() { 1 } else { 2 };
+            for &a in &idx[..split] {
+                for &b in &idx[split..] {
+                    set.hints.push((a.max(b) as u32, a.min(b) as u32));
+                }
+            }
+            if left >= 0.0 {
+                continue;
+            }
             let pt = pair.is_point_triangle();
             let (d, coef) = pair_distance(pt, &idx.map(|k| x[k]));
             if d < act {
@@ -187,8 +216,13 @@ impl SelfContact {
                 });
             }
         }
-        c.time_s += start.elapsed().as_secs_f64();
+        self.work.add_time(start);
         set
+    }
+
+    /// [`SelfContact::contact_set`] with a candidate set of its own, built for `x`.
+    pub fn contact_set_here(&self, x: &Vecs) -> ContactSet {
+        self.contact_set(x, &mut CandidateSet::default())
     }
 
     /// The first impact time in (0, 1] of the candidate pairs moving from `x` by `seg`
@@ -197,7 +231,7 @@ impl SelfContact {
     /// the list's anchor less its vertices' moves since, so (1 − 0.1)(d − ξ)/l > 1 holds without
     /// measuring d. The same result, without the distance computations that were a quarter of a
     /// settling implicit run's time (issue 47).
-    fn piece_impact(&self, c: &mut CandidateList, x: &Vecs, seg: &Vecs) -> f64 {
+    fn piece_impact(&self, c: &mut candidates::CandidateList, x: &Vecs, seg: &Vecs) -> f64 {
         const SHARE: f64 = 0.1;
         c.measure_moves(x);
         let act = self.activation_m();
@@ -261,15 +295,14 @@ impl SelfContact {
                 false
             });
         let min_distance_m = f64::from_bits(least.into_inner());
-        let active_pairs = self.contact_set(x).len();
-        let c = self.list.lock().unwrap_or_else(|e| e.into_inner());
+        let active_pairs = self.contact_set_here(x).len();
         SelfContactState {
             min_distance_m,
             kappa_J: self.kappa_J,
             kappa_growth: self.kappa_growth(),
             active_pairs,
-            broad_phases: c.broad_phases,
-            time_s: c.time_s,
+            broad_phases: self.work.broad_phases.load(Ordering::Relaxed),
+            time_s: self.work.nanos.load(Ordering::Relaxed) as f64 * 1e-9,
         }
     }
 }
@@ -285,17 +318,17 @@ impl EnergyTerm for SelfContact {
     fn name(&self) -> String {
         "contact/self".into()
     }
-    /// [`SelfContact::energy_of`] the contact set measured at `x`.
+    /// [`SelfContact::energy_of`] the contact set built at `x`.
     fn energy(&self, x: &Vecs) -> f64 {
-        self.energy_of(&self.contact_set(x), x)
+        self.energy_of(&self.contact_set_here(x), x)
     }
-    /// [`SelfContact::add_gradient_of`] the contact set measured at `x`.
+    /// [`SelfContact::add_gradient_of`] the contact set built at `x`.
     fn add_gradient(&self, x: &Vecs, g: &mut Vecs) {
-        self.add_gradient_of(&self.contact_set(x), x, g);
+        self.add_gradient_of(&self.contact_set_here(x), x, g);
     }
-    /// [`SelfContact::add_hessian_with_hints`] of the contact set measured at `x`.
+    /// [`SelfContact::add_hessian_with_hints`] of the contact set built at `x`.
     fn add_hessian(&self, x: &Vecs, h: &mut HessianBlocks, mode: HessianMode) {
-        self.add_hessian_with_hints(&self.contact_set(x), x, h, mode);
+        self.add_hessian_with_hints(&self.contact_set_here(x), x, h, mode);
     }
     fn step_bound(&self) -> Option<&dyn StepBound> {
         Some(self)
@@ -311,8 +344,6 @@ impl EnergyTerm for SelfContact {
         (self.thickness_m, self.band_m) = (c[0], c[1]);
         self.kappa_J = c[2] * growth;
         self.kappa_limit_J = KAPPA_GROWTH_LIMIT * c[2];
-        // The activation distance moved: the candidate list is rebuilt for it.
-        self.list.lock().unwrap_or_else(|e| e.into_inner()).valid = false;
     }
     /// Analytic in all three: κ ∂b′/∂c ∇d per pair, with ∂b′/∂ξ = −b″ and ∂b′/∂d̂ from
     /// [`barrier_band_derivatives`].
@@ -328,7 +359,7 @@ impl EnergyTerm for SelfContact {
             let value = dkappa * b + self.kappa_J * (db_dband * dband - db * dxi);
             (slope, value)
         };
-        self.add_pair_forces(&self.contact_set(x), (x, g), along);
+        self.add_pair_forces(&self.contact_set_here(x), (x, g), along);
         true
     }
     fn coefficient_energy(&self, x: &Vecs, dc: &[f64]) -> Option<f64> {
@@ -341,18 +372,26 @@ impl EnergyTerm for SelfContact {
             let db_dband = barrier_band_derivatives(gap, self.band_m).0;
             dkappa * b + self.kappa_J * (db_dband * dband - db * dxi)
         };
-        Some(self.sum_pairs(&self.contact_set(x), x, value))
+        Some(self.sum_pairs(&self.contact_set_here(x), x, value))
     }
 }
 
 impl StepBound for SelfContact {
-    /// Additive CCD over every candidate pair. A long step (far from equilibrium Newton may propose
-    /// a vertex move of a metre) is checked in pieces of at most `piece_m` per vertex, each
-    /// with its own broad phase, so that no swept box spans the sheet; the first piece with an
-    /// impact gives the bound.
+    /// [`SelfContact::max_step_with`] a candidate set of its own.
     fn max_step(&self, x: &Vecs, dx: &Vecs) -> f64 {
+        self.max_step_with(x, dx, &mut CandidateSet::default())
+    }
+}
+
+impl SelfContact {
+    /// The collision-free step size: additive CCD over every pair of `candidates` (the solve's
+    /// set, made to cover the step). A long step (far from equilibrium Newton may propose a
+    /// vertex move of a metre) is checked in pieces of at most `piece_m` per vertex, each with its
+    /// own broad phase, so that no swept box spans the sheet; the first piece with an impact gives
+    /// the bound.
+    pub fn max_step_with(&self, x: &Vecs, dx: &Vecs, candidates: &mut CandidateSet) -> f64 {
         let start = Instant::now();
-        let mut c = self.list.lock().unwrap_or_else(|e| e.into_inner());
+        let c = self.fitted(candidates);
         let longest = self
             .topo
             .vertices
@@ -370,14 +409,14 @@ impl StepBound for SelfContact {
                     *p += d;
                 }
             }
-            self.ensure(&mut c, &xk, Some(&seg));
-            let toi = self.piece_impact(&mut c, &xk, &seg);
+            self.ensure(c, &xk, Some(&seg));
+            let toi = self.piece_impact(c, &xk, &seg);
             if toi.is_finite() {
                 bound = (k as f64 + toi) * share;
                 break;
             }
         }
-        c.time_s += start.elapsed().as_secs_f64();
+        self.work.add_time(start);
         bound
     }
 }
@@ -480,7 +519,10 @@ mod tests {
         let (held, _) = flat(xi + 0.2 * band);
         let mut term = SelfContact::new(tris, &held, xi, band, 1e-3);
         let k0 = term.kappa_J;
-        let (held, pressed) = (term.contact_set(&held), term.contact_set(&pressed));
+        let (held, pressed) = (
+            term.contact_set_here(&held),
+            term.contact_set_here(&pressed),
+        );
         assert!(!term.stiffen_barrier(&held));
         assert_eq!(term.kappa_J, k0);
         assert!(term.stiffen_barrier(&pressed));
@@ -545,9 +587,21 @@ mod tests {
         );
     }
 
-    /// The active pairs are measured once per state and serve energy, gradient and Hessian there:
-    /// a term that measured other states in between, or whose activation distance moved, gives
-    /// what a fresh term gives.
+    /// The energy and gradient of `term` at `y` on the contact set measured over `set`.
+    fn measured(
+        term: &SelfContact,
+        y: &[Vector3<f64>],
+        set: &mut CandidateSet,
+    ) -> (f64, Vec<Vector3<f64>>) {
+        let at = term.contact_set(y, set);
+        let mut g = vec![Vector3::zeros(); y.len()];
+        term.add_gradient_of(&at, y, &mut g);
+        (term.energy_of(&at, y), g)
+    }
+
+    /// The active pairs measured over a candidate set carried from state to state are those a
+    /// fresh term measures: after other states in between, or once the term's activation distance
+    /// moved (the set is then rebuilt for it).
     #[test]
     fn active_pairs_measured_at_a_state_are_those_a_fresh_term_measures() {
         let (x, tris) = stacked(1.2e-3);
@@ -561,16 +615,21 @@ mod tests {
         };
         let mut term = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
         let c0 = [term.thickness_m, term.band_m, term.kappa_J];
+        let mut set = CandidateSet::default();
         for z in [&x, &y, &x, &x, &y] {
-            let mut g = vec![Vector3::zeros(); z.len()];
-            term.add_gradient(z, &mut g);
-            assert_eq!((term.energy(z), g), fresh(c0, z));
+            assert_eq!(measured(&term, z, &mut set), fresh(c0, z));
         }
-        // A band a fifth as wide: fewer pairs active at x, the list measured again.
-        let c1 = [c0[0], 0.2 * c0[1], c0[2]];
+        assert_eq!(
+            set.broad_phases(),
+            1,
+            "the moves stayed in the list's region"
+        );
+        // A band twice as wide: more pairs active at x, the set rebuilt for the new distance.
+        let c1 = [c0[0], 2.0 * c0[1], c0[2]];
         term.set_coefficients(&c1);
-        assert_eq!(term.energy(&x), fresh(c1, &x).0);
-        assert!(term.energy(&x) < fresh(c0, &x).0);
+        assert_eq!(measured(&term, &x, &mut set), fresh(c1, &x));
+        assert_eq!(set.activation_m, term.activation_m());
+        assert!(measured(&term, &x, &mut set).0 > fresh(c0, &x).0);
     }
 
     #[test]
@@ -613,51 +672,48 @@ mod tests {
     fn pruned_pairs_are_the_ones_out_of_range() {
         let (x, tris) = stacked(2.2e-3);
         let kept = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
-        assert_eq!(kept.energy(&x), 0.0);
+        let mut set = CandidateSet::default();
+        assert_eq!(measured(&kept, &x, &mut set).0, 0.0);
         let y = lowered(&x);
         let fresh = SelfContact::new(tris, &y, 5e-4, 1e-3, 1e-3);
-        let (e_kept, e_fresh) = (kept.energy(&y), fresh.energy(&y));
-        assert!(e_fresh > 0.0);
-        assert_eq!(e_kept, e_fresh);
-        let (mut g_kept, mut g_fresh) = (vec![Vector3::zeros(); 18], vec![Vector3::zeros(); 18]);
-        kept.add_gradient(&y, &mut g_kept);
-        fresh.add_gradient(&y, &mut g_fresh);
-        assert_eq!(g_kept, g_fresh);
-        assert_eq!(kept.state(&y).broad_phases, 1);
+        assert_measures_alike((&kept, &mut set), &fresh, &y);
+        assert_eq!(set.broad_phases(), 1);
     }
 
-    /// `a`, seeded from another state, measures at `y` (in range) the energy and gradient of `fresh`,
-    /// whose list was built at `y`, bit for bit.
-    fn assert_measures_alike(a: &SelfContact, fresh: &SelfContact, y: &[Vector3<f64>]) {
+    /// `a` over the candidate set `set` (built at another state) measures at `y` (in range) the
+    /// energy and gradient of `fresh` at `y` (its own set built there), bit for bit.
+    fn assert_measures_alike(
+        (a, set): (&SelfContact, &mut CandidateSet),
+        fresh: &SelfContact,
+        y: &[Vector3<f64>],
+    ) {
         assert!(fresh.energy(y) > 0.0);
-        assert_eq!(a.energy(y), fresh.energy(y));
-        let (mut g_a, mut g_fresh) = (
-            vec![Vector3::zeros(); y.len()],
-            vec![Vector3::zeros(); y.len()],
-        );
-        a.add_gradient(y, &mut g_a);
+        let mut g_fresh = vec![Vector3::zeros(); y.len()];
         fresh.add_gradient(y, &mut g_fresh);
-        assert_eq!(g_a, g_fresh);
+        assert_eq!(measured(a, y, set), (fresh.energy(y), g_fresh));
     }
 
     #[test]
     fn a_seeded_term_measures_what_a_fresh_one_does_without_a_broad_phase() {
         let (x, tris) = stacked(2.2e-3);
         let solved = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
-        assert_eq!(solved.energy(&x), 0.0);
-        let set = solved.candidates().expect("a broad phase ran");
-        // A new model's term (another weight, so another κ), seeded, at a state moved within the
-        // set's margin into range.
+        let mut set = CandidateSet::default();
+        assert_eq!(measured(&solved, &x, &mut set).0, 0.0);
+        assert_eq!(set.broad_phases(), 1);
+        // A new model's term (another weight, so another κ) over the solved one's set, at a state
+        // moved within the set's margin into range.
         let y = lowered(&x);
         let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 2e-3);
-        assert!(seeded.seed(&set));
         let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 2e-3);
-        assert_measures_alike(&seeded, &fresh, &y);
-        let phases = seeded.list.lock().expect("candidate list").broad_phases;
-        assert_eq!(phases, 0, "the seeded list covered the move");
-        // A set built for another activation distance does not fit.
+        let mut handed = set.clone();
+        assert_measures_alike((&seeded, &mut handed), &fresh, &y);
+        assert_eq!(handed.broad_phases(), 1, "the handed set covered the move");
+        // A set built for another activation distance is rebuilt for the term's.
         let thicker = SelfContact::new(tris, &x, 6e-4, 1e-3, 1e-3);
-        assert!(!thicker.seed(&set));
+        let mut other = set.clone();
+        thicker.contact_set(&x, &mut other);
+        assert_eq!(other.activation_m, thicker.activation_m());
+        assert_eq!(other.broad_phases(), 1, "counted from its rebuild");
     }
 
     #[test]
@@ -668,17 +724,15 @@ mod tests {
         let node = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
         let y = sunk(&x, 3.8e-3);
         let spread: Vec<f64> = (0..18).map(|p| if p >= 9 { 5e-3 } else { 0.0 }).collect();
-        let set = node.candidates_covering(&x, &spread);
+        let mut set = node.candidates_covering(&x, &spread);
         let seeded = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
-        assert!(seeded.seed(&set));
         let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 1e-3);
-        assert_measures_alike(&seeded, &fresh, &y);
-        assert_eq!(seeded.list.lock().expect("candidate list").broad_phases, 0);
+        assert_measures_alike((&seeded, &mut set), &fresh, &y);
+        assert_eq!(set.broad_phases(), 0);
         // Without the spread the same move needs a broad phase of its own.
-        let narrow = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
-        assert!(narrow.seed(&node.candidates_covering(&x, &[0.0; 18])));
-        assert_eq!(narrow.energy(&y), fresh.energy(&y));
-        assert_eq!(narrow.list.lock().expect("candidate list").broad_phases, 1);
+        let mut narrow = node.candidates_covering(&x, &[0.0; 18]);
+        assert_measures_alike((&seeded, &mut narrow), &fresh, &y);
+        assert_eq!(narrow.broad_phases(), 1);
     }
 
     #[test]
@@ -691,7 +745,8 @@ mod tests {
             .zip(&x)
             .map(|(l, v)| l - v - Vector3::z() * 3e-2)
             .collect();
-        let bound = term.max_step(&x, &dx);
+        let mut set = CandidateSet::default();
+        let bound = term.max_step_with(&x, &dx, &mut set);
         // Its bound is additive CCD's over every pair of the mesh (the list misses no pair that
         // stops the step).
         let topo = term.topology();
@@ -717,7 +772,7 @@ mod tests {
         assert_eq!(bound, want);
         {
             // Only pairs across the layers: within a layer nothing moves relative to anything.
-            let c = term.list.lock().expect("candidate list");
+            let c = &set.list;
             assert!(c.sweep.is_some() && !c.pairs.is_empty());
             let across = |p: &Pair| {
                 let idx = p.vertices(topo);
@@ -732,14 +787,14 @@ mod tests {
         for a in [-0.1, 0.5, 0.9 * bound] {
             let y = at(a);
             let fresh = SelfContact::new(tris.clone(), &y, 5e-4, 1e-3, 1e-3);
-            assert_eq!(term.energy(&y), fresh.energy(&y));
+            assert_eq!(measured(&term, &y, &mut set).0, fresh.energy(&y));
         }
         assert_measures_alike(
-            &term,
+            (&term, &mut set),
             &SelfContact::new(tris, &at(bound), 5e-4, 1e-3, 1e-3),
             &at(bound),
         );
-        assert_eq!(term.list.lock().expect("candidate list").broad_phases, 1);
+        assert_eq!(set.broad_phases(), 1);
     }
 
     /// Two flat 3 × 3 layers `gap` apart, the upper one shifted by `shift` along x and turned by
@@ -803,7 +858,7 @@ mod tests {
         assert_eq!(term.energy(&inside), f64::INFINITY);
         // Mollified pairs are there and active.
         let (y, _) = turned(xi + 0.3 * band, 0.01, SHIFT);
-        let mollified = (term.contact_set(&y).pairs.iter())
+        let mollified = (term.contact_set_here(&y).pairs.iter())
             .filter(|p| {
                 let corners = p.vertices.map(|k| y[k]);
                 term.mollifier(p.is_point_triangle(), &corners).is_some()
@@ -925,7 +980,8 @@ mod tests {
     fn the_step_bound_passes_over_only_pairs_without_an_impact() {
         let (x, tris) = stacked(2.2e-3);
         let term = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3);
-        assert_eq!(term.energy(&x), 0.0);
+        let mut set = CandidateSet::default();
+        assert_eq!(measured(&term, &x, &mut set).0, 0.0);
         let y = lowered(&x);
         let (mut passed, mut cut) = (0, 0);
         for k in 0..200 {
@@ -934,9 +990,8 @@ mod tests {
             let dx: Vec<Vector3<f64>> = (0..18)
                 .map(|p| Vector3::new(f(p), f(p + 5), f(p + 11) - 0.5) * size)
                 .collect();
-            let bound = term.max_step(&y, &dx);
-            let c = term.list.lock().expect("candidate list");
-            let every = c
+            let bound = term.max_step_with(&y, &dx, &mut set);
+            let every = (set.list)
                 .pairs
                 .iter()
                 .map(|&pair| {
@@ -975,6 +1030,8 @@ mod tests {
         // The same walk's term with the other broad phase: another candidate list, the same set.
         let tree = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3)
             .with_broad_phase(Box::new(crate::proximity::Hierarchy));
+        // Each carries its candidate set along the walk, as a solve does.
+        let (mut on_hash, mut on_tree) = (CandidateSet::default(), CandidateSet::default());
         let mut seen_active = 0;
         for step in 0..60 {
             let drift = Vector3::new(
@@ -988,15 +1045,18 @@ mod tests {
                     false => Vector3::from_fn(|_, _| rng.random_range(-2e-4..2e-4)),
                 })
                 .collect();
-            let alpha = (0.9 * term.max_step(&x, &dx)).min(1.0);
+            let bound = term.max_step_with(&x, &dx, &mut on_hash);
+            let tree_bound = tree.max_step_with(&x, &dx, &mut on_tree);
+            assert_eq!(tree_bound, bound, "step {step}");
             assert_eq!(
-                tree.max_step(&x, &dx),
                 term.max_step(&x, &dx),
-                "step {step}"
+                bound,
+                "step {step}: a set built here"
             );
+            let alpha = (0.9 * bound).min(1.0);
             x.iter_mut().zip(&dx).for_each(|(p, d)| *p += d * alpha);
-            let set = term.contact_set(&x);
-            assert_eq!(tree.contact_set(&x), set, "step {step}");
+            let set = term.contact_set(&x, &mut on_hash);
+            assert_eq!(tree.contact_set(&x, &mut on_tree), set, "step {step}");
             let mut active: Vec<([usize; 4], f64)> = set
                 .pairs
                 .iter()

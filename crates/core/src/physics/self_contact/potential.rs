@@ -103,9 +103,9 @@ impl SelfContact {
         }
     }
 
-    /// [`SelfContact::add_hessian_of`], then zero blocks for the candidate pairs near range at `x`
-    /// (a factor's pattern that holds over the next steps), except for the exact Hessian of
-    /// derivatives.
+    /// [`SelfContact::add_hessian_of`], then zero blocks for the candidate pairs near range that
+    /// `set` names ([`ContactSet::hints`]: a factor's pattern that holds over the next steps),
+    /// except for the exact Hessian of derivatives.
     pub fn add_hessian_with_hints(
         &self,
         set: &ContactSet,
@@ -115,7 +115,7 @@ impl SelfContact {
     ) {
         self.add_hessian_of(set, x, h, mode);
         if mode != HessianMode::Exact {
-            self.hint_near(x, h);
+            h.hints.extend_from_slice(&set.hints);
         }
     }
 

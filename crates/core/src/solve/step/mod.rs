@@ -2,11 +2,12 @@
 //! ([`super::strategy`]): the Hessian regularized ([`Regularization`]), a straight or curved step
 //! ([`Direction`]), a chord step with the factor at hand ([`FactorReuse`]), and a backtracking
 //! line search ([`Backtracking`] over [`Armijo`]) bounded by the terms' collision-free step
-//! ([`Model::max_step`]). [`super::newton`] owns the loop over iterations, the executor
+//! ([`Model::max_step_with`]). [`super::newton`] owns the loop over iterations, the executor
 //! ([`super::execute`]) the loop over load increments and other stages.
 
 mod factor;
 mod reuse;
+mod search;
 
 pub(super) use factor::mean_free_diagonal;
 
@@ -16,7 +17,7 @@ use super::strategy::{
     Acceptance, Armijo, Backtracking, Direction, FactorReuse, Regularization, Verdict,
 };
 use super::{Globalization, SolveReport};
-use crate::physics::{Contacts, HessianBlocks, HessianMode, Model, PairCurvature};
+use crate::physics::{CandidateSet, Contacts, HessianBlocks, HessianMode, Model, PairCurvature};
 use nalgebra::Vector3;
 
 /// (first DOF, component) of every held component of the free particles.
@@ -140,6 +141,11 @@ pub(super) struct Workspace {
     /// ([`Workspace::enter`]) and with every step it accepts (the accepted trial's set), so that
     /// gradient and Hessian at a state use the set its energy was measured with.
     pub(super) contacts: Contacts,
+    /// The broad phase's candidate set the run carries from state to state: every contact set
+    /// and step bound of the run is measured over it ([`Model::contacts_with`],
+    /// [`Model::max_step_with`]), so that a broad phase runs only where the state leaves the
+    /// region it covers.
+    pub(super) candidates: CandidateSet,
 }
 
 /// Conjugate-gradient iterations of one Newton step with a neighbour's factor before the step
@@ -197,13 +203,15 @@ const MU_MIN: f64 = 1e-8;
 impl Workspace {
     /// The workspace of a run of `model` from `x`; with a neighbour's `factor`, its Newton steps
     /// are solved by conjugate gradients preconditioned with it while that converges.
+    /// Its contact sets are measured over `candidates` (a neighbour's, or the last run's).
     pub(super) fn new(
         model: &Model,
         x: &[Vector3<f64>],
         opts: &StaticOptions,
-        factor: Option<&super::NeighbourFactor>,
+        (factor, candidates): (Option<&super::NeighbourFactor>, CandidateSet),
     ) -> Self {
         let mut ws = Self::fresh(model, x, opts);
+        ws.candidates = candidates;
         if let Some(nf) = factor {
             ws.spd = nf.0.copy();
             ws.krylov = true;
@@ -248,12 +256,13 @@ impl Workspace {
             assembled: false,
             constant_trace: None,
             contacts: Contacts::default(),
+            candidates: CandidateSet::default(),
         }
     }
 
     /// Enters the state `x` (a stage's start): its contact set, and its energy at `load`, J.
     pub(super) fn enter(&mut self, model: &Model, x: &[Vector3<f64>], load: f64) -> f64 {
-        self.contacts = model.contacts(x);
+        self.contacts = model.contacts_with(x, &mut self.candidates);
         model.energy_on(x, &self.contacts, load)
     }
 
@@ -299,89 +308,6 @@ impl Workspace {
         }
     }
 
-    /// The step's geodesic acceleration into `acc` (Transtrum & Sethna 2012): a = −(H + μD)⁻¹ T, T
-    /// the second derivative of the gradient along dx by central differences, so that the path
-    /// x + α dx + ½ α² a also cancels the gradient's second-order change. False when that is not
-    /// finite or |½ a| > [`ACCELERATION_MAX`] |dx|.
-    fn acceleration(&mut self, model: &Model, x: &[Vector3<f64>], load: f64) -> bool {
-        let h = ACCELERATION_FD;
-        for (p, xp) in x.iter().enumerate() {
-            self.trial[p] = xp + self.dx[p] * h;
-        }
-        model.gradient(&self.trial, load, &mut self.g_trial);
-        for (p, xp) in x.iter().enumerate() {
-            self.trial[p] = xp - self.dx[p] * h;
-        }
-        model.gradient(&self.trial, load, &mut self.g_back);
-        // T into g_trial (its buffer, so nothing is allocated per iteration).
-        for ((t, g), b) in self.g_trial.iter_mut().zip(&self.g).zip(&self.g_back) {
-            *t = (*t - g * 2.0 + b) / (h * h);
-        }
-        let (t, mut acc) = (
-            std::mem::take(&mut self.g_trial),
-            std::mem::take(&mut self.acc),
-        );
-        self.solve_for(&t, &mut acc);
-        (self.g_trial, self.acc) = (t, acc);
-        let norm = |v: &[Vector3<f64>]| v.iter().map(|a| a.norm_squared()).sum::<f64>().sqrt();
-        let na = norm(&self.acc);
-        na.is_finite() && 0.5 * na <= ACCELERATION_MAX * norm(&self.dx)
-    }
-
-    /// Backtracking (Armijo) line search along `dx` from the step length `alpha` (below 1 where a
-    /// term bounds the step: contact). Near the solution the energy change falls below round-off:
-    /// there a step that lowers the largest residual force is accepted instead. Returns the accepted
-    /// step length, if any.
-    fn line_search(
-        &mut self,
-        model: &Model,
-        x: &mut [Vector3<f64>],
-        load: f64,
-        (e, r): (&mut f64, f64),
-        (alpha, slope): (f64, f64),
-    ) -> Option<f64> {
-        let Self {
-            trial,
-            g_trial,
-            dx,
-            acc,
-            stats,
-            parts,
-            contacts,
-            ..
-        } = self;
-        let trial = std::cell::RefCell::new(trial);
-        // The last trial's contact set: the accepted state's, once the search returns.
-        let at_trial = std::cell::RefCell::new(Contacts::default());
-        let energy_at = |alpha: f64| {
-            let half = 0.5 * alpha * alpha;
-            let mut t = trial.borrow_mut();
-            for (p, xp) in x.iter().enumerate() {
-                t[p] = xp + dx[p] * alpha + acc[p] * half;
-            }
-            let contacts = model.contacts(&t[..]);
-            let et = model.energy_on(&t[..], &contacts, load);
-            *at_trial.borrow_mut() = contacts;
-            et
-        };
-        let lowers_residual = || {
-            model.gradient_on(&trial.borrow()[..], &at_trial.borrow(), load, g_trial);
-            model.max_residual(g_trial) < r
-        };
-        let found = parts.search.search(
-            (*e, slope),
-            alpha,
-            energy_at,
-            lowers_residual,
-            &mut stats.rejected_trials,
-        );
-        let (alpha, et) = found?;
-        x.copy_from_slice(&trial.borrow()[..]);
-        *contacts = at_trial.into_inner();
-        *e = et;
-        Some(alpha)
-    }
-
     /// One damped Newton iteration from `x`: factorize, step (curved where the acceleration is
     /// small), line search, then adapt the damping (divided by 4 after a whole step, raised tenfold
     /// from 1e-8 when no step lowers the energy); how it ended.
@@ -424,7 +350,7 @@ impl Workspace {
                 return Iteration::Unfactorizable;
             }
             let slope = self.step(x.len());
-            let mut bound = model.max_step(x, &self.dx);
+            let mut bound = model.max_step_with(x, &self.dx, &mut self.candidates);
             let curved = self.parts.direction == Direction::Curved
                 && !hessian.is_projected()
                 && self.acceleration(model, x, load);
@@ -434,7 +360,7 @@ impl Workspace {
                 for ((c, d), a) in self.g_back.iter_mut().zip(&self.dx).zip(&self.acc) {
                     *c = d + a * 0.5;
                 }
-                bound = bound.min(model.max_step(x, &self.g_back));
+                bound = bound.min(model.max_step_with(x, &self.g_back, &mut self.candidates));
             } else {
                 self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
             }

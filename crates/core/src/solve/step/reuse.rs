@@ -28,7 +28,7 @@ impl Workspace {
         }
         self.dx = d;
         self.acc.iter_mut().for_each(|a| *a = Vector3::zeros());
-        let bound = model.max_step(x, &self.dx);
+        let bound = model.max_step_with(x, &self.dx, &mut self.candidates);
         match self.line_search(model, x, load, (e, r), (bound.min(1.0), slope)) {
             Some(alpha) => {
                 self.count(alpha, bound, (false, false));
@@ -111,13 +111,16 @@ impl Workspace {
     ) -> bool {
         let slope = self.step(x.len());
         report.linear_solves += 1;
-        if slope.is_nan() || slope >= 0.0 || model.max_step(x, &self.dx) < 1.0 {
+        if slope.is_nan()
+            || slope >= 0.0
+            || model.max_step_with(x, &self.dx, &mut self.candidates) < 1.0
+        {
             return false;
         }
         for (p, xp) in x.iter().enumerate() {
             self.trial[p] = xp + self.dx[p];
         }
-        let contacts = model.contacts(&self.trial);
+        let contacts = model.contacts_with(&self.trial, &mut self.candidates);
         let et = model.energy_on(&self.trial, &contacts, load);
         if self.parts.search.condition.verdict(*e, et, 1.0, slope) == Verdict::Reject {
             self.stats.rejected_trials += 1;
