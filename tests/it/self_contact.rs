@@ -297,6 +297,13 @@ fn the_limp_table_on_a_larger_sheet_converges_without_passing_through_itself() {
     assert_uncrossed("the limp table", &s, &sol);
 }
 
+/// The sphere scenes' 30 cm sheet made 0.8 m, on the same grid, centred on the sphere.
+const SHEET_0_8_M: [&str; 3] = [
+    "cloth.size_x_m=0.8",
+    "cloth.size_y_m=0.8",
+    "cloth.origin_m=[-0.4, -0.4, 0.0]",
+];
+
 /// Issue 76: the sphere drape on a 0.8 m sheet (sphere_wool's 31 × 31 grid) folds layers onto each
 /// other; with κ as built a pair of crossing edges was pressed to 10⁻¹⁰ m beyond the thickness and
 /// Newton crept at hundreds of newtons of residual to its iteration budget. Stiffening the
@@ -304,12 +311,7 @@ fn the_limp_table_on_a_larger_sheet_converges_without_passing_through_itself() {
 /// (IPC's adaptive κ) converges it, κ grown, nothing crossed and every two parts at least ξ apart.
 #[test]
 fn a_large_sheet_on_the_sphere_converges_with_its_barrier_stiffened_where_layers_press() {
-    let big = [
-        "cloth.size_x_m=0.8",
-        "cloth.size_y_m=0.8",
-        "cloth.origin_m=[-0.4, -0.4, 0.0]",
-    ];
-    let s = scene("sphere_wool.toml", &big);
+    let s = scene("sphere_wool.toml", &SHEET_0_8_M);
     let sol = solve_scene(&s, &mut NoObserver);
     assert!(sol.report.is_converged(), "{}", sol.report.message);
     assert!(sol.report.iterations < 1000, "{}", sol.report.iterations);
@@ -320,7 +322,7 @@ fn a_large_sheet_on_the_sphere_converges_with_its_barrier_stiffened_where_layers
         .expect("self-contact modelled");
     assert!(state.kappa_growth > 1.0, "{}", state.kappa_growth);
     // κ as built: the same budget is not enough.
-    let mut fixed = big.to_vec();
+    let mut fixed = SHEET_0_8_M.to_vec();
     fixed.extend([
         "solver.static.kappa_adapt_gap_rel=0",
         "solver.static.max_iterations=600",
@@ -342,12 +344,7 @@ fn a_large_sheet_on_the_sphere_converges_with_its_barrier_stiffened_where_layers
 /// the self-contact term taken out is not a minimum (the folds are held there by contact alone).
 #[test]
 fn a_drape_resting_on_its_own_folds_is_a_minimum() {
-    let big = [
-        "cloth.size_x_m=0.8",
-        "cloth.size_y_m=0.8",
-        "cloth.origin_m=[-0.4, -0.4, 0.0]",
-    ];
-    let s = scene("sphere_cotton.toml", &big);
+    let s = scene("sphere_cotton.toml", &SHEET_0_8_M);
     let sol = solve_scene(&s, &mut NoObserver);
     assert!(sol.report.is_converged(), "{}", sol.report.message);
     assert_uncrossed("the 0.8 m cotton sphere drape", &s, &sol);

@@ -201,14 +201,7 @@ fn compare(
     (h, fixed, par, b): FineSystem<'_>,
     (dinv, nu): (&[Matrix3<f64>], usize),
 ) {
-    let cdofs = DofMap::new(cfixed);
-    let mut cspd = SparseSpd::new();
-    let t = Instant::now();
-    let ok = cspd.factorize(&cdofs, ch, &vec![0.0; cdofs.n]);
-    let first = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    cspd.refactorize(&vec![0.0; cdofs.n]);
-    let again = t.elapsed().as_secs_f64();
+    let (cspd, _, ok, first, again) = timed_factor(ch, cfixed);
     println!(
         "{name} coarse operator: {} blocks pushed{note}, factorized {ok} in {first:.3} s with its analysis, {again:.3} s numeric again, {} factor non-zeros",
         ch.pairs.len(),
@@ -249,9 +242,10 @@ fn projected_system(model: &Model, x: &Vecs) -> (HessianBlocks, Vecs) {
     (h, b)
 }
 
-/// Prints what the factorization Newton takes of `h` costs: analysis and numeric factorization,
-/// then the numeric factorization again.
-fn time_factorization(n: usize, h: &HessianBlocks, fixed: &[bool]) {
+/// `h` over the particles `fixed` leaves free, factorized as Newton does: the factor, its
+/// unknowns, whether it is positive definite, and the seconds of the first factorization (with its
+/// analysis) and of the numeric one again.
+fn timed_factor(h: &HessianBlocks, fixed: &[bool]) -> (SparseSpd, usize, bool, f64, f64) {
     let dofs = DofMap::new(fixed);
     let mut spd = SparseSpd::new();
     let t = Instant::now();
@@ -259,10 +253,15 @@ fn time_factorization(n: usize, h: &HessianBlocks, fixed: &[bool]) {
     let first = t.elapsed().as_secs_f64();
     let t = Instant::now();
     spd.refactorize(&vec![0.0; dofs.n]);
-    let numeric = t.elapsed().as_secs_f64();
+    (spd, dofs.n, ok, first, t.elapsed().as_secs_f64())
+}
+
+/// Prints what the factorization Newton takes of `h` costs: analysis and numeric factorization,
+/// then the numeric factorization again.
+fn time_factorization(n: usize, h: &HessianBlocks, fixed: &[bool]) {
+    let (spd, unknowns, ok, first, numeric) = timed_factor(h, fixed);
     println!(
-        "fine {n}²: {} unknowns; factorized {ok} in {first:.3} s with its analysis, {numeric:.3} s numeric again; factor non-zeros {}",
-        dofs.n,
+        "fine {n}²: {unknowns} unknowns; factorized {ok} in {first:.3} s with its analysis, {numeric:.3} s numeric again; factor non-zeros {}",
         spd.factor_nonzeros()
     );
 }
