@@ -55,6 +55,12 @@ impl Model {
         self.contacts_with(x, &mut CandidateSet::default())
     }
 
+    /// Total potential energy in J at `x`, its contact set measured over `candidates` (the
+    /// solve's candidate set): a solve's evaluation at a state it only looks at.
+    pub fn energy_with(&self, x: &Vecs, candidates: &mut CandidateSet, load: f64) -> f64 {
+        self.energy_on(x, &self.contacts_with(x, candidates), load)
+    }
+
     /// The largest fraction of the step `dx` from `x` that every contact term allows
     /// ([`super::StepBound`]), the self-contact term's over `candidates` (the solve's set, made to
     /// cover the step).

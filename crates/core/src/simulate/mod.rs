@@ -258,10 +258,7 @@ fn solve_built(
     // them), which the solve then carries on.
     let mut candidates = warm.candidates.cloned().unwrap_or_default();
     let opts = opts.unwrap_or(&scene.solver.static_);
-    let mut energy = |s: &[Vector3<f64>]| {
-        let contacts = model.contacts_with(s, &mut candidates);
-        model.energy_on(s, &contacts, 1.0)
-    };
+    let mut energy = |s: &[Vector3<f64>]| model.energy_with(s, &mut candidates, 1.0);
     let mut scored = starts
         .iter()
         .filter(|s| s.len() == x.len())

@@ -241,15 +241,10 @@ pub fn observe_start(
     observer: &mut dyn Observer,
 ) -> anyhow::Result<()> {
     if frame_s.is_some() || observer.wants(0) {
-        let mut g = Vec::new();
-        model.gradient(x, 1.0, &mut g);
-        observer.observe(&StateEvent {
-            index: 0,
-            time_s: Some(0.0),
-            x,
-            max_residual_N: model.max_residual(&g),
-            energy_J: model.energy(x, 1.0) + super::kinetic_energy(model, v),
-        })?;
+        let (mut g, contacts) = (Vec::new(), model.contacts(x));
+        model.gradient_on(x, &contacts, 1.0, &mut g);
+        let r = model.max_residual(&g);
+        observe_state(observer, (model, &contacts), x, v, (0, 0.0, r))?;
     }
     Ok(())
 }

@@ -14,7 +14,7 @@
 //! one gravity and bending settle on.
 
 use super::linear::{DofMap, SparseSpd};
-use crate::physics::{HessianBlocks, Model};
+use crate::physics::{CandidateSet, HessianBlocks, Model};
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::FRAC_PI_2;
 
@@ -77,11 +77,12 @@ pub fn sagged_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
     let phi = sag_shape(model, x)?;
     let x0 = x.to_vec();
     let mut trial = x0.clone();
+    let mut candidates = CandidateSet::default();
     let mut energy = |s: f64| {
         for p in 0..x0.len() {
             trial[p] = x0[p] - Vector3::new(0.0, 0.0, s * phi[p]);
         }
-        model.energy(&trial, 1.0)
+        model.energy_with(&trial, &mut candidates, 1.0)
     };
     // Bracket the minimum by doubling from a thousandth of the sheet's extent, then golden section.
     let extent = x0
@@ -176,6 +177,7 @@ pub fn folded_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
         })
         .collect();
     let mut trial = x0.clone();
+    let mut candidates = CandidateSet::default();
     let mut energy = |t: f64| {
         let (c, s) = (t.cos(), t.sin());
         for p in 0..x0.len() {
@@ -184,7 +186,7 @@ pub fn folded_start(model: &Model, x: &mut [Vector3<f64>]) -> Option<f64> {
                 trial[p] = x0[p] - perp + perp * c + turn * s;
             }
         }
-        model.energy(&trial, 1.0)
+        model.energy_with(&trial, &mut candidates, 1.0)
     };
     let step = 5f64.to_radians();
     let samples: Vec<f64> = (0..=18).map(|k| energy(k as f64 * step)).collect();
