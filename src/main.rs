@@ -26,6 +26,13 @@ fn main() {
         Err(e) => e.exit(),
     };
     drapelab::cli::init_logging(cli.verbose, cli.quiet);
+    // Ctrl-C: what the run has not finished (temporary files, staging folders, output folders
+    // still empty) is removed, and it says so; exit 130 as shells expect of SIGINT.
+    let _ = ctrlc::set_handler(|| {
+        drapelab::atomic::remove_unfinished();
+        eprintln!("drapelab: interrupted (Ctrl-C): stopped, unfinished outputs removed");
+        std::process::exit(drapelab::error::EXIT_INTERRUPTED);
+    });
     let code = match on_worker(|| drapelab::cli::run(cli)) {
         Ok(code) => code,
         Err(err) => {

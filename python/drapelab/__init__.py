@@ -247,7 +247,8 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
              frames: int = 0,
              progress: Optional[Callable[[int, Optional[float], float, float], Any]] = None,
              *, set: Optional[Mapping[str, Any]] = None,
-             fabric: Optional[PathLike] = None) -> Result:
+             fabric: Optional[PathLike] = None,
+             start: Optional[Union[PathLike, "Result"]] = None) -> Result:
     """Solves a scene as ``drapelab simulate`` does.
 
     Args:
@@ -264,6 +265,10 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
             stops the solve and is raised again.
         fabric: a fabric file (as a calibration writes it) whose material, and areal density where
             it gives one, replace the scene's, as ``drapelab simulate --fabric FILE`` does.
+        start: a saved drape to start from (a ``particles.parquet`` or ``last_state.parquet`` of
+            the same scene, or a :class:`Result`), as ``drapelab simulate --start FILE`` does: the
+            restart takes up what that run adapted (the self-contact κ growth) and continues it,
+            so a converged drape at the same parameters comes back in 0 iterations.
 
     Returns:
         The :class:`Result`, converged or not (see its ``status``).
@@ -286,10 +291,13 @@ def simulate(scene: Union[PathLike, Mapping[str, Any]],
         path, table = os.fspath(scene), None
     if not isinstance(frames, int) or frames < 0:
         raise InputError(f"frames: a count ≥ 0, got {frames!r}")
+    start_path = None
+    if start is not None:
+        start_path = os.fspath(start.table_path() if isinstance(start, Result) else start)
     tmp = tempfile.TemporaryDirectory(prefix="drapelab-")
     try:
         out = _drapelab.simulate(path, table, overrides_json, tmp.name, list(sensitivity),
-                                 frames, progress)
+                                 frames, progress, start_path)
     except BaseException:
         tmp.cleanup()
         raise

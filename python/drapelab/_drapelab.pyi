@@ -16,6 +16,7 @@ def simulate(
     sensitivity: List[str] = ...,
     frames: int = ...,
     progress: Optional[Callable[[int, Optional[float], float, float], Any]] = ...,
+    start: Optional[str] = ...,
 ) -> Tuple[str, bytes, bytes, bytes, int, int, float, List[Tuple[str, bytes]],
            List[Tuple[int, Optional[float], bytes]]]:
     """run.json's text, positions (n×3 little-endian f64, m), present (n bytes), triangles

@@ -176,7 +176,8 @@ pub fn load_scene(path: &Path, sets: &[String]) -> Result<LoadedScene, InputErro
         .map(|s| parse_override(s))
         .collect::<Result<Vec<_>, InputError>>()?;
     Scene::load(path, &overrides).map_err(|e| {
-        match crate::config::override_culprit(&e.key, &overrides) {
+        // An error in another file (a fabric, a mesh) names that file, whatever override led there.
+        match crate::config::override_culprit(&e.key, &overrides).filter(|_| e.file == path) {
             Some(i) => InputError::new(
                 format!("--set {} (over {})", sets[i], path.display()),
                 e.key,
@@ -212,7 +213,8 @@ pub fn load_scene_in_fabric(
     );
     overrides.push(("material".into(), toml::Value::Table(material)));
     Scene::load(path, &overrides).map_err(|e| {
-        match crate::config::override_culprit(&e.key, &overrides[..given]) {
+        let culprit = crate::config::override_culprit(&e.key, &overrides[..given]);
+        match culprit.filter(|_| e.file == path) {
             Some(i) => InputError::new(
                 format!("--set {} (over {})", sets[i], path.display()),
                 e.key,

@@ -3,7 +3,7 @@
 
 use super::progress::SolveProgress;
 use super::{args, load_scene};
-use crate::error::{EXIT_FAILED, EXIT_OK, InputError};
+use crate::error::{EXIT_FAILED, EXIT_OK};
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 
@@ -27,7 +27,10 @@ pub struct SimulateArgs {
     #[arg(long = "sensitivity", value_name = "KEY")]
     pub sensitivity: Vec<String>,
     /// Start the solve from a saved drape (a particles.parquet or last_state.parquet of the same
-    /// scene and grid) instead of the scene's own start: a restart.
+    /// scene and grid) instead of the scene's own start: a restart, which takes up what the run
+    /// that wrote it adapted (the self-contact κ growth, in the file's metadata) and so continues
+    /// that run: a converged drape at the same parameters comes back in 0 iterations. A table
+    /// written elsewhere starts the model as built; run.json's `start` says which.
     #[arg(long, value_name = "FILE")]
     pub start: Option<PathBuf>,
     /// Drape the scene in this fabric: its material (and its areal density, where the file gives
@@ -71,7 +74,9 @@ fn simulate(
     }
     let extras = crate::io::SimulateExtras {
         sensitivity_keys: sensitivity.to_vec(),
-        start: start.map(|f| read_start(f, &loaded.scene)).transpose()?,
+        start: start
+            .map(|f| crate::io::read_start(f, &loaded.scene, "--start"))
+            .transpose()?,
         obj,
     };
     let _out = args::out_dir(out)?;
@@ -102,55 +107,4 @@ fn simulate(
     } else {
         EXIT_FAILED
     })
-}
-
-/// The grid particles' positions of a saved drape (`--start FILE`), checked against the scene's
-/// grid (the same particles (i, j) in the same order, finite positions) and the scene itself
-/// ([`crate::build::check_start`]: fixed particles in place, none inside an obstacle, no two
-/// neighbours at one point).
-fn read_start(
-    file: &Path,
-    scene: &crate::scene::ValidatedScene,
-) -> Result<(Vec<nalgebra::Vector3<f64>>, String), InputError> {
-    let grid = &scene.grid();
-    let bad = |key: &str, m: String| InputError::new(format!("--start {}", file.display()), key, m);
-    let rows = crate::io::read_particles(file).map_err(|e| bad("", format!("{e:#}")))?;
-    if rows.len() != grid.len() {
-        return Err(bad(
-            "",
-            format!(
-                "{} particles, the scene's grid has {} ({} × {}): start from a drape of the same grid",
-                rows.len(),
-                grid.len(),
-                grid.nx,
-                grid.ny
-            ),
-        ));
-    }
-    let mut x = Vec::with_capacity(rows.len());
-    for (p, (i, j, v)) in rows.into_iter().enumerate() {
-        if (i as usize, j as usize) != grid.ij(p) {
-            return Err(bad(
-                "i",
-                format!(
-                    "row {p} is particle ({i}, {j}), expected {:?}: not particles.parquet's order",
-                    grid.ij(p)
-                ),
-            ));
-        }
-        // A drape's coordinates are finite and within a kilometre of the origin.
-        if let Some(c) = (0..3).find(|&c| !v[c].is_finite() || v[c].abs() > 1e3) {
-            return Err(bad(
-                ["x_m", "y_m", "z_m"][c],
-                format!(
-                    "row {p}: {} is not a position within a kilometre of the origin",
-                    v[c]
-                ),
-            ));
-        }
-        x.push(v);
-    }
-    let built = crate::build::build_scene(scene);
-    crate::build::check_start(scene, &built, &x).map_err(|d| bad(d.column, d.message))?;
-    Ok((x, file.display().to_string()))
 }

@@ -20,6 +20,8 @@ mod module_graph;
 mod patterns;
 mod pipeline;
 mod recordings;
+mod refusals;
+mod restart;
 mod runs;
 mod self_contact;
 mod sensitivity;

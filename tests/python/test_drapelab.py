@@ -451,3 +451,38 @@ def test_a_mesh_scene_simulates_with_the_files_vertices_and_triangles():
     assert r.run["self_contact"]["crossing_edges"] == 0
     m = drapelab.measure_drape(r)
     assert abs(m["drape_coefficient_pct"] - r.run["drape"]["drape_coefficient_pct"]) < 1.0
+
+
+def test_a_restart_from_a_result_continues_its_run_in_zero_iterations():
+    # sphere_wool's solve stiffens its self-contact barrier; the restart takes that up (issue 92).
+    sphere = ROOT / "datasets/scenes/sphere_wool.toml"
+    first = drapelab.simulate(sphere)
+    assert first.converged and first.run["self_contact"]["kappa_growth"] > 1
+    again = drapelab.simulate(sphere, start=first)
+    assert again.report["iterations"] == 0
+    assert np.abs(again.positions - first.positions).max() <= 1e-12
+    assert again.run["start"]["kappa_growth_taken_up"] == first.run["self_contact"]["kappa_growth"]
+
+
+def test_read_scene_round_trips_a_scene_with_relative_mesh_and_fabric_paths(tmp_path, monkeypatch):
+    # Read where the scene is, simulated from another folder: the files it names still resolve.
+    mesh_scene = ROOT / "datasets/bodies/sphere_wool_mesh.toml"
+    table = drapelab.read_scene(mesh_scene)
+    assert pathlib.Path(table["obstacles"][0]["mesh"]).is_absolute()
+    monkeypatch.chdir(tmp_path)
+    a = drapelab.simulate(table, {"cloth.nx": 11, "cloth.ny": 11})
+    b = drapelab.simulate(mesh_scene, {"cloth.nx": 11, "cloth.ny": 11})
+    assert a.converged and np.array_equal(a.positions, b.positions)
+    # A scene naming its fabric by a relative path.
+    sub = tmp_path / "sub"
+    sub.mkdir()
+    (sub / "wool.toml").write_text((ROOT / "datasets/fabrics/wool_seed003.toml").read_text())
+    text = (ROOT / "datasets/scenes/sphere_wool.toml").read_text()
+    head, rest = text.split("[material.continuum]", 1)
+    tail = rest[rest.index("\n["):]
+    (sub / "scene.toml").write_text(head + '[material]\nfabric = "wool.toml"\n' + tail)
+    table = drapelab.read_scene(sub / "scene.toml")
+    assert pathlib.Path(table["material"]["fabric"]).is_absolute()
+    c = drapelab.simulate(table, {"cloth.nx": 11, "cloth.ny": 11})
+    d = drapelab.simulate(sub / "scene.toml", {"cloth.nx": 11, "cloth.ny": 11})
+    assert c.converged and np.array_equal(c.positions, d.positions)

@@ -92,7 +92,9 @@ impl<I> Job<'_, I> {
         param_key: impl Fn(&str) -> String,
     ) -> Result<drapelab_core::scene::LoadedScene> {
         drapelab_core::scene::Scene::load(file, overrides).map_err(|e| {
-            match drapelab_core::config::override_culprit(&e.key, overrides) {
+            let culprit = drapelab_core::config::override_culprit(&e.key, overrides);
+            // An error in another file (a fabric, a mesh) names that file.
+            match culprit.filter(|_| e.file == file) {
                 Some(i) => self
                     .param_error(
                         &param_key(&overrides[i].0),

@@ -84,8 +84,8 @@ fn child<'a>(v: &'a mut toml::Value, part: &str) -> Result<&'a mut toml::Value, 
 
 /// Reads a TOML file into a table, with the file named in errors.
 pub fn read_toml_table(path: &Path) -> Result<toml::Table, InputError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
+    let text = crate::textfile::read_text(path, crate::textfile::NonUtf8::Refuse)
+        .map_err(|e| InputError::new(path, "", e))?;
     text.parse::<toml::Table>().map_err(|e| {
         let msg = e.message().to_string();
         let line = e.span().map(|s| text[..s.start].lines().count().max(1));

@@ -91,6 +91,8 @@ pub const EXIT_OK: i32 = 0;
 pub const EXIT_FAILED: i32 = 1;
 /// Exit code for bad input.
 pub const EXIT_BAD_INPUT: i32 = 2;
+/// Exit code of a run stopped by Ctrl-C (SIGINT), as shells report 128 + 2.
+pub const EXIT_INTERRUPTED: i32 = 130;
 
 /// Maps an error chain to the process exit code: 2 for bad input, 1 otherwise.
 pub fn exit_code(err: &anyhow::Error) -> i32 {

@@ -25,6 +25,7 @@ pub mod elastica;
 pub mod error;
 pub mod material;
 pub mod measure;
+pub mod memory;
 pub mod obstacle;
 pub mod optim;
 pub mod params;
@@ -39,6 +40,7 @@ pub mod simulate;
 pub mod solve;
 pub mod surface;
 pub mod table;
+pub mod textfile;
 pub mod wrinkles;
 
 /// Standard gravity in m/s², the default of every scene.

@@ -11,13 +11,17 @@ pub fn rel(root: &Path, p: &Path) -> String {
         .replace('\\', "/")
 }
 
-/// Removes temporary files left in `dir` by a killed run (`.NAME.*.partial`).
+/// Removes temporary files and staging folders left in `dir` by a killed run (`.NAME.*.partial`;
+/// the pipeline's lock keeps any other run of the plan out of `dir` meanwhile).
 pub fn remove_partials(dir: &Path) {
     if let Ok(entries) = std::fs::read_dir(dir) {
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().to_string();
             if name.starts_with('.') && name.ends_with(".partial") {
-                std::fs::remove_file(e.path()).ok();
+                match e.file_type().is_ok_and(|t| t.is_dir()) {
+                    true => std::fs::remove_dir_all(e.path()).ok(),
+                    false => std::fs::remove_file(e.path()).ok(),
+                };
             }
         }
     }

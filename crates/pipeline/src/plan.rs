@@ -4,6 +4,7 @@
 //! slot or key.
 
 use crate::executor::ExecutorSettings;
+use crate::files::rel;
 use crate::stage::{Registry, Stage};
 use drapelab_core::config::{from_table, read_toml_table};
 use drapelab_core::error::InputError;
@@ -365,14 +366,30 @@ fn link_inputs(
                 }
             }
             if !produced {
-                let found = glob::glob(&root.join(pat).to_string_lossy())
-                    .map(|mut g| g.next().is_some())
-                    .unwrap_or(false);
-                if !found {
+                let matches: Vec<PathBuf> = glob::glob(&root.join(pat).to_string_lossy())
+                    .map(|g| g.flatten().collect())
+                    .unwrap_or_default();
+                if matches.is_empty() {
                     return Err(InputError::new(
                         file,
                         &key,
                         format!("missing input `{pat}`: no such file, and no stage writes it"),
+                    ));
+                }
+                // A stage reads files: a folder (or a pipe) named as an input fails only when it runs.
+                if let Some(m) = matches.iter().find(|m| !m.is_file()) {
+                    let what = if m.is_dir() {
+                        "a folder"
+                    } else {
+                        "not a regular file"
+                    };
+                    return Err(InputError::new(
+                        file,
+                        &key,
+                        format!(
+                            "input `{}` is {what}: name the file (or a glob of files) inside it",
+                            rel(root, m)
+                        ),
                     ));
                 }
             }

@@ -86,8 +86,11 @@ pub fn load_scene(
             ));
         }
     };
+    let scene_file = Path::new(path.unwrap_or("scene (dict)"));
     loaded.map_err(|e| {
-        let msg = match drapelab_core::config::override_culprit(&e.key, &overrides) {
+        let culprit = drapelab_core::config::override_culprit(&e.key, &overrides);
+        // An error in another file (a fabric, a mesh) names that file.
+        let msg = match culprit.filter(|_| e.file == scene_file) {
             Some(i) => format!(
                 "set[{:?}] (over {}): key `{}`: {}",
                 overrides[i].0,

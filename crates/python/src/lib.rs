@@ -58,7 +58,7 @@ type Simulated<'py> = (
 /// Solves a scene (a TOML file, or a table as JSON text) with dotted overrides (JSON object) into
 /// the folder `out`, as `drapelab simulate --out` does.
 #[pyfunction]
-#[pyo3(signature = (scene_path, scene_json, set_json, out, sensitivity=Vec::new(), frames=0, progress=None))]
+#[pyo3(signature = (scene_path, scene_json, set_json, out, sensitivity=Vec::new(), frames=0, progress=None, start=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -69,6 +69,7 @@ fn simulate<'py>(
     sensitivity: Vec<String>,
     frames: usize,
     progress: Option<Py<PyAny>>,
+    start: Option<String>,
 ) -> PyResult<Simulated<'py>> {
     let started = std::time::Instant::now();
     let loaded = load_scene(scene_path.as_deref(), scene_json.as_deref(), set_json)?;
@@ -78,8 +79,13 @@ fn simulate<'py>(
         drapelab_core::sensitivity::check_key(&loaded.scene, key, "sensitivity")
             .map_err(|e| InputError::new_err(e.to_string()))?;
     }
+    let start = start
+        .map(|f| drapelab_record::read_start(Path::new(&f), &loaded.scene, "start"))
+        .transpose()
+        .map_err(|e| InputError::new_err(e.to_string()))?;
     let extras = drapelab_record::SimulateExtras {
         sensitivity_keys: sensitivity,
+        start,
         ..Default::default()
     };
     let out = Path::new(out).to_path_buf();
@@ -283,11 +289,13 @@ fn version() -> &'static str {
 }
 
 /// A TOML scene file's text parsed and validated; its table back as JSON text (the dict a
-/// notebook edits and passes to `simulate`).
+/// notebook edits and passes to `simulate`), the files it names as absolute paths.
 #[pyfunction]
 fn read_scene(path: &str) -> PyResult<String> {
-    let table = drapelab_core::config::read_toml_table(Path::new(path))
+    let mut table = drapelab_core::config::read_toml_table(Path::new(path))
         .map_err(|e| InputError::new_err(e.to_string()))?;
+    // The files it names made absolute: the dict means the same scene from any folder.
+    drapelab_core::scene::absolute_file_keys(&mut table, Path::new(path));
     json(&table)
 }
 

@@ -1,5 +1,7 @@
 //! `iterations.parquet`: how a solve went, one row per Newton iteration (static) or time step
-//! (dynamic) that the solve's observers see: the residual and the energy, for a convergence plot.
+//! (dynamic) that the solve's observers see: the residual and the energy, for a convergence plot,
+//! and how each Newton iteration stepped (its length, the contact bound, line-search trials,
+//! factorizations, active contact pairs): where a long path's iterations go.
 
 use crate::table::{Table, write_table};
 use anyhow::Result;
@@ -18,6 +20,22 @@ pub struct IterationRow {
     pub max_residual_N: f64,
     /// Total energy (potential, plus kinetic in dynamics), J.
     pub energy_J: f64,
+    /// The step the Newton iteration took, as a fraction of its Newton step (1: whole); null for
+    /// a start or a time step.
+    pub step_fraction: Option<f64>,
+    /// The collision-free bound on that step (contact: no pair closes more than 90 % of its gap),
+    /// as a fraction of the Newton step; null where no term bounded it.
+    pub contact_bound_fraction: Option<f64>,
+    /// Whether the contact bound cut the step (it stopped at the bound).
+    pub contact_bound_cut: Option<bool>,
+    /// Line-search trials of the iteration (the accepted one and those rejected).
+    pub line_search_trials: Option<u32>,
+    /// Factorizations the iteration made (0: it reused a factor: a chord or Krylov step).
+    pub factorizations: Option<u32>,
+    /// Self-contact pairs within the activation distance at the new state.
+    pub active_contact_pairs: Option<u64>,
+    /// The largest distance a particle moved in the iteration, m.
+    pub max_move_m: Option<f64>,
 }
 
 impl Table for IterationRow {
@@ -37,11 +55,19 @@ impl Observer for History {
         index.is_multiple_of(self.every)
     }
     fn observe(&mut self, ev: &StateEvent<'_>) -> anyhow::Result<()> {
+        let s = ev.step;
         self.rows.push(IterationRow {
             index: ev.index as u64,
             time_s: ev.time_s,
             max_residual_N: ev.max_residual_N,
             energy_J: ev.energy_J,
+            step_fraction: s.map(|s| s.alpha),
+            contact_bound_fraction: s.and_then(|s| s.bound.is_finite().then_some(s.bound)),
+            contact_bound_cut: s.map(|s| s.bound_cut),
+            line_search_trials: s.map(|s| s.trials as u32),
+            factorizations: s.map(|s| s.factorizations as u32),
+            active_contact_pairs: s.map(|s| s.active_pairs as u64),
+            max_move_m: s.map(|s| s.max_move_m),
         });
         Ok(())
     }

@@ -21,6 +21,7 @@ mod run_dir;
 mod run_sensitivity;
 mod sampled;
 mod sensitivity_table;
+mod start;
 mod surface_out;
 mod table;
 mod timeline;
@@ -34,15 +35,17 @@ pub use edges_table::EdgeRow;
 pub use edges_table::{read_edges, write_edges};
 pub use history::{History, IterationRow};
 pub use mesh_out::{TriangleRow, obj_text, read_triangles, write_triangles};
-pub use particles::{ParticleRow, read_particles, write_particles};
+pub use particles::{ParticleRow, read_particles, read_particles_with_metadata, write_particles};
 pub use parts::{gather_parquet, merge_recordings};
 pub use photo::{fit_photo, render_scene, score_files};
 pub use rrd::RerunRecorder;
 pub use run_dir::{
-    SimulateExtras, Simulated, simulate_to_dir, simulate_to_dir_state, simulate_to_dir_with,
+    SimulateExtras, Simulated, StartState, simulate_to_dir, simulate_to_dir_state,
+    simulate_to_dir_with,
 };
 pub use sampled::{Sampled, StateSink};
 pub use sensitivity_table::{SensitivityRow, read_sensitivities, write_sensitivities};
+pub use start::read_start;
 pub use surface_out::{TexturedSurface, glb_bytes, write_glb, write_surface_rrd};
 pub use table::{
     Table, join_columns, read_table, table_batch, table_fields, table_markdown, write_parquet,

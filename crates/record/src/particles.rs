@@ -31,7 +31,7 @@ pub struct ParticleRow {
 
 impl Table for ParticleRow {
     const FILE: &'static str = "particles.parquet";
-    const ROW: &'static str = "One grid particle of a solved sheet (also `last_state.parquet` of a solve that did not converge); key-value metadata `status`, `solver`, `scene`.";
+    const ROW: &'static str = "One grid particle of a solved sheet (also `last_state.parquet` of a solve that did not converge); key-value metadata `status`, `solver`, `scene`, `self_contact_kappa_growth` (what the solve adapted, taken up by a restart).";
 }
 
 /// Writes the grid particles' positions (flagged absent where `absent` says so; an empty slice:
@@ -83,4 +83,28 @@ pub fn read_particles(path: &Path) -> Result<Vec<(u32, u32, Vector3<f64>)>> {
         .into_iter()
         .map(|r| (r.i, r.j, Vector3::new(r.x_m, r.y_m, r.z_m)))
         .collect())
+}
+
+/// [`read_particles`] with the file's key-value metadata (empty for a file written without).
+pub fn read_particles_with_metadata(
+    path: &Path,
+) -> Result<(
+    Vec<(u32, u32, Vector3<f64>)>,
+    std::collections::BTreeMap<String, String>,
+)> {
+    let rows = read_particles(path)?;
+    let mut meta = std::collections::BTreeMap::new();
+    let file = std::fs::File::open(path)?;
+    if let Ok(reader) = parquet::file::reader::SerializedFileReader::new(file) {
+        use parquet::file::reader::FileReader;
+        let kv = reader
+            .metadata()
+            .file_metadata()
+            .key_value_metadata()
+            .cloned();
+        for e in kv.unwrap_or_default() {
+            meta.insert(e.key, e.value.unwrap_or_default());
+        }
+    }
+    Ok((rows, meta))
 }

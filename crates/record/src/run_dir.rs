@@ -46,6 +46,9 @@ struct RunRecord<'a> {
     /// The saved state the solve started from (`--start`), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     start_file: Option<String>,
+    /// How the solve took up that start's state.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    start: Option<StartRecord>,
     scene: &'a Scene,
 }
 
@@ -68,19 +71,63 @@ pub struct SimulateExtras {
     /// Continuous scene keys whose sensitivities dx*/dθ to write into `sensitivity.parquet`
     /// (`simulate --sensitivity KEY`); checked by [`drapelab_core::sensitivity::check_key`] first.
     pub sensitivity_keys: Vec<String>,
-    /// A saved drape to start from (`simulate --start FILE`): the grid particles' positions in
-    /// particles.parquet's row order, and the file's name for run.json.
-    pub start: Option<(Vec<nalgebra::Vector3<f64>>, String)>,
+    /// A saved drape to start from (`simulate --start FILE`).
+    pub start: Option<StartState>,
     /// Also write the converged drape as `drape.obj` (`simulate --obj`).
     pub obj: bool,
 }
 
+/// A saved drape a run starts from: a restart that continues the run that wrote it.
+#[derive(Debug, Clone)]
+pub struct StartState {
+    /// The grid particles' positions in particles.parquet's row order, m.
+    pub x: Vec<nalgebra::Vector3<f64>>,
+    /// The file's name, for run.json.
+    pub file: String,
+    /// What the run that wrote it adapted (κ growth), from the file's metadata; None for a table
+    /// written elsewhere (the solve then starts its model as built, and run.json says so).
+    pub adapted: Option<drapelab_core::physics::Adapted>,
+}
+
+/// How a run took up its start, for run.json.
+#[derive(Debug, Clone, Serialize)]
+struct StartRecord {
+    /// The saved drape's file.
+    file: String,
+    /// The self-contact κ growth the solve started with (from the file; 1 where it had none).
+    kappa_growth_taken_up: f64,
+    /// What the run did with the file's solve state.
+    note: &'static str,
+}
+
+impl StartState {
+    /// run.json's account of the start.
+    fn record(&self) -> StartRecord {
+        StartRecord {
+            file: self.file.clone(),
+            kappa_growth_taken_up: self.adapted.unwrap_or_default().kappa_growth,
+            note: match self.adapted {
+                Some(_) => {
+                    "the solve continued the run that wrote the start (its κ growth taken up)"
+                }
+                None => {
+                    "the start carries no solve state (not written by drapelab): the model started as built, κ growth 1"
+                }
+            },
+        }
+    }
+}
+
 impl SimulateExtras {
-    /// Copies the given start into `x` when it has one position per particle of `x`; whether it did.
-    fn start_into(&self, x: &mut [nalgebra::Vector3<f64>]) -> bool {
+    /// Copies the given start into `x` when it has one position per particle of `x` and gives the
+    /// model the state the start's run adapted; whether it did.
+    fn start_into(&self, x: &mut [nalgebra::Vector3<f64>], model: &mut Model) -> bool {
         match &self.start {
-            Some((start, _)) if start.len() == x.len() => {
-                x.copy_from_slice(start);
+            Some(start) if start.x.len() == x.len() => {
+                x.copy_from_slice(&start.x);
+                if let Some(a) = &start.adapted {
+                    a.apply_to(model);
+                }
                 true
             }
             _ => false,
@@ -144,9 +191,11 @@ pub fn simulate_to_dir_with(
         .suffix(".partial")
         .tempdir_in(out)
         .with_context(|| format!("cannot write into {}", out.display()))?;
-    let (simulated, written) = simulate_into(loaded, staging.path(), progress, extras)?;
-    publish(staging.path(), out, &written)?;
-    Ok(simulated)
+    drapelab_core::atomic::note_unfinished(staging.path(), drapelab_core::atomic::Removal::Whole);
+    let done = simulate_into(loaded, staging.path(), progress, extras)
+        .and_then(|(simulated, written)| publish(staging.path(), out, &written).map(|_| simulated));
+    drapelab_core::atomic::note_finished(staging.path());
+    done
 }
 
 /// Removes staging folders that a killed run left in `out`: those whose process (the pid in the
@@ -246,7 +295,7 @@ fn simulate_into(
     let absent = drapelab_core::build::absent_particles(scene, &x0);
     let (mut timeline, mut rrd) = recorders(scene, out, &grid, &model, &x0)?;
     let mut x = x0;
-    let warm = extras.start_into(&mut x[..grid.len()]);
+    let warm = extras.start_into(&mut x[..grid.len()], &mut model);
     let every = scene
         .solver
         .kind
@@ -266,7 +315,15 @@ fn simulate_into(
     history.write(&out.join("iterations.parquet"))?;
     finish_recorders(&report, &x, (timeline, rrd), &mut outputs)?;
     let state = (&grid, absent.as_slice(), x.as_slice());
-    state_files(scene, state, &report, extras.obj, out, &mut outputs)?;
+    let adapted = drapelab_core::physics::Adapted::of(&model);
+    state_files(
+        scene,
+        state,
+        (&report, adapted),
+        extras.obj,
+        out,
+        &mut outputs,
+    )?;
     let asked = &extras.sensitivity_keys;
     let (sensitivity, sens_data) = sensitivities(loaded, &grid, &model, &x, &report, asked, out)?;
     if sensitivity.as_ref().is_some_and(|s| s.written) {
@@ -291,7 +348,8 @@ fn simulate_into(
         sensitivity,
         neutral_modes: (report.is_converged() && scene.solver.kind.integrator().is_none())
             .then(|| drapelab_core::solve::neutral_modes(&model, &x)),
-        start_file: extras.start.as_ref().map(|s| s.1.clone()),
+        start_file: extras.start.as_ref().map(|s| s.file.clone()),
+        start: extras.start.as_ref().map(StartState::record),
         scene,
     };
     let written = record.outputs.clone();
@@ -331,7 +389,7 @@ fn observed_solve(
 
 /// The final state: `particles.parquet` of a converged drape, else `last_state.parquet` of a
 /// finite one (labelled by its status, for looking at where it went wrong; a non-finite state is
-/// not written); beside it the sheet as a mesh, `triangles.parquet`, and `drape.obj` of a
+/// not written), with what the solve adapted (κ growth) in its metadata for a restart; beside it the sheet as a mesh, `triangles.parquet`, and `drape.obj` of a
 /// converged drape when asked.
 fn state_files(
     scene: &Scene,
@@ -340,17 +398,18 @@ fn state_files(
         &[bool],
         &[nalgebra::Vector3<f64>],
     ),
-    report: &SolveReport,
+    (report, adapted): (&SolveReport, drapelab_core::physics::Adapted),
     obj: bool,
     out: &Path,
     outputs: &mut Vec<&'static str>,
 ) -> Result<()> {
-    let meta = [
+    let mut meta = vec![
         ("drapelab_version", drapelab_core::VERSION.to_string()),
         ("status", report.status.as_str().to_string()),
         ("solver", report.solver.report_name().to_string()),
         ("scene", scene.name.clone()),
     ];
+    meta.extend(adapted.metadata());
     let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));
     let file = match (report.status == Status::Converged, finite) {
         (true, _) => "particles.parquet",
@@ -387,6 +446,7 @@ fn finish_recorders(
         x,
         max_residual_N: report.max_residual_N,
         energy_J: report.energy_J,
+        step: None,
     };
     let finite = x.iter().all(|p| p.iter().all(|c| c.is_finite()));
     if let Some(mut t) = timeline {

@@ -59,21 +59,47 @@ pub fn initial_positions(scene: &Scene) -> Vec<Vector3<f64>> {
 }
 
 /// Checks that the scene `loaded` has something to solve: at least one free particle with mass
-/// (a 2 × 2 sheet pinned at its four corners has none). The error names the file and `boundary`.
+/// (a 2 × 2 sheet pinned at its four corners has none; the error names `boundary`, or
+/// `contact.fix_supported` where that fixed them), and where `contact.fix_supported` is the only
+/// hold, at least one particle it fixes.
 pub fn check_something_free(
     loaded: &crate::scene::LoadedScene,
 ) -> Result<(), crate::error::InputError> {
     let model = build_scene(&loaded.scene).model;
+    let n = loaded.scene.grid().len();
+    let c = &loaded.scene.contact;
+    let held = model.fixed.iter().any(|&f| f) || model.held_components.iter().flatten().any(|&h| h);
+    if c.fix_supported && !held {
+        // The scene's only hold is what rests on a support, and nothing does: the sheet would fall
+        // (or slide off) with nothing to stop it, and Newton would spend its whole budget on it.
+        return Err(crate::error::InputError::new(
+            &loaded.path,
+            "contact.fix_supported",
+            format!(
+                "fixes none of the sheet's {n} particles (none starts over an obstacle's top face): \
+pin the sheet (boundary) or place it over the support"
+            ),
+        ));
+    }
     if model.reference_weight().is_finite() {
         return Ok(());
+    }
+    if c.fix_supported && !loaded.scene.obstacles.is_empty() {
+        return Err(crate::error::InputError::new(
+            &loaded.path,
+            "contact.fix_supported",
+            format!(
+                "fixes every particle resting on an obstacle's top, and with the pins that leaves \
+none of the sheet's {n} particles free: set it to false, or make the sheet larger than the support"
+            ),
+        ));
     }
     Err(crate::error::InputError::new(
         &loaded.path,
         "boundary",
         format!(
-            "no free particle with mass on the {} particles of the sheet: every particle is pinned, \
-clamped or outside the sheet; pin fewer or use a finer sheet (cloth.nx, cloth.ny, or the mesh)",
-            loaded.scene.grid().len()
+            "no free particle with mass on the {n} particles of the sheet: every particle is pinned, \
+clamped or outside the sheet; pin fewer or use a finer sheet (cloth.nx, cloth.ny, or the mesh)"
         ),
     ))
 }

@@ -32,6 +32,8 @@ pub(super) struct LatticeDrape {
     /// The factor of its exact Hessian: an evaluation nearby solves its Newton steps by conjugate
     /// gradients preconditioned with it, without a factorization of its own.
     factor: Option<std::sync::Arc<crate::solve::SparseSpd>>,
+    /// What its solve adapted (κ growth): an evaluation nearby solves the model the node solved.
+    adapted: crate::physics::Adapted,
 }
 
 /// Where an evaluation starts: the candidate starts (a lattice drape and its tangent prediction),
@@ -47,6 +49,8 @@ pub struct WarmStart {
     pub candidates: Option<crate::physics::CandidateSet>,
     /// The node's factor, the preconditioner of the evaluation's Newton steps.
     pub factor: Option<crate::solve::NeighbourFactor>,
+    /// What the node's solve adapted (κ growth), taken up by the evaluation's model.
+    pub adapted: Option<crate::physics::Adapted>,
 }
 
 /// The two keys of the lattice's tangents.
@@ -92,6 +96,7 @@ impl LatticeDrape {
         };
         Some(Self {
             factor,
+            adapted: crate::physics::Adapted::of(&sol.model),
             candidates,
             x: sol.x,
             tangents,
@@ -185,18 +190,25 @@ impl SharedLattice {
                 k * (R.sqrt() - 1.0),
                 0.5 * (self.lengths[1] - self.lengths[0]),
             ];
-            let mut prev: Option<Vec<Vector3<f64>>> = None;
+            let mut prev: Option<(Vec<Vector3<f64>>, crate::physics::Adapted)> = None;
             self.lengths
                 .iter()
                 .map(|&l| {
                     let scene = self.scene(k, l, t);
                     let sol = match &prev {
-                        Some(x0) => crate::simulate::solve_scene_from(&scene, x0, &mut NoObserver),
+                        Some((x0, adapted)) => {
+                            let warm = crate::solve::WarmData {
+                                adapted: Some(*adapted),
+                                ..Default::default()
+                            };
+                            let from = crate::simulate::solve_scene_from_lowest;
+                            from(&scene, None, &[x0], warm, &mut NoObserver)
+                        }
                         None => crate::simulate::solve_scene(&scene, &mut NoObserver),
                     };
                     let node = LatticeDrape::of(&scene, sol, reach);
                     if let Some(n) = &node {
-                        prev = Some(n.x.clone());
+                        prev = Some((n.x.clone(), n.adapted));
                     }
                     node
                 })
@@ -289,6 +301,7 @@ impl SharedLattice {
             ordered,
             candidates: node.candidates.clone(),
             factor,
+            adapted: Some(node.adapted),
         }
     }
 

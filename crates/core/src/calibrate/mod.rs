@@ -282,6 +282,7 @@ impl Problem {
                 let neighbour = crate::solve::WarmData {
                     factor: warm.factor.as_ref(),
                     candidates: warm.candidates.as_ref(),
+                    adapted: warm.adapted,
                 };
                 let solve = match warm.ordered {
                     true => crate::simulate::solve_scene_from_first,

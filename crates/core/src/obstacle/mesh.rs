@@ -59,6 +59,15 @@ pub enum BodyDefect {
     MissingVertex(usize),
     /// A triangle without area (its corners on a line, or two the same).
     Degenerate(usize),
+    /// An edge (its vertices, 0-based) of one face only: a hole or a border, so the mesh encloses
+    /// no inside (a triangle soup's every edge is one).
+    Open(u32, u32),
+    /// An edge (its vertices) of more than two faces: a fin or two bodies touching along it.
+    NonManifold(u32, u32),
+    /// An edge two faces run the same way: their orientations disagree.
+    Inconsistent(u32, u32),
+    /// The faces are counter-clockwise seen from inside (the enclosed volume is negative).
+    InsideOut,
 }
 
 impl std::fmt::Display for BodyDefect {
@@ -74,13 +83,41 @@ impl std::fmt::Display for BodyDefect {
             BodyDefect::Degenerate(t) => {
                 write!(f, "face {} has no area (its corners on a line)", t + 1)
             }
+            BodyDefect::Open(a, b) => write!(
+                f,
+                "the mesh is open: the edge from vertex {} to {} borders one face only (a hole or \
+a border); a body must be closed (watertight): close it, e.g. MeshLab's Close Holes",
+                a + 1,
+                b + 1
+            ),
+            BodyDefect::NonManifold(a, b) => write!(
+                f,
+                "the edge from vertex {} to {} borders more than two faces (a fin, or bodies \
+touching): give each body as one closed surface",
+                a + 1,
+                b + 1
+            ),
+            BodyDefect::Inconsistent(a, b) => write!(
+                f,
+                "two faces run the edge from vertex {} to {} the same way: orient every face \
+counter-clockwise seen from outside",
+                a + 1,
+                b + 1
+            ),
+            BodyDefect::InsideOut => write!(
+                f,
+                "the mesh is inside out (its faces are clockwise seen from outside, the volume \
+they enclose negative): reverse every face's vertex order"
+            ),
         }
     }
 }
 
 impl TriangleBody {
     /// The body of `triangles` over `vertices` (m), checked: every coordinate finite, every index
-    /// present, every triangle with an area above 10⁻¹² of the mesh's box's squared size.
+    /// present, every triangle with an area above 10⁻¹² of the mesh's box's squared size, and the
+    /// triangles a closed, consistently outward-oriented surface ([`closed_surface_defect`]): the
+    /// pseudo-normal sign of inside and outside means nothing otherwise.
     pub fn new(vertices: Vec<V3>, triangles: Vec<[u32; 3]>) -> Result<Self, BodyDefect> {
         if triangles.is_empty() {
             return Err(BodyDefect::NoTriangles);
@@ -109,6 +146,9 @@ impl TriangleBody {
                 return Err(BodyDefect::Degenerate(i));
             }
             face_normals.push(n.normalize());
+        }
+        if let Some(d) = closed_surface_defect(&vertices, &triangles) {
+            return Err(d);
         }
         let (vertex_normals, edge_normals) = pseudo_normals(&vertices, &triangles, &face_normals);
         let flat_edges = flat_edges(&triangles, &face_normals);
@@ -235,6 +275,16 @@ impl TriangleBody {
             }
         }
         (best.1 != u32::MAX).then_some(best)
+    }
+
+    /// Whether the segment pq crosses a face of the body (touching counts): an edge of the sheet
+    /// through a thin wall whose ends both lie outside.
+    pub fn segment_crosses(&self, p: &V3, q: &V3) -> bool {
+        let bounds = Aabb::point(p).union(&Aabb::point(q));
+        self.triangles_overlapping(&bounds).iter().any(|t| {
+            let [a, b, c] = t.map(|k| self.vertices[k as usize]);
+            crate::proximity::segment_crosses_triangle(p, q, &a, &b, &c)
+        })
     }
 
     /// The triangles whose boxes overlap `bounds`, found through the hierarchy.
@@ -437,6 +487,43 @@ fn flat_edges(
         }
     }
     flat
+}
+
+/// What keeps `triangles` from being a closed, consistently oriented surface that faces outward:
+/// every edge in exactly two faces which run it in opposite directions, and a positive enclosed
+/// volume (the divergence theorem: V = Σ (a · (b × c)) / 6 over the faces). None when it is one.
+pub fn closed_surface_defect(vertices: &[V3], triangles: &[[u32; 3]]) -> Option<BodyDefect> {
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(3 * triangles.len());
+    for t in triangles {
+        for k in 0..3 {
+            *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    let mut edges: Vec<(u32, u32)> = directed.keys().copied().collect();
+    edges.sort_unstable();
+    for (a, b) in edges {
+        let (here, back) = (
+            directed[&(a, b)],
+            directed.get(&(b, a)).copied().unwrap_or(0),
+        );
+        if here + back > 2 {
+            return Some(BodyDefect::NonManifold(a.min(b), a.max(b)));
+        }
+        if here > 1 {
+            return Some(BodyDefect::Inconsistent(a, b));
+        }
+        if back == 0 {
+            return Some(BodyDefect::Open(a, b));
+        }
+    }
+    let volume: f64 = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            a.dot(&b.cross(&c)) / 6.0
+        })
+        .sum();
+    (volume <= 0.0).then_some(BodyDefect::InsideOut)
 }
 
 fn pseudo_normals(

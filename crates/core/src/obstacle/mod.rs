@@ -11,6 +11,9 @@ use crate::error::KeyError;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+/// Points along a segment at which [`Obstacle::segment_enters`] asks an analytic shape.
+pub const SEGMENT_SAMPLES: usize = 16;
+
 /// A rigid obstacle. Every length in m; positions in the scene's frame (z up).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
@@ -246,6 +249,22 @@ impl Obstacle {
                 // Not read (a scene built in code without loading): nothing to touch.
                 None => (f64::INFINITY, Vector3::z()),
             },
+        }
+    }
+
+    /// Whether the straight segment pq passes through the obstacle: a mesh body's faces crossed
+    /// (exact), an analytic shape's inside met at one of [`SEGMENT_SAMPLES`] points along it.
+    pub fn segment_enters(&self, p: &Vector3<f64>, q: &Vector3<f64>) -> bool {
+        match self {
+            Obstacle::Mesh {
+                offset_m,
+                body: Some(b),
+                ..
+            } => b.segment_crosses(&(p - v(*offset_m)), &(q - v(*offset_m))),
+            _ => (0..=SEGMENT_SAMPLES).any(|k| {
+                let t = k as f64 / SEGMENT_SAMPLES as f64;
+                self.signed_distance(&(p + (q - p) * t)).0 <= 0.0
+            }),
         }
     }
 

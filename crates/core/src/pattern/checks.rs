@@ -179,20 +179,41 @@ pub(super) fn manifold(raw: &Raw, tris: &[[usize; 3]]) -> Result<(), Defect> {
                 > 0
         };
         if components(faces.len(), |i, j| shares(faces[i], faces[j])) > 1 {
-            return Err(defect(
-                "vertices",
-                format!(
+            let message = match seam_vertex(raw, v) {
+                true => format!(
+                    "vertex {} is sewn (faces of two pieces share it) but the pieces meet only \
+at it: the two edges of a seam do not have the same vertices (unequal counts); give both edges \
+of the seam the same number of vertices, shared pairwise",
+                    v + 1
+                ),
+                false => format!(
                     "a non-manifold vertex: the faces around vertex {} meet only at it (a bow-tie); split it in two",
                     v + 1
                 ),
-            ));
+            };
+            return Err(defect("vertices", message));
         }
     }
     Ok(())
 }
 
-/// One piece: every vertex reachable from the first through faces.
-pub(super) fn connected(n: usize, tris: &[[usize; 3]]) -> Result<(), Defect> {
+/// Whether vertex `v` is a seam's: its faces give it more than one flat position (`vt`).
+fn seam_vertex(raw: &Raw, v: usize) -> bool {
+    let mut vts = raw
+        .faces
+        .iter()
+        .zip(&raw.face_vt)
+        .filter_map(|((f, _), vt)| {
+            let k = f.iter().position(|&a| a == v)?;
+            vt.map(|t| t[k])
+        });
+    vts.next()
+        .is_some_and(|first| vts.any(|other| other != first))
+}
+
+/// The piece (a root vertex of its connected component through shared faces) of every one of
+/// the `n` vertices of `tris`.
+pub(super) fn pieces(n: usize, tris: &[[usize; 3]]) -> Vec<usize> {
     let mut parent: Vec<usize> = (0..n).collect();
     fn root(p: &mut [usize], mut i: usize) -> usize {
         while p[i] != i {
@@ -207,14 +228,21 @@ pub(super) fn connected(n: usize, tris: &[[usize; 3]]) -> Result<(), Defect> {
             parent[a] = b;
         }
     }
-    let r0 = root(&mut parent, 0);
-    let pieces: std::collections::BTreeSet<usize> = (0..n).map(|i| root(&mut parent, i)).collect();
-    match (0..n).find(|&i| root(&mut parent, i) != r0) {
+    (0..n).map(|i| root(&mut parent, i)).collect()
+}
+
+/// One piece: every vertex reachable from the first through faces.
+pub(super) fn connected(n: usize, tris: &[[usize; 3]]) -> Result<(), Defect> {
+    let piece = pieces(n, tris);
+    let count = piece
+        .iter()
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    match (0..n).find(|&i| piece[i] != piece[0]) {
         Some(k) => Err(defect(
             "faces",
             format!(
-                "{} disconnected pieces (vertex {} is not joined to vertex 1): give one piece per file, or sew the pieces (faces of both pieces sharing the seam's vertices)",
-                pieces.len(),
+                "{count} disconnected pieces (vertex {} is not joined to vertex 1): give one piece per file, or sew the pieces (faces of both pieces sharing the seam's vertices)",
                 k + 1
             ),
         )),

@@ -12,6 +12,7 @@
 //! and `l` polylines) that pins and clamps can address.
 
 mod checks;
+mod overlap;
 mod refine;
 
 use checks::{connected, manifold, off_plane, oriented, rest_layout, unused_vertex};
@@ -86,8 +87,8 @@ pub fn parse_obj(text: &str, unit_m: f64) -> Result<Pattern, Defect> {
 /// Reads and checks `path` ([`parse_obj`]); errors name the file and the line or defect.
 pub fn read_obj(path: &std::path::Path, unit_m: f64) -> Result<Pattern, crate::error::InputError> {
     use crate::error::InputError;
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| InputError::new(path, "", format!("cannot read: {e}")))?;
+    let text = crate::textfile::read_text(path, crate::textfile::NonUtf8::Replace)
+        .map_err(|e| InputError::new(path, "", e))?;
     parse_obj(&text, unit_m).map_err(|d| InputError::new(path, d.key, d.message))
 }
 
@@ -281,6 +282,11 @@ fn check(raw: Raw, unit_m: f64) -> Result<Pattern, Defect> {
     let (rest_triangles, triangles) = oriented(&raw, &rest)?;
     manifold(&raw, &triangles)?;
     connected(raw.v.len(), &triangles)?;
+    let lines: Vec<usize> = raw.faces.iter().map(|f| f.1).collect();
+    overlap::no_self_overlap(&rest.points, &rest_triangles, &lines)?;
+    if off_plane(&raw.v).is_some() {
+        overlap::rest_at_start_scale(&rest.points, &rest_triangles, &raw.v, &triangles)?;
+    }
     Ok(Pattern {
         rest_m: rest.points.iter().map(|p| p.map(|c| c * unit_m)).collect(),
         rest_triangles,

@@ -2,6 +2,7 @@
 //! semi-definite (projected) Hessian as 3×3 blocks. A [`Model`] is the sum of the terms a scene needs,
 //! the lumped masses and the pinned particles; solvers see nothing else.
 
+mod adapted;
 mod assembly;
 mod barrier;
 mod bending;
@@ -22,6 +23,7 @@ mod springs;
 #[cfg(test)]
 pub(crate) mod testing;
 
+pub use adapted::{Adapted, KAPPA_GROWTH_KEY};
 pub use assembly::ModelBuilder;
 pub use bending::{
     CellTwist, LinearBending, MirrorBending, MirrorKernel, QuadraticKernel, QuadraticStencil,

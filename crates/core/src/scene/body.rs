@@ -20,10 +20,7 @@ pub(super) fn read_bodies(obstacles: &mut [Obstacle], scene_path: &Path) -> Resu
         } = o
         {
             let key = |name: &str| format!("obstacles.{k}.{name}");
-            if !(mesh_unit_m.is_finite() && *mesh_unit_m > 0.0) {
-                let m = format!(
-                    "must be a finite number > 0 (1 for metres, 0.01 for centimetres), got {mesh_unit_m}"
-                );
+            if let Some(m) = super::mesh::mesh_unit_error(*mesh_unit_m) {
                 return Err(InputError::new(scene_path, key("mesh_unit_m"), m));
             }
             let path = super::files::named_file(scene_path, mesh, &key("mesh"))?;
@@ -35,8 +32,8 @@ pub(super) fn read_bodies(obstacles: &mut [Obstacle], scene_path: &Path) -> Resu
 
 /// A body mesh from the OBJ file at `path` in units of `unit_m` metres.
 pub fn read_body(path: &Path, unit_m: f64) -> Result<TriangleBody, InputError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| InputError::new(path, "file", format!("cannot be read: {e}")))?;
+    let text = crate::textfile::read_text(path, crate::textfile::NonUtf8::Replace)
+        .map_err(|e| InputError::new(path, "file", e))?;
     let (v, faces) = crate::pattern::parse_obj_triangles(&text)
         .map_err(|d| InputError::new(path, d.key, d.message))?;
     let vertices: Vec<Vector3<f64>> = v
@@ -67,6 +64,10 @@ pub fn read_body(path: &Path, unit_m: f64) -> Result<TriangleBody, InputError> {
                 line(t),
                 "a face names a vertex the file does not have",
             ),
+            d @ (BodyDefect::Open(..)
+            | BodyDefect::NonManifold(..)
+            | BodyDefect::Inconsistent(..)
+            | BodyDefect::InsideOut) => InputError::new(path, "f", d.to_string()),
         }
     })
 }

@@ -138,62 +138,18 @@ in the key's unit (SI)",
     /// The material: mass-spring or continuum, every constant in range.
     fn check_material(&self, ck: &Check<'_>) -> Result<(), InputError> {
         let c = &self.cloth;
-        match (&self.material.mass_spring, &self.material.continuum) {
-            (Some(_), Some(_)) => {
-                return ck.err(
-                    "material",
-                    "give either [material.mass_spring] or [material.continuum], not both".into(),
-                );
-            }
-            (None, None) => {
-                return ck.err(
-                    "material",
-                    "missing: add [material.mass_spring] or [material.continuum]".into(),
-                );
-            }
-            (Some(ms), None) => {
-                ck.pos(
-                    "material.mass_spring.stiffness_N_per_m",
-                    ms.stiffness_N_per_m,
-                )?;
-                for (k, v) in [
-                    (
-                        "structural_stiffness_N_per_m",
-                        ms.structural_stiffness_N_per_m,
-                    ),
-                    ("shear_stiffness_N_per_m", ms.shear_stiffness_N_per_m),
-                    ("bend_stiffness_N_per_m", ms.bend_stiffness_N_per_m),
-                    ("natural_length_m", ms.natural_length_m),
-                ] {
-                    if let Some(v) = v {
-                        ck.pos(&format!("material.mass_spring.{k}"), v)?;
-                    }
-                }
-                ck.nonneg("material.mass_spring.damping_Ns_per_m", ms.damping_Ns_per_m)?;
-                ck.pos("material.mass_spring.elongation_rate", ms.elongation_rate)?;
-                if ms.natural_length_m.is_some() && c.spacing != Spacing::Uniform {
-                    return ck.err(
-                        "material.mass_spring.natural_length_m",
-                        "needs cloth.spacing = \"uniform\"".into(),
-                    );
-                }
-            }
-            (None, Some(cont)) => {
-                let r = cont.rigidities().map_err(|e| {
-                    InputError::new(ck.path, format!("material.continuum.{}", e.key), e.message)
-                })?;
-                for (k, v) in [
-                    ("tensile_warp", r.tensile_warp_N_per_m),
-                    ("tensile_weft", r.tensile_weft_N_per_m),
-                    ("bending_warp", r.bending_warp_N_m),
-                    ("bending_weft", r.bending_weft_N_m),
-                ] {
-                    ck.pos(&format!("material.continuum.{k}"), v)?;
-                }
-                ck.nonneg("material.continuum.shear", r.shear_N_per_m)?;
-                ck.nonneg("material.continuum.bending_twist", r.bending_twist_N_m)?;
-                self.check_hinge_keys(ck, cont)?;
-            }
+        check_material_model(&self.material, ck, "material")?;
+        if let Some(ms) = &self.material.mass_spring
+            && ms.natural_length_m.is_some()
+            && c.spacing != Spacing::Uniform
+        {
+            return ck.err(
+                "material.mass_spring.natural_length_m",
+                "needs cloth.spacing = \"uniform\"".into(),
+            );
+        }
+        if let Some(cont) = &self.material.continuum {
+            self.check_hinge_keys(ck, cont)?;
         }
         Ok(())
     }
@@ -348,14 +304,16 @@ would already touch itself; use a coarser grid or a thinner sheet"
             return Ok(());
         }
         let flat = self.initial_positions();
+        let edges = self.sheet_edges();
         for (k, o) in self.obstacles.iter().enumerate() {
             o.check().map_err(|e| {
                 InputError::new(ck.path, format!("obstacles.{k}.{}", e.key), e.message)
             })?;
-            if let Some((p, d)) = flat
+            let d: Vec<f64> = flat.iter().map(|x| o.signed_distance(x).0).collect();
+            if let Some((p, d)) = d
                 .iter()
+                .copied()
                 .enumerate()
-                .map(|(p, x)| (p, o.signed_distance(x).0))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .filter(|(_, d)| *d <= 0.0)
             {
@@ -369,8 +327,48 @@ would already touch itself; use a coarser grid or a thinner sheet"
                     ),
                 );
             }
+            // Both ends outside, the edge through the obstacle: a wall thinner than the sheet's
+            // spacing. An edge longer than the distance of neither end can reach it.
+            if let Some(&[a, b]) = edges.iter().find(|[a, b]| {
+                let l = (flat[*a] - flat[*b]).norm();
+                (d[*a] <= l || d[*b] <= l) && o.segment_enters(&flat[*a], &flat[*b])
+            }) {
+                return ck.err(
+                    &format!("obstacles.{k}"),
+                    format!(
+                        "the sheet starts through this obstacle: the edge from particle {} to {} \
+passes through it (a part thinner than the sheet's spacing): move the obstacle or the sheet \
+(cloth.origin_m) so that the sheet starts clear of it",
+                        self.particle_name(a),
+                        self.particle_name(b)
+                    ),
+                );
+            }
         }
         Ok(())
+    }
+
+    /// The sheet's edges as its flat start has them: a mesh's triangles' edges, the grid's lines.
+    fn sheet_edges(&self) -> Vec<[usize; 2]> {
+        let mut edges: Vec<[usize; 2]> = match self.pattern() {
+            Some(p) => p
+                .triangles
+                .iter()
+                .flat_map(|t| {
+                    (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])])
+                })
+                .collect(),
+            None => {
+                let (nx, ny) = (self.cloth.nx, self.cloth.ny);
+                let right =
+                    (0..ny).flat_map(|j| (1..nx).map(move |i| [j * nx + i - 1, j * nx + i]));
+                let up = (1..ny).flat_map(|j| (0..nx).map(move |i| [(j - 1) * nx + i, j * nx + i]));
+                right.chain(up).collect()
+            }
+        };
+        edges.sort_unstable();
+        edges.dedup();
+        edges
     }
 
     /// Gravity, the solvers' tolerances and budgets, and the recording.
@@ -496,3 +494,74 @@ pub const SHEET_SIDE_M: (f64, f64) = (1e-4, 100.0);
 /// The gravitational accelerations a scene may have, m/s²: none (0, loads alone) to 1000 (a
 /// centrifuge's 100 g).
 pub const GRAVITY_M_PER_S2: (f64, f64) = (0.0, 1000.0);
+
+/// A material model's own values, each under the key its table gives (`PREFIX.continuum.KEY`,
+/// `PREFIX.mass_spring.KEY`): exactly one model; stiffnesses, rigidities and the thickness > 0;
+/// shear, twist and damping ≥ 0. A scene's prefix is `material`, a fabric file's `fabric`.
+pub(super) fn check_material_model(
+    m: &crate::material::Material,
+    ck: &Check<'_>,
+    prefix: &str,
+) -> Result<(), InputError> {
+    match (&m.mass_spring, &m.continuum) {
+        (Some(_), Some(_)) => ck.err(
+            prefix,
+            format!("give either [{prefix}.mass_spring] or [{prefix}.continuum], not both"),
+        ),
+        (None, None) => ck.err(
+            prefix,
+            format!("missing: add [{prefix}.mass_spring] or [{prefix}.continuum]"),
+        ),
+        (Some(ms), None) => {
+            let key = |k: &str| format!("{prefix}.mass_spring.{k}");
+            ck.pos(&key("stiffness_N_per_m"), ms.stiffness_N_per_m)?;
+            for (k, v) in [
+                (
+                    "structural_stiffness_N_per_m",
+                    ms.structural_stiffness_N_per_m,
+                ),
+                ("shear_stiffness_N_per_m", ms.shear_stiffness_N_per_m),
+                ("bend_stiffness_N_per_m", ms.bend_stiffness_N_per_m),
+                ("natural_length_m", ms.natural_length_m),
+            ] {
+                if let Some(v) = v {
+                    ck.pos(&key(k), v)?;
+                }
+            }
+            ck.nonneg(&key("damping_Ns_per_m"), ms.damping_Ns_per_m)?;
+            ck.pos(&key("elongation_rate"), ms.elongation_rate)
+        }
+        (None, Some(cont)) => check_continuum(cont, ck, &format!("{prefix}.continuum")),
+    }
+}
+
+/// The continuum's keys as given (never a converted value under an invented name): every key of
+/// both units present or missing as [`crate::material::Continuum::rigidities`] says, tensile and
+/// bending rigidities and the thickness > 0, shear and twist ≥ 0.
+fn check_continuum(
+    cont: &crate::material::Continuum,
+    ck: &Check<'_>,
+    prefix: &str,
+) -> Result<(), InputError> {
+    cont.rigidities()
+        .map_err(|e| InputError::new(ck.path, format!("{prefix}.{}", e.key), e.message))?;
+    let Ok(toml::Value::Table(t)) = toml::Value::try_from(cont) else {
+        return Ok(());
+    };
+    for (k, v) in &t {
+        let Some(v) = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) else {
+            continue;
+        };
+        let key = format!("{prefix}.{k}");
+        if k.starts_with("shear") || k.starts_with("bending_twist") {
+            ck.nonneg(&key, v)?;
+        } else if k.starts_with("tensile")
+            || k.starts_with("bending_warp")
+            || k.starts_with("bending_weft")
+            || k == "thickness_m"
+        {
+            ck.pos(&key, v)?;
+        }
+    }
+    Ok(())
+}

@@ -92,7 +92,17 @@ impl Fabric {
                 }
                 keys
             }
-            (None, Some(m)) => table_keys(m),
+            (None, Some(m)) => {
+                if let Some((k, _)) = f.bending_lengths().first() {
+                    return bad(
+                        format!("fabric.{k}"),
+                        "sets a continuum's bending rigidity; a mass-spring fabric has none: \
+remove it or give [fabric.continuum]"
+                            .into(),
+                    );
+                }
+                table_keys(m)
+            }
             (Some(_), Some(_)) => {
                 return bad(
                     "fabric".into(),
@@ -119,13 +129,35 @@ impl Fabric {
                 return bad("fabric.calibrated".into(), m);
             }
         }
+        let ck = super::check::Check { path };
+        super::check::check_material_model(&f.material(), &ck, "fabric")?;
         for (k, [lo, hi]) in &f.intervals {
             if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
                 let m = format!("must be [low, high] with low ≤ high, got [{lo}, {hi}]");
                 return bad(format!("fabric.intervals.{k}"), m);
             }
+            if let Some(v) = f.value_of(k).filter(|v| !(lo..=hi).contains(&v)) {
+                let m = format!(
+                    "[{lo}, {hi}] does not hold the fabric's own `{k}` = {v}: an interval brackets its value"
+                );
+                return bad(format!("fabric.intervals.{k}"), m);
+            }
         }
         Ok(f)
+    }
+
+    /// The value the fabric gives for `key` (a material key or a bending length), where numeric.
+    fn value_of(&self, key: &str) -> Option<f64> {
+        if let Some((_, v)) = self.bending_lengths().into_iter().find(|(k, _)| *k == key) {
+            return Some(v);
+        }
+        let table = match (&self.continuum, &self.mass_spring) {
+            (Some(c), _) => toml::Value::try_from(c).ok()?,
+            (_, Some(m)) => toml::Value::try_from(m).ok()?,
+            _ => return None,
+        };
+        let v = table.get(key)?;
+        v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
     }
 
     /// The bending lengths the fabric gives, by key.

@@ -26,3 +26,35 @@ pub(super) fn named_file(
     }
     Ok(path)
 }
+
+/// Rewrites the files a scene's table names (`cloth.mesh`, `obstacles.N.mesh`,
+/// `material.fabric`) as absolute paths from the folder of `scene_path`: the table then means the
+/// same scene wherever it is used (a notebook's dict handed back to `simulate`).
+pub fn absolute_file_keys(table: &mut toml::Table, scene_path: &Path) {
+    let dir = scene_path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+    let absolute = |v: &mut toml::Value| {
+        if let Some(s) = v.as_str()
+            && Path::new(s).is_relative()
+        {
+            *v = toml::Value::String(dir.join(s).display().to_string());
+        }
+    };
+    for (section, key) in [("cloth", "mesh"), ("material", "fabric")] {
+        if let Some(v) = table
+            .get_mut(section)
+            .and_then(|t| t.as_table_mut())
+            .and_then(|t| t.get_mut(key))
+        {
+            absolute(v);
+        }
+    }
+    if let Some(list) = table.get_mut("obstacles").and_then(|o| o.as_array_mut()) {
+        for v in list.iter_mut().filter_map(|o| o.get_mut("mesh")) {
+            absolute(v);
+        }
+    }
+}

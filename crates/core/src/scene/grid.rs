@@ -9,9 +9,13 @@ impl Scene {
     /// 0 (a mesh sheet has none), which is said as missing rather than "got 0".
     pub(super) fn grid_count_error(&self) -> Option<(&'static str, String)> {
         let c = &self.cloth;
-        let (key, n) = [("cloth.nx", c.nx), ("cloth.ny", c.ny)]
+        let Some((key, n)) = [("cloth.nx", c.nx), ("cloth.ny", c.ny)]
             .into_iter()
-            .find(|(_, n)| !(2..=2049).contains(n))?;
+            .find(|(_, n)| !(2..=2049).contains(n))
+        else {
+            let key = if c.nx >= c.ny { "cloth.nx" } else { "cloth.ny" };
+            return crate::memory::too_large((c.nx * c.ny) as f64).map(|m| (key, m));
+        };
         let got = match n {
             0 => "it is missing (a grid sheet needs nx and ny; a mesh sheet gives `mesh`)".into(),
             n => format!("got {n}"),

@@ -15,7 +15,7 @@ use std::path::Path;
 /// the scene, so that a changed OBJ makes the stages that read the scene stale. Empty for a grid
 /// scene without mesh obstacles or a file that is not a scene.
 pub fn mesh_files_of(scene_path: &Path) -> Vec<std::path::PathBuf> {
-    let Some(table) = std::fs::read_to_string(scene_path)
+    let Some(table) = crate::textfile::read_text(scene_path, crate::textfile::NonUtf8::Refuse)
         .ok()
         .and_then(|t| t.parse::<toml::Table>().ok())
     else {
@@ -41,6 +41,19 @@ pub fn mesh_files_of(scene_path: &Path) -> Vec<std::path::PathBuf> {
         .collect()
 }
 
+/// The units an OBJ file's coordinates may have, m: a micrometre to a kilometre.
+const MESH_UNIT_M: (f64, f64) = (1e-6, 1e3);
+
+/// Why `unit_m` is no unit of an OBJ file's coordinates (`mesh_unit_m`), or None.
+pub(super) fn mesh_unit_error(unit_m: f64) -> Option<String> {
+    let (lo, hi) = MESH_UNIT_M;
+    (!(unit_m.is_finite() && (lo..=hi).contains(&unit_m))).then(|| {
+        format!(
+            "must be a unit in m from {lo:e} to {hi:e} (1 for metres, 0.01 for centimetres, 0.001 for millimetres), got {unit_m}"
+        )
+    })
+}
+
 /// The most uniform refinements a scene may ask of its mesh (`cloth.mesh_refine`): 4⁴ = 256 times
 /// the file's triangles.
 const MAX_MESH_REFINE: usize = 4;
@@ -58,15 +71,8 @@ impl ClothSpec {
             self.pattern = None;
             return Ok(());
         };
-        if !(self.mesh_unit_m.is_finite() && self.mesh_unit_m > 0.0) {
-            return Err(InputError::new(
-                scene_path,
-                "cloth.mesh_unit_m",
-                format!(
-                    "must be a finite number > 0 (1 for metres, 0.01 for centimetres), got {}",
-                    self.mesh_unit_m
-                ),
-            ));
+        if let Some(m) = mesh_unit_error(self.mesh_unit_m) {
+            return Err(InputError::new(scene_path, "cloth.mesh_unit_m", m));
         }
         if self.mesh_refine > MAX_MESH_REFINE {
             return Err(InputError::new(
@@ -80,6 +86,16 @@ impl ClothSpec {
         }
         let path = super::files::named_file(scene_path, file, "cloth.mesh")?;
         let mut pattern = crate::pattern::read_obj(&path, self.mesh_unit_m)?;
+        // Each level splits every triangle in four: about four times the vertices.
+        let refined = pattern.vertex_count() as f64 * 4f64.powi(self.mesh_refine as i32);
+        if let Some(m) = crate::memory::too_large(refined) {
+            let m = format!(
+                "{} refinements of {}: {m}",
+                self.mesh_refine,
+                path.display()
+            );
+            return Err(InputError::new(scene_path, "cloth.mesh_refine", m));
+        }
         for _ in 0..self.mesh_refine {
             pattern = pattern.refined();
         }

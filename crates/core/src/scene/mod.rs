@@ -21,6 +21,7 @@ mod mesh;
 pub use body::{carry_bodies, read_body};
 pub use check::{GRAVITY_M_PER_S2, MAGNITUDES, SHEET_SIDE_M, ValidatedScene};
 pub use fabric::{Fabric, FabricFile};
+pub use files::absolute_file_keys;
 pub use mesh::mesh_files_of;
 
 /// The sheet: size, resolution, spacing and areal density.

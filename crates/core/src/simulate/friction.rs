@@ -86,10 +86,15 @@ impl crate::solve::Continuation for FrictionLag {
             }
         }
         let Some(&load) = self.loads.get(self.stage) else {
-            return Stage::Done(format!(
-                " (friction μ = {}: lag updates still moving the sheet)",
-                self.mu
-            ));
+            // Not settled: the anchors still move the sheet, so the state is no equilibrium of
+            // the friction it carries (a status, never "converged").
+            return Stage::Stop(
+                crate::solve::StopReason::ContactRounds,
+                format!(
+                    "friction μ = {}: {FRICTION_UPDATES} lag updates at full load still move the sheet by more than {FRICTION_SETTLED_M} m",
+                    self.mu
+                ),
+            );
         };
         let anchors = self
             .contact

@@ -187,7 +187,8 @@ pub fn solve_scene(scene: &Scene, observer: &mut dyn Observer) -> Solution {
 
 /// Solves a validated scene statically or dynamically from the given positions of all particles
 /// (a warm start: no coarse or sagged start is made); the scene's own start when `x0` does not match
-/// the built model's particle count.
+/// the built model's particle count. The model starts as built (κ growth 1): to continue the run
+/// that made `x0`, hand its [`crate::physics::Adapted`] to [`solve_scene_from_lowest`].
 pub fn solve_scene_from(
     scene: &Scene,
     x0: &[Vector3<f64>],
@@ -254,6 +255,9 @@ fn solve_built(
         mut model,
         x0: mut x,
     } = build_scene(scene);
+    if let Some(a) = &warm.adapted {
+        a.apply_to(&mut model);
+    }
     // The starts are scored over the neighbour's candidate set (no broad phase where it covers
     // them), which the solve then carries on.
     let mut candidates = warm.candidates.cloned().unwrap_or_default();

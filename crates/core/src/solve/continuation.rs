@@ -144,7 +144,20 @@ impl super::executor::Iterative for Staged<'_> {
 
     /// Asks the continuation for the next stage: done or stopped ends the loop.
     fn terminate(&mut self, _observer: &mut dyn Observer) -> Option<Verdict> {
-        match self.continuation.next(self.model, self.x, self.solved) {
+        let next = self.continuation.next(self.model, self.x, self.solved);
+        let spent = self.total.as_ref().map_or(0, |t| t.iterations);
+        if matches!(next, Stage::Solve(_) | Stage::Increment(_))
+            && spent >= self.opts.max_iterations
+        {
+            // `max_iterations` is the whole solve's budget, over every stage.
+            self.close();
+            let m = format!(
+                "{spent} Newton iterations over {} stages without finishing them (max_iterations {})",
+                self.stages, self.opts.max_iterations
+            );
+            return Some(Verdict::Stopped(StopReason::Iterations, m));
+        }
+        match next {
             Stage::Solve(load) => self.next = (load, Goal::Tolerance),
             Stage::Increment(load) => self.next = (load, Goal::Increment),
             Stage::Done(note) => {

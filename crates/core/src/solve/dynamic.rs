@@ -278,6 +278,7 @@ impl Limits {
             x,
             max_residual_N: r,
             energy_J: etot,
+            step: None,
         };
         obs.observe(&event).err().map(|err| {
             let msg = format!("an observer failed at step {step}: {err:#}");

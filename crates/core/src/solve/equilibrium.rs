@@ -313,7 +313,7 @@ mod tests {
         let factor = crate::solve::NeighbourFactor(shared);
         let warm = crate::solve::WarmData {
             factor: Some(&factor),
-            candidates: None,
+            ..Default::default()
         };
         let mut obs = crate::solve::NoObserver;
         let r = crate::solve::solve_static_warm(&mut seeded, &mut xs, &opts, warm, &mut obs);

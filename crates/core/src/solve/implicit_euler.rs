@@ -229,6 +229,7 @@ fn observe_state(
         x,
         max_residual_N: r,
         energy_J: model.energy_on(x, contacts, 1.0) + super::kinetic_energy(model, v),
+        step: None,
     })
 }
 

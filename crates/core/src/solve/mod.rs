@@ -64,6 +64,27 @@ pub struct StateEvent<'a> {
     pub max_residual_N: f64,
     /// Total energy (potential, plus kinetic in dynamics) in J.
     pub energy_J: f64,
+    /// How the Newton iteration that reached this state stepped (None for a start, a time step).
+    pub step: Option<StepRecord>,
+}
+
+/// How one Newton iteration stepped: where a long path's iterations go (issue 90).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepRecord {
+    /// The step taken as a fraction of the Newton step (1: whole).
+    pub alpha: f64,
+    /// The terms' collision-free bound on the step (infinite where none bounded it).
+    pub bound: f64,
+    /// Whether the bound cut the step (the step stopped at it).
+    pub bound_cut: bool,
+    /// Line-search trials (the accepted one and those rejected).
+    pub trials: usize,
+    /// Factorizations the iteration made (0: a chord or Krylov step on a factor at hand).
+    pub factorizations: usize,
+    /// Self-contact pairs within the activation distance at the new state.
+    pub active_pairs: usize,
+    /// The largest distance a particle moved, m.
+    pub max_move_m: f64,
 }
 
 /// Receives states during a solve (argmin's observer pattern): recorders, progress bars. Observers do

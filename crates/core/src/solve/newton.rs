@@ -16,7 +16,7 @@ use super::executor::{Budget, Verdict};
 use super::static_options::StaticOptions;
 use super::step::{Iteration, Workspace};
 use super::warm::NeighbourFactor;
-use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StopReason};
+use super::{DivergenceReason, Observer, SolveReport, StateEvent, Status, StepRecord, StopReason};
 use crate::physics::{CandidateSet, Contacts, HessianBlocks, HessianMode, Model, PairCurvature};
 use nalgebra::Vector3;
 use std::time::Instant;
@@ -141,6 +141,8 @@ impl NewtonRun {
             w_ref,
             e,
             r: f64::NAN,
+            step: None,
+            before: Vec::new(),
         };
         let budget = Budget::iterations(opts.max_iterations);
         let verdict = super::executor::run(&mut stage, budget, observer);
@@ -178,6 +180,10 @@ struct Stage<'a> {
     e: f64,
     /// The largest residual force at the current state, N.
     r: f64,
+    /// How the iteration that reached the current state stepped (None at the start).
+    step: Option<StepRecord>,
+    /// The state the current iteration started from (a buffer).
+    before: Vec<Vector3<f64>>,
 }
 
 impl super::executor::Iterative for Stage<'_> {
@@ -198,7 +204,8 @@ impl super::executor::Iterative for Stage<'_> {
                 message: None,
             });
         }
-        if let Err(err) = observe_iterate(observer, self.run.iter, self.x, (r, self.e)) {
+        let at = (self.run.iter, self.step.take());
+        if let Err(err) = observe_iterate(observer, at, self.x, (r, self.e)) {
             let message = format!("an observer failed at iteration {}: {err:#}", self.run.iter);
             return Some(Verdict::Stopped(StopReason::Observer, message));
         }
@@ -225,6 +232,9 @@ impl super::executor::Iterative for Stage<'_> {
             false => run.pairs,
         };
         let (model, x, load) = (&*self.model, &mut *self.x, self.load);
+        self.before.clear();
+        self.before.extend_from_slice(x);
+        let counters = (run.report.factorizations, run.ws.stats.rejected_trials);
         let taken = run.ws.iterate(
             model,
             x,
@@ -246,6 +256,7 @@ impl super::executor::Iterative for Stage<'_> {
             );
             return Err(Verdict::Stopped(StopReason::LineSearch, message));
         }
+        self.step = Some(step_record(run, x, &self.before, counters));
         let contacts = &run.ws.contacts;
         if adapt_kappa(self.model, contacts, self.opts, &mut run.last_gap_rel) {
             self.e = self.model.energy_on(self.x, contacts, load);
@@ -287,10 +298,11 @@ fn adapt_kappa(
     closing && model.stiffen_barriers(contacts)
 }
 
-/// Hands Newton iterate `iter` (residual `r` N, energy `e` J) to `observer` when it wants it.
+/// Hands Newton iterate `iter` (residual `r` N, energy `e` J, reached by `step`) to `observer`
+/// when it wants it.
 fn observe_iterate(
     observer: &mut dyn Observer,
-    iter: usize,
+    (iter, step): (usize, Option<StepRecord>),
     x: &[Vector3<f64>],
     (r, e): (f64, f64),
 ) -> anyhow::Result<()> {
@@ -303,7 +315,32 @@ fn observe_iterate(
         x,
         max_residual_N: r,
         energy_J: e,
+        step,
     })
+}
+
+/// What the run's counters and `before` (the state the iteration started from) say of the
+/// iteration that just stepped to `x`.
+fn step_record(
+    run: &NewtonRun,
+    x: &[Vector3<f64>],
+    before: &[Vector3<f64>],
+    (factorizations, rejected): (usize, usize),
+) -> StepRecord {
+    let (alpha, bound) = run.ws.last_alpha_bound;
+    StepRecord {
+        alpha,
+        bound,
+        bound_cut: alpha == bound && alpha < 1.0,
+        trials: 1 + run.ws.stats.rejected_trials - rejected,
+        factorizations: run.report.factorizations - factorizations,
+        active_pairs: run.ws.contacts.len(),
+        max_move_m: x
+            .iter()
+            .zip(before)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max),
+    }
 }
 
 /// The final numbers of a static solve (residual and energy at the final load, times) and, when it

@@ -51,7 +51,7 @@ pub enum StopReason {
     WallTime,
     /// The line search found no step that lowers the energy away from the solution.
     LineSearch,
-    /// The vertical-gap contact rounds did not settle.
+    /// The vertical-gap contact rounds, or the lagged friction's anchor updates, did not settle.
     ContactRounds,
     /// A divergence was detected ([`SolveReport::divergence`] says which).
     Diverged,

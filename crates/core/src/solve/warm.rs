@@ -2,7 +2,7 @@
 //! neighbouring solve (a nearby parameter's equilibrium, the last time step), handed to the solve
 //! in its own argument ([`WarmData`]), never carried by the options.
 
-use crate::physics::CandidateSet;
+use crate::physics::{Adapted, CandidateSet};
 
 /// A neighbouring equilibrium's factor, shared. As a preconditioner of conjugate gradients it
 /// needs no scale: a model whose energy is a multiple of the neighbour's takes the same steps.
@@ -27,4 +27,7 @@ pub struct WarmData<'a> {
     /// ([`crate::physics::Model::candidates_covering`]): the solve starts carrying it (rebuilt
     /// where it was built for another mesh or activation distance).
     pub candidates: Option<&'a CandidateSet>,
+    /// What the neighbour's solve adapted in its model (κ growth): the model takes it up before
+    /// its start is scored, so a restart at the neighbour's parameters continues its run.
+    pub adapted: Option<Adapted>,
 }

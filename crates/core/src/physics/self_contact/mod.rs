@@ -155,6 +155,16 @@ impl SelfContact {
         }
         pressed
     }
+    /// Sets κ to `growth` times κ as built (clamped to 1 ..= [`KAPPA_GROWTH_LIMIT`]): a restart
+    /// taking up the κ its run's solve adapted ([`crate::physics::Adapted`]).
+    pub fn set_kappa_growth(&mut self, growth: f64) {
+        let g = if growth.is_finite() {
+            growth.clamp(1.0, KAPPA_GROWTH_LIMIT)
+        } else {
+            1.0
+        };
+        self.kappa_J = self.kappa_built_J() * g;
+    }
     /// The smallest gap of a pair of `set` beyond the thickness, as a fraction of the band (0 at
     /// the thickness, 1 at the edge of the band), or None with no pair in range: what a static
     /// solve watches to adapt κ.
@@ -270,7 +280,7 @@ impl SelfContact {
     }
 
     /// κ over κ as built (1 unless a solve stiffened the barrier).
-    fn kappa_growth(&self) -> f64 {
+    pub fn kappa_growth(&self) -> f64 {
         self.kappa_J / self.kappa_built_J()
     }
 

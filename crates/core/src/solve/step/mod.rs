@@ -127,6 +127,9 @@ pub(super) struct Workspace {
     last_step: Taken,
     /// What the globalization did so far.
     pub(super) stats: Globalization,
+    /// The last iteration's step length (a fraction of its Newton step) and the terms' bound on
+    /// it (infinite where no term bounded it): iterations.parquet's columns.
+    pub(super) last_alpha_bound: (f64, f64),
     /// Whether steps are solved by conjugate gradients preconditioned with a neighbour's factor
     /// ([`super::WarmData::factor`]); off for the rest of the run once that fails or the
     /// line search shortens one of its steps.
@@ -252,6 +255,7 @@ impl Workspace {
             r_prev: f64::INFINITY,
             last_step: Taken::Partial,
             stats: Globalization::default(),
+            last_alpha_bound: (1.0, f64::INFINITY),
             krylov: false,
             assembled: false,
             constant_trace: None,
@@ -320,6 +324,7 @@ impl Workspace {
         (r, tol): (f64, f64),
         report: &mut SolveReport,
     ) -> Iteration {
+        self.last_alpha_bound = (1.0, f64::INFINITY);
         if self.krylov {
             if self.krylov_step(model, x, load, e, r, report) {
                 return Iteration::Stepped;
@@ -404,6 +409,7 @@ impl Workspace {
 
     /// Counts an accepted step of length `alpha` under the terms' `bound`.
     fn count(&mut self, alpha: f64, bound: f64, (curved, projected): (bool, bool)) {
+        self.last_alpha_bound = (alpha, bound);
         let s = &mut self.stats;
         if alpha == 1.0 {
             s.full_steps += 1;

@@ -1,0 +1,33 @@
+//! The memory a solve needs, estimated before it starts: a sheet too large for the machine is
+//! refused up front with the estimate, never run until the kernel kills it.
+
+/// The peak resident memory of a solve per particle, bytes: the sparse factor of the Hessian
+/// (nested dissection's fill grows a little faster than the particles), the Hessian's blocks,
+/// self-contact's candidate sets and the recorders. Measured peaks (`/usr/bin/time -v`) put it at
+/// 10–25 kB a particle from 10⁴ to 3·10⁵ particles (docs/src/science/limits.md); the upper end is
+/// taken.
+pub const BYTES_PER_PARTICLE: f64 = 25e3;
+
+/// The machine's memory, bytes (`MemTotal` of /proc/meminfo); None where it cannot be read.
+pub fn machine_bytes() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0)
+}
+
+/// Why a sheet of `particles` particles cannot be solved on this machine, or None when its
+/// estimated peak ([`BYTES_PER_PARTICLE`]) fits in the machine's memory.
+pub fn too_large(particles: f64) -> Option<String> {
+    let machine = machine_bytes()?;
+    let need = particles * BYTES_PER_PARTICLE;
+    (need > machine).then(|| {
+        format!(
+            "{particles:.0} particles need about {:.1} GB (an estimated {:.0} kB each) and this \
+machine has {:.1} GB: use a coarser sheet",
+            need / 1e9,
+            BYTES_PER_PARTICLE / 1e3,
+            machine / 1e9
+        )
+    })
+}
