@@ -164,3 +164,144 @@ fn mutated_pattern_meshes_never_panic_and_every_exit_is_a_result_or_a_refusal() 
         "{outcomes:?}"
     );
 }
+
+/// `text` (a body OBJ, a pattern OBJ or a fabric file) with one byte-level or line-level mutation
+/// drawn by `rng` (issue 92): truncated at a random byte, a number made NaN, huge or negative, an
+/// index out of range, a line deleted, doubled or reversed, a byte-order mark or a Latin-1 byte
+/// added, an unknown key.
+fn mutated_bytes(text: &str, rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let numbered: Vec<usize> = (0..lines.len())
+        .filter(|&k| {
+            lines[k]
+                .split_whitespace()
+                .any(|w| w.parse::<f64>().is_ok())
+        })
+        .collect();
+    let k = numbered[rng.random_range(0..numbered.len())];
+    let swap_number = |line: &str, to: &str, rng: &mut ChaCha8Rng| {
+        let mut words: Vec<String> = line.split_whitespace().map(String::from).collect();
+        let at: Vec<usize> = (0..words.len())
+            .filter(|&i| words[i].parse::<f64>().is_ok())
+            .collect();
+        words[at[rng.random_range(0..at.len())]] = to.to_string();
+        words.join(" ")
+    };
+    match rng.random_range(0..10) {
+        0 => {
+            let cut = rng.random_range(0..text.len());
+            let cut = (0..=cut)
+                .rev()
+                .find(|&c| text.is_char_boundary(c))
+                .unwrap_or(0);
+            return text.as_bytes()[..cut].to_vec();
+        }
+        1 => lines[k] = swap_number(&lines[k], "nan", rng),
+        2 => lines[k] = swap_number(&lines[k], "1e300", rng),
+        3 => lines[k] = swap_number(&lines[k], "-0.5", rng),
+        4 => lines[k] = swap_number(&lines[k], "99999", rng),
+        5 => lines[k].clear(),
+        6 => {
+            let copy = lines[k].clone();
+            lines.insert(k, copy);
+        }
+        7 => {
+            // A face (or any line) read backwards: a face turned over.
+            let mut words: Vec<&str> = lines[k].split_whitespace().collect();
+            words[1..].reverse();
+            lines[k] = words.join(" ");
+        }
+        8 => lines.insert(k, "unknown_key_m = 1.0".into()),
+        _ => {
+            let mut b = b"\xEF\xBB\xBF# caf\xE9\n".to_vec();
+            b.extend((lines.join("\n") + "\n").bytes());
+            return b;
+        }
+    }
+    (lines.join("\n") + "\n").into_bytes()
+}
+
+/// Issue 92's fuzz test: the bundled mesh body, fabric file and pattern mutated (truncation, NaN,
+/// huge and negative numbers, out-of-range indices, missing and unknown keys, turned faces, a BOM
+/// and a Latin-1 byte), each run through `drapelab simulate` unchanged otherwise: a mutated file
+/// is refused naming it (exit 2, one line, nothing left) or the drape converges (exit 0). Nothing
+/// is passed off: no converged drape through a body, no solve that cannot end.
+#[test]
+fn mutated_bodies_fabrics_and_patterns_are_refused_naming_them_or_drape() {
+    let bodies = root().join("datasets/bodies");
+    let body = std::fs::read_to_string(bodies.join("table_10cm.obj")).unwrap();
+    let body_scene = std::fs::read_to_string(bodies.join("table_wool_mesh.toml")).unwrap();
+    let fabric =
+        std::fs::read_to_string(root().join("datasets/fabrics/wool_seed003.toml")).unwrap();
+    let sphere = root().join("datasets/scenes/sphere_wool.toml");
+    let panel_dir = root().join("datasets/patterns");
+    let panel = std::fs::read_to_string(panel_dir.join("l_panel.obj")).unwrap();
+    let panel_scene = std::fs::read_to_string(panel_dir.join("l_panel_table.toml")).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(92);
+    let dir = tempfile::tempdir().unwrap();
+    let mut outcomes = [0usize; 3];
+    for case in 0..45 {
+        let out = dir.path().join(format!("out{case}"));
+        let what = format!("case {case}");
+        let code = match case % 3 {
+            0 => {
+                std::fs::write(
+                    dir.path().join("table_10cm.obj"),
+                    mutated_bytes(&body, &mut rng),
+                )
+                .unwrap();
+                let scene = dir.path().join("table_wool_mesh.toml");
+                std::fs::write(&scene, &body_scene).unwrap();
+                let sets = [
+                    "cloth.nx=11",
+                    "cloth.ny=11",
+                    "cloth.refine_x_m=[]",
+                    "cloth.refine_y_m=[]",
+                    "cloth.spacing=\"uniform\"",
+                ];
+                checked_run(&scene, &out, &sets, &["table_10cm.obj"], &what)
+            }
+            1 => {
+                let f = dir.path().join("wool.toml");
+                std::fs::write(&f, mutated_bytes(&fabric, &mut rng)).unwrap();
+                let scene = dir.path().join("sphere.toml");
+                let text = std::fs::read_to_string(&sphere).unwrap();
+                let (head, rest) = text.split_once("[material.continuum]").unwrap();
+                let tail = &rest[rest.find("\n[").unwrap()..];
+                std::fs::write(
+                    &scene,
+                    format!("{head}[material]\nfabric = \"wool.toml\"\n{tail}"),
+                )
+                .unwrap();
+                let sets = [
+                    "cloth.nx=11",
+                    "cloth.ny=11",
+                    "boundary.pin_particles=[[5,5]]",
+                ];
+                checked_run(&scene, &out, &sets, &["wool.toml"], &what)
+            }
+            _ => {
+                std::fs::write(
+                    dir.path().join("l_panel.obj"),
+                    mutated_bytes(&panel, &mut rng),
+                )
+                .unwrap();
+                let scene = dir.path().join("l_panel_table.toml");
+                std::fs::write(&scene, &panel_scene).unwrap();
+                checked_run(&scene, &out, &[], &["l_panel.obj"], &what)
+            }
+        };
+        if code == 1 {
+            let run = std::fs::read_to_string(out.join("run.json")).unwrap_or_default();
+            let v: serde_json::Value = serde_json::from_str(&run).unwrap_or_default();
+            eprintln!("case {case}: {} {}", v["status"], v["report"]["message"]);
+        }
+        outcomes[code] += 1;
+    }
+    eprintln!("exits 0 / 1 / 2: {outcomes:?}");
+    assert_eq!(
+        outcomes[1], 0,
+        "a mutated input neither refused nor draped: {outcomes:?}"
+    );
+    assert!(outcomes[2] > 10 && outcomes[0] > 5, "{outcomes:?}");
+}

@@ -73,10 +73,12 @@ const NOT_IN_CORE: [&str; 8] = [
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank. The
 /// error types (`error`: a bad key, a bad input) are below everything that checks its input.
-const CORE_RANKS: [(&str, u8); 28] = [
+const CORE_RANKS: [(&str, u8); 30] = [
     ("error", 0),
     ("provenance", 0),
     ("atomic", 0),
+    ("textfile", 0),
+    ("memory", 0),
     ("table", 0),
     ("material", 1),
     ("obstacle", 1),

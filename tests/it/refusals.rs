@@ -197,11 +197,15 @@ fn a_body_mesh_that_is_not_a_closed_outward_surface_is_refused_saying_why() {
             .collect::<String>();
     let finned = format!("{cube}v 0.0 0.0 -0.0005\nv 0.0 0.2 -0.0005\nf 7 8 10\n");
     let quad = "v -0.05 -0.05 -0.0005\nv 0.05 -0.05 -0.0005\nv 0.05 0.05 -0.0005\nv -0.05 0.05 -0.0005\nf 1 2 3 4\n";
+    // The fuzz test's find: one top corner moved below the bottom, the faces through each other.
+    let crossed = cube.replacen("v -0.05 0.05 -0.0005", "v -0.05 0.05 -0.5", 1);
+    assert_ne!(crossed, cube);
     for (text, words) in [
         (inside_out, "inside out"),
         (open, "open"),
         (quad.to_string(), "open"),
         (finned, "more than two faces"),
+        (crossed, "crosses itself"),
     ] {
         let tmp = tempfile::tempdir().unwrap();
         let scene = scene_copy(tmp.path(), &table, &[("table_10cm.obj", text)], |t| t);

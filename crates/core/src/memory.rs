@@ -3,9 +3,9 @@
 
 /// The peak resident memory of a solve per particle, bytes: the sparse factor of the Hessian
 /// (nested dissection's fill grows a little faster than the particles), the Hessian's blocks,
-/// self-contact's candidate sets and the recorders. Measured peaks (`/usr/bin/time -v`) put it at
-/// 10–25 kB a particle from 10⁴ to 3·10⁵ particles (docs/src/science/limits.md); the upper end is
-/// taken.
+/// self-contact's candidate sets and the recorders. Measured resident peaks (`/usr/bin/time -v`,
+/// docs/src/science/limits.md): 16 kB a particle on hang4 at 161² (25,921 particles), 22 kB on
+/// the dress form's skirt refined to about 85,000 particles with self-contact; rounded up.
 pub const BYTES_PER_PARTICLE: f64 = 25e3;
 
 /// The machine's memory, bytes (`MemTotal` of /proc/meminfo); None where it cannot be read.

@@ -85,13 +85,14 @@ pub fn read_particles(path: &Path) -> Result<Vec<(u32, u32, Vector3<f64>)>> {
         .collect())
 }
 
-/// [`read_particles`] with the file's key-value metadata (empty for a file written without).
-pub fn read_particles_with_metadata(
-    path: &Path,
-) -> Result<(
+/// Particles as [`read_particles`] gives them, with the file's key-value metadata.
+pub type ParticlesWithMetadata = (
     Vec<(u32, u32, Vector3<f64>)>,
     std::collections::BTreeMap<String, String>,
-)> {
+);
+
+/// [`read_particles`] with the file's key-value metadata (empty for a file written without).
+pub fn read_particles_with_metadata(path: &Path) -> Result<ParticlesWithMetadata> {
     let rows = read_particles(path)?;
     let mut meta = std::collections::BTreeMap::new();
     let file = std::fs::File::open(path)?;

@@ -329,34 +329,10 @@ fn simulate_into(
     if sensitivity.as_ref().is_some_and(|s| s.written) {
         outputs.push("sensitivity.parquet");
     }
-    let terms = model.term_names();
-    let record = RunRecord {
-        drapelab_version: drapelab_core::VERSION,
-        build_id: drapelab_core::provenance::build_id(),
-        finished_utc: drapelab_core::provenance::utc(drapelab_core::provenance::unix_now_s()),
-        host: drapelab_core::provenance::host(),
-        scene_file: loaded.path.display().to_string(),
-        command_line: std::env::args().collect(),
-        status: report.status.as_str(),
-        report: &report,
-        terms: &terms,
-        particles: grid.len(),
-        outputs,
-        drape: (report.is_converged() && !scene.obstacles.is_empty())
-            .then(|| drapelab_core::measure::drape_measures(scene, &x)),
-        self_contact: drapelab_core::simulate::self_contact_summary(scene, &model, &x),
-        sensitivity,
-        neutral_modes: (report.is_converged() && scene.solver.kind.integrator().is_none())
-            .then(|| drapelab_core::solve::neutral_modes(&model, &x)),
-        start_file: extras.start.as_ref().map(|s| s.file.clone()),
-        start: extras.start.as_ref().map(StartState::record),
-        scene,
-    };
-    let written = record.outputs.clone();
-    crate::write_text(
-        &out.join("run.json"),
-        &serde_json::to_string_pretty(&record)?,
-    )?;
+    let solved = (&grid, &model, x.as_slice(), &report);
+    let record = run_record(loaded, solved, extras, (outputs, sensitivity))?;
+    let written = record.1.clone();
+    crate::write_text(&out.join("run.json"), &record.0)?;
     Ok((
         Simulated {
             report,
@@ -366,6 +342,43 @@ fn simulate_into(
             sensitivity: sens_data,
         },
         written,
+    ))
+}
+
+/// run.json's text for a solved scene, and the outputs it lists.
+fn run_record(
+    loaded: &LoadedScene,
+    (grid, model, x, report): (&Grid, &Model, &[nalgebra::Vector3<f64>], &SolveReport),
+    extras: &SimulateExtras,
+    (outputs, sensitivity): (Vec<&'static str>, Option<SensitivityRecord>),
+) -> Result<(String, Vec<&'static str>)> {
+    let scene = &loaded.scene;
+    let terms = model.term_names();
+    let record = RunRecord {
+        drapelab_version: drapelab_core::VERSION,
+        build_id: drapelab_core::provenance::build_id(),
+        finished_utc: drapelab_core::provenance::utc(drapelab_core::provenance::unix_now_s()),
+        host: drapelab_core::provenance::host(),
+        scene_file: loaded.path.display().to_string(),
+        command_line: std::env::args().collect(),
+        status: report.status.as_str(),
+        report,
+        terms: &terms,
+        particles: grid.len(),
+        outputs,
+        drape: (report.is_converged() && !scene.obstacles.is_empty())
+            .then(|| drapelab_core::measure::drape_measures(scene, x)),
+        self_contact: drapelab_core::simulate::self_contact_summary(scene, model, x),
+        sensitivity,
+        neutral_modes: (report.is_converged() && scene.solver.kind.integrator().is_none())
+            .then(|| drapelab_core::solve::neutral_modes(model, x)),
+        start_file: extras.start.as_ref().map(|s| s.file.clone()),
+        start: extras.start.as_ref().map(StartState::record),
+        scene,
+    };
+    Ok((
+        serde_json::to_string_pretty(&record)?,
+        record.outputs.clone(),
     ))
 }
 

@@ -7,6 +7,7 @@
 //! Triangles face outward when counter-clockwise seen from outside. The sign is right for a closed,
 //! consistently oriented mesh; near an open mesh's border it is that of the nearest face's side.
 
+pub use super::mesh_defect::{BodyDefect, closed_surface_defect};
 use crate::proximity::{Aabb, point_triangle_distance};
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -46,71 +47,6 @@ pub struct TriangleBody {
     nodes: Vec<Node>,
     /// Triangle indices in the leaves' order.
     order: Vec<u32>,
-}
-
-/// What is wrong with a body mesh, for an error naming the file.
-#[derive(Debug, Clone, PartialEq)]
-pub enum BodyDefect {
-    /// No triangle at all.
-    NoTriangles,
-    /// A vertex with a coordinate that is not finite.
-    NotFinite(usize),
-    /// A triangle naming a vertex the mesh does not have.
-    MissingVertex(usize),
-    /// A triangle without area (its corners on a line, or two the same).
-    Degenerate(usize),
-    /// An edge (its vertices, 0-based) of one face only: a hole or a border, so the mesh encloses
-    /// no inside (a triangle soup's every edge is one).
-    Open(u32, u32),
-    /// An edge (its vertices) of more than two faces: a fin or two bodies touching along it.
-    NonManifold(u32, u32),
-    /// An edge two faces run the same way: their orientations disagree.
-    Inconsistent(u32, u32),
-    /// The faces are counter-clockwise seen from inside (the enclosed volume is negative).
-    InsideOut,
-}
-
-impl std::fmt::Display for BodyDefect {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            BodyDefect::NoTriangles => write!(f, "the mesh has no triangles"),
-            BodyDefect::NotFinite(v) => {
-                write!(f, "vertex {} has a coordinate that is not finite", v + 1)
-            }
-            BodyDefect::MissingVertex(t) => {
-                write!(f, "face {} names a vertex the file does not have", t + 1)
-            }
-            BodyDefect::Degenerate(t) => {
-                write!(f, "face {} has no area (its corners on a line)", t + 1)
-            }
-            BodyDefect::Open(a, b) => write!(
-                f,
-                "the mesh is open: the edge from vertex {} to {} borders one face only (a hole or \
-a border); a body must be closed (watertight): close it, e.g. MeshLab's Close Holes",
-                a + 1,
-                b + 1
-            ),
-            BodyDefect::NonManifold(a, b) => write!(
-                f,
-                "the edge from vertex {} to {} borders more than two faces (a fin, or bodies \
-touching): give each body as one closed surface",
-                a + 1,
-                b + 1
-            ),
-            BodyDefect::Inconsistent(a, b) => write!(
-                f,
-                "two faces run the edge from vertex {} to {} the same way: orient every face \
-counter-clockwise seen from outside",
-                a + 1,
-                b + 1
-            ),
-            BodyDefect::InsideOut => write!(
-                f,
-                "the mesh is inside out (its faces are clockwise seen from outside, the volume \
-they enclose negative): reverse every face's vertex order"
-            ),
-        }
-    }
 }
 
 impl TriangleBody {
@@ -174,7 +110,36 @@ impl TriangleBody {
             order: Vec::new(),
         };
         body.build_hierarchy();
-        Ok(body)
+        match body.self_intersection() {
+            Some(d) => Err(d),
+            None => Ok(body),
+        }
+    }
+
+    /// The first edge that passes through a face sharing no vertex with it, if any (found through
+    /// the hierarchy: each edge against the faces whose boxes its box overlaps).
+    fn self_intersection(&self) -> Option<BodyDefect> {
+        let mut edges: Vec<(u32, u32)> = self
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges.into_iter().find_map(|(a, b)| {
+            let (p, q) = (self.vertices[a as usize], self.vertices[b as usize]);
+            let bounds = Aabb::point(&p).union(&Aabb::point(&q));
+            self.triangles_overlapping_ids(&bounds)
+                .into_iter()
+                .find(|&t| {
+                    let tri = self.triangles[t as usize];
+                    !tri.contains(&a) && !tri.contains(&b) && {
+                        let [u, v, w] = tri.map(|k| self.vertices[k as usize]);
+                        crate::proximity::segment_crosses_triangle(&p, &q, &u, &v, &w)
+                    }
+                })
+                .map(|t| BodyDefect::SelfIntersecting(a, b, t as usize))
+        })
     }
 
     /// The number of triangles.
@@ -289,6 +254,14 @@ impl TriangleBody {
 
     /// The triangles whose boxes overlap `bounds`, found through the hierarchy.
     fn triangles_overlapping(&self, bounds: &Aabb) -> Vec<[u32; 3]> {
+        self.triangles_overlapping_ids(bounds)
+            .into_iter()
+            .map(|t| self.triangles[t as usize])
+            .collect()
+    }
+
+    /// The indices of the triangles whose boxes overlap `bounds`, found through the hierarchy.
+    fn triangles_overlapping_ids(&self, bounds: &Aabb) -> Vec<u32> {
         let mut found = Vec::new();
         let mut stack = vec![0u32];
         while let Some(i) = stack.pop() {
@@ -303,8 +276,7 @@ impl TriangleBody {
             let run = &self.order[node.first as usize..(node.first + node.count) as usize];
             found.extend(
                 run.iter()
-                    .filter(|&&t| self.triangle_box(t).overlaps(bounds))
-                    .map(|&t| self.triangles[t as usize]),
+                    .filter(|&&t| self.triangle_box(t).overlaps(bounds)),
             );
         }
         found
@@ -487,43 +459,6 @@ fn flat_edges(
         }
     }
     flat
-}
-
-/// What keeps `triangles` from being a closed, consistently oriented surface that faces outward:
-/// every edge in exactly two faces which run it in opposite directions, and a positive enclosed
-/// volume (the divergence theorem: V = Σ (a · (b × c)) / 6 over the faces). None when it is one.
-pub fn closed_surface_defect(vertices: &[V3], triangles: &[[u32; 3]]) -> Option<BodyDefect> {
-    let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(3 * triangles.len());
-    for t in triangles {
-        for k in 0..3 {
-            *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
-        }
-    }
-    let mut edges: Vec<(u32, u32)> = directed.keys().copied().collect();
-    edges.sort_unstable();
-    for (a, b) in edges {
-        let (here, back) = (
-            directed[&(a, b)],
-            directed.get(&(b, a)).copied().unwrap_or(0),
-        );
-        if here + back > 2 {
-            return Some(BodyDefect::NonManifold(a.min(b), a.max(b)));
-        }
-        if here > 1 {
-            return Some(BodyDefect::Inconsistent(a, b));
-        }
-        if back == 0 {
-            return Some(BodyDefect::Open(a, b));
-        }
-    }
-    let volume: f64 = triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| vertices[i as usize]);
-            a.dot(&b.cross(&c)) / 6.0
-        })
-        .sum();
-    (volume <= 0.0).then_some(BodyDefect::InsideOut)
 }
 
 fn pseudo_normals(

@@ -4,15 +4,15 @@
 //! of its upper surface above a point (for the vertical-gap method of §10.7.1).
 
 pub(crate) mod mesh;
+mod mesh_defect;
+mod parameters;
+mod segment;
 
 pub use mesh::{BodyDefect, TriangleBody};
 
 use crate::error::KeyError;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-
-/// Points along a segment at which [`Obstacle::segment_enters`] asks an analytic shape.
-pub const SEGMENT_SAMPLES: usize = 16;
 
 /// A rigid obstacle. Every length in m; positions in the scene's frame (z up).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -148,60 +148,6 @@ impl Obstacle {
         !matches!(self, Obstacle::Revolution { .. } | Obstacle::Mesh { .. })
     }
 
-    /// The obstacle's real-valued shape parameters (its points, directions, radii, heights and
-    /// profile, in the order the scene file writes them), for derivatives in them: mutable, so that
-    /// one list serves reading ([`Obstacle::parameters`]) and setting
-    /// ([`Obstacle::set_parameters`]).
-    pub fn parameters_mut(&mut self) -> Vec<&mut f64> {
-        use std::iter::once;
-        match self {
-            Obstacle::Plane { point_m, normal } => point_m.iter_mut().chain(normal).collect(),
-            Obstacle::Box { min_m, max_m } => min_m.iter_mut().chain(max_m).collect(),
-            Obstacle::Cylinder {
-                point_m,
-                axis,
-                radius_m,
-            } => point_m
-                .iter_mut()
-                .chain(axis)
-                .chain(once(radius_m))
-                .collect(),
-            Obstacle::Sphere { centre_m, radius_m } => {
-                centre_m.iter_mut().chain(once(radius_m)).collect()
-            }
-            Obstacle::Pedestal {
-                centre_m,
-                radius_m,
-                height_m,
-            } => centre_m
-                .iter_mut()
-                .chain(once(radius_m))
-                .chain(once(height_m))
-                .collect(),
-            Obstacle::Revolution { axis_m, profile_m } => axis_m
-                .iter_mut()
-                .chain(profile_m.iter_mut().flatten())
-                .collect(),
-            Obstacle::Mesh { offset_m, .. } => offset_m.iter_mut().collect(),
-        }
-    }
-
-    /// The shape parameters ([`Obstacle::parameters_mut`]), SI units.
-    pub fn parameters(&self) -> Vec<f64> {
-        self.clone()
-            .parameters_mut()
-            .into_iter()
-            .map(|p| *p)
-            .collect()
-    }
-
-    /// Sets the shape parameters (the layout of [`Obstacle::parameters`]).
-    pub fn set_parameters(&mut self, values: &[f64]) {
-        for (p, v) in self.parameters_mut().into_iter().zip(values) {
-            *p = *v;
-        }
-    }
-
     /// Signed distance (m, positive outside) and the unit outward normal at the closest point.
     pub fn signed_distance(&self, p: &Vector3<f64>) -> (f64, Vector3<f64>) {
         match self {
@@ -249,22 +195,6 @@ impl Obstacle {
                 // Not read (a scene built in code without loading): nothing to touch.
                 None => (f64::INFINITY, Vector3::z()),
             },
-        }
-    }
-
-    /// Whether the straight segment pq passes through the obstacle: a mesh body's faces crossed
-    /// (exact), an analytic shape's inside met at one of [`SEGMENT_SAMPLES`] points along it.
-    pub fn segment_enters(&self, p: &Vector3<f64>, q: &Vector3<f64>) -> bool {
-        match self {
-            Obstacle::Mesh {
-                offset_m,
-                body: Some(b),
-                ..
-            } => b.segment_crosses(&(p - v(*offset_m)), &(q - v(*offset_m))),
-            _ => (0..=SEGMENT_SAMPLES).any(|k| {
-                let t = k as f64 / SEGMENT_SAMPLES as f64;
-                self.signed_distance(&(p + (q - p) * t)).0 <= 0.0
-            }),
         }
     }
 

@@ -67,7 +67,8 @@ pub fn read_body(path: &Path, unit_m: f64) -> Result<TriangleBody, InputError> {
             d @ (BodyDefect::Open(..)
             | BodyDefect::NonManifold(..)
             | BodyDefect::Inconsistent(..)
-            | BodyDefect::InsideOut) => InputError::new(path, "f", d.to_string()),
+            | BodyDefect::InsideOut
+            | BodyDefect::SelfIntersecting(..)) => InputError::new(path, "f", d.to_string()),
         }
     })
 }

@@ -22,47 +22,12 @@ impl Scene {
     /// zero or of a size drapelab computes in ([`MAGNITUDES`]); the error names the key as the other
     /// checks do and `--set` takes it (`loads.0.magnitude_N`, `obstacles.1.centre_m`).
     fn check_magnitudes(&self, ck: &Check<'_>) -> Result<(), InputError> {
-        // The key is spelled only for an error: a scene is checked once per solve, and a
-        // calibration solves tens of thousands.
-        fn walk(
-            ck: &Check<'_>,
-            key: &dyn Fn() -> String,
-            v: &toml::Value,
-        ) -> Result<(), InputError> {
-            match v {
-                toml::Value::Float(f) if !f.is_finite() => {
-                    ck.err(&key(), format!("must be a finite number, got {f}"))
-                }
-                toml::Value::Float(f)
-                    if *f != 0.0 && !(MAGNITUDES.0..=MAGNITUDES.1).contains(&f.abs()) =>
-                {
-                    ck.err(
-                        &key(),
-                        format!(
-                            "{f} is outside the sizes drapelab computes in: zero, or {:e} to {:e} \
-in the key's unit (SI)",
-                            MAGNITUDES.0, MAGNITUDES.1
-                        ),
-                    )
-                }
-                toml::Value::Table(t) => t
-                    .iter()
-                    .try_for_each(|(k, v)| walk(ck, &|| format!("{}.{k}", key()), v)),
-                // A list of tables names its entry as the other checks do (`loads[0].magnitude_N`);
-                // a list of numbers (a point, a profile) is named as a whole.
-                toml::Value::Array(a) => a.iter().enumerate().try_for_each(|(i, v)| match v {
-                    toml::Value::Table(_) => walk(ck, &|| format!("{}.{i}", key()), v),
-                    _ => walk(ck, key, v),
-                }),
-                _ => Ok(()),
-            }
-        }
         let Ok(toml::Value::Table(t)) = toml::Value::try_from(self) else {
             return Ok(());
         };
         t.iter()
             .filter(|(k, _)| !["solver", "record"].contains(&k.as_str()))
-            .try_for_each(|(k, v)| walk(ck, &|| k.clone(), v))
+            .try_for_each(|(k, v)| super::check_values::magnitudes(ck, &|| k.clone(), v))
     }
 
     /// The cloth: sizes, density, grid, grading and refined lines.
@@ -138,7 +103,7 @@ in the key's unit (SI)",
     /// The material: mass-spring or continuum, every constant in range.
     fn check_material(&self, ck: &Check<'_>) -> Result<(), InputError> {
         let c = &self.cloth;
-        check_material_model(&self.material, ck, "material")?;
+        super::check_values::check_material_model(&self.material, ck, "material")?;
         if let Some(ms) = &self.material.mass_spring
             && ms.natural_length_m.is_some()
             && c.spacing != Spacing::Uniform
@@ -320,8 +285,9 @@ would already touch itself; use a coarser grid or a thinner sheet"
                 return ck.err(
                     &format!("obstacles.{k}"),
                     format!(
-                        "the sheet starts inside this obstacle (particle {} is {:.3e} m deep): \
+                        "the sheet starts inside this obstacle{} (particle {} is {:.3e} m deep): \
                          move the obstacle down or the sheet up (cloth.origin_m)",
+                        mesh_named(o),
                         self.particle_name(p),
                         -d
                     ),
@@ -336,9 +302,10 @@ would already touch itself; use a coarser grid or a thinner sheet"
                 return ck.err(
                     &format!("obstacles.{k}"),
                     format!(
-                        "the sheet starts through this obstacle: the edge from particle {} to {} \
+                        "the sheet starts through this obstacle{}: the edge from particle {} to {} \
 passes through it (a part thinner than the sheet's spacing): move the obstacle or the sheet \
 (cloth.origin_m) so that the sheet starts clear of it",
+                        mesh_named(o),
                         self.particle_name(a),
                         self.particle_name(b)
                     ),
@@ -483,6 +450,14 @@ impl Check<'_> {
     }
 }
 
+/// A mesh obstacle's file, as an error names it (` (mesh FILE)`); empty for an analytic shape.
+fn mesh_named(o: &crate::obstacle::Obstacle) -> String {
+    match o {
+        crate::obstacle::Obstacle::Mesh { mesh, .. } => format!(" (mesh {})", mesh.display()),
+        _ => String::new(),
+    }
+}
+
 /// The sizes drapelab computes in: every physical number of a scene is zero or between these in
 /// size, in SI units (10⁻¹² to 10¹²): beyond them sums of forces and energies lose their digits or
 /// overflow, and a solve would end in NaN as if the physics had failed.
@@ -494,74 +469,3 @@ pub const SHEET_SIDE_M: (f64, f64) = (1e-4, 100.0);
 /// The gravitational accelerations a scene may have, m/s²: none (0, loads alone) to 1000 (a
 /// centrifuge's 100 g).
 pub const GRAVITY_M_PER_S2: (f64, f64) = (0.0, 1000.0);
-
-/// A material model's own values, each under the key its table gives (`PREFIX.continuum.KEY`,
-/// `PREFIX.mass_spring.KEY`): exactly one model; stiffnesses, rigidities and the thickness > 0;
-/// shear, twist and damping ≥ 0. A scene's prefix is `material`, a fabric file's `fabric`.
-pub(super) fn check_material_model(
-    m: &crate::material::Material,
-    ck: &Check<'_>,
-    prefix: &str,
-) -> Result<(), InputError> {
-    match (&m.mass_spring, &m.continuum) {
-        (Some(_), Some(_)) => ck.err(
-            prefix,
-            format!("give either [{prefix}.mass_spring] or [{prefix}.continuum], not both"),
-        ),
-        (None, None) => ck.err(
-            prefix,
-            format!("missing: add [{prefix}.mass_spring] or [{prefix}.continuum]"),
-        ),
-        (Some(ms), None) => {
-            let key = |k: &str| format!("{prefix}.mass_spring.{k}");
-            ck.pos(&key("stiffness_N_per_m"), ms.stiffness_N_per_m)?;
-            for (k, v) in [
-                (
-                    "structural_stiffness_N_per_m",
-                    ms.structural_stiffness_N_per_m,
-                ),
-                ("shear_stiffness_N_per_m", ms.shear_stiffness_N_per_m),
-                ("bend_stiffness_N_per_m", ms.bend_stiffness_N_per_m),
-                ("natural_length_m", ms.natural_length_m),
-            ] {
-                if let Some(v) = v {
-                    ck.pos(&key(k), v)?;
-                }
-            }
-            ck.nonneg(&key("damping_Ns_per_m"), ms.damping_Ns_per_m)?;
-            ck.pos(&key("elongation_rate"), ms.elongation_rate)
-        }
-        (None, Some(cont)) => check_continuum(cont, ck, &format!("{prefix}.continuum")),
-    }
-}
-
-/// The continuum's keys as given (never a converted value under an invented name): every key of
-/// both units present or missing as [`crate::material::Continuum::rigidities`] says, tensile and
-/// bending rigidities and the thickness > 0, shear and twist ≥ 0.
-fn check_continuum(
-    cont: &crate::material::Continuum,
-    ck: &Check<'_>,
-    prefix: &str,
-) -> Result<(), InputError> {
-    cont.rigidities()
-        .map_err(|e| InputError::new(ck.path, format!("{prefix}.{}", e.key), e.message))?;
-    let Ok(toml::Value::Table(t)) = toml::Value::try_from(cont) else {
-        return Ok(());
-    };
-    for (k, v) in &t {
-        let Some(v) = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) else {
-            continue;
-        };
-        let key = format!("{prefix}.{k}");
-        if k.starts_with("shear") || k.starts_with("bending_twist") {
-            ck.nonneg(&key, v)?;
-        } else if k.starts_with("tensile")
-            || k.starts_with("bending_warp")
-            || k.starts_with("bending_weft")
-            || k == "thickness_m"
-        {
-            ck.pos(&key, v)?;
-        }
-    }
-    Ok(())
-}

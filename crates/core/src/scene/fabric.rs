@@ -130,7 +130,10 @@ remove it or give [fabric.continuum]"
             }
         }
         let ck = super::check::Check { path };
-        super::check::check_material_model(&f.material(), &ck, "fabric")?;
+        if let Ok(v) = toml::Value::try_from(&f) {
+            super::check_values::magnitudes(&ck, &|| "fabric".to_string(), &v)?;
+        }
+        super::check_values::check_material_model(&f.with_length_rigidities(), &ck, "fabric")?;
         for (k, [lo, hi]) in &f.intervals {
             if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
                 let m = format!("must be [low, high] with low ≤ high, got [{lo}, {hi}]");
@@ -144,6 +147,26 @@ remove it or give [fabric.continuum]"
             }
         }
         Ok(f)
+    }
+
+    /// The fabric's material with a stand-in rigidity (1 N·m) where a bending length gives it:
+    /// what the material's own checks see before the scene's density resolves the length.
+    fn with_length_rigidities(&self) -> Material {
+        let mut m = self.material();
+        if let Some(c) = m.continuum.as_mut() {
+            for (k, _) in self.bending_lengths() {
+                let (si, kes) = match k {
+                    "bending_length_warp_m" => {
+                        (&mut c.bending_warp_N_m, c.bending_warp_gf_cm2_per_cm)
+                    }
+                    _ => (&mut c.bending_weft_N_m, c.bending_weft_gf_cm2_per_cm),
+                };
+                if si.is_none() && kes.is_none() {
+                    *si = Some(1.0);
+                }
+            }
+        }
+        m
     }
 
     /// The value the fabric gives for `key` (a material key or a bending length), where numeric.

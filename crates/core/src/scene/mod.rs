@@ -12,6 +12,7 @@ use std::path::PathBuf;
 
 mod body;
 mod check;
+mod check_values;
 mod fabric;
 mod files;
 mod grid;

@@ -37,6 +37,12 @@ pub trait Continuation {
     /// the positions (a contact pull-back, a rejected increment rolled back) before a
     /// [`Stage::Solve`] that starts a fresh run.
     fn next(&mut self, model: &mut Model, x: &mut [Vector3<f64>], solved: bool) -> Stage;
+    /// Whether `max_iterations` bounds the Newton iterations of all its stages together (a
+    /// continuation whose stages need not end, as lagged friction's updates), rather than each
+    /// stage's run. Default false.
+    fn shares_budget(&self) -> bool {
+        false
+    }
 }
 
 /// The reports of the runs so far, merged ([`Part::Stage`]).
@@ -146,10 +152,11 @@ impl super::executor::Iterative for Staged<'_> {
     fn terminate(&mut self, _observer: &mut dyn Observer) -> Option<Verdict> {
         let next = self.continuation.next(self.model, self.x, self.solved);
         let spent = self.total.as_ref().map_or(0, |t| t.iterations);
-        if matches!(next, Stage::Solve(_) | Stage::Increment(_))
+        if self.continuation.shares_budget()
+            && matches!(next, Stage::Solve(_) | Stage::Increment(_))
             && spent >= self.opts.max_iterations
         {
-            // `max_iterations` is the whole solve's budget, over every stage.
+            // `max_iterations` is the whole continuation's budget, over every stage.
             self.close();
             let m = format!(
                 "{spent} Newton iterations over {} stages without finishing them (max_iterations {})",
