@@ -2,7 +2,7 @@
 //! "FILE"` or `--fabric FILE`) and drapes exactly as with the same material written inline; bad
 //! fabric inputs are refused naming the file and the key.
 
-use crate::support::{assert_bad_input, drapelab, root};
+use crate::support::{assert_bad_input, root};
 use drapelab::io::read_particles;
 use std::path::Path;
 
@@ -24,16 +24,7 @@ fn sphere_with(dir: &Path, material: &str) -> std::path::PathBuf {
 }
 
 fn simulate(scene: &Path, out: &Path, extra: &[&str]) -> Vec<(u32, u32, nalgebra::Vector3<f64>)> {
-    let o = drapelab()
-        .arg("-q")
-        .arg("simulate")
-        .arg(scene)
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    crate::support::simulate_ok(scene, out, extra);
     read_particles(&out.join("particles.parquet")).unwrap()
 }
 

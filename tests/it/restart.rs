@@ -4,7 +4,7 @@
 //! differences of restarted drapes are the derivative `--sensitivity` gives of the model that
 //! made the drape.
 
-use crate::support::{drapelab, root};
+use crate::support::{root, simulate_ok as simulate};
 use drapelab::io::{read_particles, read_sensitivities};
 use std::path::Path;
 
@@ -23,19 +23,6 @@ fn sphere_wool() -> std::path::PathBuf {
 
 fn run_json(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
-}
-
-/// `drapelab -q simulate SCENE --out OUT EXTRA…`, asserted to converge.
-fn simulate(scene: &Path, out: &Path, extra: &[&str]) {
-    let o = drapelab()
-        .args(["-q", "simulate"])
-        .arg(scene)
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 #[test]

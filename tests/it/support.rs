@@ -22,6 +22,19 @@ pub fn scene(name: &str, sets: &[&str]) -> Scene {
         .into_inner()
 }
 
+/// `drapelab -q simulate SCENE --out OUT EXTRA…`, asserted to exit 0 (a converged drape).
+pub fn simulate_ok(scene: &Path, out: &Path, extra: &[&str]) {
+    let o = drapelab()
+        .args(["-q", "simulate"])
+        .arg(scene)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// The drapelab binary built for these tests.
 pub fn drapelab() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_drapelab"))

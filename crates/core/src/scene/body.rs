@@ -101,7 +101,10 @@ pub fn carry_bodies(obstacles: &mut [Obstacle], from: &[Obstacle]) {
 
 impl super::Scene {
     /// `contact.body_edges` needs a mesh body and the barrier method.
-    pub(super) fn check_body_edges(&self, ck: &super::check::Check<'_>) -> Result<(), InputError> {
+    pub(super) fn check_body_edges(
+        &self,
+        ck: &super::check_values::Check<'_>,
+    ) -> Result<(), InputError> {
         let meshed = self
             .obstacles
             .iter()

@@ -1,6 +1,8 @@
 //! The checks of a scene, section by section, each naming the file and the key; the physical
 //! bounds drapelab computes in; [`ValidatedScene`], a scene that passed them.
 
+use super::check_values::Check;
+pub use super::check_values::MAGNITUDES;
 use super::*;
 use crate::error::InputError;
 use serde::Serialize;
@@ -420,35 +422,12 @@ impl ValidatedScene {
     }
 }
 
-/// The range checks of [`Scene::validate`], naming the file and the key.
-pub(super) struct Check<'a> {
-    pub(super) path: &'a Path,
-}
+/// The sides a sheet may have, m: from 0.1 mm (a yarn's width) to 100 m.
+pub const SHEET_SIDE_M: (f64, f64) = (1e-4, 100.0);
 
-impl Check<'_> {
-    pub(super) fn err(&self, key: &str, message: String) -> Result<(), InputError> {
-        Err(InputError::new(self.path, key, message))
-    }
-    pub(super) fn pos(&self, key: &str, v: f64) -> Result<(), InputError> {
-        if !v.is_finite() || v <= 0.0 {
-            return self.err(key, format!("must be a finite number > 0, got {v}"));
-        }
-        Ok(())
-    }
-    pub(super) fn nonneg(&self, key: &str, v: f64) -> Result<(), InputError> {
-        if !v.is_finite() || v < 0.0 {
-            return self.err(key, format!("must be a finite number ≥ 0, got {v}"));
-        }
-        Ok(())
-    }
-    /// `v` within the physical bounds `(lo, hi)` of the key (in its unit).
-    pub(super) fn within(&self, key: &str, v: f64, (lo, hi): (f64, f64)) -> Result<(), InputError> {
-        if !(v.is_finite() && (lo..=hi).contains(&v)) {
-            return self.err(key, format!("must be in {lo} to {hi}, got {v}"));
-        }
-        Ok(())
-    }
-}
+/// The gravitational accelerations a scene may have, m/s²: none (0, loads alone) to 1000 (a
+/// centrifuge's 100 g).
+pub const GRAVITY_M_PER_S2: (f64, f64) = (0.0, 1000.0);
 
 /// A mesh obstacle's file, as an error names it (` (mesh FILE)`); empty for an analytic shape.
 fn mesh_named(o: &crate::obstacle::Obstacle) -> String {
@@ -457,15 +436,3 @@ fn mesh_named(o: &crate::obstacle::Obstacle) -> String {
         _ => String::new(),
     }
 }
-
-/// The sizes drapelab computes in: every physical number of a scene is zero or between these in
-/// size, in SI units (10⁻¹² to 10¹²): beyond them sums of forces and energies lose their digits or
-/// overflow, and a solve would end in NaN as if the physics had failed.
-pub const MAGNITUDES: (f64, f64) = (1e-12, 1e12);
-
-/// The sides a sheet may have, m: from 0.1 mm (a yarn's width) to 100 m.
-pub const SHEET_SIDE_M: (f64, f64) = (1e-4, 100.0);
-
-/// The gravitational accelerations a scene may have, m/s²: none (0, loads alone) to 1000 (a
-/// centrifuge's 100 g).
-pub const GRAVITY_M_PER_S2: (f64, f64) = (0.0, 1000.0);

@@ -2,8 +2,43 @@
 //! finite and of a size drapelab computes in, and a material model's own values under the keys
 //! its table gives (`material.…` in a scene, `fabric.…` in a fabric file).
 
-use super::check::{Check, MAGNITUDES};
 use crate::error::InputError;
+use std::path::Path;
+
+/// The sizes drapelab computes in: every physical number of a scene is zero or between these in
+/// size, in SI units (10⁻¹² to 10¹²): beyond them sums of forces and energies lose their digits or
+/// overflow, and a solve would end in NaN as if the physics had failed.
+pub const MAGNITUDES: (f64, f64) = (1e-12, 1e12);
+
+/// The range checks of [`Scene::validate`], naming the file and the key.
+pub(super) struct Check<'a> {
+    pub(super) path: &'a Path,
+}
+
+impl Check<'_> {
+    pub(super) fn err(&self, key: &str, message: String) -> Result<(), InputError> {
+        Err(InputError::new(self.path, key, message))
+    }
+    pub(super) fn pos(&self, key: &str, v: f64) -> Result<(), InputError> {
+        if !v.is_finite() || v <= 0.0 {
+            return self.err(key, format!("must be a finite number > 0, got {v}"));
+        }
+        Ok(())
+    }
+    pub(super) fn nonneg(&self, key: &str, v: f64) -> Result<(), InputError> {
+        if !v.is_finite() || v < 0.0 {
+            return self.err(key, format!("must be a finite number ≥ 0, got {v}"));
+        }
+        Ok(())
+    }
+    /// `v` within the physical bounds `(lo, hi)` of the key (in its unit).
+    pub(super) fn within(&self, key: &str, v: f64, (lo, hi): (f64, f64)) -> Result<(), InputError> {
+        if !(v.is_finite() && (lo..=hi).contains(&v)) {
+            return self.err(key, format!("must be in {lo} to {hi}, got {v}"));
+        }
+        Ok(())
+    }
+}
 
 /// A material model's own values, each under the key its table gives (`PREFIX.continuum.KEY`,
 /// `PREFIX.mass_spring.KEY`): exactly one model; stiffnesses, rigidities and the thickness > 0;

@@ -129,7 +129,7 @@ remove it or give [fabric.continuum]"
                 return bad("fabric.calibrated".into(), m);
             }
         }
-        let ck = super::check::Check { path };
+        let ck = super::check_values::Check { path };
         if let Ok(v) = toml::Value::try_from(&f) {
             super::check_values::magnitudes(&ck, &|| "fabric".to_string(), &v)?;
         }

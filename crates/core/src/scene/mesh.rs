@@ -2,7 +2,7 @@
 //! `rotation_deg` and `origin_m`, and the checks a mesh sheet adds — the grid's keys refused, pins by
 //! the file's groups, the continuum material required.
 
-use super::check::Check;
+use super::check_values::Check;
 use super::{ClothSpec, Scene, SheetShape};
 use crate::cloth::Spacing;
 use crate::error::InputError;
