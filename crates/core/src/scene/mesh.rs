@@ -49,7 +49,7 @@ pub(super) fn mesh_unit_error(unit_m: f64) -> Option<String> {
     let (lo, hi) = MESH_UNIT_M;
     (!(unit_m.is_finite() && (lo..=hi).contains(&unit_m))).then(|| {
         format!(
-            "must be a unit in m from {lo:e} to {hi:e} (1 for metres, 0.01 for centimetres, 0.001 for millimetres), got {unit_m}"
+            "must be a unit in m from {lo:e} to {hi:e} (1 for metres, 0.01 for centimetres, 0.001 for millimetres), got {unit_m:e}"
         )
     })
 }
