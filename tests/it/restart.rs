@@ -4,9 +4,8 @@
 //! differences of restarted drapes are the derivative `--sensitivity` gives of the model that
 //! made the drape.
 
-use crate::support::{root, simulate_ok as simulate};
+use crate::support::{root, run_json, simulate_ok as simulate};
 use drapelab::io::{read_particles, read_sensitivities};
-use std::path::Path;
 
 const BEND: &str = "material.continuum.bending_warp_gf_cm2_per_cm";
 
@@ -19,10 +18,6 @@ fn dot(a: &[V3], b: &[V3]) -> f64 {
 
 fn sphere_wool() -> std::path::PathBuf {
     root().join("datasets/scenes/sphere_wool.toml")
-}
-
-fn run_json(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! `simulate --sensitivity KEY` and `simulate --start FILE` at the command line: the table's rows and
 //! values, run.json's word on them, bad keys and bad start files refused as bad input.
 
-use crate::support::{assert_bad_input, drapelab, root, run_python};
+use crate::support::{assert_bad_input, drapelab, root, run_json, run_python};
 use drapelab::io::{read_particles, read_sensitivities};
 use std::path::Path;
 
@@ -10,10 +10,6 @@ const RHO: &str = "cloth.areal_density_kg_per_m2";
 
 fn hang4() -> std::path::PathBuf {
     root().join("datasets/scenes/hang4.toml")
-}
-
-fn run_json(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
 }
 
 #[test]

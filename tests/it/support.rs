@@ -35,6 +35,11 @@ pub fn simulate_ok(scene: &Path, out: &Path, extra: &[&str]) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// A run folder's run.json, parsed.
+pub fn run_json(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
+}
+
 /// The drapelab binary built for these tests.
 pub fn drapelab() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_drapelab"))

@@ -75,8 +75,12 @@ fn neighbour(scene: &ValidatedScene, sol: &Solution) -> Option<Vec<Vector3<f64>>
     let mut x: Vec<Vector3<f64>> = (0..sol.x.len())
         .map(|p| if b.model.fixed[p] { b.x0[p] } else { sol.x[p] })
         .collect();
+    // Lagged friction's stages share one iteration budget; a neighbour at μ = 10⁻⁶ of a
+    // frictionless drape re-ramps its load from the drape (20 increments), so it gets ten times
+    // the scene's.
     let held = drapelab_core::solve::StaticOptions {
         kappa_adapt_gap_rel: 0.0,
+        max_iterations: 10 * scene.solver.static_.max_iterations,
         ..scene.solver.static_.clone()
     };
     let r = drapelab_core::simulate::solve_model_warm(
