@@ -73,7 +73,7 @@ const NOT_IN_CORE: [&str; 8] = [
 
 /// The modules of the core, lowest first: a module may import only modules of a lower rank. The
 /// error types (`error`: a bad key, a bad input) are below everything that checks its input.
-const CORE_RANKS: [(&str, u8); 30] = [
+const CORE_RANKS: [(&str, u8); 31] = [
     ("error", 0),
     ("provenance", 0),
     ("atomic", 0),
@@ -88,22 +88,23 @@ const CORE_RANKS: [(&str, u8); 30] = [
     ("raster", 1),
     ("config", 2),
     ("cloth", 2),
-    ("pattern", 2),
+    ("pattern", 1),
     ("physics", 2),
     ("solve", 3),
-    ("scene", 4),
-    ("build", 5),
-    ("params", 5),
-    ("sensitivity", 6),
-    ("simulate", 6),
-    ("measure", 6),
-    ("cusick", 7),
-    ("elastica", 7),
-    ("edges", 7),
-    ("wrinkles", 7),
-    ("calibrate", 8),
-    ("benchmark", 9),
-    ("lib", 10),
+    ("sewing", 4),
+    ("scene", 5),
+    ("build", 6),
+    ("params", 6),
+    ("sensitivity", 7),
+    ("simulate", 7),
+    ("measure", 7),
+    ("cusick", 8),
+    ("elastica", 8),
+    ("edges", 8),
+    ("wrinkles", 8),
+    ("calibrate", 9),
+    ("benchmark", 10),
+    ("lib", 11),
 ];
 
 fn cargo() -> std::process::Command {

@@ -36,6 +36,7 @@ pub mod proximity;
 pub mod raster;
 pub mod scene;
 pub mod sensitivity;
+pub mod sewing;
 pub mod simulate;
 pub mod solve;
 pub mod surface;

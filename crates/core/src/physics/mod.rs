@@ -17,6 +17,8 @@ mod membrane;
 mod mesh_bending;
 mod obstacle_barrier;
 mod patch_bending;
+mod pattern_sheet;
+mod seam;
 mod self_contact;
 mod shear;
 mod springs;
@@ -42,6 +44,8 @@ pub use mesh_bending::{
 };
 pub use obstacle_barrier::{ObstacleBarrier, max_penetration_m};
 pub use patch_bending::{patch_bending, reads_creases};
+pub use pattern_sheet::{PatternSheet, pattern_builder};
+pub use seam::{SeamKernel, Seams};
 pub use self_contact::{
     CandidateSet, ContactPair, ContactSet, PairKind, SelfContact, SelfContactState,
 };

@@ -37,6 +37,7 @@ impl Scene {
             scene.cloth.read_mesh(path)?;
             super::body::read_bodies(&mut scene.obstacles, path)?;
             super::fabric::apply_fabric(&mut scene, path)?;
+            super::sew::sew_pattern(&mut scene, path)?;
             Ok(scene)
         };
         let mut scene = with(&|_| true)?;

@@ -21,7 +21,10 @@ pub fn mesh_files_of(scene_path: &Path) -> Vec<std::path::PathBuf> {
     else {
         return Vec::new();
     };
-    let cloth = table.get("cloth").and_then(|c| c.get("mesh"));
+    let cloth_table = table.get("cloth");
+    let cloth = ["mesh", "pattern"]
+        .into_iter()
+        .filter_map(|k| cloth_table.and_then(|c| c.get(k)));
     let obstacles = table.get("obstacles").and_then(|o| o.as_array());
     let bodies = obstacles
         .into_iter()
@@ -61,7 +64,7 @@ const MAX_MESH_REFINE: usize = 4;
 impl ClothSpec {
     /// Whether the sheet is a mesh (`cloth.mesh`) rather than the grid.
     pub fn is_mesh(&self) -> bool {
-        self.mesh.is_some()
+        self.mesh.is_some() || self.sewing_pattern.is_some()
     }
 
     /// Reads `cloth.mesh` (a relative path from the folder of `scene_path`) into `pattern`; the

@@ -18,6 +18,7 @@ mod files;
 mod grid;
 mod load;
 mod mesh;
+mod sew;
 
 pub use body::{carry_bodies, read_body};
 pub use check::{GRAVITY_M_PER_S2, MAGNITUDES, SHEET_SIDE_M, ValidatedScene};
@@ -66,9 +67,23 @@ pub struct ClothSpec {
     /// stands a pattern in the x–z plane (a curtain hung from its top).
     #[serde(default, skip_serializing_if = "is_zero3")]
     pub rotation_deg: [f64; 3],
-    /// The pattern read from `mesh` (set when the scene is loaded).
+    /// The pattern read from `mesh`, or sewn from the sewing pattern (set when the scene is loaded).
     #[serde(skip)]
     pub pattern: Option<std::sync::Arc<crate::pattern::Pattern>>,
+    /// A garment from a sewing pattern instead of `mesh`: GarmentCode's JSON (`*_specification.json`,
+    /// [`crate::sewing`]), relative to the scene file's folder. Its panels are triangulated at
+    /// `resolution_m`, placed where the pattern places them (clear of the body), sewn without
+    /// crossing on the scene's bodies in the scene's fabric, and welded into one sheet, which the
+    /// scene then drapes. Needs `[material.continuum]` (or a fabric file). Default none.
+    #[serde(default, rename = "pattern", skip_serializing_if = "Option::is_none")]
+    pub sewing_pattern: Option<PathBuf>,
+    /// A sewing pattern's mesh resolution, m: the length of its boundary segments and triangles'
+    /// sides. Default 0.01 (1 cm); 0.02 for a quick look, finer for small folds.
+    #[serde(default = "default_resolution", skip_serializing_if = "is_default_resolution")]
+    pub resolution_m: f64,
+    /// How the sewing pattern was sewn (set when the scene is loaded).
+    #[serde(skip)]
+    pub sewing: Option<std::sync::Arc<crate::sewing::sew::SewReport>>,
     /// "uniform" (default) or "graded" (finer towards the edges).
     #[serde(default)]
     pub spacing: Spacing,
@@ -99,6 +114,14 @@ pub struct ClothSpec {
     /// used to break the mirror symmetry of a hang. Default 0.
     #[serde(default)]
     pub initial_perturbation_m: f64,
+}
+
+fn default_resolution() -> f64 {
+    0.01
+}
+
+fn is_default_resolution(r: &f64) -> bool {
+    *r == 0.01
 }
 
 fn default_grading() -> f64 {

@@ -1,0 +1,231 @@
+//! Sewing (issue 91): the pieces start where the pattern places them, moved clear of the body
+//! ([`arrange`]); each stitch's vertex pairs are pulled together by capped zero-rest-length springs
+//! ([`crate::physics::Seams`]) whose stiffness a continuation raises ten-fold a stage, integrated
+//! by implicit Euler without gravity (each step a minimisation of the incremental potential,
+//! [`crate::solve::solve_dynamic`]), while the body's barrier keeps the pieces off the body and
+//! self-contact keeps them off each other (every triangle but those touching a seam, whose two
+//! sides must meet). When the largest seam gap is below the tolerance the pairs are welded
+//! ([`super::weld`]): one sheet, hinges across its seams, ready to drape.
+
+use super::panels::Unsewn;
+use crate::material::Rigidities;
+use crate::obstacle::Obstacle;
+use crate::pattern::{Defect, Pattern};
+use crate::physics::{Model, PatternSheet, Seams, Vecs, pattern_builder};
+use crate::solve::{DynamicOptions, Integrator, NoObserver, solve_dynamic};
+use nalgebra::Vector3;
+
+/// What sewing needs of the scene: the fabric, the body and the contact's distances.
+pub struct SewSetup<'a> {
+    /// The fabric's rigidities (SI).
+    pub rigidities: &'a Rigidities,
+    /// Areal density, kg/m².
+    pub areal_density_kg_per_m2: f64,
+    /// The warp's angle from each panel's +x, rad.
+    pub warp_angle_rad: f64,
+    /// The bodies.
+    pub obstacles: &'a [Obstacle],
+    /// The body barrier's activation distance, m.
+    pub distance_m: f64,
+    /// Self-contact thickness (and band), m.
+    pub thickness_m: f64,
+}
+
+/// How sewing went: the numbers run.json reports.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SewReport {
+    /// Seam vertex pairs.
+    pub seam_pairs: usize,
+    /// The largest seam gap where the pattern places the pieces, m.
+    pub start_gap_m: f64,
+    /// How far each panel was moved out to clear the body, m (by panel name; absent: not moved).
+    pub moved_out_m: Vec<(String, f64)>,
+    /// The largest seam gap when the pairs were welded, m.
+    pub gap_before_weld_m: f64,
+    /// The seam stiffness of each stage, N/m, and the largest gap after it, m.
+    pub stages: Vec<(f64, f64)>,
+    /// Newton iterations over all stages.
+    pub iterations: usize,
+    /// Mesh edges crossing a triangle of another part of the garment before welding.
+    pub crossing_edges: usize,
+    /// The deepest particle inside a body before welding, m (0: none).
+    pub penetration_m: f64,
+    /// Wall time, s.
+    pub time_s: f64,
+}
+
+/// Welded when every seam gap is below this, m.
+pub const GAP_TOLERANCE_M: f64 = 1e-3;
+/// The first stage's seam stiffness, N/m per pair; each stage ten times the one before.
+const FIRST_STIFFNESS_N_PER_M: f64 = 1.0;
+/// Stages of the continuation at most.
+const STAGES: usize = 5;
+/// Simulated time per stage, s.
+const STAGE_TIME_S: f64 = 0.5;
+
+/// The unsewn pieces as a pattern (no vertex shared; the caller's start positions `x`).
+pub fn unsewn_pattern(u: &Unsewn, x: &[[f64; 3]]) -> Pattern {
+    Pattern {
+        rest_m: u.rest_m.clone(),
+        rest_triangles: u.triangles.clone(),
+        triangles: u.triangles.clone(),
+        vertex_of_rest: (0..u.rest_m.len()).collect(),
+        start_m: x.to_vec(),
+        groups: u.groups.clone(),
+    }
+}
+
+/// The sewing model: the pieces' membrane and bending, no gravity, the body's barrier,
+/// self-contact away from the seams, and the seams at `stiffness` N/m.
+fn sewing_model(u: &Unsewn, s: &SewSetup<'_>, x: &Vecs, stiffness: f64) -> Result<Model, Defect> {
+    let pattern = unsewn_pattern(u, &x.iter().map(|v| [v.x, v.y, v.z]).collect::<Vec<_>>());
+    let sheet = PatternSheet {
+        pattern: &pattern,
+        rigidities: s.rigidities,
+        warp_angle_rad: s.warp_angle_rad,
+        bending_saturation_per_m: f64::INFINITY,
+        curl_per_m: None,
+        areal_density_kg_per_m2: s.areal_density_kg_per_m2,
+    };
+    let mut b = pattern_builder(&sheet, 0.0, &[]).map_err(|e| Defect {
+        key: "pattern".into(),
+        message: format!("a panel's triangles cannot carry the membrane: {e:?}"),
+    })?;
+    let g = crate::STANDARD_GRAVITY_M_PER_S2;
+    b.obstacles(s.obstacles.to_vec(), s.distance_m, g);
+    let mut on_seam = vec![false; x.len()];
+    u.seams.iter().flatten().for_each(|&v| on_seam[v] = true);
+    let away: Vec<[u32; 3]> = u
+        .triangles
+        .iter()
+        .filter(|t| t.iter().all(|&v| !on_seam[v]))
+        .map(|t| t.map(|v| v as u32))
+        .collect();
+    b.self_contact(away, x, (s.thickness_m, s.thickness_m), g);
+    b.term(Box::new(Seams::new(&u.seams, stiffness, 0.05)));
+    Ok(b.build())
+}
+
+fn as_arrays(x: &Vecs) -> Vec<[f64; 3]> {
+    x.iter().map(|v| [v.x, v.y, v.z]).collect()
+}
+
+/// Sews `u` (its start as placed, moved clear by [`arrange`]) in `s`'s fabric on `s`'s bodies.
+pub fn sew(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Pattern, SewReport), Defect> {
+    let clock = std::time::Instant::now();
+    let (start, moved_out_m) = arrange(u, s)?;
+    let mut x: Vec<Vector3<f64>> = start.iter().map(|p| Vector3::from(*p)).collect();
+    let mut v: Vec<Vector3<f64>> = vec![Vector3::zeros(); x.len()];
+    let mut report = SewReport {
+        seam_pairs: u.seams.len(),
+        start_gap_m: super::weld::largest_gap_m(&u.seams, &start),
+        moved_out_m,
+        gap_before_weld_m: f64::NAN,
+        stages: Vec::new(),
+        iterations: 0,
+        crossing_edges: 0,
+        penetration_m: 0.0,
+        time_s: 0.0,
+    };
+    let opts = DynamicOptions {
+        dt_s: 1e-3,
+        max_time_s: STAGE_TIME_S,
+        rayleigh_mass_per_s: 20.0,
+        ..DynamicOptions::default()
+    };
+    let mut k = FIRST_STIFFNESS_N_PER_M;
+    for _ in 0..STAGES {
+        let mut model = sewing_model(u, s, &x, k)?;
+        v.iter_mut().for_each(|v| *v = Vector3::zeros());
+        let r = solve_dynamic(&mut model, Integrator::ImplicitEuler, &mut x, &mut v, &opts, &mut NoObserver);
+        report.iterations += r.iterations;
+        let gap = super::weld::largest_gap_m(&u.seams, &as_arrays(&x));
+        report.stages.push((k, gap));
+        if gap < GAP_TOLERANCE_M || r.divergence.is_some() {
+            break;
+        }
+        k *= 10.0;
+    }
+    let xs = as_arrays(&x);
+    report.gap_before_weld_m = super::weld::largest_gap_m(&u.seams, &xs);
+    let topo = crate::proximity::MeshTopology::from_triangles(
+        u.triangles.iter().map(|t| t.map(|v| v as u32)).collect(),
+    );
+    report.crossing_edges = crate::proximity::edge_triangle_crossings(&topo, &x).len();
+    report.penetration_m = crate::physics::max_penetration_m(s.obstacles, &x);
+    report.time_s = clock.elapsed().as_secs_f64();
+    if report.gap_before_weld_m >= GAP_TOLERANCE_M {
+        return Err(Defect {
+            key: "pattern.stitches".into(),
+            message: format!(
+                "the seams did not close: the largest gap is {:.1} mm after {} stages (stiffness up to {k:e} N/m); \
+                 the panels may be placed too far apart or a stitch joins edges that cannot meet",
+                1e3 * report.gap_before_weld_m,
+                report.stages.len()
+            ),
+        });
+    }
+    let welded = super::weld::weld(u, &xs)?;
+    Ok((welded, report))
+}
+
+/// The pieces' start, each panel moved out from the body (horizontally, away from the vertical
+/// line through the bodies' centre) in steps of a centimetre until every vertex is clear of every
+/// body by twice the barrier's distance; the panels moved and how far. A panel still inside a body
+/// 30 cm out is refused, naming it.
+pub fn arrange(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Vec<[f64; 3]>, Vec<(String, f64)>), Defect> {
+    let mut x = u.start_m.clone();
+    let centre = body_centre(s.obstacles);
+    let clear = |p: &[f64; 3]| {
+        let q = Vector3::from(*p);
+        s.obstacles.iter().all(|o| o.signed_distance(&q).0 > 2.0 * s.distance_m)
+    };
+    let mut moved = Vec::new();
+    for (k, name) in u.panel_names.iter().enumerate() {
+        let vs: Vec<usize> = (0..x.len()).filter(|&v| u.panel_of[v] == k).collect();
+        let c = vs.iter().fold(Vector3::zeros(), |a, &v| a + Vector3::from(x[v])) / vs.len() as f64;
+        let mut out = Vector3::new(c.x - centre.x, c.y - centre.y, 0.0);
+        if out.norm() < 1e-9 {
+            out = Vector3::new(0.0, -1.0, 0.0);
+        }
+        let out = out.normalize();
+        let mut shift = 0.0;
+        while !vs.iter().all(|&v| clear(&x[v])) {
+            if shift > 0.3 {
+                return Err(Defect {
+                    key: format!("pattern.panels.{name}"),
+                    message: "starts inside the body and is still inside it 30 cm further out: place it outside the body (translation)".into(),
+                });
+            }
+            shift += 0.01;
+            for &v in &vs {
+                x[v] = [x[v][0] + 0.01 * out.x, x[v][1] + 0.01 * out.y, x[v][2]];
+            }
+        }
+        if shift > 0.0 {
+            moved.push((name.clone(), shift));
+        }
+    }
+    Ok((x, moved))
+}
+
+/// The centre of the mesh bodies' bounding box, or the origin.
+fn body_centre(obstacles: &[Obstacle]) -> Vector3<f64> {
+    let pts: Vec<Vector3<f64>> = obstacles
+        .iter()
+        .filter_map(|o| match o {
+            Obstacle::Mesh { body: Some(b), .. } => {
+                let bx = b.bounds();
+                Some(vec![bx.lo, bx.hi])
+            }
+            _ => None,
+        })
+        .flatten()
+        .collect();
+    if pts.is_empty() {
+        return Vector3::zeros();
+    }
+    let lo = pts.iter().fold(Vector3::repeat(f64::INFINITY), |a, p| a.inf(p));
+    let hi = pts.iter().fold(Vector3::repeat(f64::NEG_INFINITY), |a, p| a.sup(p));
+    (lo + hi) / 2.0
+}
