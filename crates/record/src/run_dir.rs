@@ -49,6 +49,10 @@ struct RunRecord<'a> {
     /// How the solve took up that start's state.
     #[serde(skip_serializing_if = "Option::is_none")]
     start: Option<StartRecord>,
+    /// How a garment from a sewing pattern (`cloth.pattern`) was sewn before it was draped: seam
+    /// gaps before welding, stages, crossing edges of the welded garment, penetration of the body.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sewing: Option<&'a drapelab_core::sewing::sew::SewReport>,
     scene: &'a Scene,
 }
 
@@ -374,6 +378,7 @@ fn run_record(
             .then(|| drapelab_core::solve::neutral_modes(model, x)),
         start_file: extras.start.as_ref().map(|s| s.file.clone()),
         start: extras.start.as_ref().map(StartState::record),
+        sewing: scene.cloth.sewing.as_deref(),
         scene,
     };
     Ok((

@@ -81,7 +81,7 @@ pub(super) fn sew_pattern(scene: &mut Scene, scene_path: &Path) -> Result<(), In
     let (pattern, report) = match cached {
         Some(s) => s,
         None => {
-            let (p, rep) = sew(&unsewn, &setup).map_err(bad)?;
+            let (p, rep) = sew(&unsewn, &setup, &mut |line| eprintln!("{line}"), &mut crate::solve::NoObserver).map_err(bad)?;
             let s = (Arc::new(p), Arc::new(rep));
             if let Ok(mut c) = sewn_before().lock() {
                 c.insert(key, s.clone());

@@ -12,7 +12,8 @@ use crate::material::Rigidities;
 use crate::obstacle::Obstacle;
 use crate::pattern::{Defect, Pattern};
 use crate::physics::{Model, PatternSheet, Seams, Vecs, pattern_builder};
-use crate::solve::{DynamicOptions, Integrator, NoObserver, solve_dynamic};
+use crate::physics::Contacts;
+use crate::solve::{Inertia, Observer, StaticOptions, solve_static};
 use nalgebra::Vector3;
 
 /// What sewing needs of the scene: the fabric, the body and the contact's distances.
@@ -46,7 +47,7 @@ pub struct SewReport {
     pub stages: Vec<(f64, f64)>,
     /// Newton iterations over all stages.
     pub iterations: usize,
-    /// Mesh edges crossing a triangle of another part of the garment before welding.
+    /// Edges of the welded garment crossing one of its triangles (an independent edge–triangle test).
     pub crossing_edges: usize,
     /// The deepest particle inside a body before welding, m (0: none).
     pub penetration_m: f64,
@@ -60,8 +61,10 @@ pub const GAP_TOLERANCE_M: f64 = 1e-3;
 const FIRST_STIFFNESS_N_PER_M: f64 = 1.0;
 /// Stages of the continuation at most.
 const STAGES: usize = 5;
-/// Simulated time per stage, s.
-const STAGE_TIME_S: f64 = 0.5;
+/// Newton iterations per stage at most.
+const STAGE_ITERATIONS: usize = 400;
+/// The proximal term's time, s: its weight per particle is m/h² (a 60 µg particle: 6 mN/m).
+const PROXIMAL_H_S: f64 = 0.1;
 
 /// The unsewn pieces as a pattern (no vertex shared; the caller's start positions `x`).
 pub fn unsewn_pattern(u: &Unsewn, x: &[[f64; 3]]) -> Pattern {
@@ -111,11 +114,16 @@ fn as_arrays(x: &Vecs) -> Vec<[f64; 3]> {
 }
 
 /// Sews `u` (its start as placed, moved clear by [`arrange`]) in `s`'s fabric on `s`'s bodies.
-pub fn sew(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Pattern, SewReport), Defect> {
+/// `progress` hears a line per stage; `observer` sees the stages' states.
+pub fn sew(
+    u: &Unsewn,
+    s: &SewSetup<'_>,
+    progress: &mut dyn FnMut(String),
+    observer: &mut dyn Observer,
+) -> Result<(Pattern, SewReport), Defect> {
     let clock = std::time::Instant::now();
     let (start, moved_out_m) = arrange(u, s)?;
     let mut x: Vec<Vector3<f64>> = start.iter().map(|p| Vector3::from(*p)).collect();
-    let mut v: Vec<Vector3<f64>> = vec![Vector3::zeros(); x.len()];
     let mut report = SewReport {
         seam_pairs: u.seams.len(),
         start_gap_m: super::weld::largest_gap_m(&u.seams, &start),
@@ -127,20 +135,31 @@ pub fn sew(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Pattern, SewReport), Defect>
         penetration_m: 0.0,
         time_s: 0.0,
     };
-    let opts = DynamicOptions {
-        dt_s: 1e-3,
-        max_time_s: STAGE_TIME_S,
-        rayleigh_mass_per_s: 20.0,
-        ..DynamicOptions::default()
+    let opts = StaticOptions {
+        residual_tol_rel: 1e-3,
+        max_iterations: STAGE_ITERATIONS,
+        ..StaticOptions::default()
     };
     let mut k = FIRST_STIFFNESS_N_PER_M;
     for _ in 0..STAGES {
         let mut model = sewing_model(u, s, &x, k)?;
-        v.iter_mut().for_each(|v| *v = Vector3::zeros());
-        let r = solve_dynamic(&mut model, Integrator::ImplicitEuler, &mut x, &mut v, &opts, &mut NoObserver);
+        // A weak tether to the stage's start (a proximal term m/(2h²)|x − x_k|²) holds the
+        // garment's free rigid motions; re-anchored every stage, it leaves no bias behind.
+        let zeros = vec![Vector3::zeros(); x.len()];
+        let tether = Inertia::new(&model, (&x, &Contacts::default()), &zeros, PROXIMAL_H_S, (0.0, 0.0, 0.0));
+        model.terms.push(Box::new(tether));
+        let r = solve_static(&mut model, &mut x, &opts, observer);
         report.iterations += r.iterations;
         let gap = super::weld::largest_gap_m(&u.seams, &as_arrays(&x));
         report.stages.push((k, gap));
+        progress(format!(
+            "sewing: seam stiffness {k:e} N/m, largest gap {:.2} mm ({}), {} Newton iterations, {:.1} s ({})",
+            1e3 * gap,
+            widest_seam(u, &x),
+            r.iterations,
+            clock.elapsed().as_secs_f64(),
+            r.message
+        ));
         if gap < GAP_TOLERANCE_M || r.divergence.is_some() {
             break;
         }
@@ -148,10 +167,6 @@ pub fn sew(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Pattern, SewReport), Defect>
     }
     let xs = as_arrays(&x);
     report.gap_before_weld_m = super::weld::largest_gap_m(&u.seams, &xs);
-    let topo = crate::proximity::MeshTopology::from_triangles(
-        u.triangles.iter().map(|t| t.map(|v| v as u32)).collect(),
-    );
-    report.crossing_edges = crate::proximity::edge_triangle_crossings(&topo, &x).len();
     report.penetration_m = crate::physics::max_penetration_m(s.obstacles, &x);
     report.time_s = clock.elapsed().as_secs_f64();
     if report.gap_before_weld_m >= GAP_TOLERANCE_M {
@@ -166,47 +181,80 @@ pub fn sew(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Pattern, SewReport), Defect>
         });
     }
     let welded = super::weld::weld(u, &xs)?;
+    let topo = crate::proximity::MeshTopology::from_triangles(
+        welded.triangles.iter().map(|t| t.map(|v| v as u32)).collect(),
+    );
+    let xw: Vec<Vector3<f64>> = welded.start_m.iter().map(|p| Vector3::from(*p)).collect();
+    let crossings = crate::proximity::edge_triangle_crossings(&topo, &xw);
+    report.crossing_edges = crossings.iter().map(|c| c.0).collect::<std::collections::BTreeSet<_>>().len();
     Ok((welded, report))
 }
 
-/// The pieces' start, each panel moved out from the body (horizontally, away from the vertical
+/// The pieces' start: each panel moved out from the body (horizontally, away from the vertical
 /// line through the bodies' centre) in steps of a centimetre until every vertex is clear of every
-/// body by twice the barrier's distance; the panels moved and how far. A panel still inside a body
-/// 30 cm out is refused, naming it.
+/// body by twice the barrier's distance; then the whole garment raised, in steps of a centimetre,
+/// to the lowest height at which no seam's straight pull passes through a body (a shoulder seam
+/// placed below the shoulder would pull its sides into it; GarmentCode merges such seams at once
+/// and repairs what crosses). The start, and the moves made (by panel name, `lift` for the
+/// garment). A panel still inside a body 30 cm out is refused, naming it.
 pub fn arrange(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Vec<[f64; 3]>, Vec<(String, f64)>), Defect> {
     let mut x = u.start_m.clone();
+    let mut moved = Vec::new();
+    for k in 0..u.panel_names.len() {
+        if let Some(shift) = move_out(u, s, k, &mut x)? {
+            moved.push((u.panel_names[k].clone(), shift));
+        }
+    }
+    let blocked = |x: &[[f64; 3]], dz: f64| {
+        let at = |v: usize| Vector3::new(x[v][0], x[v][1], x[v][2] + dz);
+        u.seams
+            .iter()
+            .filter(|&&[a, b]| s.obstacles.iter().any(|o| o.segment_enters(&at(a), &at(b))))
+            .count()
+    };
+    let lift = (0..=MAX_LIFT_CM)
+        .map(|cm| (blocked(&x, cm as f64 * 0.01), cm))
+        .min()
+        .map_or(0, |(_, cm)| cm);
+    if lift > 0 {
+        let dz = lift as f64 * 0.01;
+        x.iter_mut().for_each(|p| p[2] += dz);
+        moved.push(("lift".into(), dz));
+    }
+    Ok((x, moved))
+}
+
+/// The highest the garment is raised to clear its seams' pulls, cm.
+const MAX_LIFT_CM: usize = 30;
+
+/// Moves panel `k` out until clear of the bodies; how far, where it moved.
+fn move_out(u: &Unsewn, s: &SewSetup<'_>, k: usize, x: &mut [[f64; 3]]) -> Result<Option<f64>, Defect> {
     let centre = body_centre(s.obstacles);
     let clear = |p: &[f64; 3]| {
         let q = Vector3::from(*p);
         s.obstacles.iter().all(|o| o.signed_distance(&q).0 > 2.0 * s.distance_m)
     };
-    let mut moved = Vec::new();
-    for (k, name) in u.panel_names.iter().enumerate() {
-        let vs: Vec<usize> = (0..x.len()).filter(|&v| u.panel_of[v] == k).collect();
-        let c = vs.iter().fold(Vector3::zeros(), |a, &v| a + Vector3::from(x[v])) / vs.len() as f64;
-        let mut out = Vector3::new(c.x - centre.x, c.y - centre.y, 0.0);
-        if out.norm() < 1e-9 {
-            out = Vector3::new(0.0, -1.0, 0.0);
+    let vs: Vec<usize> = (0..x.len()).filter(|&v| u.panel_of[v] == k).collect();
+    let c = vs.iter().fold(Vector3::zeros(), |a, &v| a + Vector3::from(x[v])) / vs.len() as f64;
+    let mut out = Vector3::new(c.x - centre.x, c.y - centre.y, 0.0);
+    if out.norm() < 1e-9 {
+        out = Vector3::new(0.0, -1.0, 0.0);
+    }
+    let out = out.normalize();
+    let mut shift = 0.0;
+    while !vs.iter().all(|&v| clear(&x[v])) {
+        if shift > 0.3 {
+            return Err(Defect {
+                key: format!("pattern.panels.{}", u.panel_names[k]),
+                message: "starts inside the body and is still inside it 30 cm further out: place it outside the body (translation)".into(),
+            });
         }
-        let out = out.normalize();
-        let mut shift = 0.0;
-        while !vs.iter().all(|&v| clear(&x[v])) {
-            if shift > 0.3 {
-                return Err(Defect {
-                    key: format!("pattern.panels.{name}"),
-                    message: "starts inside the body and is still inside it 30 cm further out: place it outside the body (translation)".into(),
-                });
-            }
-            shift += 0.01;
-            for &v in &vs {
-                x[v] = [x[v][0] + 0.01 * out.x, x[v][1] + 0.01 * out.y, x[v][2]];
-            }
-        }
-        if shift > 0.0 {
-            moved.push((name.clone(), shift));
+        shift += 0.01;
+        for &v in &vs {
+            x[v] = [x[v][0] + 0.01 * out.x, x[v][1] + 0.01 * out.y, x[v][2]];
         }
     }
-    Ok((x, moved))
+    Ok((shift > 0.0).then_some(shift))
 }
 
 /// The centre of the mesh bodies' bounding box, or the origin.
@@ -228,4 +276,17 @@ fn body_centre(obstacles: &[Obstacle]) -> Vector3<f64> {
     let lo = pts.iter().fold(Vector3::repeat(f64::INFINITY), |a, p| a.inf(p));
     let hi = pts.iter().fold(Vector3::repeat(f64::NEG_INFINITY), |a, p| a.sup(p));
     (lo + hi) / 2.0
+}
+
+/// Where the widest seam gap is: the panels of its two vertices and their positions.
+fn widest_seam(u: &Unsewn, x: &Vecs) -> String {
+    let Some(&[a, b]) = u
+        .seams
+        .iter()
+        .max_by(|p, q| (x[p[0]] - x[p[1]]).norm().total_cmp(&(x[q[0]] - x[q[1]]).norm()))
+    else {
+        return "no seams".into();
+    };
+    let at = |v: usize| format!("{} at [{:.3}, {:.3}, {:.3}] m", u.panel_names[u.panel_of[v]], x[v].x, x[v].y, x[v].z);
+    format!("between {} and {}", at(a), at(b))
 }
