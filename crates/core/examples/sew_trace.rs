@@ -36,7 +36,7 @@ fn main() {
         areal_density_kg_per_m2: 0.2,
         warp_angle_rad: std::f64::consts::FRAC_PI_2,
         obstacles: &[obstacle],
-        distance_m: 0.002,
+        distance_m: 0.005,
         thickness_m: 1e-3,
     };
     eprintln!("{} vertices, {} triangles, {} seam pairs", u.start_m.len(), u.triangles.len(), u.seams.len());
@@ -44,7 +44,32 @@ fn main() {
     let clock = std::time::Instant::now();
     let mut trace = Trace { clock, seams: u.seams.clone() };
     match sew(&u, &setup, &mut |l| eprintln!("{l}"), &mut trace) {
-        Ok((p, rep)) => eprintln!("welded: {} particles; {rep:?}", p.vertex_count()),
+        Ok((p, rep)) => {
+            eprintln!("welded: {} particles; {rep:?}", p.vertex_count());
+            let o = &setup.obstacles[0];
+            let x: Vec<nalgebra::Vector3<f64>> = p.start_m.iter().map(|q| (*q).into()).collect();
+            let mut n = 0;
+            for t in &p.triangles {
+                for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                    if a < b && o.segment_enters(&x[a], &x[b]) {
+                        n += 1;
+                        if n < 6 {
+                            eprintln!("edge {a}-{b}: {:?} {:?} distances {:.4} {:.4} length {:.4}", x[a].as_slice(), x[b].as_slice(), o.signed_distance(&x[a]).0, o.signed_distance(&x[b]).0, (x[a]-x[b]).norm());
+                        }
+                    }
+                }
+            }
+            eprintln!("{n} edges through the body");
+            for g in ["waist", "hem"] {
+                if let Some(vs) = p.groups.get(g) {
+                    let mut ring: Vec<nalgebra::Vector3<f64>> = vs.iter().map(|&v| x[v]).collect();
+                    let c = ring.iter().fold(nalgebra::Vector3::zeros(), |a, b| a + b) / ring.len() as f64;
+                    ring.sort_by(|a, b| (a.y - c.y).atan2(a.x - c.x).total_cmp(&(b.y - c.y).atan2(b.x - c.x)));
+                    let per: f64 = (0..ring.len()).map(|i| (ring[i] - ring[(i + 1) % ring.len()]).norm()).sum();
+                    eprintln!("{g}: {} vertices, perimeter {per:.3} m, centre {:?}", ring.len(), c.as_slice());
+                }
+            }
+        }
         Err(e) => eprintln!("failed: {} {}", e.key, e.message),
     }
 }

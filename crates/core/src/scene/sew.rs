@@ -69,7 +69,10 @@ pub(super) fn sew_pattern(scene: &mut Scene, scene_path: &Path) -> Result<(), In
         areal_density_kg_per_m2: scene.cloth.areal_density_kg_per_m2,
         warp_angle_rad: scene.cloth.warp_angle_deg.to_radians(),
         obstacles: &scene.obstacles,
-        distance_m: scene.contact.distance_m,
+        // Sewn a quarter of the spacing off the body at least: an edge between two vertices held
+        // off a curved body by the barrier dips towards it by L²/8R, and the welded start must not
+        // cut into it (the scene's check of the sheet's edges).
+        distance_m: scene.contact.distance_m.max(0.25 * r),
         thickness_m: thickness,
     };
     let key = blake3::hash(

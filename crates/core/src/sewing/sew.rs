@@ -12,7 +12,7 @@ use crate::material::Rigidities;
 use crate::obstacle::Obstacle;
 use crate::pattern::{Defect, Pattern};
 use crate::physics::{Model, PatternSheet, Seams, Vecs, pattern_builder};
-use crate::physics::Contacts;
+use crate::physics::{BodyEdgeBarrier, Contacts, EnergyTerm};
 use crate::solve::{Inertia, Observer, StaticOptions, solve_static};
 use nalgebra::Vector3;
 
@@ -59,12 +59,27 @@ pub struct SewReport {
 pub const GAP_TOLERANCE_M: f64 = 1e-3;
 /// The first stage's seam stiffness, N/m per pair; each stage ten times the one before.
 const FIRST_STIFFNESS_N_PER_M: f64 = 1.0;
+/// The most a seam pair pulls, N: beyond SEAM_FORCE_N / k the spring's pull stays at it.
+const SEAM_FORCE_N: f64 = 0.5;
 /// Stages of the continuation at most.
-const STAGES: usize = 5;
+const STAGES: usize = 9;
+/// The stiffest seams, N/m per pair: later stages repeat it (re-anchored) until the seams close.
+const LAST_STIFFNESS_N_PER_M: f64 = 1e4;
 /// Newton iterations per stage at most.
-const STAGE_ITERATIONS: usize = 400;
+const STAGE_ITERATIONS: usize = 200;
 /// The proximal term's time, s: its weight per particle is m/h² (a 60 µg particle: 6 mN/m).
 const PROXIMAL_H_S: f64 = 0.1;
+
+/// Whether the last two stages at the stiffest seams closed the widest gap by under 5 % each:
+/// something (the body, another panel) holds the seam open, and more stages will not shut it.
+fn stalled(stages: &[(f64, f64)]) -> bool {
+    let n = stages.len();
+    n >= 3
+        && stages[n - 2].0 == LAST_STIFFNESS_N_PER_M
+        && stages[n - 3..]
+            .windows(2)
+            .all(|w| w[1].1 > 0.95 * w[0].1)
+}
 
 /// The unsewn pieces as a pattern (no vertex shared; the caller's start positions `x`).
 pub fn unsewn_pattern(u: &Unsewn, x: &[[f64; 3]]) -> Pattern {
@@ -94,8 +109,13 @@ fn sewing_model(u: &Unsewn, s: &SewSetup<'_>, x: &Vecs, stiffness: f64) -> Resul
         key: "pattern".into(),
         message: format!("a panel's triangles cannot carry the membrane: {e:?}"),
     })?;
-    let g = crate::STANDARD_GRAVITY_M_PER_S2;
+    // The barriers as stiff as a hundred times a particle's weight in the band: they hold the
+    // seams' pull (up to SEAM_FORCE_N a pair) off the body.
+    let g = 100.0 * crate::STANDARD_GRAVITY_M_PER_S2;
     b.obstacles(s.obstacles.to_vec(), s.distance_m, g);
+    let all: Vec<[u32; 3]> = u.triangles.iter().map(|t| t.map(|v| v as u32)).collect();
+    let edges = BodyEdgeBarrier::new(s.obstacles, &all, &b.masses, &b.fixed, (s.distance_m, g));
+    b.terms.extend(edges.map(|t| Box::new(t) as Box<dyn EnergyTerm>));
     let mut on_seam = vec![false; x.len()];
     u.seams.iter().flatten().for_each(|&v| on_seam[v] = true);
     let away: Vec<[u32; 3]> = u
@@ -105,7 +125,7 @@ fn sewing_model(u: &Unsewn, s: &SewSetup<'_>, x: &Vecs, stiffness: f64) -> Resul
         .map(|t| t.map(|v| v as u32))
         .collect();
     b.self_contact(away, x, (s.thickness_m, s.thickness_m), g);
-    b.term(Box::new(Seams::new(&u.seams, stiffness, 0.05)));
+    b.term(Box::new(Seams::new(&u.seams, stiffness, SEAM_FORCE_N / stiffness)));
     Ok(b.build())
 }
 
@@ -160,10 +180,10 @@ pub fn sew(
             clock.elapsed().as_secs_f64(),
             r.message
         ));
-        if gap < GAP_TOLERANCE_M || r.divergence.is_some() {
+        if gap < GAP_TOLERANCE_M || r.divergence.is_some() || stalled(&report.stages) {
             break;
         }
-        k *= 10.0;
+        k = (k * 10.0).min(LAST_STIFFNESS_N_PER_M);
     }
     let xs = as_arrays(&x);
     report.gap_before_weld_m = super::weld::largest_gap_m(&u.seams, &xs);
@@ -173,10 +193,11 @@ pub fn sew(
         return Err(Defect {
             key: "pattern.stitches".into(),
             message: format!(
-                "the seams did not close: the largest gap is {:.1} mm after {} stages (stiffness up to {k:e} N/m); \
-                 the panels may be placed too far apart or a stitch joins edges that cannot meet",
+                "the seams did not close: the largest gap is {:.1} mm after {} stages (seam stiffness up to {LAST_STIFFNESS_N_PER_M:e} N/m); \
+                 something holds it open ({}): a body part between a seam's sides that the panels cannot slide round (a shoulder seam placed below the shoulder), or a stitch joining edges that cannot meet; place the panels so that each seam's sides meet round the body",
                 1e3 * report.gap_before_weld_m,
-                report.stages.len()
+                report.stages.len(),
+                widest_seam(u, &x)
             ),
         });
     }
@@ -209,7 +230,7 @@ pub fn arrange(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Vec<[f64; 3]>, Vec<(Stri
         let at = |v: usize| Vector3::new(x[v][0], x[v][1], x[v][2] + dz);
         u.seams
             .iter()
-            .filter(|&&[a, b]| s.obstacles.iter().any(|o| o.segment_enters(&at(a), &at(b))))
+            .filter(|&&[a, b]| pull_blocked(s.obstacles, &at(a), &at(b)))
             .count()
     };
     let lift = (0..=MAX_LIFT_CM)
@@ -223,6 +244,20 @@ pub fn arrange(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Vec<[f64; 3]>, Vec<(Stri
     }
     Ok((x, moved))
 }
+
+/// Whether the straight pull from `p` to `q` passes within [`PULL_CLEARANCE_M`] of a body (or
+/// through it), sampled every 5 mm.
+fn pull_blocked(obstacles: &[Obstacle], p: &Vector3<f64>, q: &Vector3<f64>) -> bool {
+    let n = ((q - p).norm() / 0.005).ceil().max(1.0) as usize;
+    obstacles.iter().any(|o| {
+        o.segment_enters(p, q)
+            || (0..=n).any(|i| o.signed_distance(&(p + (q - p) * (i as f64 / n as f64))).0 <= PULL_CLEARANCE_M)
+    })
+}
+
+/// How far a seam's straight pull must pass from the body at the start, m: its sides move towards
+/// each other along it and slide round what they meet.
+const PULL_CLEARANCE_M: f64 = 0.0;
 
 /// The highest the garment is raised to clear its seams' pulls, cm.
 const MAX_LIFT_CM: usize = 30;
