@@ -25,6 +25,7 @@ mod restart;
 mod runs;
 mod self_contact;
 mod sensitivity;
+mod sewing;
 mod slurm;
 mod stress;
 mod subpixel;

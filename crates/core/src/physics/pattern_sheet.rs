@@ -95,4 +95,3 @@ fn bending(sewn: &SewnSheet<'_>, sheet: &PatternSheet<'_>) -> Box<dyn EnergyTerm
         None => Box::new(sewn_hinge_bending(sewn, b, warp_angle_rad, kappa0)),
     }
 }
-

@@ -109,7 +109,11 @@ mod tests {
                 let mut xm = x;
                 xm[1][i] -= h;
                 let fd = (k.energy(0, &xp) - k.energy(0, &xm)) / (2.0 * h);
-                assert!((fd - g[1][i]).abs() < 1e-6, "d {d} component {i}: {fd} vs {}", g[1][i]);
+                assert!(
+                    (fd - g[1][i]).abs() < 1e-6,
+                    "d {d} component {i}: {fd} vs {}",
+                    g[1][i]
+                );
             }
         }
         // Far apart the pull is k c = 1 N whatever the distance.

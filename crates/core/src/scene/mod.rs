@@ -79,7 +79,10 @@ pub struct ClothSpec {
     pub sewing_pattern: Option<PathBuf>,
     /// A sewing pattern's mesh resolution, m: the length of its boundary segments and triangles'
     /// sides. Default 0.01 (1 cm); 0.02 for a quick look, finer for small folds.
-    #[serde(default = "default_resolution", skip_serializing_if = "is_default_resolution")]
+    #[serde(
+        default = "default_resolution",
+        skip_serializing_if = "is_default_resolution"
+    )]
     pub resolution_m: f64,
     /// How the sewing pattern was sewn (set when the scene is loaded).
     #[serde(skip)]

@@ -36,12 +36,18 @@ pub(super) fn sew_pattern(scene: &mut Scene, scene_path: &Path) -> Result<(), In
     };
     let at = |k: &str, m: String| InputError::new(scene_path, k, m);
     if scene.cloth.mesh.is_some() {
-        return Err(at("cloth.pattern", "and cloth.mesh are both given: a sheet is one or the other".into()));
+        return Err(at(
+            "cloth.pattern",
+            "and cloth.mesh are both given: a sheet is one or the other".into(),
+        ));
     }
     let (lo, hi) = RESOLUTION_M;
     let r = scene.cloth.resolution_m;
     if !(r.is_finite() && (lo..=hi).contains(&r)) {
-        return Err(at("cloth.resolution_m", format!("must be from {lo} to {hi} m, got {r}")));
+        return Err(at(
+            "cloth.resolution_m",
+            format!("must be from {lo} to {hi} m, got {r}"),
+        ));
     }
     let path = super::files::named_file(scene_path, &file, "cloth.pattern")?;
     let text = crate::textfile::read_text(&path, crate::textfile::NonUtf8::Refuse)
@@ -52,18 +58,7 @@ pub(super) fn sew_pattern(scene: &mut Scene, scene_path: &Path) -> Result<(), In
     if let Some(m) = crate::memory::too_large(unsewn.start_m.len() as f64) {
         return Err(at("cloth.resolution_m", m));
     }
-    let continuum = scene.material.continuum.as_ref().ok_or_else(|| {
-        at("material", "a sewn garment needs [material.continuum] (or a fabric file): its membrane holds the seams".into())
-    })?;
-    let rigidities = continuum
-        .rigidities()
-        .map_err(|e| at(&format!("material.continuum.{}", e.key), e.message))?;
-    let thickness = scene
-        .contact
-        .self_thickness_m
-        .or(continuum.thickness_m)
-        .unwrap_or(1e-3)
-        .min(0.1 * r);
+    let (rigidities, thickness) = fabric_of(scene, scene_path, r)?;
     let setup = SewSetup {
         rigidities: &rigidities,
         areal_density_kg_per_m2: scene.cloth.areal_density_kg_per_m2,
@@ -76,15 +71,27 @@ pub(super) fn sew_pattern(scene: &mut Scene, scene_path: &Path) -> Result<(), In
         thickness_m: thickness,
     };
     let key = blake3::hash(
-        format!("{text}\n{r}\n{rigidities:?}\n{:?}\n{}\n{}\n{thickness}\n{}",
-            scene.obstacles, setup.areal_density_kg_per_m2, setup.warp_angle_rad, setup.distance_m)
+        format!(
+            "{text}\n{r}\n{rigidities:?}\n{:?}\n{}\n{}\n{thickness}\n{}",
+            scene.obstacles, setup.areal_density_kg_per_m2, setup.warp_angle_rad, setup.distance_m
+        )
         .as_bytes(),
     );
-    let cached = sewn_before().lock().map(|c| c.get(&key).cloned()).ok().flatten();
+    let cached = sewn_before()
+        .lock()
+        .map(|c| c.get(&key).cloned())
+        .ok()
+        .flatten();
     let (pattern, report) = match cached {
         Some(s) => s,
         None => {
-            let (p, rep) = sew(&unsewn, &setup, &mut |line| eprintln!("{line}"), &mut crate::solve::NoObserver).map_err(bad)?;
+            let (p, rep) = sew(
+                &unsewn,
+                &setup,
+                &mut |line| eprintln!("{line}"),
+                &mut crate::solve::NoObserver,
+            )
+            .map_err(bad)?;
             let s = (Arc::new(p), Arc::new(rep));
             if let Ok(mut c) = sewn_before().lock() {
                 c.insert(key, s.clone());
@@ -95,4 +102,30 @@ pub(super) fn sew_pattern(scene: &mut Scene, scene_path: &Path) -> Result<(), In
     scene.cloth.pattern = Some(pattern);
     scene.cloth.sewing = Some(report);
     Ok(())
+}
+
+/// The fabric's rigidities and the sewing's self-contact thickness (the scene's, or the fabric's,
+/// at most a tenth of the resolution `r`).
+fn fabric_of(
+    scene: &Scene,
+    scene_path: &Path,
+    r: f64,
+) -> Result<(crate::material::Rigidities, f64), InputError> {
+    let at = |k: &str, m: String| InputError::new(scene_path, k, m);
+    let continuum = scene.material.continuum.as_ref().ok_or_else(|| {
+        at(
+            "material",
+            "a sewn garment needs [material.continuum] (or a fabric file): its membrane holds the seams".into(),
+        )
+    })?;
+    let rigidities = continuum
+        .rigidities()
+        .map_err(|e| at(&format!("material.continuum.{}", e.key), e.message))?;
+    let thickness = scene
+        .contact
+        .self_thickness_m
+        .or(continuum.thickness_m)
+        .unwrap_or(1e-3)
+        .min(0.1 * r);
+    Ok((rigidities, thickness))
 }

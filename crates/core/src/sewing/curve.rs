@@ -241,6 +241,9 @@ mod tests {
     #[test]
     fn relative_control_points_follow_the_edge_frame() {
         // Half-way along (0,0)→(2,0) and a quarter of its length to the left: (1, 0.5).
-        assert_eq!(relative_point([0.0, 0.0], [2.0, 0.0], [0.5, 0.25]), [1.0, 0.5]);
+        assert_eq!(
+            relative_point([0.0, 0.0], [2.0, 0.0], [0.5, 0.25]),
+            [1.0, 0.5]
+        );
     }
 }

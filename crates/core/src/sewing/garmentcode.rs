@@ -114,15 +114,27 @@ fn unit(root: &Value) -> Result<f64, Defect> {
 }
 
 /// `n` finite numbers at `key`.
-fn numbers<const N: usize>(v: Option<&Value>, key: &str, default: Option<[f64; N]>) -> Result<[f64; N], Defect> {
+fn numbers<const N: usize>(
+    v: Option<&Value>,
+    key: &str,
+    default: Option<[f64; N]>,
+) -> Result<[f64; N], Defect> {
     let Some(v) = v else {
         return default.ok_or_else(|| defect(key, format!("missing: needs {N} numbers")));
     };
     let a = v.as_array().filter(|a| a.len() == N);
-    let c: Option<Vec<f64>> = a.map(|a| a.iter().filter_map(Value::as_f64).filter(|x| x.is_finite() && x.abs() < 1e6).collect());
+    let c: Option<Vec<f64>> = a.map(|a| {
+        a.iter()
+            .filter_map(Value::as_f64)
+            .filter(|x| x.is_finite() && x.abs() < 1e6)
+            .collect()
+    });
     match c {
         Some(c) if c.len() == N => Ok(std::array::from_fn(|i| c[i])),
-        _ => Err(defect(key, format!("must be {N} finite numbers (under 1e6 in size), got {v}"))),
+        _ => Err(defect(
+            key,
+            format!("must be {N} finite numbers (under 1e6 in size), got {v}"),
+        )),
     }
 }
 
@@ -150,21 +162,34 @@ fn panel(name: &str, p: &Value, absolute: bool) -> Result<Panel, Defect> {
         let (a, b) = endpoints(e, verts.len(), &key)?;
         ends.push((a, b));
         let curve = curve(e.get("curvature"), verts[a], verts[b], absolute, &key)?;
-        let label = e.get("label").and_then(Value::as_str).unwrap_or("").to_string();
+        let label = e
+            .get("label")
+            .and_then(Value::as_str)
+            .unwrap_or("")
+            .to_string();
         edges.push(Edge { curve, label });
     }
     closed_loop(&ends, &at)?;
     Ok(Panel {
         name: name.to_string(),
         edges,
-        translation: numbers(p.get("translation"), &format!("{at}.translation"), Some([0.0; 3]))?,
+        translation: numbers(
+            p.get("translation"),
+            &format!("{at}.translation"),
+            Some([0.0; 3]),
+        )?,
         rotation_deg: numbers(p.get("rotation"), &format!("{at}.rotation"), Some([0.0; 3]))?,
     })
 }
 
 fn endpoints(e: &Value, n: usize, key: &str) -> Result<(usize, usize), Defect> {
     let ep = e.get("endpoints").and_then(Value::as_array);
-    let idx: Option<Vec<usize>> = ep.map(|a| a.iter().filter_map(Value::as_u64).map(|i| i as usize).collect());
+    let idx: Option<Vec<usize>> = ep.map(|a| {
+        a.iter()
+            .filter_map(Value::as_u64)
+            .map(|i| i as usize)
+            .collect()
+    });
     match idx.as_deref() {
         Some(&[a, b]) if a < n && b < n && a != b => Ok((a, b)),
         _ => Err(defect(
@@ -209,7 +234,12 @@ fn curve(c: Option<&Value>, a: P2, b: P2, absolute: bool, key: &str) -> Result<C
     let pk = |i: usize| format!("{key}.params.{i}");
     match kind {
         "quadratic" => Ok(Curve::Bezier(vec![a, control(p(0), &pk(0))?, b])),
-        "cubic" => Ok(Curve::Bezier(vec![a, control(p(0), &pk(0))?, control(p(1), &pk(1))?, b])),
+        "cubic" => Ok(Curve::Bezier(vec![
+            a,
+            control(p(0), &pk(0))?,
+            control(p(1), &pk(1))?,
+            b,
+        ])),
         "circle" => {
             let r = p(0).as_f64().filter(|r| r.is_finite() && *r > 0.0);
             let flag = |v: &Value| v.as_bool().or(v.as_i64().map(|i| i != 0));
@@ -265,11 +295,17 @@ fn stitches(v: Option<&Value>, panels: &[Panel]) -> Result<Vec<Stitch>, Defect> 
 fn side(v: &Value, panels: &[Panel], key: &str) -> Result<Side, Defect> {
     let name = v.get("panel").and_then(Value::as_str).unwrap_or("");
     let panel = panels.iter().position(|p| p.name == name).ok_or_else(|| {
-        defect(format!("{key}.panel"), format!("`{name}` is no panel of the pattern"))
+        defect(
+            format!("{key}.panel"),
+            format!("`{name}` is no panel of the pattern"),
+        )
     })?;
     let n = panels[panel].edges.len();
     match v.get("edge").and_then(Value::as_u64) {
-        Some(e) if (e as usize) < n => Ok(Side { panel, edge: e as usize }),
+        Some(e) if (e as usize) < n => Ok(Side {
+            panel,
+            edge: e as usize,
+        }),
         _ => Err(defect(
             format!("{key}.edge"),
             format!("must be an edge index of panel {name} (it has {n} edges)"),
@@ -307,12 +343,21 @@ mod tests {
         assert_eq!(p.panels.len(), 2);
         assert_eq!(p.unit_m, 0.01);
         let back = p.panels.iter().position(|pn| pn.name == "back").unwrap();
-        assert_eq!(p.stitches[0].sides[1], Side { panel: back, edge: 3 });
+        assert_eq!(
+            p.stitches[0].sides[1],
+            Side {
+                panel: back,
+                edge: 3
+            }
+        );
         assert!(p.stitches[0].reversed);
         // The curved edge bulges by 0.2 × 10 / 2 = 1 at its middle (a quadratic's midpoint is half
         // way to its control point's offset).
         let mid = p.panels[0].edges[2].curve.point(0.5);
-        assert!((mid[0] - 5.0).abs() < 1e-12 && (mid[1] - 9.0).abs() < 1e-12, "{mid:?}");
+        assert!(
+            (mid[0] - 5.0).abs() < 1e-12 && (mid[1] - 9.0).abs() < 1e-12,
+            "{mid:?}"
+        );
     }
 
     #[test]

@@ -38,10 +38,14 @@ mod tests {
             let w = weld::weld(&u, &u.start_m).unwrap_or_else(|d| panic!("{name}: {d:?}"));
             assert!(w.vertex_count() < u.start_m.len(), "{name}");
             // The rest shape is the panels' own area.
-            let flat: f64 = u.triangles.iter().map(|t| {
-                let [a, b, c] = t.map(|v| u.rest_m[v]);
-                0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
-            }).sum();
+            let flat: f64 = u
+                .triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| u.rest_m[v]);
+                    0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
+                })
+                .sum();
             assert!((w.rest_area_m2() - flat).abs() < 1e-9, "{name}");
         }
     }
@@ -81,7 +85,11 @@ mod tests {
     }
 
     fn rod(radius_m: f64) -> Obstacle {
-        Obstacle::Cylinder { point_m: [0.0; 3], axis: [0.0, 0.0, 1.0], radius_m }
+        Obstacle::Cylinder {
+            point_m: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+            radius_m,
+        }
     }
 
     #[test]
@@ -98,11 +106,15 @@ mod tests {
             thickness_m: 1e-3,
         };
         let (w, report) = sew(&u, &setup, &mut |_| {}, &mut crate::solve::NoObserver).unwrap();
-        assert!(report.gap_before_weld_m < sew::GAP_TOLERANCE_M, "{report:?}");
+        assert!(
+            report.gap_before_weld_m < sew::GAP_TOLERANCE_M,
+            "{report:?}"
+        );
         assert_eq!(report.crossing_edges, 0);
         assert_eq!(report.penetration_m, 0.0);
         // Both side seams' vertices became one particle each.
-        let seam_vertices: std::collections::BTreeSet<usize> = u.seams.iter().map(|s| s[0]).collect();
+        let seam_vertices: std::collections::BTreeSet<usize> =
+            u.seams.iter().map(|s| s[0]).collect();
         assert_eq!(w.vertex_count(), u.start_m.len() - seam_vertices.len());
         // The hem is one closed loop round the rod, as long as the two panels are wide.
         let hem = &w.groups["hem"];
@@ -114,7 +126,10 @@ mod tests {
                 ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
             })
             .sum();
-        assert!((perimeter - 0.60).abs() < 0.02 * 0.60, "hem {perimeter} m round, panels 0.60 m wide");
+        assert!(
+            (perimeter - 0.60).abs() < 0.02 * 0.60,
+            "hem {perimeter} m round, panels 0.60 m wide"
+        );
         assert!(ring.iter().all(|p| p[0].hypot(p[1]) > 0.06));
     }
 
@@ -154,11 +169,25 @@ mod tests {
             thickness_m: 1e-3,
         };
         let (x, moved) = arrange(&u, &setup).unwrap();
-        assert_eq!(moved.iter().filter(|m| m.0 != "lift").count(), 2, "{moved:?}");
-        assert!(x.iter().all(|p| p[0].hypot(p[1]) > 0.06 + 2.0 * setup.distance_m));
+        assert_eq!(
+            moved.iter().filter(|m| m.0 != "lift").count(),
+            2,
+            "{moved:?}"
+        );
+        assert!(
+            x.iter()
+                .all(|p| p[0].hypot(p[1]) > 0.06 + 2.0 * setup.distance_m)
+        );
         // A rod wider than 30 cm of moves can clear is refused, naming the panel.
         let wide = [rod(0.5)];
-        let e = arrange(&u, &SewSetup { obstacles: &wide, ..setup }).unwrap_err();
+        let e = arrange(
+            &u,
+            &SewSetup {
+                obstacles: &wide,
+                ..setup
+            },
+        )
+        .unwrap_err();
         assert!(e.key.starts_with("pattern.panels."), "{e:?}");
     }
 }

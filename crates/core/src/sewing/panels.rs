@@ -83,15 +83,27 @@ fn mesh_panel(panel: &Panel, counts: &[usize], resolution: f64) -> Result<PanelM
         .map(|i| (0..counts[i]).map(|k| (starts[i] + k) % nb).collect())
         .collect();
     // Counter-clockwise in the plane the triangulation sees; a clockwise panel mirrored there.
-    let flip = if signed_area(&boundary) < 0.0 { -1.0 } else { 1.0 };
-    let pts: Vec<Point2<f64>> = boundary.iter().map(|p| Point2::new(flip * p[0], p[1])).collect();
+    let flip = if signed_area(&boundary) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let pts: Vec<Point2<f64>> = boundary
+        .iter()
+        .map(|p| Point2::new(flip * p[0], p[1]))
+        .collect();
     let segments: Vec<[usize; 2]> = (0..nb).map(|i| [i, (i + 1) % nb]).collect();
     let bad = |m: String| Defect {
         key: format!("pattern.panels.{}", panel.name),
         message: m,
     };
-    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(pts.clone(), segments)
-        .map_err(|e| bad(format!("cannot be triangulated ({e:?}): its outline crosses itself or repeats a point")))?;
+    let mut cdt =
+        ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(pts.clone(), segments)
+            .map_err(|e| {
+                bad(format!(
+                    "cannot be triangulated ({e:?}): its outline crosses itself or repeats a point"
+                ))
+            })?;
     let area = 3f64.sqrt() / 4.0 * resolution * resolution;
     let params = RefinementParameters::<f64>::new()
         .exclude_outer_faces(true)
@@ -102,25 +114,31 @@ fn mesh_panel(panel: &Panel, counts: &[usize], resolution: f64) -> Result<PanelM
     let result = cdt.refine(params);
     let excluded: std::collections::HashSet<_> = result.excluded_faces.into_iter().collect();
     let key = |p: Point2<f64>| (p.x.to_bits(), p.y.to_bits());
-    let by_position: HashMap<_, usize> = pts.iter().enumerate().map(|(i, &p)| (key(p), i)).collect();
+    let by_position: HashMap<_, usize> =
+        pts.iter().enumerate().map(|(i, &p)| (key(p), i)).collect();
     let mut index: HashMap<usize, usize> = HashMap::new();
     let mut points = boundary.clone();
     let mut triangles = Vec::new();
     for f in cdt.inner_faces().filter(|f| !excluded.contains(&f.fix())) {
         let t = f.vertices().map(|v| {
             let p = v.position();
-            *index.entry(v.fix().index()).or_insert_with(|| match by_position.get(&key(p)) {
-                Some(&i) => i,
-                None => {
-                    points.push([flip * p.x, p.y]);
-                    points.len() - 1
-                }
-            })
+            *index
+                .entry(v.fix().index())
+                .or_insert_with(|| match by_position.get(&key(p)) {
+                    Some(&i) => i,
+                    None => {
+                        points.push([flip * p.x, p.y]);
+                        points.len() - 1
+                    }
+                })
         });
         triangles.push(t);
     }
     if index.len() < nb || triangles.is_empty() {
-        return Err(bad("triangulates to nothing inside its outline: check that its edges form one simple loop".into()));
+        return Err(bad(
+            "triangulates to nothing inside its outline: check that its edges form one simple loop"
+                .into(),
+        ));
     }
     if flip < 0.0 {
         triangles.iter_mut().for_each(|t| t.swap(1, 2));
@@ -160,22 +178,37 @@ pub fn unsewn(p: &SewingPattern, resolution_m: f64) -> Result<Unsewn, Defect> {
         let r = rotation(panel.rotation_deg);
         let t = Vector3::from(panel.translation);
         let lo = m.points.iter().map(|q| q[0]).fold(f64::INFINITY, f64::min);
-        let hi = m.points.iter().map(|q| q[0]).fold(f64::NEG_INFINITY, f64::max);
+        let hi = m
+            .points
+            .iter()
+            .map(|q| q[0])
+            .fold(f64::NEG_INFINITY, f64::max);
         for q in &m.points {
             let w = (r * Vector3::new(q[0], q[1], 0.0) + t) * p.unit_m;
             u.start_m.push([w.x, -w.z, w.y]);
-            u.rest_m.push([x_offset + (q[0] - lo) * p.unit_m, q[1] * p.unit_m]);
+            u.rest_m
+                .push([x_offset + (q[0] - lo) * p.unit_m, q[1] * p.unit_m]);
             u.panel_of.push(k);
         }
         x_offset += (hi - lo) * p.unit_m + 0.05;
-        u.triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
-        u.groups.insert(panel.name.clone(), (base..u.start_m.len()).collect());
+        u.triangles
+            .extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
+        u.groups
+            .insert(panel.name.clone(), (base..u.start_m.len()).collect());
         for (e, ev) in panel.edges.iter().zip(&m.edge_vertices) {
             if !e.label.is_empty() {
-                u.groups.entry(e.label.clone()).or_default().extend(ev.iter().map(|v| v + base));
+                u.groups
+                    .entry(e.label.clone())
+                    .or_default()
+                    .extend(ev.iter().map(|v| v + base));
             }
         }
-        edge_vertices.push(m.edge_vertices.iter().map(|ev| ev.iter().map(|v| v + base).collect::<Vec<_>>()).collect::<Vec<_>>());
+        edge_vertices.push(
+            m.edge_vertices
+                .iter()
+                .map(|ev| ev.iter().map(|v| v + base).collect::<Vec<_>>())
+                .collect::<Vec<_>>(),
+        );
     }
     for s in &p.stitches {
         let [a, b] = s.sides;

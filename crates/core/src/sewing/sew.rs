@@ -11,8 +11,8 @@ use super::panels::Unsewn;
 use crate::material::Rigidities;
 use crate::obstacle::Obstacle;
 use crate::pattern::{Defect, Pattern};
-use crate::physics::{Model, PatternSheet, Seams, Vecs, pattern_builder};
 use crate::physics::{BodyEdgeBarrier, Contacts, EnergyTerm};
+use crate::physics::{Model, PatternSheet, Seams, Vecs, pattern_builder};
 use crate::solve::{Inertia, Observer, StaticOptions, solve_static};
 use nalgebra::Vector3;
 
@@ -76,9 +76,7 @@ fn stalled(stages: &[(f64, f64)]) -> bool {
     let n = stages.len();
     n >= 3
         && stages[n - 2].0 == LAST_STIFFNESS_N_PER_M
-        && stages[n - 3..]
-            .windows(2)
-            .all(|w| w[1].1 > 0.95 * w[0].1)
+        && stages[n - 3..].windows(2).all(|w| w[1].1 > 0.95 * w[0].1)
 }
 
 /// The unsewn pieces as a pattern (no vertex shared; the caller's start positions `x`).
@@ -115,7 +113,8 @@ fn sewing_model(u: &Unsewn, s: &SewSetup<'_>, x: &Vecs, stiffness: f64) -> Resul
     b.obstacles(s.obstacles.to_vec(), s.distance_m, g);
     let all: Vec<[u32; 3]> = u.triangles.iter().map(|t| t.map(|v| v as u32)).collect();
     let edges = BodyEdgeBarrier::new(s.obstacles, &all, &b.masses, &b.fixed, (s.distance_m, g));
-    b.terms.extend(edges.map(|t| Box::new(t) as Box<dyn EnergyTerm>));
+    b.terms
+        .extend(edges.map(|t| Box::new(t) as Box<dyn EnergyTerm>));
     let mut on_seam = vec![false; x.len()];
     u.seams.iter().flatten().for_each(|&v| on_seam[v] = true);
     let away: Vec<[u32; 3]> = u
@@ -125,7 +124,11 @@ fn sewing_model(u: &Unsewn, s: &SewSetup<'_>, x: &Vecs, stiffness: f64) -> Resul
         .map(|t| t.map(|v| v as u32))
         .collect();
     b.self_contact(away, x, (s.thickness_m, s.thickness_m), g);
-    b.term(Box::new(Seams::new(&u.seams, stiffness, SEAM_FORCE_N / stiffness)));
+    b.term(Box::new(Seams::new(
+        &u.seams,
+        stiffness,
+        SEAM_FORCE_N / stiffness,
+    )));
     Ok(b.build())
 }
 
@@ -162,13 +165,7 @@ pub fn sew(
     };
     let mut k = FIRST_STIFFNESS_N_PER_M;
     for _ in 0..STAGES {
-        let mut model = sewing_model(u, s, &x, k)?;
-        // A weak tether to the stage's start (a proximal term m/(2h²)|x − x_k|²) holds the
-        // garment's free rigid motions; re-anchored every stage, it leaves no bias behind.
-        let zeros = vec![Vector3::zeros(); x.len()];
-        let tether = Inertia::new(&model, (&x, &Contacts::default()), &zeros, PROXIMAL_H_S, (0.0, 0.0, 0.0));
-        model.terms.push(Box::new(tether));
-        let r = solve_static(&mut model, &mut x, &opts, observer);
+        let r = stage(u, s, (&mut x, k), &opts, observer)?;
         report.iterations += r.iterations;
         let gap = super::weld::largest_gap_m(&u.seams, &as_arrays(&x));
         report.stages.push((k, gap));
@@ -190,25 +187,65 @@ pub fn sew(
     report.penetration_m = crate::physics::max_penetration_m(s.obstacles, &x);
     report.time_s = clock.elapsed().as_secs_f64();
     if report.gap_before_weld_m >= GAP_TOLERANCE_M {
-        return Err(Defect {
-            key: "pattern.stitches".into(),
-            message: format!(
-                "the seams did not close: the largest gap is {:.1} mm after {} stages (seam stiffness up to {LAST_STIFFNESS_N_PER_M:e} N/m); \
-                 something holds it open ({}): a body part between a seam's sides that the panels cannot slide round (a shoulder seam placed below the shoulder), or a stitch joining edges that cannot meet; place the panels so that each seam's sides meet round the body",
-                1e3 * report.gap_before_weld_m,
-                report.stages.len(),
-                widest_seam(u, &x)
-            ),
-        });
+        return Err(not_closed(u, &x, &report));
     }
     let welded = super::weld::weld(u, &xs)?;
-    let topo = crate::proximity::MeshTopology::from_triangles(
-        welded.triangles.iter().map(|t| t.map(|v| v as u32)).collect(),
+    report.crossing_edges = crossing_edges(&welded);
+    Ok((welded, report))
+}
+
+/// One stage: the model at seam stiffness `k` with a weak tether to the stage's start (a proximal
+/// term m/(2h²)|x − x_k|², which holds the garment's free rigid motions and, re-anchored every
+/// stage, leaves no bias behind), solved from `x`.
+fn stage(
+    u: &Unsewn,
+    s: &SewSetup<'_>,
+    (x, k): (&mut Vec<Vector3<f64>>, f64),
+    opts: &StaticOptions,
+    observer: &mut dyn Observer,
+) -> Result<crate::solve::SolveReport, Defect> {
+    let mut model = sewing_model(u, s, x, k)?;
+    let zeros = vec![Vector3::zeros(); x.len()];
+    let tether = Inertia::new(
+        &model,
+        (x, &Contacts::default()),
+        &zeros,
+        PROXIMAL_H_S,
+        (0.0, 0.0, 0.0),
     );
+    model.terms.push(Box::new(tether));
+    Ok(solve_static(&mut model, x, opts, observer))
+}
+
+/// Why the seams did not close, naming the widest.
+fn not_closed(u: &Unsewn, x: &Vecs, report: &SewReport) -> Defect {
+    Defect {
+        key: "pattern.stitches".into(),
+        message: format!(
+            "the seams did not close: the largest gap is {:.1} mm after {} stages (seam stiffness up to {LAST_STIFFNESS_N_PER_M:e} N/m); \
+             something holds it open ({}): a body part between a seam's sides that the panels cannot slide round (a shoulder seam placed below the shoulder), or a stitch joining edges that cannot meet; place the panels so that each seam's sides meet round the body",
+            1e3 * report.gap_before_weld_m,
+            report.stages.len(),
+            widest_seam(u, x)
+        ),
+    }
+}
+
+/// Edges of a welded garment at its start that cross one of its triangles.
+fn crossing_edges(welded: &Pattern) -> usize {
+    let tris = welded
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| v as u32))
+        .collect();
+    let topo = crate::proximity::MeshTopology::from_triangles(tris);
     let xw: Vec<Vector3<f64>> = welded.start_m.iter().map(|p| Vector3::from(*p)).collect();
     let crossings = crate::proximity::edge_triangle_crossings(&topo, &xw);
-    report.crossing_edges = crossings.iter().map(|c| c.0).collect::<std::collections::BTreeSet<_>>().len();
-    Ok((welded, report))
+    crossings
+        .iter()
+        .map(|c| c.0)
+        .collect::<std::collections::BTreeSet<_>>()
+        .len()
 }
 
 /// The pieces' start: each panel moved out from the body (horizontally, away from the vertical
@@ -218,7 +255,10 @@ pub fn sew(
 /// placed below the shoulder would pull its sides into it; GarmentCode merges such seams at once
 /// and repairs what crosses). The start, and the moves made (by panel name, `lift` for the
 /// garment). A panel still inside a body 30 cm out is refused, naming it.
-pub fn arrange(u: &Unsewn, s: &SewSetup<'_>) -> Result<(Vec<[f64; 3]>, Vec<(String, f64)>), Defect> {
+pub fn arrange(
+    u: &Unsewn,
+    s: &SewSetup<'_>,
+) -> Result<(Vec<[f64; 3]>, Vec<(String, f64)>), Defect> {
     let mut x = u.start_m.clone();
     let mut moved = Vec::new();
     for k in 0..u.panel_names.len() {
@@ -251,7 +291,9 @@ fn pull_blocked(obstacles: &[Obstacle], p: &Vector3<f64>, q: &Vector3<f64>) -> b
     let n = ((q - p).norm() / 0.005).ceil().max(1.0) as usize;
     obstacles.iter().any(|o| {
         o.segment_enters(p, q)
-            || (0..=n).any(|i| o.signed_distance(&(p + (q - p) * (i as f64 / n as f64))).0 <= PULL_CLEARANCE_M)
+            || (0..=n).any(|i| {
+                o.signed_distance(&(p + (q - p) * (i as f64 / n as f64))).0 <= PULL_CLEARANCE_M
+            })
     })
 }
 
@@ -263,14 +305,24 @@ const PULL_CLEARANCE_M: f64 = 0.0;
 const MAX_LIFT_CM: usize = 30;
 
 /// Moves panel `k` out until clear of the bodies; how far, where it moved.
-fn move_out(u: &Unsewn, s: &SewSetup<'_>, k: usize, x: &mut [[f64; 3]]) -> Result<Option<f64>, Defect> {
+fn move_out(
+    u: &Unsewn,
+    s: &SewSetup<'_>,
+    k: usize,
+    x: &mut [[f64; 3]],
+) -> Result<Option<f64>, Defect> {
     let centre = body_centre(s.obstacles);
     let clear = |p: &[f64; 3]| {
         let q = Vector3::from(*p);
-        s.obstacles.iter().all(|o| o.signed_distance(&q).0 > 2.0 * s.distance_m)
+        s.obstacles
+            .iter()
+            .all(|o| o.signed_distance(&q).0 > 2.0 * s.distance_m)
     };
     let vs: Vec<usize> = (0..x.len()).filter(|&v| u.panel_of[v] == k).collect();
-    let c = vs.iter().fold(Vector3::zeros(), |a, &v| a + Vector3::from(x[v])) / vs.len() as f64;
+    let c = vs
+        .iter()
+        .fold(Vector3::zeros(), |a, &v| a + Vector3::from(x[v]))
+        / vs.len() as f64;
     let mut out = Vector3::new(c.x - centre.x, c.y - centre.y, 0.0);
     if out.norm() < 1e-9 {
         out = Vector3::new(0.0, -1.0, 0.0);
@@ -308,20 +360,29 @@ fn body_centre(obstacles: &[Obstacle]) -> Vector3<f64> {
     if pts.is_empty() {
         return Vector3::zeros();
     }
-    let lo = pts.iter().fold(Vector3::repeat(f64::INFINITY), |a, p| a.inf(p));
-    let hi = pts.iter().fold(Vector3::repeat(f64::NEG_INFINITY), |a, p| a.sup(p));
+    let lo = pts
+        .iter()
+        .fold(Vector3::repeat(f64::INFINITY), |a, p| a.inf(p));
+    let hi = pts
+        .iter()
+        .fold(Vector3::repeat(f64::NEG_INFINITY), |a, p| a.sup(p));
     (lo + hi) / 2.0
 }
 
 /// Where the widest seam gap is: the panels of its two vertices and their positions.
 fn widest_seam(u: &Unsewn, x: &Vecs) -> String {
-    let Some(&[a, b]) = u
-        .seams
-        .iter()
-        .max_by(|p, q| (x[p[0]] - x[p[1]]).norm().total_cmp(&(x[q[0]] - x[q[1]]).norm()))
-    else {
+    let Some(&[a, b]) = u.seams.iter().max_by(|p, q| {
+        (x[p[0]] - x[p[1]])
+            .norm()
+            .total_cmp(&(x[q[0]] - x[q[1]]).norm())
+    }) else {
         return "no seams".into();
     };
-    let at = |v: usize| format!("{} at [{:.3}, {:.3}, {:.3}] m", u.panel_names[u.panel_of[v]], x[v].x, x[v].y, x[v].z);
+    let at = |v: usize| {
+        format!(
+            "{} at [{:.3}, {:.3}, {:.3}] m",
+            u.panel_names[u.panel_of[v]], x[v].x, x[v].y, x[v].z
+        )
+    };
     format!("between {} and {}", at(a), at(b))
 }

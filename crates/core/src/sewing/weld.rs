@@ -61,7 +61,16 @@ pub fn welded_obj(u: &Unsewn, x: &[[f64; 3]]) -> String {
     for (k, name) in u.panel_names.iter().enumerate() {
         let _ = writeln!(s, "o {name}");
         for t in u.triangles.iter().filter(|t| u.panel_of[t[0]] == k) {
-            let _ = writeln!(s, "f {}/{} {}/{} {}/{}", p(t[0]), t[0] + 1, p(t[1]), t[1] + 1, p(t[2]), t[2] + 1);
+            let _ = writeln!(
+                s,
+                "f {}/{} {}/{} {}/{}",
+                p(t[0]),
+                t[0] + 1,
+                p(t[1]),
+                t[1] + 1,
+                p(t[2]),
+                t[2] + 1
+            );
         }
     }
     for (g, vs) in u.groups.iter().filter(|(g, _)| !u.panel_names.contains(g)) {
@@ -69,7 +78,14 @@ pub fn welded_obj(u: &Unsewn, x: &[[f64; 3]]) -> String {
         let mut ids: Vec<usize> = vs.iter().map(|&v| p(v)).collect();
         ids.sort_unstable();
         ids.dedup();
-        let _ = writeln!(s, "l {}", ids.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" "));
+        let _ = writeln!(
+            s,
+            "l {}",
+            ids.iter()
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
     }
     s
 }
