@@ -142,6 +142,16 @@ impl TriangleBody {
         })
     }
 
+    /// The vertices, m (the file's frame, before a scene's offset).
+    pub fn vertices(&self) -> &[V3] {
+        &self.vertices
+    }
+
+    /// The triangles, vertex indices, facing outward.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
     /// The number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()

@@ -183,7 +183,7 @@ impl Scene {
             && self.boundary.pin_groups.is_empty()
             && (!self.contact.fix_supported || self.obstacles.is_empty())
             // A sewn garment closes round its body: the body alone holds it.
-            && !(c.is_sewn() && !self.obstacles.is_empty())
+            && (!c.is_sewn() || self.obstacles.is_empty())
         {
             return ck.err(
                 "boundary",

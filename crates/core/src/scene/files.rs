@@ -43,7 +43,11 @@ pub fn absolute_file_keys(table: &mut toml::Table, scene_path: &Path) {
             *v = toml::Value::String(dir.join(s).display().to_string());
         }
     };
-    for (section, key) in [("cloth", "mesh"), ("material", "fabric")] {
+    for (section, key) in [
+        ("cloth", "mesh"),
+        ("cloth", "pattern"),
+        ("material", "fabric"),
+    ] {
         if let Some(v) = table
             .get_mut(section)
             .and_then(|t| t.as_table_mut())

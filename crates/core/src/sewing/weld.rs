@@ -40,8 +40,7 @@ pub fn welded_obj(u: &Unsewn, x: &[[f64; 3]]) -> String {
     let class = classes(x.len(), &u.seams);
     let mut particle = vec![usize::MAX; x.len()];
     let mut members: Vec<Vec<usize>> = Vec::new();
-    for v in 0..x.len() {
-        let c = class[v];
+    for (v, &c) in class.iter().enumerate() {
         if particle[c] == usize::MAX {
             particle[c] = members.len();
             members.push(Vec::new());
