@@ -446,31 +446,9 @@ fn state_files(
         outputs.push("drape.obj");
     }
     if scene.cloth.is_sewn() {
-        body_obj(scene, &out.join("body.obj"))?;
+        crate::mesh_out::write_body_obj(scene, &out.join("body.obj"))?;
         outputs.push("body.obj");
     }
-    Ok(())
-}
-
-/// A sewn garment's bodies as one OBJ in the particles' frame (each mesh body moved by its
-/// offset), to show the garment on what holds it.
-fn body_obj(scene: &Scene, path: &Path) -> Result<()> {
-    let (mut x, mut tris) = (Vec::new(), Vec::new());
-    for o in &scene.obstacles {
-        if let drapelab_core::obstacle::Obstacle::Mesh {
-            offset_m,
-            body: Some(b),
-            ..
-        } = o
-        {
-            let base = x.len() as u32;
-            let off = nalgebra::Vector3::from(*offset_m);
-            x.extend(b.vertices().iter().map(|v| v + off));
-            tris.extend(b.triangles().iter().map(|t| t.map(|k| k + base)));
-        }
-    }
-    let text = crate::obj_text("body", &x, &tris);
-    drapelab_core::atomic::write_text(path, &text)?;
     Ok(())
 }
 

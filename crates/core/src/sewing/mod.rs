@@ -92,19 +92,24 @@ mod tests {
         }
     }
 
+    /// Sewing in wool `r` on `body`, the warp along the panels' length.
+    fn setup<'a>(r: &'a Rigidities, body: &'a [Obstacle]) -> SewSetup<'a> {
+        SewSetup {
+            rigidities: r,
+            areal_density_kg_per_m2: 0.2,
+            warp_angle_rad: std::f64::consts::FRAC_PI_2,
+            obstacles: body,
+            distance_m: 0.002,
+            thickness_m: 1e-3,
+        }
+    }
+
     #[test]
     fn a_tube_of_two_panels_sewn_round_a_cylinder_closes_to_their_width_and_welds() {
         let u = unsewn(&parse(&tube(30.0, 20.0, 20.0, 12.0)).unwrap(), 0.03).unwrap();
         let r = wool();
         let body = [rod(0.06)];
-        let setup = SewSetup {
-            rigidities: &r,
-            areal_density_kg_per_m2: 0.2,
-            warp_angle_rad: std::f64::consts::FRAC_PI_2,
-            obstacles: &body,
-            distance_m: 0.002,
-            thickness_m: 1e-3,
-        };
+        let setup = setup(&r, &body);
         let (w, report) = sew(&u, &setup, &mut |_| {}, &mut crate::solve::NoObserver).unwrap();
         assert!(
             report.gap_before_weld_m < sew::GAP_TOLERANCE_M,
@@ -160,14 +165,7 @@ mod tests {
         let u = unsewn(&parse(&tube(30.0, 20.0, 20.0, 2.0)).unwrap(), 0.03).unwrap();
         let r = wool();
         let body = [rod(0.06)];
-        let setup = SewSetup {
-            rigidities: &r,
-            areal_density_kg_per_m2: 0.2,
-            warp_angle_rad: 0.0,
-            obstacles: &body,
-            distance_m: 0.002,
-            thickness_m: 1e-3,
-        };
+        let setup = setup(&r, &body);
         let (x, moved) = arrange(&u, &setup).unwrap();
         assert_eq!(
             moved.iter().filter(|m| m.0 != "lift").count(),
