@@ -116,6 +116,34 @@ mod tests {
                 );
             }
         }
+        // The Hessian blocks against central differences of the gradient, within the cap and
+        // beyond it; the derivative in k against differences of the gradient and energy in k.
+        for d in [0.05, 0.3] {
+            let x = [Vector3::zeros(), Vector3::new(d, 0.02, -0.01)];
+            let mut blocks = Vec::new();
+            k.hessian(0, &x, false, &mut |a, b, m| blocks.push((a, b, m)));
+            let h11 = blocks
+                .iter()
+                .find(|(a, b, _)| (*a, *b) == (1, 1))
+                .unwrap()
+                .2;
+            for j in 0..3 {
+                let (mut xp, mut xm) = (x, x);
+                xp[1][j] += 1e-7;
+                xm[1][j] -= 1e-7;
+                let col = (k.gradient(0, &xp)[1] - k.gradient(0, &xm)[1]) / 2e-7;
+                assert!(
+                    (col - h11.column(j)).norm() < 1e-5,
+                    "d {d}: {col} vs {}",
+                    h11.column(j)
+                );
+            }
+            let stiffer = Seams::new(&[[0, 1]], 10.0 + 1e-6, 0.1);
+            let dg = (stiffer.kernel.gradient(0, &x)[1] - k.gradient(0, &x)[1]) / 1e-6;
+            assert!((dg - k.coefficient_gradient(0, &x, &[1.0])[1]).norm() < 1e-6);
+            let de = (stiffer.kernel.energy(0, &x) - k.energy(0, &x)) / 1e-6;
+            assert!((de - k.coefficient_energy(0, &x, &[1.0])).abs() < 1e-6);
+        }
         // Far apart the pull is k c = 1 N whatever the distance.
         let far = k.gradient(0, &[Vector3::zeros(), Vector3::new(5.0, 0.0, 0.0)]);
         assert!((far[1].norm() - 1.0).abs() < 1e-12);

@@ -139,6 +139,16 @@ mod tests {
     }
 
     #[test]
+    fn a_panel_whose_outline_crosses_itself_is_refused_naming_it() {
+        // The front's third corner moved onto its first: the loop passes through one point twice.
+        let text =
+            tube(30.0, 20.0, 20.0, 12.0).replacen("[30, 20], [0, 20]]", "[0, 0], [0, 20]]", 1);
+        let e = unsewn(&parse(&text).unwrap(), 0.03).unwrap_err();
+        assert_eq!(e.key, "pattern.panels.front", "{e:?}");
+        assert!(e.message.contains("crosses itself"), "{}", e.message);
+    }
+
+    #[test]
     fn a_seam_of_two_unequal_edges_gathers_the_longer_onto_the_shorter() {
         // The front's 20 cm right side sewn to the back's 10 cm one: both edges get the longer
         // edge's 11 vertices at 2 cm, so the back's are 1 cm apart and the front gathers onto it.

@@ -97,13 +97,27 @@ fn mesh_panel(panel: &Panel, counts: &[usize], resolution: f64) -> Result<PanelM
         key: format!("pattern.panels.{}", panel.name),
         message: m,
     };
-    let mut cdt =
-        ConstrainedDelaunayTriangulation::<Point2<f64>>::bulk_load_cdt(pts.clone(), segments)
-            .map_err(|e| {
-                bad(format!(
-                    "cannot be triangulated ({e:?}): its outline crosses itself or repeats a point"
-                ))
-            })?;
+    let crossing = || {
+        bad(
+            "crosses itself or passes through one point twice: its edges must form one simple loop"
+                .into(),
+        )
+    };
+    let distinct: std::collections::HashSet<_> =
+        pts.iter().map(|p| (p.x.to_bits(), p.y.to_bits())).collect();
+    if distinct.len() < nb {
+        return Err(crossing());
+    }
+    let mut conflicts = 0;
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(
+        pts.clone(),
+        segments,
+        |_| conflicts += 1,
+    )
+    .map_err(|_| crossing())?;
+    if conflicts > 0 {
+        return Err(crossing());
+    }
     let area = 3f64.sqrt() / 4.0 * resolution * resolution;
     let params = RefinementParameters::<f64>::new()
         .exclude_outer_faces(true)
