@@ -97,27 +97,7 @@ fn mesh_panel(panel: &Panel, counts: &[usize], resolution: f64) -> Result<PanelM
         key: format!("pattern.panels.{}", panel.name),
         message: m,
     };
-    let crossing = || {
-        bad(
-            "crosses itself or passes through one point twice: its edges must form one simple loop"
-                .into(),
-        )
-    };
-    let distinct: std::collections::HashSet<_> =
-        pts.iter().map(|p| (p.x.to_bits(), p.y.to_bits())).collect();
-    if distinct.len() < nb {
-        return Err(crossing());
-    }
-    let mut conflicts = 0;
-    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(
-        pts.clone(),
-        segments,
-        |_| conflicts += 1,
-    )
-    .map_err(|_| crossing())?;
-    if conflicts > 0 {
-        return Err(crossing());
-    }
+    let mut cdt = outline_cdt(pts.clone(), segments).map_err(bad)?;
     let area = 3f64.sqrt() / 4.0 * resolution * resolution;
     let params = RefinementParameters::<f64>::new()
         .exclude_outer_faces(true)
@@ -162,6 +142,27 @@ fn mesh_panel(panel: &Panel, counts: &[usize], resolution: f64) -> Result<PanelM
         triangles,
         edge_vertices,
     })
+}
+
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// The constrained triangulation of a panel's outline, or why the outline is no simple loop.
+fn outline_cdt(pts: Vec<Point2<f64>>, segments: Vec<[usize; 2]>) -> Result<Cdt, String> {
+    let crossing = || {
+        "crosses itself or passes through one point twice: its edges must form one simple loop"
+            .to_string()
+    };
+    let distinct: std::collections::HashSet<_> =
+        pts.iter().map(|p| (p.x.to_bits(), p.y.to_bits())).collect();
+    if distinct.len() < pts.len() {
+        return Err(crossing());
+    }
+    let mut conflicts = 0;
+    let cdt = Cdt::try_bulk_load_cdt(pts, segments, |_| conflicts += 1).map_err(|_| crossing())?;
+    if conflicts > 0 {
+        return Err(crossing());
+    }
+    Ok(cdt)
 }
 
 /// GarmentCode's rotation: XYZ Euler angles in degrees, R = Rz·Ry·Rx.
