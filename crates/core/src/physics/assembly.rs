@@ -74,8 +74,22 @@ impl ModelBuilder {
         &mut self,
         triangles: Vec<[u32; 3]>,
         rest: &Vecs,
+        distances: (f64, f64),
+        g_kappa: f64,
+    ) {
+        self.self_contact_twinned(triangles, rest, distances, g_kappa, Vec::new());
+    }
+
+    /// [`Self::self_contact`] where `twins[v]` is vertex v's class: vertices of one class (a seam's
+    /// sides being sewn) are to become one and pairs joined through a class do not repel
+    /// ([`SelfContact::with_twins`]).
+    pub fn self_contact_twinned(
+        &mut self,
+        triangles: Vec<[u32; 3]>,
+        rest: &Vecs,
         (thickness_m, band_m): (f64, f64),
         g_kappa: f64,
+        twins: Vec<u32>,
     ) {
         let heavy: Vec<f64> = self.masses[..self.n_mesh]
             .iter()
@@ -86,7 +100,7 @@ impl ModelBuilder {
             return;
         }
         let weight = g_kappa * heavy.iter().sum::<f64>() / heavy.len() as f64;
-        let t = SelfContact::new(triangles, rest, thickness_m, band_m, weight);
+        let t = SelfContact::new(triangles, rest, thickness_m, band_m, weight).with_twins(twins);
         self.terms.push(Box::new(t));
     }
 

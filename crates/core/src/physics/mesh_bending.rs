@@ -79,19 +79,12 @@ pub fn sewn_hinge_bending(
     warp_angle_rad: f64,
     kappa0_per_m: f64,
 ) -> super::QuadraticStencil<4> {
-    let (ws, wc) = warp_angle_rad.sin_cos();
-    let mean = 0.5 * (rigidity_N_m[0] + rigidity_N_m[1]);
     let (mut stencils, mut coef, mut stiff, mut u0) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for h in hinges(sheet) {
         stencils.push(h.stencil);
         coef.push(h.coef);
-        // Unit in-plane normal of the edge, then its share along the warp.
-        let e0 = h.rest[1] - h.rest[0];
-        let along_warp = (e0.y * wc - e0.x * ws) / e0.norm();
-        let cos2 = 2.0 * along_warp.powi(2) - 1.0;
-        let b = (mean + 0.75 * (rigidity_N_m[0] - rigidity_N_m[1]) * cos2).max(0.02 * mean);
-        stiff.push(b / h.area);
+        stiff.push(hinge_rigidity(&h, rigidity_N_m, warp_angle_rad) / h.area);
         u0.push(kappa0_per_m * h.area / 3f64.sqrt());
     }
     let term = super::QuadraticStencil::from_stencils("bending/hinge", stencils, coef, stiff);
@@ -102,8 +95,63 @@ pub fn sewn_hinge_bending(
     }
 }
 
+/// A hinge's rigidity b(θ) = B̄ + ¾ (B_warp − B_weft) cos 2θ, θ the angle of its in-plane normal
+/// from the warp ([`orthotropic_hinge_bending`]), floored at 2 % of B̄, N·m.
+fn hinge_rigidity(h: &Hinge, rigidity_N_m: [f64; 2], warp_angle_rad: f64) -> f64 {
+    let (ws, wc) = warp_angle_rad.sin_cos();
+    let mean = 0.5 * (rigidity_N_m[0] + rigidity_N_m[1]);
+    let e0 = h.rest[1] - h.rest[0];
+    let along_warp = (e0.y * wc - e0.x * ws) / e0.norm();
+    let cos2 = 2.0 * along_warp.powi(2) - 1.0;
+    (mean + 0.75 * (rigidity_N_m[0] - rigidity_N_m[1]) * cos2).max(0.02 * mean)
+}
+
+/// Hinges across seams not yet closed (sewing, issue 91): the pieces' `triangles` over unsewn
+/// vertices, `class[v]` the particle vertex v becomes when welded. Each hinge of the welded sheet
+/// whose two triangles lie in different pieces joins them through its edge's midpoints,
+/// u = K₀(a₀ + b₀)/2 + K₁(a₁ + b₁)/2 + K₂x₂ + K₃x₃ (Bergou's K of the welded hinge, a and b the
+/// edge's ends in each piece), E = ½ k |u|²: the welded hinge once the seam is shut, and while it
+/// closes a pull towards opening flat, so that a seam does not shut folded into a fin.
+pub fn seam_hinge_bending(
+    rest: &[[f64; 2]],
+    triangles: &[[usize; 3]],
+    class: &[usize],
+    rigidity_N_m: [f64; 2],
+    warp_angle_rad: f64,
+) -> super::QuadraticStencil<6> {
+    let welded: Vec<[usize; 3]> = triangles.iter().map(|t| t.map(|v| class[v])).collect();
+    let sheet = SewnSheet {
+        rest,
+        rest_triangles: triangles,
+        triangles: &welded,
+    };
+    let (mut stencils, mut coef, mut stiff) = (Vec::new(), Vec::new(), Vec::new());
+    for h in hinges(&sheet) {
+        // Each triangle's own vertices in the hinge's order: edge ends, then the opposite.
+        let own = |t: usize| {
+            let find = |c: usize| triangles[t].into_iter().find(|&v| class[v] == c);
+            let (s0, s1) = (find(h.stencil[0])?, find(h.stencil[1])?);
+            let o = triangles[t].into_iter().find(|&v| v != s0 && v != s1)?;
+            Some([s0, s1, o])
+        };
+        let (Some(p), Some(q)) = (own(h.triangles[0]), own(h.triangles[1])) else {
+            continue;
+        };
+        if p[..2] == q[..2] {
+            continue;
+        }
+        let k = h.coef;
+        stencils.push([p[0], q[0], p[1], q[1], p[2], q[2]]);
+        coef.push([k[0] / 2.0, k[0] / 2.0, k[1] / 2.0, k[1] / 2.0, k[2], k[3]]);
+        stiff.push(hinge_rigidity(&h, rigidity_N_m, warp_angle_rad) / h.area);
+    }
+    super::QuadraticStencil::from_stencils("bending/seam hinge", stencils, coef, stiff)
+}
+
 /// One hinge of a sheet: an edge two triangles share, in its rest geometry.
 pub(super) struct Hinge {
+    /// The two triangles (indices into the sheet's triangles), in the stencil's order.
+    pub triangles: [usize; 2],
     /// Particles: the edge's two ends (smaller first), then the first and the second triangle's
     /// opposite particle.
     pub stencil: [usize; 4],
@@ -124,9 +172,9 @@ pub(super) fn hinges(sheet: &SewnSheet<'_>) -> Vec<Hinge> {
     let cot = |a: Vector3<f64>, b: Vector3<f64>| a.dot(&b) / a.cross(&b).norm().max(1e-300);
     // Each undirected particle edge → (opposite particle, triangle area, rest vertices of the edge's
     // two ends and the opposite vertex) of its triangles.
-    type Side = (usize, f64, [usize; 3]);
+    type Side = (usize, f64, [usize; 3], usize);
     let mut sides: BTreeMap<(usize, usize), Vec<Side>> = BTreeMap::new();
-    for (t, r) in sheet.triangles.iter().zip(sheet.rest_triangles) {
+    for (n, (t, r)) in sheet.triangles.iter().zip(sheet.rest_triangles).enumerate() {
         let a = 0.5 * (p3(r[1]) - p3(r[0])).cross(&(p3(r[2]) - p3(r[0]))).norm();
         for k in 0..3 {
             let (i, j, o) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
@@ -136,12 +184,12 @@ pub(super) fn hinges(sheet: &SewnSheet<'_>) -> Vec<Hinge> {
             sides
                 .entry((i.min(j), i.max(j)))
                 .or_default()
-                .push((o, a, c));
+                .push((o, a, c, n));
         }
     }
     let mut out = Vec::new();
     for (&(i0, i1), opp) in &sides {
-        let [(i2, a0, c0), (i3, a1, c1)] = opp.as_slice() else {
+        let [(i2, a0, c0, t0), (i3, a1, c1, t1)] = opp.as_slice() else {
             continue;
         };
         let (x0, x1, x2) = (p3(c0[0]), p3(c0[1]), p3(c0[2]));
@@ -153,6 +201,7 @@ pub(super) fn hinges(sheet: &SewnSheet<'_>) -> Vec<Hinge> {
         let (e0, e1, e2, e3, e4) = (x1 - x0, x2 - x0, x3 - x0, x2 - x1, x3 - x1);
         let (c01, c02, c03, c04) = (cot(e0, e1), cot(e0, e2), cot(-e0, e3), cot(-e0, e4));
         out.push(Hinge {
+            triangles: [*t0, *t1],
             stencil: [i0, i1, *i2, *i3],
             coef: [c03 + c04, c01 + c02, -c01 - c03, -c02 - c04],
             area: a0 + a1,
@@ -229,6 +278,47 @@ mod tests {
                 "turn {turn}: {a} vs {b}"
             );
         }
+    }
+
+    /// The strip cut into its triangles, each with particles of its own (nothing welded): with
+    /// every seam shut (each particle where its strip vertex is), the seam hinges store what the
+    /// uncut strip's hinges do.
+    #[test]
+    fn seam_hinges_of_shut_seams_bend_as_the_uncut_sheet() {
+        use crate::physics::EnergyTerm;
+        let rest: Vec<[f64; 2]> = (0..8)
+            .map(|k| [(k / 2) as f64 * 0.01, (k % 2) as f64 * 0.01])
+            .collect();
+        let tris: Vec<[usize; 3]> = (0..3)
+            .flat_map(|c| {
+                let (a, b, d, e) = (2 * c, 2 * c + 2, 2 * c + 3, 2 * c + 1);
+                [[a, b, d], [a, d, e]]
+            })
+            .collect();
+        let x: Vec<Vector3<f64>> = rest
+            .iter()
+            .enumerate()
+            .map(|(k, p)| Vector3::new(p[0], p[1], 0.004 * ((k * 7 % 5) as f64 - 2.0)))
+            .collect();
+        let (mut own_rest, mut own_tris, mut class) = (Vec::new(), Vec::new(), Vec::new());
+        for (k, t) in tris.iter().enumerate() {
+            own_tris.push([3 * k, 3 * k + 1, 3 * k + 2]);
+            for &v in t {
+                own_rest.push([rest[v][0] + 0.05 * k as f64, rest[v][1]]);
+                class.push(v);
+            }
+        }
+        let rigidity = [2e-5, 1e-5];
+        let whole = saturating_hinge_bending(&rest, &tris, rigidity, 0.0, f64::INFINITY);
+        let seams = seam_hinge_bending(&own_rest, &own_tris, &class, rigidity, 0.0);
+        assert_eq!(
+            seams.len(),
+            5,
+            "one seam hinge per interior edge of the strip"
+        );
+        let shut: Vec<Vector3<f64>> = class.iter().map(|&v| x[v]).collect();
+        let (a, b) = (whole.energy(&x), seams.energy(&shut));
+        assert!(a > 0.0 && (a - b).abs() <= 1e-9 * a, "{a} vs {b}");
     }
 
     /// A flat rectangle `lx` × `ly` of `nx` × `ny` points, cells cut along alternating diagonals.

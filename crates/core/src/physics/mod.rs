@@ -40,7 +40,7 @@ pub use loads::{Gravity, LoadKernel, PointLoads};
 pub use membrane::{Membrane, MembraneError, MembraneKernel};
 pub use mesh_bending::{
     SewnSheet, hinge_bending, orthotropic_hinge_bending, saturating_hinge_bending,
-    sewn_hinge_bending,
+    seam_hinge_bending, sewn_hinge_bending,
 };
 pub use obstacle_barrier::{ObstacleBarrier, max_penetration_m};
 pub use patch_bending::{patch_bending, reads_creases};

@@ -265,6 +265,9 @@ impl SelfContact {
             .broad_phase
             .candidate_pairs(topo, &boxes, 0.5 * act, &|pair| {
                 let (idx, pt) = (pair.vertices(topo), pair.is_point_triangle());
+                if !self.can_collide(pair) {
+                    return false;
+                }
                 let reach = dirs
                     .iter()
                     .map(|d| relative_motion(pt, &idx.map(|k| d[k])).1)
@@ -325,6 +328,9 @@ impl SelfContact {
             .broad_phase
             .candidate_pairs(topo, &c.region, 0.5 * act, &|pair| {
                 let (idx, pt) = (pair.vertices(topo), pair.is_point_triangle());
+                if !self.can_collide(pair) {
+                    return false;
+                }
                 let (at, reach) = (idx.map(|k| x[k]), farthest(pair, &idx, &rho));
                 pair_distance_lower_bound(pt, &at) - reach < act
                     && pair_distance(pt, &at).0 - reach < act

@@ -25,7 +25,7 @@ mod potential;
 use super::barrier::{barrier, barrier_band_derivatives};
 use super::{EnergyTerm, HessianBlocks, HessianMode, StepBound, Vecs};
 use crate::proximity::{
-    Aabb, BroadPhase, HashGrid, MeshTopology, additive_ccd, pair_distance, relative_motion,
+    Aabb, BroadPhase, HashGrid, MeshTopology, Pair, additive_ccd, pair_distance, relative_motion,
 };
 pub use candidates::CandidateSet;
 pub use contact_set::{ContactPair, ContactSet, PairKind};
@@ -71,6 +71,10 @@ pub struct SelfContact {
     broad_phase: Box<dyn BroadPhase>,
     /// What the term's queries cost so far (counters for the run report, no state of a solve).
     work: Work,
+    /// Each vertex's twin class (vertices of one class are to become one particle: a seam's two
+    /// sides while it is sewn); a pair joined through a class, like a pair sharing a vertex, is
+    /// not a contact (ipc-toolkit's `can_collide`). Empty: every vertex its own class.
+    twins: Vec<u32>,
 }
 
 /// The work counters of a self-contact term.
@@ -126,7 +130,29 @@ impl SelfContact {
             piece_m: (4.0 * longest).max(margin_m),
             broad_phase: Box::new(HashGrid),
             work: Work::default(),
+            twins: Vec::new(),
         }
+    }
+
+    /// The term with `twins[v]` the class of vertex v: the two sides of a seam being sewn (one
+    /// class a welded vertex) do not repel where they are to meet.
+    pub fn with_twins(mut self, twins: Vec<u32>) -> Self {
+        self.twins = twins;
+        self
+    }
+
+    /// Whether `pair` may be a contact: no vertex of one primitive is a twin of one of the other's.
+    pub(super) fn can_collide(&self, pair: Pair) -> bool {
+        if self.twins.is_empty() {
+            return true;
+        }
+        let c = pair.vertices(&self.topo).map(|v| self.twins[v]);
+        let (a, b) = if pair.is_point_triangle() {
+            (&c[..1], &c[1..])
+        } else {
+            (&c[..2], &c[2..])
+        };
+        !a.iter().any(|v| b.contains(v))
     }
 
     /// The term with `broad_phase` building its candidate lists (the same pairs, another cost).
@@ -299,6 +325,9 @@ impl SelfContact {
         let topo = &self.topo;
         self.broad_phase
             .candidate_pairs(topo, &boxes, 0.5 * longest, &|p| {
+                if !self.can_collide(p) {
+                    return false;
+                }
                 let idx = p.vertices(&self.topo);
                 let d = pair_distance(p.is_point_triangle(), &idx.map(|k| x[k])).0;
                 least.fetch_min(d.to_bits(), std::sync::atomic::Ordering::Relaxed);
@@ -654,6 +683,40 @@ mod tests {
         assert!(term.energy(&touching).is_infinite());
         let (far, _) = stacked(5e-3);
         assert_eq!(term.energy(&far), 0.0);
+    }
+
+    /// Twins (a seam's sides being sewn) do not repel where they are joined: the upper layer's
+    /// middle vertex made a twin of the lower's leaves out exactly the pairs joined through it,
+    /// and the step bound lets the twins meet while the rest of the layers still cannot.
+    #[test]
+    fn pairs_joined_through_twins_are_no_contacts() {
+        let (x, tris) = stacked(1.2e-3);
+        let plain = SelfContact::new(tris.clone(), &x, 5e-4, 1e-3, 1e-3);
+        let mut twins: Vec<u32> = (0..18).collect();
+        twins[13] = 4;
+        let twinned = SelfContact::new(tris, &x, 5e-4, 1e-3, 1e-3).with_twins(twins);
+        let (all, kept) = (plain.contact_set_here(&x), twinned.contact_set_here(&x));
+        let joined = |p: &ContactPair| {
+            let v = p.vertices;
+            let (a, b) = if p.is_point_triangle() {
+                (&v[..1], &v[1..])
+            } else {
+                (&v[..2], &v[2..])
+            };
+            (a.contains(&4) && b.contains(&13)) || (a.contains(&13) && b.contains(&4))
+        };
+        let expected = all.pairs.iter().filter(|p| !joined(p)).count();
+        assert!(expected < all.len() && kept.len() == expected);
+        // Moving the upper middle vertex onto the lower one: no step bound from the twins'
+        // own pairs, but the upper layer as a whole cannot pass the lower.
+        let mut dx = vec![Vector3::zeros(); x.len()];
+        dx[13] = x[4] - x[13];
+        assert!(twinned.max_step(&x, &dx) >= 1.0);
+        assert!(plain.max_step(&x, &dx) < 1.0);
+        let down: Vec<Vector3<f64>> = (0..18)
+            .map(|v| Vector3::new(0.0, 0.0, if v >= 9 { -2.4e-3 } else { 0.0 }))
+            .collect();
+        assert!(twinned.max_step(&x, &down) < 1.0);
     }
 
     /// The pairs left unmeasured because their vertices have not moved far enough to reach the
