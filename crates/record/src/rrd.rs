@@ -92,6 +92,36 @@ impl RerunRecorder {
     }
 }
 
+impl Sampled<RerunRecorder> {
+    /// Logs a sewn garment's stages before its drape: the unsewn pieces (`sewing/pieces`) at the
+    /// arranged start and after each stage on a `sewing_stage` timeline, with the stage's seam
+    /// stiffness and largest gap as scalars.
+    pub fn log_sewing(&mut self, sewing: &drapelab_core::sewing::sew::SewReport) -> Result<()> {
+        let rec = self
+            .sink_mut()
+            .rec
+            .as_ref()
+            .ok_or_else(|| anyhow::anyhow!("the rerun recording is already closed"))?;
+        rec.log_static(
+            "sewing/pieces",
+            &rerun::Mesh3D::update_fields().with_triangle_indices(sewing.pieces.iter().copied()),
+        )?;
+        for (i, x) in sewing.stage_positions.iter().enumerate() {
+            rec.set_time_sequence("sewing_stage", i as i64);
+            rec.log(
+                "sewing/pieces",
+                &rerun::Mesh3D::update_fields().with_vertex_positions(x.iter().copied()),
+            )?;
+            if let Some(&(k, gap)) = i.checked_sub(1).and_then(|s| sewing.stages.get(s)) {
+                rec.log("sewing/seam_stiffness_N_per_m", &rerun::Scalars::single(k))?;
+                rec.log("sewing/largest_gap_m", &rerun::Scalars::single(gap))?;
+            }
+        }
+        rec.reset_time();
+        Ok(())
+    }
+}
+
 impl StateSink for RerunRecorder {
     fn write(&mut self, ev: &StateEvent<'_>) -> Result<()> {
         self.log_state(ev)

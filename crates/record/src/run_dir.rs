@@ -273,10 +273,13 @@ fn recorders(
         None
     };
     let rrd = if scene.record.rerun {
-        Some(
+        let mut r =
             RerunRecorder::new(&out.join("drape.rrd"), &scene.name, sheet, x0, &pins, every)?
-                .at_frame_rate(scene.record.frame_rate_hz),
-        )
+                .at_frame_rate(scene.record.frame_rate_hz);
+        if let Some(sewing) = &scene.cloth.sewing {
+            r.log_sewing(sewing)?;
+        }
+        Some(r)
     } else {
         None
     };

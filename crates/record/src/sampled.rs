@@ -23,6 +23,11 @@ pub struct Sampled<S> {
 }
 
 impl<S: StateSink> Sampled<S> {
+    /// The sink, for what it writes outside the sampled states.
+    pub(crate) fn sink_mut(&mut self) -> &mut S {
+        &mut self.sink
+    }
+
     /// Records every `every`-th state (at least every state when `every` is 0 or 1) into `sink`.
     pub fn new(sink: S, every: usize) -> Self {
         Self {

@@ -8,6 +8,8 @@
 //! consistently oriented mesh; near an open mesh's border it is that of the nearest face's side.
 
 pub use super::mesh_defect::{BodyDefect, closed_surface_defect};
+mod barrier_shares;
+
 use crate::proximity::{Aabb, point_triangle_distance};
 use nalgebra::Vector3;
 use std::collections::HashMap;

@@ -142,6 +142,11 @@ fn revolution_sdf(profile: &[[f64; 2]], r: f64, z: f64) -> (f64, f64, f64) {
     }
 }
 
+/// One share of an obstacle's barrier at a point: distance (m), outward unit normal, the normal's
+/// derivative (1/m) where known in closed form (none: left to the caller, or zero inside a mesh
+/// body's face), and the share's weight ([`TriangleBody::pieces_within`]).
+pub type BarrierPiece = (f64, Vector3<f64>, Option<nalgebra::Matrix3<f64>>, f64);
+
 impl Obstacle {
     /// Whether the solid is convex (every kind but a solid of revolution, whose profile may narrow).
     pub fn is_convex(&self) -> bool {
@@ -209,6 +214,26 @@ impl Obstacle {
             } => b.signed_distance_within(&(p - v(*offset_m)), r),
             _ => Some(self.signed_distance(p)).filter(|(d, _)| *d < r),
         }
+    }
+
+    /// What a barrier of band `r` sums over at `p` ([`BarrierPiece`]). A mesh body outside its
+    /// surface gives its faces, edges and vertices within `r`, weighted ±1
+    /// ([`TriangleBody::pieces_within`]); every other case the closest point alone
+    /// ([`Obstacle::signed_distance_within`]), weight 1, its normal's derivative left to the caller.
+    pub fn barrier_pieces(&self, p: &Vector3<f64>, r: f64) -> Vec<BarrierPiece> {
+        if let Obstacle::Mesh {
+            offset_m,
+            body: Some(b),
+            ..
+        } = self
+            && let Some(pieces) = b.pieces_within(&(p - v(*offset_m)), r)
+        {
+            return pieces;
+        }
+        self.signed_distance_within(p, r)
+            .map(|(d, n)| (d, n, None, 1.0))
+            .into_iter()
+            .collect()
     }
 
     /// Height of the obstacle's upper surface on the vertical through (x, y), if the vertical meets it

@@ -53,6 +53,12 @@ pub struct SewReport {
     pub penetration_m: f64,
     /// Wall time, s.
     pub time_s: f64,
+    /// The unsewn pieces' triangles (for a recording of the stages; not in run.json).
+    #[serde(skip)]
+    pub pieces: Vec<[u32; 3]>,
+    /// The pieces' positions at the arranged start and after each stage, m (for a recording).
+    #[serde(skip)]
+    pub stage_positions: Vec<Vec<[f32; 3]>>,
 }
 
 /// Welded when every seam gap is below this, m.
@@ -136,6 +142,12 @@ fn sewing_model(
     Ok(b.build())
 }
 
+fn as_f32(x: &Vecs) -> Vec<[f32; 3]> {
+    x.iter()
+        .map(|v| [v.x as f32, v.y as f32, v.z as f32])
+        .collect()
+}
+
 fn as_arrays(x: &Vecs) -> Vec<[f64; 3]> {
     x.iter().map(|v| [v.x, v.y, v.z]).collect()
 }
@@ -161,6 +173,8 @@ pub fn sew(
         crossing_edges: 0,
         penetration_m: 0.0,
         time_s: 0.0,
+        pieces: u.triangles.iter().map(|t| t.map(|v| v as u32)).collect(),
+        stage_positions: vec![as_f32(&x)],
     };
     let opts = StaticOptions {
         residual_tol_rel: 1e-3,
@@ -173,6 +187,7 @@ pub fn sew(
         report.iterations += r.iterations;
         let gap = super::weld::largest_gap_m(&u.seams, &as_arrays(&x));
         report.stages.push((k, gap));
+        report.stage_positions.push(as_f32(&x));
         progress(format!(
             "sewing: seam stiffness {k:e} N/m, largest gap {:.2} mm ({}), {} Newton iterations, {:.1} s ({})",
             1e3 * gap,
