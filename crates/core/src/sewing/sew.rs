@@ -70,6 +70,9 @@ const SEAM_FORCE_N: f64 = 0.5;
 /// The most a seam pair pulls in the last stages, N: where the stiffest seams stall (the cloth
 /// round a neckline must stretch a little to close), the cap is raised four-fold a stage to this.
 const LAST_SEAM_FORCE_N: f64 = 32.0;
+/// The widest gap a raised cap is tried on, m: wider, the seam is held open by something the pull
+/// cannot move (a body part between its sides), and sewing refuses at once.
+const STRETCH_GAP_M: f64 = 0.02;
 /// Stages of the continuation at most.
 const STAGES: usize = 12;
 /// The stiffest seams, N/m per pair: later stages repeat it (re-anchored) until the seams close.
@@ -162,6 +165,7 @@ pub fn sew(
 ) -> Result<(Pattern, SewReport), Defect> {
     let clock = std::time::Instant::now();
     let (start, moved_out_m) = arrange(u, s)?;
+    refuse_crossed_start(u, &start)?;
     let mut x: Vec<Vector3<f64>> = start.iter().map(|p| Vector3::from(*p)).collect();
     let mut report = SewReport {
         seam_pairs: u.seams.len(),
@@ -202,7 +206,9 @@ pub fn sew(
         if k < LAST_STIFFNESS_N_PER_M {
             k *= 10.0;
         } else if stalled(&report.stages) {
-            if cap >= LAST_SEAM_FORCE_N {
+            // A seam held wide open (a body part between its sides) does not close by pulling
+            // harder; only the last few millimetres a little stretch closes.
+            if cap >= LAST_SEAM_FORCE_N || gap > STRETCH_GAP_M {
                 break;
             }
             cap *= 4.0;
@@ -240,6 +246,21 @@ fn stage(
         (0.0, 0.0, 0.0),
     );
     model.terms.push(Box::new(tether));
+    let infinite: Vec<String> = model
+        .terms
+        .iter()
+        .filter(|t| !t.energy(x).is_finite())
+        .map(|t| t.name())
+        .collect();
+    if !infinite.is_empty() {
+        return Err(Defect {
+            key: "pattern.panels".into(),
+            message: format!(
+                "the pieces cannot be sewn from where they are: the {} energy is infinite there (a body's edge through a panel, or two panels nearer than the cloth's thickness); place the panels apart and clear of the body",
+                infinite.join(", ")
+            ),
+        });
+    }
     Ok(solve_static(&mut model, x, opts, observer))
 }
 
@@ -256,6 +277,29 @@ fn not_closed(u: &Unsewn, x: &Vecs, report: &SewReport) -> Defect {
             widest_seam(u, x)
         ),
     }
+}
+
+/// Refuses a start whose pieces pass through each other (an edge of one through a triangle of
+/// another, or of itself) where the pattern places them: sewing keeps whatever crossing it starts
+/// from, so it would weld a garment through itself. Names the two panels.
+fn refuse_crossed_start(u: &Unsewn, x: &[[f64; 3]]) -> Result<(), Defect> {
+    let tris = u.triangles.iter().map(|t| t.map(|v| v as u32)).collect();
+    let topo = crate::proximity::MeshTopology::from_triangles(tris);
+    let xs: Vec<Vector3<f64>> = x.iter().map(|p| Vector3::from(*p)).collect();
+    let Some(&(e, t)) = crate::proximity::edge_triangle_crossings(&topo, &xs).first() else {
+        return Ok(());
+    };
+    let name = |v: u32| &u.panel_names[u.panel_of[v as usize]];
+    let (a, b) = (
+        name(topo.edges[e as usize][0]),
+        name(topo.triangles[t as usize][0]),
+    );
+    Err(Defect {
+        key: format!("pattern.panels.{a}"),
+        message: format!(
+            "passes through panel {b} where the pattern places them (translation, rotation): sewing would keep the crossing; place the panels apart"
+        ),
+    })
 }
 
 /// Edges of a welded garment at its start that cross one of its triangles.
