@@ -231,11 +231,11 @@ pub(super) fn unfolded(a: &[Vector3<f64>; 3], b: &[Vector3<f64>; 3]) -> Vector3<
 mod tests {
     use super::*;
 
-    /// A flat strip cut along its interior edges into pieces, each moved and turned in the
-    /// pattern's plane, and sewn back (its rest vertices mapped to the strip's vertices): the
-    /// same hinges, so the same energy at any deformation, as the uncut strip.
-    #[test]
-    fn a_sheet_cut_and_sewn_back_bends_as_the_uncut_sheet() {
+    /// A flat sheet's rest points and triangles, and its particles placed in 3D.
+    type Strip = (Vec<[f64; 2]>, Vec<[usize; 3]>, Vec<Vector3<f64>>);
+
+    /// A strip of three cells (8 points, 1 cm), each cut along a diagonal, and a wavy bending of it.
+    fn strip() -> Strip {
         let rest: Vec<[f64; 2]> = (0..8)
             .map(|k| [(k / 2) as f64 * 0.01, (k % 2) as f64 * 0.01])
             .collect();
@@ -245,12 +245,21 @@ mod tests {
                 [[a, b, d], [a, d, e]]
             })
             .collect();
-        use crate::physics::EnergyTerm;
         let x: Vec<Vector3<f64>> = rest
             .iter()
             .enumerate()
             .map(|(k, p)| Vector3::new(p[0], p[1], 0.004 * ((k * 7 % 5) as f64 - 2.0)))
             .collect();
+        (rest, tris, x)
+    }
+
+    /// A flat strip cut along its interior edges into pieces, each moved and turned in the
+    /// pattern's plane, and sewn back (its rest vertices mapped to the strip's vertices): the
+    /// same hinges, so the same energy at any deformation, as the uncut strip.
+    #[test]
+    fn a_sheet_cut_and_sewn_back_bends_as_the_uncut_sheet() {
+        use crate::physics::EnergyTerm;
+        let (rest, tris, x) = strip();
         // Each triangle its own piece, moved by k·5 cm (the grain kept: orthotropic), or also
         // turned by 0.3·k rad (which turns its grain: isotropic).
         for (turn, rigidity) in [(0.0, [2e-5, 1e-5]), (0.3, [1.5e-5, 1.5e-5])] {
@@ -286,20 +295,7 @@ mod tests {
     #[test]
     fn seam_hinges_of_shut_seams_bend_as_the_uncut_sheet() {
         use crate::physics::EnergyTerm;
-        let rest: Vec<[f64; 2]> = (0..8)
-            .map(|k| [(k / 2) as f64 * 0.01, (k % 2) as f64 * 0.01])
-            .collect();
-        let tris: Vec<[usize; 3]> = (0..3)
-            .flat_map(|c| {
-                let (a, b, d, e) = (2 * c, 2 * c + 2, 2 * c + 3, 2 * c + 1);
-                [[a, b, d], [a, d, e]]
-            })
-            .collect();
-        let x: Vec<Vector3<f64>> = rest
-            .iter()
-            .enumerate()
-            .map(|(k, p)| Vector3::new(p[0], p[1], 0.004 * ((k * 7 % 5) as f64 - 2.0)))
-            .collect();
+        let (rest, tris, x) = strip();
         let (mut own_rest, mut own_tris, mut class) = (Vec::new(), Vec::new(), Vec::new());
         for (k, t) in tris.iter().enumerate() {
             own_tris.push([3 * k, 3 * k + 1, 3 * k + 2]);
