@@ -160,7 +160,8 @@ fn sewing_keys_out_of_range_are_refused() {
 
 /// The sensitivity of a sewn skirt's hem to its fabric's bending (`--sensitivity`, from the factor
 /// of the exact Hessian at the drape) against the central difference of drapes solved tightly at
-/// θ(1 ± 10⁻³) from it: the hem's particles (within 1 cm of the lowest) agree to 10⁻² in 2-norm.
+/// θ(1 ± 10⁻³) from it: the hem's particles (within 1 cm of the lowest) agree to 10⁻⁴ in 2-norm
+/// (measured: 3.2·10⁻⁷).
 #[test]
 fn a_sewn_skirts_hem_sensitivity_to_bending_matches_central_differences() {
     use drapelab::config::parse_override;
@@ -206,6 +207,6 @@ fn a_sewn_skirts_hem_sensitivity_to_bending_matches_central_differences() {
         scale += fd.norm_squared();
     }
     let rel = (diff / scale).sqrt();
-    assert!(scale > 0.0 && rel <= 1e-2, "{rel:e}");
+    assert!(scale > 0.0 && rel <= 1e-4, "{rel:e}");
     eprintln!("hem sensitivity to bending against central differences: {rel:.2e}");
 }
