@@ -69,7 +69,8 @@ impl ObstacleBarrier {
     }
 
     /// Calls `f(p, piece, o)` for every share of every obstacle's barrier on every particle with
-    /// κ ([`Obstacle::barrier_pieces`]: a mesh body's triangles within d̂, or the closest point).
+    /// κ ([`Obstacle::barrier_pieces`]: a mesh body's faces, edges and vertices within d̂, weighted
+    /// ±1, or the closest point).
     fn each(&self, x: &Vecs, mut f: impl FnMut(usize, &BarrierPiece, &Obstacle)) {
         for (p, xp) in x.iter().enumerate() {
             let k = self.kappa_J.get(p).copied().unwrap_or(0.0);
